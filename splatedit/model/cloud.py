@@ -1,0 +1,159 @@
+"""SplatCloud: elliptical surface splats as plain numpy arrays.
+
+A splat i is the ellipse ``{p_i + s u_i + t v_i : s^2 + t^2 <= 1}``: the
+tangent axes ``u``, ``v`` carry the ellipse's semi-axes as their lengths and
+the normal is ``normalize(u x v)``.  Arrays are float64 on the CPU (fitting
+precision); the renderer converts to float32 when it uploads.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from splatedit.errors import InputError
+from splatedit.tolerances import MIN_AXIS_LENGTH_REL, MIN_AXIS_SINE
+
+
+def _as_array(name, value, shape_tail, dtype, source):
+    arr = np.asarray(value)
+    if arr.ndim != 1 + len(shape_tail) or tuple(arr.shape[1:]) != shape_tail:
+        raise InputError(f"expected shape (n, {', '.join(map(str, shape_tail))}), "
+                         f"got {arr.shape}", path=source, prop=name)
+    return np.ascontiguousarray(arr, dtype=dtype)
+
+
+@dataclass(eq=False)
+class SplatCloud:
+    """A cloud of elliptical splats.
+
+    Attributes:
+        positions: (n, 3) float64, splat centres (model units).
+        u: (n, 3) float64, first tangent semi-axis (model units).
+        v: (n, 3) float64, second tangent semi-axis (model units).
+        colors: (n, 4) uint8 RGBA, or None for the default material.
+        faces: (f, 3) int64 vertex indices, or None; kept when the input was a
+            triangle mesh so a deformed mesh can be written back.
+        name: a human-readable name (usually the file name).
+        source: the path it was read from, used in error messages.
+    """
+
+    positions: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    colors: np.ndarray | None = None
+    faces: np.ndarray | None = None
+    name: str = ""
+    source: str | None = field(default=None, repr=False)
+
+    def __post_init__(self):
+        src = self.source
+        self.positions = _as_array("positions", self.positions, (3,), np.float64, src)
+        n = len(self.positions)
+        self.u = _as_array("u", self.u, (3,), np.float64, src)
+        self.v = _as_array("v", self.v, (3,), np.float64, src)
+        for nm, arr in (("u", self.u), ("v", self.v)):
+            if len(arr) != n:
+                raise InputError(f"has {len(arr)} rows but positions has {n}", path=src, prop=nm)
+        if self.colors is not None:
+            self.colors = _as_array("colors", self.colors, (4,), np.uint8, src)
+            if len(self.colors) != n:
+                raise InputError(f"has {len(self.colors)} rows but positions has {n}",
+                                 path=src, prop="colors")
+        if self.faces is not None:
+            self.faces = _as_array("faces", self.faces, (3,), np.int64, src)
+        self.validate()
+
+    # ------------------------------------------------------------------ checks
+    def validate(self) -> None:
+        """Check the invariants; raise :class:`InputError` naming the first bad row.
+
+        Invariants: at least one splat; finite positions and axes; axes longer
+        than ``MIN_AXIS_LENGTH_REL`` of the bounding-box diagonal and not
+        parallel; faces index existing splats.
+        """
+        src = self.source
+        n = len(self.positions)
+        if n == 0:
+            raise InputError("no splats (empty point set)", path=src)
+        for nm, arr in (("positions", self.positions), ("u", self.u), ("v", self.v)):
+            bad = ~np.isfinite(arr).all(axis=1)
+            if bad.any():
+                row = int(np.flatnonzero(bad)[0])
+                raise InputError(f"non-finite value {arr[row].tolist()}", path=src,
+                                 element="vertex", row=row, prop=nm)
+        diag = float(np.linalg.norm(self.positions.max(0) - self.positions.min(0)))
+        min_len = MIN_AXIS_LENGTH_REL * max(diag, 1e-300)
+        lu = np.linalg.norm(self.u, axis=1)
+        lv = np.linalg.norm(self.v, axis=1)
+        for nm, ln in (("u", lu), ("v", lv)):
+            bad = ln <= min_len
+            if bad.any():
+                row = int(np.flatnonzero(bad)[0])
+                raise InputError(f"degenerate splat axis (length {ln[row]:.3g})", path=src,
+                                 element="vertex", row=row, prop=nm)
+        sine = np.linalg.norm(np.cross(self.u, self.v), axis=1) / (lu * lv)
+        bad = sine < MIN_AXIS_SINE
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise InputError("degenerate splat: axes u and v are parallel", path=src,
+                             element="vertex", row=row, prop="u")
+        if self.faces is not None and len(self.faces):
+            lo, hi = int(self.faces.min()), int(self.faces.max())
+            if lo < 0 or hi >= n:
+                row = int(np.flatnonzero((self.faces < 0).any(1) | (self.faces >= n).any(1))[0])
+                raise InputError(f"vertex index out of range 0..{n - 1}: {self.faces[row].tolist()}",
+                                 path=src, element="face", row=row, prop="vertex_indices")
+
+    # ------------------------------------------------------------- derived data
+    def __len__(self) -> int:
+        return len(self.positions)
+
+    @property
+    def n(self) -> int:
+        """Number of splats."""
+        return len(self.positions)
+
+    @property
+    def normals(self) -> np.ndarray:
+        """(n, 3) float64 unit normals, ``normalize(u x v)``."""
+        nrm = np.cross(self.u, self.v)
+        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+    @property
+    def radii(self) -> np.ndarray:
+        """(n,) float64, the larger semi-axis of every splat (model units)."""
+        return np.maximum(np.linalg.norm(self.u, axis=1), np.linalg.norm(self.v, axis=1))
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(min, max) corners of the axis-aligned bounding box of the centres."""
+        return self.positions.min(axis=0), self.positions.max(axis=0)
+
+    @property
+    def diagonal(self) -> float:
+        """Length of the bounding-box diagonal (model units)."""
+        lo, hi = self.bounds()
+        return float(np.linalg.norm(hi - lo))
+
+    # --------------------------------------------------------------- copies
+    def copy(self) -> "SplatCloud":
+        return SplatCloud(self.positions.copy(), self.u.copy(), self.v.copy(),
+                          None if self.colors is None else self.colors.copy(),
+                          None if self.faces is None else self.faces.copy(),
+                          name=self.name, source=self.source)
+
+    def replace(self, *, positions=None, u=None, v=None) -> "SplatCloud":
+        """A new cloud with some geometry arrays replaced (colours, faces and
+        name are shared, they are never modified in place)."""
+        return SplatCloud(self.positions if positions is None else positions,
+                          self.u if u is None else u,
+                          self.v if v is None else v,
+                          self.colors, self.faces, name=self.name, source=self.source)
+
+    def subset(self, index) -> "SplatCloud":
+        """A new cloud with only the splats selected by ``index`` (mask or
+        indices); faces are dropped (they would need re-indexing)."""
+        return SplatCloud(self.positions[index], self.u[index], self.v[index],
+                          None if self.colors is None else self.colors[index],
+                          None, name=self.name, source=self.source)
