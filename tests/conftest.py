@@ -1,0 +1,26 @@
+"""Shared pytest fixtures.
+
+``shared_data`` gives the path of ../shared/data (the team's sample scans) and
+skips the test when it is absent, as it is in a user's clone.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import pytest
+
+REPO_ROOT = Path(__file__).resolve().parent.parent
+SHARED_DATA = REPO_ROOT.parent / "shared" / "data"
+
+# The whole suite runs with the Vulkan validation layer on (see splatedit/render/vk).
+os.environ.setdefault("SPLATEDIT_VALIDATION", "1")
+
+
+@pytest.fixture
+def shared_data() -> Path:
+    """Path of ../shared/data; skips the test when the folder is absent."""
+    if not SHARED_DATA.is_dir():
+        pytest.skip(f"sample data folder {SHARED_DATA} is absent (it is not part of a user's clone)")
+    return SHARED_DATA
