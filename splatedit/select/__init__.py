@@ -1,1 +1,5 @@
-"""splatedit.select"""
+"""Selections of splats: geometric regions (edit scripts) and brush painting (editor)."""
+
+from splatedit.select.regions import Box, Indices, Region, Sphere
+
+__all__ = ["Box", "Indices", "Region", "Sphere"]

@@ -1,0 +1,246 @@
+"""Command line: ``splatedit [demo|edit|info|convert|deform|render|bench] ...``.
+
+Bad input (files, edit scripts, parameters) prints one line ``splatedit: error: ...``
+to stderr and exits with code 2, without a traceback.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import sys
+import time
+from pathlib import Path
+
+from splatedit.errors import SplatEditError
+
+EXIT_BAD_INPUT = 2
+
+
+# ------------------------------------------------------------------ progress
+class _Progress:
+    """A ``progress(stage, fraction)`` callback drawing one tqdm bar per stage on stderr."""
+
+    def __init__(self, enabled: bool = True):
+        self.enabled = enabled
+        self._bar = None
+        self._stage = None
+
+    def __call__(self, stage: str, fraction: float) -> None:
+        if not self.enabled:
+            return
+        from tqdm import tqdm
+        if stage != self._stage:
+            self.close()
+            self._stage = stage
+            self._bar = tqdm(total=1000, desc=stage, leave=False, file=sys.stderr,
+                             bar_format="{desc}: {percentage:3.0f}%|{bar}| {elapsed}", disable=None)
+        self._bar.n = int(round(fraction * 1000))
+        self._bar.refresh()
+
+    def close(self) -> None:
+        if self._bar is not None:
+            self._bar.close()
+            self._bar = None
+            self._stage = None
+
+
+def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
+    try:
+        parts = [float(x) for x in text.split(",")]
+    except ValueError:
+        parts = []
+    if len(parts) != 3:
+        raise argparse.ArgumentTypeError(f"{name} must be three comma-separated numbers like 0,0,1, got {text!r}")
+    return tuple(parts)  # type: ignore[return-value]
+
+
+def _parse_size(text: str) -> tuple[int, int]:
+    try:
+        w, h = (int(x) for x in text.lower().split("x"))
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"size must look like 1280x720, got {text!r}") from None
+    if not (1 <= w <= 16384 and 1 <= h <= 16384):
+        raise argparse.ArgumentTypeError(f"size must be between 1x1 and 16384x16384, got {text!r}")
+    return w, h
+
+
+# ------------------------------------------------------------------ commands
+def cmd_info(args) -> int:
+    import numpy as np
+    from splatedit.io import read
+    from splatedit.model.spacing import point_spacing
+    cloud = read(args.file, progress=args.progress)
+    lo, hi = cloud.bounds()
+    radii = cloud.radii
+    info = {
+        "file": str(args.file),
+        "splats": cloud.n,
+        "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
+        "colors": cloud.colors is not None,
+        "bounds_min": lo.round(6).tolist(),
+        "bounds_max": hi.round(6).tolist(),
+        "diagonal": round(cloud.diagonal, 6),
+        "spacing": round(point_spacing(cloud.positions), 6),
+        "splat_radius_median": round(float(np.median(radii)), 6),
+        "splat_radius_max": round(float(radii.max()), 6),
+    }
+    if args.json:
+        print(json.dumps(info))
+    else:
+        width = max(map(len, info))
+        for k, v in info.items():
+            print(f"{k:<{width}}  {v}")
+    return 0
+
+
+def cmd_convert(args) -> int:
+    from splatedit.io import read, write
+    cloud = read(args.input, progress=args.progress)
+    write(args.output, cloud, overwrite=args.force)
+    print(f"wrote {args.output}: {cloud.n} splats" + ("" if cloud.faces is None else f", {len(cloud.faces)} faces"))
+    return 0
+
+
+def _run_edits(args, cloud, script_path, on_gpu=None):
+    from splatedit.script import load_script, run_script
+    script = load_script(script_path)
+    return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
+                      source=str(script_path), progress=args.progress,
+                      on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+
+
+def cmd_deform(args) -> int:
+    from splatedit.io import read, write
+    from splatedit.io.atomic import check_writable_target
+    check_writable_target(args.output, overwrite=args.force, protect=args.input)
+    cloud = read(args.input, progress=args.progress)
+    t0 = time.perf_counter()
+    out, reports = _run_edits(args, cloud, args.edit)
+    write(args.output, out, overwrite=args.force)
+    print(f"wrote {args.output}: {out.n} splats, {len(reports)} edit(s) in {time.perf_counter() - t0:.2f} s")
+    return 0
+
+
+def cmd_render(args) -> int:
+    from splatedit.io import read
+    from splatedit.render.headless import render_file
+    cloud = read(args.input, progress=args.progress)
+    render_file(cloud, args.output, size=args.size, eye=args.eye, target=args.target, up=args.up,
+                fov=args.fov, edit_script=args.edit, buffers_path=args.buffers, overwrite=args.force,
+                progress=args.progress, log=print)
+    return 0
+
+
+def cmd_demo(args) -> int:
+    from splatedit.demo import run_demo
+    run_demo(Path(args.output_dir), progress=args.progress, log=print, render=not args.no_render,
+             overwrite=args.force)
+    return 0
+
+
+def cmd_edit(args) -> int:
+    try:
+        from splatedit.app.editor import run_editor
+    except ImportError as exc:  # the interactive editor is optional at this stage
+        raise SplatEditError(f"the interactive editor is not available: {exc}") from None
+    return run_editor(args.file)
+
+
+def cmd_main(args) -> int:
+    """No sub-command: the editor when a display is present, else the headless demo."""
+    if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
+        try:
+            import splatedit.app.editor  # noqa: F401
+        except ImportError:
+            pass
+        else:
+            args.file = None
+            return cmd_edit(args)
+    args.output_dir = "."
+    args.no_render = False
+    args.force = True
+    return cmd_demo(args)
+
+
+def cmd_bench(args) -> int:
+    from splatedit.bench.runner import run_bench
+    for line in run_bench(args.what, quick=args.quick, progress=args.progress):
+        print(json.dumps(line), flush=True)
+    return 0
+
+
+# ------------------------------------------------------------------- parser
+def build_parser() -> argparse.ArgumentParser:
+    p = argparse.ArgumentParser(prog="splatedit", description=__doc__.split("\n")[0])
+    p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
+    sub = p.add_subparsers(dest="command")
+
+    s = sub.add_parser("demo", help="headless demo edit of the bundled bunny (writes PLY, JSON and PNG)")
+    s.add_argument("-o", "--output-dir", default=".", help="where to write the results (default: .)")
+    s.add_argument("--no-render", action="store_true", help="skip the PNG renders")
+    s.add_argument("-f", "--force", action="store_true", help="overwrite existing outputs")
+    s.set_defaults(func=cmd_demo)
+
+    s = sub.add_parser("info", help="counts, bounds, attributes and spacing of a model")
+    s.add_argument("file")
+    s.add_argument("--json", action="store_true", help="print one JSON object")
+    s.set_defaults(func=cmd_info)
+
+    s = sub.add_parser("convert", help="convert PLY/XYZ/OFF to a splat PLY (estimates normals and sizes when missing)")
+    s.add_argument("input")
+    s.add_argument("output")
+    s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists")
+    s.set_defaults(func=cmd_convert)
+
+    s = sub.add_parser("deform", help="apply a JSON edit script to a model")
+    s.add_argument("input")
+    s.add_argument("--edit", required=True, type=Path, help="edit script (JSON)")
+    s.add_argument("-o", "--output", required=True, help="output PLY")
+    s.add_argument("--method", choices=("auto", "lu", "iqr"), help="override the script's solver method")
+    s.add_argument("--tol", type=float, help="override the script's IQR tolerance")
+    s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists (even the input)")
+    s.set_defaults(func=cmd_deform)
+
+    s = sub.add_parser("render", help="render a model to PNG with the Vulkan EWA splat renderer")
+    s.add_argument("input")
+    s.add_argument("-o", "--output", required=True, help="output PNG")
+    s.add_argument("--size", type=_parse_size, default=(1280, 720), help="WxH (default 1280x720)")
+    s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"))
+    s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"))
+    s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"))
+    s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
+    s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
+    s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
+    s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
+    s.set_defaults(func=cmd_render)
+
+    s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
+    s.add_argument("what", choices=("solve", "qr", "render", "all"))
+    s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
+    s.set_defaults(func=cmd_bench)
+    return p
+
+
+def main(argv: list[str] | None = None) -> int:
+    parser = build_parser()
+    args = parser.parse_args(argv)
+    args.progress = _Progress(enabled=not args.quiet)
+    func = getattr(args, "func", cmd_main)
+    try:
+        return func(args) or 0
+    except SplatEditError as exc:
+        args.progress.close()
+        print(f"splatedit: error: {exc}", file=sys.stderr)
+        return EXIT_BAD_INPUT
+    except KeyboardInterrupt:
+        args.progress.close()
+        print("splatedit: interrupted", file=sys.stderr)
+        return 130
+    finally:
+        args.progress.close()
+
+
+if __name__ == "__main__":
+    sys.exit(main())

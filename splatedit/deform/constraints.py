@@ -1,0 +1,366 @@
+"""Displacement constraints of the modeling metaphor (paper Sect. 3, 4 and 6).
+
+The user partitions the cloud into
+
+* the *support* (the splats the edit may move),
+* inside it one or more disjoint *handles* (moved by an affine map each),
+* the *free* region = support minus handles (moved by the RBF), and
+* everything else, *fixed*.
+
+The RBF displacement field is constrained on two kinds of bands, each
+``rings * spacing`` thick (``BAND_RINGS`` = 3: a finite-difference C^2
+boundary condition, "three rings of vertices" in the paper):
+
+* the **fixed band**: splats *outside* the support whose distance to the
+  nearest support splat is at most ``rings * spacing``; displacement 0;
+* the **handle band** of every handle: handle splats whose distance to the
+  nearest free splat is at most ``rings * spacing``.  Its displacement is
+  ``M dC`` where ``M`` are the affine coordinates of the splats w.r.t. the
+  handle's control frame ``C`` (4 points) and ``dC = m(C) - C``.
+
+The fitted right-hand sides are therefore not displacements but the columns
+of ``M`` (paper Sect. 6): ``values`` is (m, 4h), one 4-column block per
+handle, zero in other handles' blocks and in the fixed band.
+
+Constraint groups.  A handle is one *group*: a set of constraint points, a
+(p, k) matrix of weight rows and k control points whose affine combination
+(weights) gives the points.  A rigid handle has k = 4 (its affine frame);
+a non-rigid control curve (paper Sect. 3, not implemented yet) would be a
+group of curve samples ``c(t_i)`` with B-spline weights ``B_j(t_i)`` and
+k + 1 control points.  The fixed band is not a group (its value is 0).
+
+Control frame (decision).  ``a`` = centroid of the handle splats,
+``b, c, d = a + r e_x, a + r e_y, a + r e_z`` with ``r`` = RMS distance of
+the handle splats to ``a`` (at least one point spacing).  Axis-aligned frames
+are a regular tetrahedron corner, so the affine coordinates are
+``(1 - sum(x - a) / r, (x - a) / r)``: bounded by O(1) on the handle and
+well conditioned whatever the handle's shape (flat, a line, one splat) --
+a PCA frame would degenerate for flat handles.
+
+Whole-model support (decision).  When no splat lies within the band width
+outside the support (the support is the whole cloud, or a separate
+component), there is no fixed band.  This is allowed: the field then only
+interpolates the handle bands (quadratic polynomial precision means one
+handle moves the whole support rigidly, two handles blend between their
+transforms).  ``Constraints.has_fixed_band`` tells the caller, which may
+warn.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from splatedit.errors import ParameterError, SolverError
+from splatedit.model.spacing import point_spacing
+from splatedit.tolerances import BAND_RINGS
+
+#: relative slack on the band width so points at exactly ``rings * spacing``
+#: (regular samplings) are not lost to rounding
+_BAND_SLACK_REL = 1e-9
+
+
+# ----------------------------------------------------------------- frames
+def handle_frame(points: np.ndarray, spacing: float = 0.0) -> np.ndarray:
+    """Control frame (4, 3) ``(a, b, c, d)`` of a handle: ``a`` its centroid,
+    ``b, c, d`` = ``a + r e_x``, ``a + r e_y``, ``a + r e_z`` with ``r`` the RMS
+    distance of ``points`` to the centroid, at least ``spacing`` (and > 0)."""
+    pts = np.asarray(points, dtype=np.float64)
+    a = pts.mean(axis=0)
+    r = float(np.sqrt(np.mean(np.sum((pts - a) ** 2, axis=1))))
+    r = max(r, float(spacing))
+    if not r > 0.0:
+        r = max(1.0, float(np.abs(a).max()))  # one splat and no spacing known
+    return np.vstack([a, a + r * np.eye(3)])
+
+
+def _frame_inverse(frame: np.ndarray) -> np.ndarray:
+    """(3, 3) G with ``lambda_bcd(x) = G (x - a)`` for a non-degenerate frame."""
+    c = np.asarray(frame, dtype=np.float64)
+    if c.shape != (4, 3):
+        raise ParameterError("frame", f"must be 4 points (4, 3), got shape {c.shape}")
+    e = (c[1:] - c[0]).T  # columns b - a, c - a, d - a
+    scale = max(float(np.abs(e).max()), 1e-300)
+    if abs(np.linalg.det(e / scale)) < 1e-12:
+        raise ParameterError("frame", "its 4 points are (nearly) coplanar")
+    return np.linalg.inv(e)
+
+
+def affine_coordinates(points: np.ndarray, frame: np.ndarray) -> np.ndarray:
+    """Affine coordinates (p, 4) of ``points`` (p, 3) w.r.t. ``frame`` (4, 3).
+
+    Rows sum to 1 and ``affine_coordinates(x, C) @ C == x``.
+    """
+    c = np.asarray(frame, dtype=np.float64)
+    g = _frame_inverse(c)
+    lam = (np.asarray(points, dtype=np.float64) - c[0]) @ g.T
+    return np.column_stack([1.0 - lam.sum(axis=1), lam])
+
+
+def affine_coordinate_gradients(frame: np.ndarray) -> np.ndarray:
+    """(4, 3) constant gradients of the 4 affine coordinates w.r.t. ``frame``
+    (row k = d lambda_k / d(x, y, z)); rows sum to 0."""
+    g = _frame_inverse(frame)
+    return np.vstack([-g.sum(axis=0), g])
+
+
+# ------------------------------------------------------------- structures
+@dataclass
+class ConstraintGroup:
+    """Constraint points that are an affine combination of control points.
+
+    Attributes:
+        kind: ``"handle"`` (rigid control handle, k = 4); later ``"curve"``.
+        points: (p, 3) constraint positions (model units).
+        weights: (p, k) rows of affine weights, ``points == weights @ controls``.
+        controls: (k, 3) control points (the handle's frame C).
+        band_index: (p,) cloud indices of the constraint points (the handle
+            band), or None for samples that are not splats (curves).
+        member_index: (q,) cloud indices of every splat that moves with the
+            group as a whole (all handle splats), empty for curves.
+    """
+
+    kind: str
+    points: np.ndarray
+    weights: np.ndarray
+    controls: np.ndarray
+    band_index: np.ndarray | None = None
+    member_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+
+    @property
+    def n_columns(self) -> int:
+        return self.weights.shape[1]
+
+
+@dataclass
+class Constraints:
+    """Everything the RBF fit and the basis precomputation need.
+
+    Attributes:
+        points: (m, 3) constraint points: fixed band first, then each group's
+            band in order.
+        values: (m, K) right-hand sides, K = sum of group columns (4 per
+            handle); block column ``columns(g)`` holds group g's weights on its
+            own rows, zeros elsewhere.
+        fixed_index: (f,) cloud indices of the fixed band.
+        groups: the constraint groups (handles), in the order given.
+        spacing: point spacing used (model units).
+        band_width: ``rings * spacing`` (model units).
+        support_index: (N,) sorted cloud indices of the support.
+        free_index: (N_free,) sorted cloud indices of support minus handles.
+        n_points: number of splats of the cloud the masks refer to.
+    """
+
+    points: np.ndarray
+    values: np.ndarray
+    fixed_index: np.ndarray
+    groups: list[ConstraintGroup]
+    spacing: float
+    band_width: float
+    support_index: np.ndarray
+    free_index: np.ndarray
+    n_points: int
+
+    @property
+    def n_constraints(self) -> int:
+        return len(self.points)
+
+    @property
+    def n_columns(self) -> int:
+        return self.values.shape[1]
+
+    @property
+    def has_fixed_band(self) -> bool:
+        return len(self.fixed_index) > 0
+
+    @property
+    def handles(self) -> list[ConstraintGroup]:
+        return [g for g in self.groups if g.kind == "handle"]
+
+    @property
+    def handle_band_index(self) -> list[np.ndarray]:
+        """Cloud indices of each handle's band."""
+        return [g.band_index for g in self.handles]
+
+    @property
+    def handle_index(self) -> list[np.ndarray]:
+        """Cloud indices of all splats of each handle."""
+        return [g.member_index for g in self.handles]
+
+    @property
+    def control_frames(self) -> np.ndarray:
+        """(h, 4, 3) control frames of the handles."""
+        hs = self.handles
+        if not hs:
+            return np.zeros((0, 4, 3))
+        return np.stack([g.controls for g in hs])
+
+    def columns(self, group: int) -> slice:
+        """Column block of ``values`` belonging to group ``group``."""
+        if not 0 <= group < len(self.groups):
+            raise ParameterError("handle", f"index {group} out of range 0..{len(self.groups) - 1}")
+        start = sum(g.n_columns for g in self.groups[:group])
+        return slice(start, start + self.groups[group].n_columns)
+
+    def rows(self, group: int) -> slice:
+        """Rows of ``points``/``values`` holding group ``group``'s band."""
+        self.columns(group)  # range check
+        start = len(self.fixed_index) + sum(len(g.points) for g in self.groups[:group])
+        return slice(start, start + len(self.groups[group].points))
+
+
+# --------------------------------------------------------------- building
+def _as_mask(name: str, sel, n: int) -> np.ndarray:
+    arr = np.asarray(sel)
+    if arr.dtype == bool:
+        if arr.shape != (n,):
+            raise ParameterError(name, f"mask must have shape ({n},), got {arr.shape}")
+        return arr
+    if arr.ndim != 1 or (arr.size and not np.issubdtype(arr.dtype, np.integer)):
+        raise ParameterError(name, "must be a boolean mask or a 1-D array of splat indices")
+    idx = arr.astype(np.int64)
+    if idx.size and (idx.min() < 0 or idx.max() >= n):
+        raise ParameterError(name, f"splat index out of range 0..{n - 1}")
+    mask = np.zeros(n, dtype=bool)
+    mask[idx] = True
+    return mask
+
+
+def _unique_rows(index: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """Drop splats whose position exactly repeats an earlier one (duplicate
+    vertices make the interpolation matrix singular); returns kept indices."""
+    if len(index) < 2:
+        return index
+    _, first = np.unique(points, axis=0, return_index=True)
+    if len(first) == len(index):
+        return index
+    return index[np.sort(first)]
+
+
+def _near(query: np.ndarray, reference: np.ndarray, width: float,
+          tree: cKDTree | None = None) -> np.ndarray:
+    """Mask of ``query`` points within ``width`` of any ``reference`` point."""
+    if len(query) == 0 or len(reference) == 0:
+        return np.zeros(len(query), dtype=bool)
+    lo = reference.min(axis=0) - width
+    hi = reference.max(axis=0) + width
+    inbox = np.all((query >= lo) & (query <= hi), axis=1)
+    out = np.zeros(len(query), dtype=bool)
+    cand = np.flatnonzero(inbox)
+    if len(cand):
+        tree = cKDTree(reference) if tree is None else tree
+        d, _ = tree.query(query[cand], k=1, distance_upper_bound=width, workers=-1)
+        out[cand] = np.isfinite(d)
+    return out
+
+
+def build_constraints(cloud, support, handles, *, rings: float = BAND_RINGS,
+                      spacing: float | None = None) -> Constraints:
+    """Constraints of an edit (see the module docstring).
+
+    Args:
+        cloud: the :class:`~splatedit.model.cloud.SplatCloud` being edited.
+        support: (n,) bool mask (or index array) of the splats the edit may move.
+        handles: list of (n,) bool masks (or index arrays), each inside the
+            support, pairwise disjoint, in the order of their column blocks.
+        rings: band thickness in point spacings (default ``BAND_RINGS`` = 3).
+        spacing: point spacing in model units; default: median nearest-
+            neighbour distance of the support splats.
+    Raises:
+        ParameterError: bad masks (shape, empty support or handle, no handles,
+            handle outside the support, overlapping handles, no free splats,
+            rings <= 0).
+        SolverError: a handle with no splat within the band width of the free
+            region (the handle is not next to anything the edit can bend).
+    """
+    pos = cloud.positions
+    n = len(pos)
+    if not (np.isfinite(rings) and rings > 0):
+        raise ParameterError("rings", f"must be > 0, got {rings}")
+    sup = _as_mask("support", support, n)
+    if not sup.any():
+        raise ParameterError("support", "selects no splats (empty support region)")
+    if isinstance(handles, np.ndarray) and handles.ndim == 1:
+        handles = [handles]
+    handles = list(handles)
+    if not handles:
+        raise ParameterError("handles", "at least one handle is needed")
+    hmasks = []
+    covered = np.zeros(n, dtype=bool)
+    for i, h in enumerate(handles):
+        m = _as_mask(f"handles[{i}]", h, n)
+        if not m.any():
+            raise ParameterError(f"handles[{i}]", "selects no splats (empty handle)")
+        outside = m & ~sup
+        if outside.any():
+            raise ParameterError(f"handles[{i}]", f"{int(outside.sum())} handle splats lie "
+                                 f"outside the support (first: splat {int(np.flatnonzero(outside)[0])}); "
+                                 "a handle must be inside the support")
+        both = m & covered
+        if both.any():
+            other = next(j for j, hm in enumerate(hmasks) if (hm & m).any())
+            raise ParameterError(f"handles[{i}]", f"overlaps handles[{other}] in {int(both.sum())} "
+                                 "splats; handles must be disjoint")
+        covered |= m
+        hmasks.append(m)
+    free = sup & ~covered
+    if not free.any():
+        raise ParameterError("handles", "cover the whole support: no free splats are left "
+                             "for the deformation to bend")
+
+    support_index = np.flatnonzero(sup)
+    free_index = np.flatnonzero(free)
+    sup_pts = pos[support_index]
+    sup_tree = cKDTree(sup_pts)
+    if spacing is None:
+        h = point_spacing(sup_pts, tree=sup_tree) if len(sup_pts) > 1 else 0.0
+        if h <= 0.0:
+            h = point_spacing(pos)
+        if h <= 0.0:
+            raise SolverError("cannot determine the point spacing: the splats coincide")
+    else:
+        h = float(spacing)
+        if not (np.isfinite(h) and h > 0):
+            raise ParameterError("spacing", f"must be > 0, got {spacing}")
+    width = rings * h
+    w_query = width * (1.0 + _BAND_SLACK_REL)
+
+    # fixed band: outside the support, within the width of a support splat
+    out_index = np.flatnonzero(~sup)
+    fixed_index = out_index[_near(pos[out_index], sup_pts, w_query, sup_tree)]
+    fixed_index = _unique_rows(fixed_index, pos[fixed_index])
+
+    # handle bands: handle splats within the width of a free splat
+    free_pts = pos[free_index]
+    free_tree = cKDTree(free_pts)
+    groups = []
+    for i, m in enumerate(hmasks):
+        hidx = np.flatnonzero(m)
+        frame = handle_frame(pos[hidx], h)
+        band = hidx[_near(pos[hidx], free_pts, w_query, free_tree)]
+        band = _unique_rows(band, pos[band])
+        if len(band) == 0:
+            raise SolverError(f"handle {i} has no splat within {rings:g} point spacings "
+                              f"({width:.4g} model units) of the free region; a handle must "
+                              "touch the part of the support that can bend")
+        groups.append(ConstraintGroup(kind="handle", points=pos[band],
+                                      weights=affine_coordinates(pos[band], frame),
+                                      controls=frame, band_index=band, member_index=hidx))
+
+    pts = np.concatenate([pos[fixed_index]] + [g.points for g in groups], axis=0)
+    if len(np.unique(pts, axis=0)) != len(pts):
+        raise SolverError("two splats at the same position get different constraints "
+                          "(duplicate vertices on either side of a selection boundary); "
+                          "remove duplicate points or change the selection")
+    k_total = sum(g.n_columns for g in groups)
+    values = np.zeros((len(pts), k_total))
+    row, col = len(fixed_index), 0
+    for g in groups:
+        values[row:row + len(g.points), col:col + g.n_columns] = g.weights
+        row += len(g.points)
+        col += g.n_columns
+    return Constraints(points=pts, values=values, fixed_index=fixed_index, groups=groups,
+                       spacing=h, band_width=width, support_index=support_index,
+                       free_index=free_index, n_points=n)

@@ -1,0 +1,66 @@
+"""Atomic file replacement: write to a temporary file beside the target, then rename.
+
+A crash or error half-way never leaves a truncated file where a good one was.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import tempfile
+from pathlib import Path
+from typing import IO, Iterator
+
+from splatedit.errors import InputError
+
+
+def check_writable_target(path: str | Path, *, overwrite: bool, protect: str | Path | None = None) -> Path:
+    """Refuse to clobber an existing file (or the input ``protect``) unless asked.
+
+    Raises:
+        InputError: naming the path, when it exists and ``overwrite`` is False,
+            or when it is the protected input file and ``overwrite`` is False.
+    """
+    p = Path(path)
+    if protect is not None and p.exists() and Path(protect).exists() and p.resolve() == Path(protect).resolve() and not overwrite:
+        raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
+    if p.exists() and not overwrite:
+        raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
+    if p.exists() and p.is_dir():
+        raise InputError("is a directory", path=str(p))
+    return p
+
+
+@contextlib.contextmanager
+def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
+    """Open a temp file beside ``path``; on success rename it onto ``path``.
+
+    On any exception the temporary file is removed and ``path`` is untouched.
+    """
+    p = Path(path)
+    directory = p.parent if str(p.parent) else Path(".")
+    if not directory.is_dir():
+        raise InputError("directory does not exist", path=str(directory))
+    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=directory)
+    try:
+        with os.fdopen(fd, mode) as fh:
+            yield fh
+            fh.flush()
+            os.fsync(fh.fileno())
+        os.replace(tmp, p)
+    except BaseException:
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise
+
+
+def atomic_write_text(path: str | Path, text: str) -> None:
+    """Write ``text`` (UTF-8) to ``path`` atomically."""
+    with atomic_open(path, "w") as fh:
+        fh.write(text)
+
+
+def atomic_write_bytes(path: str | Path, data: bytes) -> None:
+    """Write ``data`` to ``path`` atomically."""
+    with atomic_open(path, "wb") as fh:
+        fh.write(data)

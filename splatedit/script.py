@@ -1,0 +1,436 @@
+"""JSON edit scripts: parse, validate and run a sequence of RBF edits headlessly.
+
+Format (version 1)::
+
+    {"version": 1,
+     "solver": {"method": "auto"|"iqr"|"lu", "tol": 1e-7, "max_centers": null},
+     "edits": [
+       {"support": REGION,
+        "handle": REGION,                    # or "handles": [REGION, ...]
+        "transform": TRANSFORM}]}            # or "transforms": [TRANSFORM, ...]
+
+    REGION    = {"sphere": {"center": [x,y,z], "radius": r}}
+              | {"box": {"min": [x,y,z], "max": [x,y,z]}}
+              | {"indices": [i, ...]}
+    TRANSFORM = {"matrix": [[4 numbers] x 4]}                      (row-major, acts on column vectors)
+              | {"translate": [dx,dy,dz],
+                 "rotate": {"axis": [ax,ay,az], "degrees": a, "center": [x,y,z]},
+                 "scale": s | {"factor": s, "center": [x,y,z]}}     (any subset)
+
+A handle region is intersected with its support.  A TRS transform applies
+scale, then rotation, then translation; the rotation and scale centres default
+to the handle's centroid.  Edits run one after another: each edit's result is
+the base of the next (the paper's Bunny: ears, then head).  Every error names
+the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis``.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import time
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable
+
+import numpy as np
+
+from splatedit.errors import EditScriptError, SplatEditError
+from splatedit.select.regions import Box, Indices, Region, Sphere
+from splatedit.tolerances import IQR_DEFAULT_TOL
+
+SCRIPT_VERSION = 1
+METHODS = ("auto", "iqr", "lu")
+
+
+# ----------------------------------------------------------------- data model
+@dataclass(frozen=True)
+class TRS:
+    """Scale about a centre, rotate about an axis through a centre, translate.
+
+    ``None`` centres mean "the handle's centroid" and are resolved at run time.
+    """
+    translate: tuple[float, float, float] = (0.0, 0.0, 0.0)
+    rotate_axis: tuple[float, float, float] | None = None
+    rotate_degrees: float = 0.0
+    rotate_center: tuple[float, float, float] | None = None
+    scale: float = 1.0
+    scale_center: tuple[float, float, float] | None = None
+
+    def matrix(self, handle_centroid: np.ndarray) -> np.ndarray:
+        """(4, 4) float64 affine matrix acting on column vectors (x, y, z, 1)."""
+        from splatedit.deform import transform as tf
+        m = np.eye(4)
+        if self.scale != 1.0:
+            c = handle_centroid if self.scale_center is None else np.asarray(self.scale_center)
+            m = tf.scaling(self.scale, c) @ m
+        if self.rotate_axis is not None and self.rotate_degrees != 0.0:
+            c = handle_centroid if self.rotate_center is None else np.asarray(self.rotate_center)
+            m = tf.rotation(self.rotate_axis, self.rotate_degrees, c) @ m
+        return tf.translation(self.translate) @ m
+
+
+@dataclass(frozen=True)
+class Matrix:
+    """An explicit (4, 4) affine matrix."""
+    values: tuple[tuple[float, ...], ...]
+
+    def matrix(self, handle_centroid: np.ndarray) -> np.ndarray:
+        return np.array(self.values, dtype=np.float64)
+
+
+Transform = TRS | Matrix
+
+
+@dataclass(frozen=True)
+class Edit:
+    """One edit: a support region, one or more handles and their transforms."""
+    support: Region
+    handles: tuple[Region, ...]
+    transforms: tuple[Transform, ...]
+    json_path: str = "$"
+
+
+@dataclass(frozen=True)
+class SolverSettings:
+    method: str = "auto"
+    tol: float = IQR_DEFAULT_TOL
+    max_centers: int | None = None
+
+
+@dataclass(frozen=True)
+class EditScript:
+    edits: tuple[Edit, ...]
+    solver: SolverSettings = field(default_factory=SolverSettings)
+
+    # ---------------------------------------------------------------- output
+    def to_json(self) -> dict:
+        """The script as a JSON-ready dict in the documented format."""
+        def region(r: Region) -> dict:
+            if isinstance(r, Sphere):
+                return {"sphere": {"center": list(r.center), "radius": r.radius}}
+            if isinstance(r, Box):
+                return {"box": {"min": list(r.min), "max": list(r.max)}}
+            return {"indices": list(r.indices)}
+
+        def transform(t: Transform) -> dict:
+            if isinstance(t, Matrix):
+                return {"matrix": [list(row) for row in t.values]}
+            out: dict[str, Any] = {"translate": list(t.translate)}
+            if t.rotate_axis is not None:
+                rot: dict[str, Any] = {"axis": list(t.rotate_axis), "degrees": t.rotate_degrees}
+                if t.rotate_center is not None:
+                    rot["center"] = list(t.rotate_center)
+                out["rotate"] = rot
+            if t.scale != 1.0:
+                out["scale"] = (t.scale if t.scale_center is None
+                                else {"factor": t.scale, "center": list(t.scale_center)})
+            return out
+
+        solver: dict[str, Any] = {"method": self.solver.method, "tol": self.solver.tol}
+        if self.solver.max_centers is not None:
+            solver["max_centers"] = self.solver.max_centers
+        edits = []
+        for e in self.edits:
+            item: dict[str, Any] = {"support": region(e.support)}
+            if len(e.handles) == 1:
+                item["handle"] = region(e.handles[0])
+                item["transform"] = transform(e.transforms[0])
+            else:
+                item["handles"] = [region(h) for h in e.handles]
+                item["transforms"] = [transform(t) for t in e.transforms]
+            edits.append(item)
+        return {"version": SCRIPT_VERSION, "solver": solver, "edits": edits}
+
+    def save(self, path: str | Path) -> None:
+        """Write the script as JSON (atomic: temp file + rename)."""
+        from splatedit.io.atomic import atomic_write_text
+        atomic_write_text(path, json.dumps(self.to_json(), indent=1) + "\n")
+
+
+# -------------------------------------------------------------------- parsing
+class _Ctx:
+    def __init__(self, source: str | None):
+        self.source = source
+
+    def fail(self, json_path: str, message: str) -> EditScriptError:
+        return EditScriptError(message, json_path=json_path, path=self.source)
+
+    def obj(self, value, jp: str, required: tuple[str, ...] = (), allowed: tuple[str, ...] | None = None) -> dict:
+        if not isinstance(value, dict):
+            raise self.fail(jp, f"must be an object, got {_kind(value)}")
+        for key in required:
+            if key not in value:
+                raise self.fail(jp, f"missing key {key!r}")
+        if allowed is not None:
+            extra = sorted(set(value) - set(allowed))
+            if extra:
+                raise self.fail(f"{jp}.{extra[0]}", f"unknown key (allowed: {', '.join(allowed)})")
+        return value
+
+    def number(self, value, jp: str, *, positive: bool = False, nonnegative: bool = False) -> float:
+        if isinstance(value, bool) or not isinstance(value, (int, float)):
+            raise self.fail(jp, f"must be a number, got {_kind(value)}")
+        x = float(value)
+        if not math.isfinite(x):
+            raise self.fail(jp, "must be finite")
+        if positive and x <= 0:
+            raise self.fail(jp, f"must be > 0, got {x:g}")
+        if nonnegative and x < 0:
+            raise self.fail(jp, f"must be >= 0, got {x:g}")
+        return x
+
+    def vec3(self, value, jp: str, *, nonzero: bool = False) -> tuple[float, float, float]:
+        if not isinstance(value, list) or len(value) != 3:
+            raise self.fail(jp, f"must be a list of 3 numbers, got {_kind(value)}")
+        v = tuple(self.number(x, f"{jp}[{i}]") for i, x in enumerate(value))
+        if nonzero and not any(v):
+            raise self.fail(jp, "must not be the zero vector")
+        return v  # type: ignore[return-value]
+
+
+def _kind(value) -> str:
+    if value is None:
+        return "null"
+    if isinstance(value, bool):
+        return "a boolean"
+    if isinstance(value, (int, float)):
+        return f"the number {value!r}"
+    if isinstance(value, str):
+        return f"the string {value!r}"
+    if isinstance(value, list):
+        return f"a list of {len(value)}"
+    return "an object"
+
+
+def _region(ctx: _Ctx, value, jp: str) -> Region:
+    obj = ctx.obj(value, jp, allowed=("sphere", "box", "indices"))
+    if len(obj) != 1:
+        raise ctx.fail(jp, "must have exactly one of 'sphere', 'box', 'indices'")
+    kind, body = next(iter(obj.items()))
+    jp = f"{jp}.{kind}"
+    if kind == "sphere":
+        body = ctx.obj(body, jp, required=("center", "radius"), allowed=("center", "radius"))
+        return Sphere(ctx.vec3(body["center"], f"{jp}.center"),
+                      ctx.number(body["radius"], f"{jp}.radius", positive=True))
+    if kind == "box":
+        body = ctx.obj(body, jp, required=("min", "max"), allowed=("min", "max"))
+        lo = ctx.vec3(body["min"], f"{jp}.min")
+        hi = ctx.vec3(body["max"], f"{jp}.max")
+        for i in range(3):
+            if lo[i] > hi[i]:
+                raise ctx.fail(f"{jp}.min[{i}]", f"is greater than max[{i}] ({lo[i]:g} > {hi[i]:g})")
+        return Box(lo, hi)
+    if not isinstance(body, list) or not body:
+        raise ctx.fail(jp, f"must be a non-empty list of splat indices, got {_kind(body)}")
+    out = []
+    for i, x in enumerate(body):
+        if isinstance(x, bool) or not isinstance(x, int) or x < 0:
+            raise ctx.fail(f"{jp}[{i}]", f"must be a non-negative integer, got {_kind(x)}")
+        out.append(x)
+    return Indices(tuple(out))
+
+
+def _transform(ctx: _Ctx, value, jp: str) -> Transform:
+    obj = ctx.obj(value, jp, allowed=("matrix", "translate", "rotate", "scale"))
+    if not obj:
+        raise ctx.fail(jp, "is empty: give 'matrix' or any of 'translate', 'rotate', 'scale'")
+    if "matrix" in obj:
+        if len(obj) != 1:
+            raise ctx.fail(jp, "'matrix' cannot be combined with 'translate', 'rotate' or 'scale'")
+        rows = obj["matrix"]
+        if not isinstance(rows, list) or len(rows) != 4:
+            raise ctx.fail(f"{jp}.matrix", f"must be 4 rows of 4 numbers, got {_kind(rows)}")
+        vals = []
+        for r, row in enumerate(rows):
+            if not isinstance(row, list) or len(row) != 4:
+                raise ctx.fail(f"{jp}.matrix[{r}]", f"must be a list of 4 numbers, got {_kind(row)}")
+            vals.append(tuple(ctx.number(x, f"{jp}.matrix[{r}][{c}]") for c, x in enumerate(row)))
+        m = np.array(vals)
+        if not np.allclose(m[3], [0, 0, 0, 1]):
+            raise ctx.fail(f"{jp}.matrix[3]", "the last row of an affine matrix must be [0, 0, 0, 1]")
+        if abs(np.linalg.det(m[:3, :3])) < 1e-12:
+            raise ctx.fail(f"{jp}.matrix", "is singular (it would flatten the handle)")
+        return Matrix(tuple(vals))
+    translate = ctx.vec3(obj["translate"], f"{jp}.translate") if "translate" in obj else (0.0, 0.0, 0.0)
+    axis, degrees, rcenter = None, 0.0, None
+    if "rotate" in obj:
+        rjp = f"{jp}.rotate"
+        rot = ctx.obj(obj["rotate"], rjp, required=("axis", "degrees"), allowed=("axis", "degrees", "center"))
+        axis = ctx.vec3(rot["axis"], f"{rjp}.axis", nonzero=True)
+        degrees = ctx.number(rot["degrees"], f"{rjp}.degrees")
+        rcenter = ctx.vec3(rot["center"], f"{rjp}.center") if "center" in rot else None
+    scale, scenter = 1.0, None
+    if "scale" in obj:
+        sjp = f"{jp}.scale"
+        s = obj["scale"]
+        if isinstance(s, dict):
+            s = ctx.obj(s, sjp, required=("factor",), allowed=("factor", "center"))
+            scale = ctx.number(s["factor"], f"{sjp}.factor", positive=True)
+            scenter = ctx.vec3(s["center"], f"{sjp}.center") if "center" in s else None
+        else:
+            scale = ctx.number(s, sjp, positive=True)
+    return TRS(translate, axis, degrees, rcenter, scale, scenter)
+
+
+def parse_script(data: Any, source: str | None = None) -> EditScript:
+    """Validate a decoded JSON document and build an :class:`EditScript`.
+
+    Raises:
+        EditScriptError: naming the JSON path of the first bad value.
+    """
+    ctx = _Ctx(source)
+    top = ctx.obj(data, "$", required=("version", "edits"), allowed=("version", "solver", "edits"))
+    if top["version"] != SCRIPT_VERSION:
+        raise ctx.fail("$.version", f"unsupported version {top['version']!r} (this splatedit reads {SCRIPT_VERSION})")
+    solver = SolverSettings()
+    if "solver" in top:
+        s = ctx.obj(top["solver"], "$.solver", allowed=("method", "tol", "max_centers"))
+        method = s.get("method", "auto")
+        if method not in METHODS:
+            raise ctx.fail("$.solver.method", f"must be one of {', '.join(METHODS)}, got {_kind(method)}")
+        tol = ctx.number(s["tol"], "$.solver.tol", positive=True) if "tol" in s else IQR_DEFAULT_TOL
+        max_centers = None
+        if s.get("max_centers") is not None:
+            mc = s["max_centers"]
+            if isinstance(mc, bool) or not isinstance(mc, int) or mc < 1:
+                raise ctx.fail("$.solver.max_centers", f"must be a positive integer, got {_kind(mc)}")
+            max_centers = mc
+        solver = SolverSettings(method, tol, max_centers)
+    edits_in = top["edits"]
+    if not isinstance(edits_in, list) or not edits_in:
+        raise ctx.fail("$.edits", f"must be a non-empty list of edits, got {_kind(edits_in)}")
+    edits = []
+    for i, e in enumerate(edits_in):
+        jp = f"$.edits[{i}]"
+        e = ctx.obj(e, jp, required=("support",),
+                    allowed=("support", "handle", "handles", "transform", "transforms"))
+        support = _region(ctx, e["support"], f"{jp}.support")
+        if ("handle" in e) == ("handles" in e):
+            raise ctx.fail(jp, "needs exactly one of 'handle' or 'handles'")
+        if "handle" in e:
+            handles = (_region(ctx, e["handle"], f"{jp}.handle"),)
+            if "transform" not in e:
+                raise ctx.fail(jp, "missing key 'transform'")
+            if "transforms" in e:
+                raise ctx.fail(f"{jp}.transforms", "use 'transform' with a single 'handle'")
+            transforms = (_transform(ctx, e["transform"], f"{jp}.transform"),)
+        else:
+            hs = e["handles"]
+            if not isinstance(hs, list) or not hs:
+                raise ctx.fail(f"{jp}.handles", f"must be a non-empty list of regions, got {_kind(hs)}")
+            handles = tuple(_region(ctx, h, f"{jp}.handles[{k}]") for k, h in enumerate(hs))
+            ts = e.get("transforms")
+            if not isinstance(ts, list) or len(ts) != len(hs):
+                raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
+            transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
+        edits.append(Edit(support, handles, transforms, jp))
+    return EditScript(tuple(edits), solver)
+
+
+def load_script(path: str | Path) -> EditScript:
+    """Read and validate an edit script file (errors name the file and JSON path)."""
+    p = Path(path)
+    try:
+        text = p.read_text(encoding="utf-8")
+    except OSError as exc:
+        raise EditScriptError(f"cannot read: {exc.strerror or exc}", path=str(p)) from None
+    try:
+        data = json.loads(text)
+    except json.JSONDecodeError as exc:
+        raise EditScriptError(f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}",
+                              path=str(p)) from None
+    return parse_script(data, source=str(p))
+
+
+# -------------------------------------------------------------------- running
+@dataclass
+class EditReport:
+    """What one edit did (printed by the CLI)."""
+    index: int
+    support: int
+    handles: list[int]
+    constraints: int
+    centers: int
+    residual: float
+    method: str
+    fit_seconds: float
+    basis_seconds: float
+    max_displacement: float
+    notes: list[str] = field(default_factory=list)
+
+    def line(self) -> str:
+        hs = "+".join(map(str, self.handles))
+        notes = f" ({'; '.join(self.notes)})" if self.notes else ""
+        return (f"edit {self.index}: support {self.support} splats, handle {hs}, "
+                f"{self.constraints} constraints, {self.method} with {self.centers} centers "
+                f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
+                f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
+
+
+def resolve_edit(cloud, edit: Edit, source: str | None = None):
+    """Masks and matrices of one edit on ``cloud``.
+
+    Returns:
+        (support (n,) bool, handles list of (n,) bool, matrices list of (4,4) float64)
+    Raises:
+        EditScriptError: a region selects nothing or indexes past the cloud.
+    """
+    ctx = _Ctx(source)
+    n = cloud.n
+
+    def mask(region: Region, jp: str) -> np.ndarray:
+        if isinstance(region, Indices) and max(region.indices) >= n:
+            bad = next(i for i, x in enumerate(region.indices) if x >= n)
+            raise ctx.fail(f"{jp}.indices[{bad}]", f"index {region.indices[bad]} is out of range (the model has {n} splats)")
+        return region.mask(cloud.positions)
+
+    support = mask(edit.support, f"{edit.json_path}.support")
+    if not support.any():
+        raise ctx.fail(f"{edit.json_path}.support", "selects no splat")
+    handles, matrices = [], []
+    single = len(edit.handles) == 1
+    for k, (h, t) in enumerate(zip(edit.handles, edit.transforms)):
+        jp = f"{edit.json_path}.handle" if single else f"{edit.json_path}.handles[{k}]"
+        hm = mask(h, jp) & support
+        if not hm.any():
+            raise ctx.fail(jp, "selects no splat inside the support")
+        handles.append(hm)
+        matrices.append(t.matrix(cloud.positions[hm].mean(axis=0)))
+    return support, handles, matrices
+
+
+def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
+               source: str | None = None, progress=None,
+               on_edit: Callable[[EditReport], None] | None = None):
+    """Apply every edit of ``script`` to ``cloud`` in order (CPU path).
+
+    ``method``/``tol`` override the script's solver settings when given.
+    Returns:
+        (deformed SplatCloud, list of EditReport)
+    """
+    from splatedit.deform.basis import DeformationBasis
+
+    method = method or script.solver.method
+    tol = script.solver.tol if tol is None else tol
+    reports = []
+    for i, edit in enumerate(script.edits):
+        support, handles, matrices = resolve_edit(cloud, edit, source)
+        try:
+            basis = DeformationBasis.fit(cloud, support, handles, method=method, tol=tol,
+                                         max_centers=script.solver.max_centers, progress=progress)
+        except SplatEditError as exc:
+            raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
+        d_c = basis.displacement(matrices)
+        t0 = time.perf_counter()
+        new = basis.apply(cloud, d_c)
+        disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
+        stats = basis.stats
+        rep = EditReport(i, int(support.sum()), [int(h.sum()) for h in handles], stats.n_constraints,
+                         stats.n_centers, stats.residual, stats.method, stats.fit_seconds,
+                         stats.basis_seconds + (time.perf_counter() - t0), disp, list(stats.notes))
+        reports.append(rep)
+        if on_edit is not None:
+            on_edit(rep)
+        cloud = new
+    return cloud, reports
