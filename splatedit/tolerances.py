@@ -18,6 +18,31 @@ ORIENT_NEIGHBOURS = 8
 #: splat radius = this factor * distance to the SPACING_NEIGHBOUR-th neighbour
 SPLAT_RADIUS_FACTOR = 1.0
 SPACING_NEIGHBOUR = 6
+#: points per chunk of the batched 3x3 covariance / eigen-decomposition
+#: (bounds memory to about ESTIMATE_CHUNK_POINTS * NORMAL_NEIGHBOURS * 24 bytes)
+ESTIMATE_CHUNK_POINTS = 65536
+#: added to the Riemannian-graph weight 1 - |n_i . n_j| so that parallel
+#: normals still give a (positive-weight) edge in the sparse MST
+ORIENT_WEIGHT_EPS = 1e-9
+#: a component's seed normal (at its highest point) with |n_z| below this is
+#: oriented away from the component centroid instead of towards +z
+ORIENT_SEED_MIN_NZ = 1e-3
+#: a k-th-neighbour radius below this fraction of the median radius (duplicate
+#: points) is replaced by the median radius
+MIN_SPLAT_RADIUS_REL_MEDIAN = 1e-3
+#: splat radius used when there are no neighbours at all (a single point or
+#: all points identical), model units
+FALLBACK_SPLAT_RADIUS = 1.0
+#: mesh vertex splat radius = this factor * the longest edge of the incident
+#: triangles.  Every point of a triangle lies within L/sqrt(3) of one of its
+#: corners (L = longest edge; equality for the equilateral triangle), so
+#: 1/sqrt(3) just closes the surface; the 1.2 margin makes neighbouring EWA
+#: kernels overlap instead of touching.  See splatedit.model.mesh.
+MESH_SPLAT_RADIUS_FACTOR = 1.2 / 3 ** 0.5
+
+# --- file input ---------------------------------------------------------
+#: text files (XYZ, OFF) are tokenised in blocks of about this many bytes
+TEXT_BLOCK_BYTES = 1 << 24
 
 # --- RBF fitting --------------------------------------------------------
 #: the paper's relative L2 tolerance for the incremental QR (Sect. 5 and 8)

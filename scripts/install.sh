@@ -1,0 +1,32 @@
+#!/usr/bin/env bash
+# Install everything splatedit needs on Debian 12 (run as root), into ./.venv.
+#   System: Python 3 + venv, Mesa lavapipe (CPU Vulkan), the Vulkan loader,
+#   glslang (shader compiler, for the SPIR-V staleness test), the Khronos
+#   validation layer (the test suite runs with it on) and Xvfb (window tests).
+#   Python: this package and its test extras from PyPI.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+
+apt_packages=(python3 python3-venv python3-pip mesa-vulkan-drivers libvulkan1 glslang-tools
+              vulkan-validationlayers xvfb xauth x11-utils xdotool)
+if command -v apt-get >/dev/null 2>&1; then
+    missing=()
+    for p in "${apt_packages[@]}"; do
+        dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+    done
+    if [ ${#missing[@]} -gt 0 ]; then
+        echo "install.sh: installing Debian packages: ${missing[*]}"
+        export DEBIAN_FRONTEND=noninteractive
+        apt-get update -q
+        apt-get install -y -q --no-install-recommends "${missing[@]}"
+    fi
+else
+    echo "install.sh: no apt-get here; install these yourself: ${apt_packages[*]}" >&2
+fi
+
+if [ ! -x .venv/bin/python ]; then
+    python3 -m venv .venv
+fi
+.venv/bin/python -m pip install -q --upgrade pip
+.venv/bin/python -m pip install -q -e '.[test]'
+echo "install.sh: ready (.venv)"
