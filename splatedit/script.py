@@ -63,11 +63,11 @@ class TRS:
         m = np.eye(4)
         if self.scale != 1.0:
             c = handle_centroid if self.scale_center is None else np.asarray(self.scale_center)
-            m = tf.scaling(self.scale, c) @ m
+            m = tf.scale(self.scale, c) @ m
         if self.rotate_axis is not None and self.rotate_degrees != 0.0:
             c = handle_centroid if self.rotate_center is None else np.asarray(self.rotate_center)
-            m = tf.rotation(self.rotate_axis, self.rotate_degrees, c) @ m
-        return tf.translation(self.translate) @ m
+            m = tf.rotate(self.rotate_axis, self.rotate_degrees, c) @ m
+        return tf.translate(self.translate) @ m
 
 
 @dataclass(frozen=True)

@@ -57,6 +57,19 @@ EVAL_CHUNK_ROWS = 8192
 #: relative singular-value cutoff that declares the polynomial block rank
 #: deficient (constraints on a quadric)
 POLY_RANK_RTOL = 1e-9
+#: cap on the bytes of one (chunk rows x n_centers) float64 work matrix when
+#: evaluating a fitted RBF; the chunk is min(EVAL_CHUNK_ROWS, this / (8 n))
+#: rows, so evaluation memory stays bounded even for thousands of centers
+EVAL_CHUNK_MAX_BYTES = 32 * 2**20
+#: constraint points closer than this (relative to the bounding-box diagonal)
+#: are duplicates: merged when their values agree, a SolverError otherwise
+DUPLICATE_POINT_REL = 1e-10
+#: duplicate points "agree" when their values differ by at most this times
+#: the largest |value|
+DUPLICATE_VALUE_RTOL = 1e-9
+#: the exact (LU) solve raises SolverError below this reciprocal condition
+#: number (1-norm estimate of the normalised system)
+LU_MIN_RCOND = 1e-15
 
 # --- constraints --------------------------------------------------------
 #: thickness of the fixed and handle bands, in point spacings ("three rings")
