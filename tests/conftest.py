@@ -7,6 +7,7 @@ skips the test when it is absent, as it is in a user's clone.
 from __future__ import annotations
 
 import os
+import sys
 from pathlib import Path
 
 import pytest
@@ -24,3 +25,24 @@ def shared_data() -> Path:
     if not SHARED_DATA.is_dir():
         pytest.skip(f"sample data folder {SHARED_DATA} is absent (it is not part of a user's clone)")
     return SHARED_DATA
+
+
+@pytest.hookimpl(hookwrapper=True)
+def pytest_runtest_makereport(item, call):
+    """Fail the test (setup, call or teardown phase) during which the Vulkan
+    validation layer reported any warning or error (see splatedit.render.vk)."""
+    outcome = yield
+    core = sys.modules.get("splatedit.render.vk.core")
+    if core is None:          # Vulkan never imported: nothing to check
+        return
+    msgs = core.drain_validation_messages()
+    if not msgs:
+        return
+    rep = outcome.get_result()
+    text = (f"{len(msgs)} Vulkan validation message(s) during {call.when}:\n  "
+            + "\n  ".join(m[:2000] for m in msgs))
+    if rep.passed or rep.skipped:
+        rep.outcome = "failed"
+        rep.longrepr = text
+    else:
+        rep.sections.append(("Vulkan validation", text))

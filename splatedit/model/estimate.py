@@ -43,8 +43,47 @@ def _points(points) -> np.ndarray:
     return pts
 
 
+def knn(points, k: int, *, tree: cKDTree | None = None, query=None,
+        progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """k nearest neighbours (the point itself included), chunked.
+
+    Args:
+        points: (n, 3) float64 positions.
+        k: neighbours per point including itself, clamped to n.
+        query: optional (m,) indices of the points to query (default all).
+    Returns:
+        dist (m, k) float64 sorted distances (model units) and idx (m, k)
+        int64 indices into ``points``.
+    """
+    pts = _points(points)
+    k = int(min(max(k, 1), len(pts)))
+    idx_q = np.arange(len(pts)) if query is None else np.asarray(query, dtype=np.int64)
+    tree = cKDTree(pts) if tree is None else tree
+    dist = np.empty((len(idx_q), k))
+    idx = np.empty((len(idx_q), k), dtype=np.int64)
+    step = 8 * ESTIMATE_CHUNK_POINTS
+    for lo in range(0, len(idx_q), step):
+        d, i = tree.query(pts[idx_q[lo:lo + step]], k=k, workers=-1)
+        dist[lo:lo + step] = d.reshape(-1, k)
+        idx[lo:lo + step] = i.reshape(-1, k)
+        report(progress, "finding neighbours", (lo + step) / max(len(idx_q), 1))
+    return dist, idx
+
+
+def _self_first(idx: np.ndarray, query: np.ndarray) -> np.ndarray:
+    """Neighbour lists with the query point itself removed (duplicates of the
+    point may come first in a k-d tree answer); returns (m, k-1)."""
+    m, k = idx.shape
+    is_self = idx == query[:, None]
+    # move the (first) self entry to column 0, keep the others in order
+    has = is_self.any(axis=1)
+    col = np.where(has, is_self.argmax(axis=1), k - 1)
+    order = np.argsort(np.arange(k)[None, :] != col[:, None], axis=1, kind="stable")
+    return np.take_along_axis(idx, order, axis=1)[:, 1:]
+
+
 def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None = None,
-                     query=None, progress=None) -> np.ndarray:
+                     query=None, neighbours=None, progress=None) -> np.ndarray:
     """Unoriented PCA normals.
 
     Args:
@@ -52,6 +91,8 @@ def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None
         k: neighbourhood size including the point itself, clamped to n.
         tree: optional prebuilt ``cKDTree(points)``.
         query: optional (m,) indices; only their normals are computed.
+        neighbours: optional (m, >= k) int64 neighbour indices from
+            :func:`knn` (saves the k-d tree query).
         progress: optional progress callback (stage ``"estimating normals"``).
     Returns:
         (n, 3) (or (m, 3) with ``query``) float64 unit normals, signs arbitrary.
@@ -66,17 +107,16 @@ def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None
         out[:, 2] = 1.0
         return out
     k = int(min(max(k, 3), n))
-    tree = cKDTree(pts) if tree is None else tree
+    if neighbours is None or neighbours.shape[1] < k:
+        _, neighbours = knn(pts, k, tree=tree, query=idx_q, progress=progress)
     step = ESTIMATE_CHUNK_POINTS
     for lo in range(0, len(idx_q), step):
-        q = idx_q[lo:lo + step]
-        _, nb = tree.query(pts[q], k=k, workers=-1)
-        nbp = pts[nb]                                   # (c, k, 3)
+        nbp = pts[neighbours[lo:lo + step, :k]]         # (c, k, 3)
         nbp -= nbp.mean(axis=1, keepdims=True)
-        cov = np.matmul(nbp.transpose(0, 2, 1), nbp)    # (c, 3, 3)
+        cov = np.einsum("cki,ckj->cij", nbp, nbp)       # (c, 3, 3)
         _, vec = np.linalg.eigh(cov)
         out[lo:lo + step] = vec[:, :, 0]
-        report(progress, "estimating normals", (lo + len(q)) / len(idx_q))
+        report(progress, "estimating normals", (lo + len(nbp)) / len(idx_q))
     out /= np.linalg.norm(out, axis=1, keepdims=True)
     return out
 
@@ -99,7 +139,7 @@ def _seed_flips(pts, nrm, labels, ncomp):
 
 
 def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree | None = None,
-                   progress=None) -> np.ndarray:
+                   neighbours=None, progress=None) -> np.ndarray:
     """Consistently orient normals by MST propagation (Hoppe et al. 1992).
 
     Args:
@@ -107,6 +147,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree
         normals: (n, 3) float64 unit normals with arbitrary signs.
         k: neighbours per point in the Riemannian graph.
         tree: optional prebuilt ``cKDTree(points)``.
+        neighbours: optional (n, >= k + 1) int64 indices from :func:`knn`.
     Returns:
         (n, 3) float64 normals, each equal to ``+-normals[i]``; every
         connected component of the k-NN graph is seeded at its highest point
@@ -126,12 +167,15 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree
         return np.where(flip[:, None], -nrm, nrm)
     report(progress, "orienting normals", 0.0)
     k = int(min(max(k, 1), n - 1))
-    tree = cKDTree(pts) if tree is None else tree
-    _, nb = tree.query(pts, k=k + 1, workers=-1)
-    rows = np.repeat(np.arange(n), k + 1)
+    if neighbours is None or neighbours.shape[1] < k + 1:
+        _, neighbours = knn(pts, k + 1, tree=tree)
+    nb = _self_first(neighbours[:, :k + 1], np.arange(n))
+    rows = np.repeat(np.arange(n), k)
     cols = nb.ravel()
-    keep = rows != cols
-    rows, cols = rows[keep], cols[keep]
+    keep = rows < cols      # the MST treats the graph as undirected: one edge per pair
+    rows, cols = np.concatenate([rows[keep], cols[~keep]]), np.concatenate([cols[keep], rows[~keep]])
+    key = np.unique(rows * n + cols)
+    rows, cols = key // n, key % n
     w = 1.0 - np.abs(np.einsum("ij,ij->i", nrm[rows], nrm[cols])) + ORIENT_WEIGHT_EPS
     graph = coo_matrix((w, (rows, cols)), shape=(n, n)).tocsr()
     report(progress, "orienting normals", 0.3)
@@ -186,7 +230,7 @@ def tangent_frame(normals) -> tuple[np.ndarray, np.ndarray]:
 
 
 def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS_FACTOR, *,
-                tree: cKDTree | None = None, query=None) -> np.ndarray:
+                tree: cKDTree | None = None, query=None, distances=None) -> np.ndarray:
     """Splat radius of every point: ``factor`` * distance to its k-th neighbour.
 
     Why this closes the surface: a hole at a surface point x means no splat
@@ -206,6 +250,8 @@ def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS
     Args:
         points: (n, 3) float64 positions (model units).
         query: optional (m,) indices of the points whose radius is wanted.
+        distances: optional (m, >= k + 1) sorted neighbour distances from
+            :func:`knn` (column 0 is the point itself).
     Returns:
         (n,) (or (m,)) float64 radii (model units), all > 0.
     """
@@ -215,12 +261,12 @@ def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS
     if n < 2:
         return np.full(len(idx_q), FALLBACK_SPLAT_RADIUS)
     k = int(min(k, n - 1))
-    tree = cKDTree(pts) if tree is None else tree
-    d, _ = tree.query(pts[idx_q], k=k + 1, workers=-1)
-    r = d[:, k] * factor
+    if distances is None or distances.shape[1] < k + 1:
+        distances, _ = knn(pts, k + 1, tree=tree, query=idx_q)
+    r = distances[:, k] * factor
     ok = r[np.isfinite(r) & (r > 0)]
     if len(ok) == 0:
-        allr = nearest_neighbour_distances(pts, k, tree) * factor
+        allr = nearest_neighbour_distances(pts, k, tree or cKDTree(pts)) * factor
         allr = allr[allr > 0]
         med = float(np.median(allr)) if len(allr) else FALLBACK_SPLAT_RADIUS
     else:
@@ -231,7 +277,7 @@ def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS
 
 
 def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
-               progress=None) -> tuple[np.ndarray, np.ndarray]:
+               distances=None, progress=None) -> tuple[np.ndarray, np.ndarray]:
     """Circular splats: tangent axes ``(u, v)`` of length ``radius``.
 
     Args:
@@ -239,6 +285,7 @@ def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
         normals: (n, 3) float64 normals (normalised here; u x v points along them).
         radius: None (estimate with :func:`splat_radii`), a scalar, or (n,)
             float64 radii in model units.
+        distances: optional (n, >= SPACING_NEIGHBOUR + 1) distances from :func:`knn`.
     Returns:
         u, v: (n, 3) float64, orthogonal, ``|u| = |v| = radius``,
         ``normalize(u x v) = normal``.
@@ -250,7 +297,7 @@ def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
     report(progress, "sizing splats", 0.0)
     nrm = nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
     if radius is None:
-        r = splat_radii(pts, tree=tree)
+        r = splat_radii(pts, tree=tree, distances=distances)
     else:
         r = np.broadcast_to(np.asarray(radius, dtype=np.float64), (len(pts),))
     t1, t2 = tangent_frame(nrm)
@@ -298,13 +345,17 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
     """
     pts = _points(points)
     tree = cKDTree(pts) if len(pts) > 1 else None
+    dist = nb = None
+    if len(pts) > 1:
+        kmax = max(NORMAL_NEIGHBOURS, ORIENT_NEIGHBOURS + 1, SPACING_NEIGHBOUR + 1)
+        dist, nb = knn(pts, kmax, tree=tree, progress=progress)
     if normals is None:
-        nrm = estimate_normals(pts, tree=tree, progress=progress)
-        nrm = orient_normals(pts, nrm, tree=tree, progress=progress)
+        nrm = estimate_normals(pts, tree=tree, neighbours=nb, progress=progress)
+        nrm = orient_normals(pts, nrm, tree=tree, neighbours=nb, progress=progress)
     else:
         nrm = np.asarray(normals, dtype=np.float64)
         if nrm.shape != pts.shape:
             raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
         nrm = _fill_missing_normals(pts, nrm, tree)
-    u, v = splat_axes(pts, nrm, radius=radius, tree=tree, progress=progress)
+    u, v = splat_axes(pts, nrm, radius=radius, tree=tree, distances=dist, progress=progress)
     return SplatCloud(pts, u, v, colors, faces, name=name, source=source)

@@ -1,0 +1,21 @@
+// Per-frame uniform block shared by every splatedit shader (std140, set 0 binding 0).
+// Mirrors splatedit/render/renderer.py:_frame_ubo().
+
+layout(std140, set = 0, binding = 0) uniform Frame {
+    mat4 view;          // world -> eye (right-handed, camera looks down -z)
+    mat4 proj;          // eye -> clip (Vulkan: y down, depth 0..1)
+    vec4 viewport;      // width, height, 1/width, 1/height (pixels)
+    vec4 pix_to_ray;    // D00, D02, D11, D12: eye ray through pixel (x,y) = (D00 x + D02, D11 y + D12, -1)
+    vec4 depth_params;  // near, far, visibility epsilon (in splat radii), low-pass radius (pixels)
+    vec4 tint_support;  // rgb (linear), strength
+    vec4 tint_handle;   // rgb (linear), strength
+    vec4 background;    // rgb (sRGB, written as is), alpha
+    vec4 light;         // ambient, diffuse, specular, shininess
+    vec4 misc;          // gaussian sharpness, 1/gamma, min weight, point-size threshold (pixels)
+    uvec4 options;      // backface culling, apply gamma, -, -
+} F;
+
+// Per-splat flag bits (renderer.py FLAG_*).
+const uint FLAG_SUPPORT = 1u;
+const uint FLAG_HANDLE = 2u;
+const uint FLAG_DEFORMED = 4u;

@@ -1,0 +1,175 @@
+"""Screen-space selection brush on a pick map.
+
+A *pick map* is an ``(h, w)`` int array with the index of the front-most splat
+per pixel (-1 = background), as the renderer's pick pass returns it.  The
+brush is a circle of ``radius`` pixels; a stroke paints every splat whose
+pick-map pixels fall inside the circle, so only visible splats are selected.
+
+Splats smaller than a pixel can be missing from the pick map although they
+are visible; with projected centres and depths (:class:`BrushPicker` given
+``centers_px``/``depths``/``radii``) a splat whose centre falls in the circle
+is also painted when it is not behind the splat the pick map shows at that
+pixel (depth test with a tolerance of two splat radii).
+
+Selection semantics (the paper's Sect. 3): the *support* (blue) is painted
+first, then the *handle* (green) inside it; a handle splat is always a
+support splat, erasing support erases the handle there too.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+SUPPORT = "support"
+HANDLE = "handle"
+
+
+def disc_offsets(radius: float) -> tuple[np.ndarray, np.ndarray]:
+    """Integer pixel offsets (dy, dx) within ``radius`` of a pixel centre."""
+    r = max(float(radius), 0.5)
+    ri = int(math.ceil(r))
+    dy, dx = np.mgrid[-ri:ri + 1, -ri:ri + 1]
+    keep = dx * dx + dy * dy <= r * r
+    return dy[keep], dx[keep]
+
+
+def indices_in_circle(pick: np.ndarray, cx: float, cy: float, radius: float) -> np.ndarray:
+    """Sorted unique splat indices (>= 0) of the pick-map pixels whose centres
+    lie within ``radius`` pixels of (cx, cy)."""
+    h, w = pick.shape
+    r = max(float(radius), 0.5)
+    x0, x1 = max(int(math.floor(cx - r)), 0), min(int(math.ceil(cx + r)) + 1, w)
+    y0, y1 = max(int(math.floor(cy - r)), 0), min(int(math.ceil(cy + r)) + 1, h)
+    if x0 >= x1 or y0 >= y1:
+        return np.zeros(0, np.int64)
+    ys, xs = np.mgrid[y0:y1, x0:x1]
+    inside = (xs + 0.5 - cx) ** 2 + (ys + 0.5 - cy) ** 2 <= r * r
+    vals = pick[y0:y1, x0:x1][inside]
+    return np.unique(vals[vals >= 0]).astype(np.int64)
+
+
+def stroke_points(x0: float, y0: float, x1: float, y1: float, radius: float) -> list[tuple[float, float]]:
+    """Dab positions from (x0, y0) (exclusive) to (x1, y1) (inclusive) spaced
+    at most half a radius apart, so a fast drag leaves no gaps."""
+    d = math.hypot(x1 - x0, y1 - y0)
+    step = max(radius * 0.5, 1.0)
+    n = max(1, int(math.ceil(d / step)))
+    return [(x0 + (x1 - x0) * k / n, y0 + (y1 - y0) * k / n) for k in range(1, n + 1)]
+
+
+@dataclass
+class BrushPicker:
+    """A pick map plus (optionally) projected splat centres for sub-pixel splats.
+
+    Args:
+        pick: (h, w) int, splat index per pixel, -1 = background.
+        centers_px: (n, 2) float pixel coordinates of the splat centres, or None.
+        depths: (n,) camera-space depths (positive in front), or None.
+        radii: (n,) world radii of the splats (depth tolerance), or None.
+    """
+    pick: np.ndarray
+    centers_px: np.ndarray | None = None
+    depths: np.ndarray | None = None
+    radii: np.ndarray | None = None
+
+    def __post_init__(self):
+        self.pick = np.asarray(self.pick)
+        self._order = None
+        if self.centers_px is not None:
+            h, w = self.pick.shape
+            px = self.centers_px
+            ok = (np.isfinite(px).all(1) & (px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0)
+                  & (px[:, 1] < h) & (self.depths > 0))
+            idx = np.flatnonzero(ok)
+            ix = px[idx, 0].astype(np.int64)
+            iy = px[idx, 1].astype(np.int64)
+            front = self.pick[iy, ix]
+            vis = front == idx
+            has = front >= 0
+            tol = 2.0 * (self.radii[idx] if self.radii is not None else 0.0)
+            vis |= has & (self.depths[idx] <= self.depths[np.where(has, front, 0)] + tol)
+            idx = idx[vis]
+            # bucket visible centres by row for fast circle queries
+            rows = px[idx, 1].astype(np.int64)
+            order = np.argsort(rows, kind="stable")
+            self._vis_idx = idx[order]
+            self._vis_rows = rows[order]
+            self._order = True
+
+    @property
+    def shape(self) -> tuple[int, int]:
+        return self.pick.shape
+
+    def query(self, cx: float, cy: float, radius: float) -> np.ndarray:
+        """Sorted unique indices of the visible splats under the brush circle."""
+        out = indices_in_circle(self.pick, cx, cy, radius)
+        if self._order is None:
+            return out
+        r = max(float(radius), 0.5)
+        lo = np.searchsorted(self._vis_rows, int(math.floor(cy - r)), "left")
+        hi = np.searchsorted(self._vis_rows, int(math.floor(cy + r)), "right")
+        cand = self._vis_idx[lo:hi]
+        if len(cand):
+            p = self.centers_px[cand]
+            near = (p[:, 0] - cx) ** 2 + (p[:, 1] - cy) ** 2 <= r * r
+            if near.any():
+                out = np.union1d(out, cand[near])
+        return out
+
+
+class Selection:
+    """Support and handle masks over n splats with the paint/erase rules."""
+
+    def __init__(self, n: int, support: np.ndarray | None = None, handle: np.ndarray | None = None):
+        self.n = int(n)
+        self.support = np.zeros(n, bool) if support is None else np.asarray(support, bool).copy()
+        self.handle = np.zeros(n, bool) if handle is None else np.asarray(handle, bool).copy()
+        self.handle &= self.support
+
+    def copy(self) -> "Selection":
+        return Selection(self.n, self.support, self.handle)
+
+    def paint(self, indices: np.ndarray, target: str, erase: bool = False) -> bool:
+        """Add (or with ``erase`` remove) ``indices`` to the support or handle.
+
+        Painting the handle only takes splats inside the support.  Returns
+        True when a mask changed.
+        """
+        idx = np.asarray(indices, np.int64)
+        if len(idx) == 0:
+            return False
+        before_s = self.support[idx].copy()
+        before_h = self.handle[idx].copy()
+        if target == SUPPORT:
+            if erase:
+                self.support[idx] = False
+                self.handle[idx] = False
+            else:
+                self.support[idx] = True
+        elif target == HANDLE:
+            if erase:
+                self.handle[idx] = False
+            else:
+                self.handle[idx] = self.support[idx]
+        else:
+            raise ValueError(f"unknown brush target {target!r}")
+        return bool((before_s != self.support[idx]).any() or (before_h != self.handle[idx]).any())
+
+    def clear(self, target: str | None = None) -> bool:
+        """Clear the handle (target HANDLE) or everything (None/SUPPORT)."""
+        changed = bool(self.handle.any()) or (target != HANDLE and bool(self.support.any()))
+        self.handle[:] = False
+        if target != HANDLE:
+            self.support[:] = False
+        return changed
+
+    @property
+    def counts(self) -> tuple[int, int]:
+        return int(self.support.sum()), int(self.handle.sum())
+
+    def key(self) -> tuple:
+        """Hashable content key (to detect changes and stale fits)."""
+        return (self.n, np.packbits(self.support).tobytes(), np.packbits(self.handle).tobytes())

@@ -1,0 +1,181 @@
+"""Orbit camera for the editor: orbit about a pivot, pan, dolly to the cursor, frame.
+
+Pure numpy.  The camera is a *turntable* like Blender's default: yaw about
+the world up axis, pitch about the camera's right axis (clamped short of the
+poles so "up" never flips).  State: ``target`` (the pivot), ``distance``,
+``yaw``/``pitch`` in radians and the vertical field of view.
+
+Screen conventions: pixel (0, 0) is the top-left corner, x to the right, y
+down; NDC follows Vulkan (y down, depth 0..1).  ``view`` maps world to camera
+space looking down -z (OpenGL-style right-handed camera space);
+``projection`` includes the Vulkan y flip.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+
+#: pitch is kept within +-this (radians) of the horizon
+PITCH_LIMIT = math.radians(89.0)
+#: radians of orbit per pixel of mouse motion
+ORBIT_RAD_PER_PX = 0.008
+#: distance factor per wheel step (zoom in for positive steps)
+DOLLY_STEP = 0.85
+#: closest and farthest camera distance relative to the model radius
+MIN_DIST_REL = 1e-3
+MAX_DIST_REL = 1e3
+
+
+def _normalize(v: np.ndarray) -> np.ndarray:
+    n = float(np.linalg.norm(v))
+    return v / n if n > 0 else v
+
+
+@dataclass
+class OrbitCamera:
+    target: np.ndarray = field(default_factory=lambda: np.zeros(3))
+    distance: float = 3.0
+    yaw: float = 0.0
+    pitch: float = 0.0
+    fov_deg: float = 40.0
+    up_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
+    scene_radius: float = 1.0
+
+    # -------------------------------------------------------------- frames
+    def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+        """(right, up, back) unit vectors of the camera in world space; the
+        camera looks along ``-back``."""
+        up = _normalize(np.asarray(self.up_axis, float))
+        # a reference "forward" perpendicular to up for yaw = 0
+        ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
+        ref = _normalize(ref - up * (ref @ up))
+        side = np.cross(up, ref)
+        cy, sy = math.cos(self.yaw), math.sin(self.yaw)
+        cp, sp = math.cos(self.pitch), math.sin(self.pitch)
+        horiz = cy * ref + sy * side
+        back = cp * horiz + sp * up
+        right = _normalize(np.cross(up, back))
+        cam_up = np.cross(back, right)
+        return right, cam_up, back
+
+    @property
+    def eye(self) -> np.ndarray:
+        return np.asarray(self.target, float) + self.distance * self.basis()[2]
+
+    def view(self) -> np.ndarray:
+        """(4, 4) world -> camera matrix."""
+        r, u, b = self.basis()
+        e = self.eye
+        m = np.eye(4)
+        m[0, :3], m[1, :3], m[2, :3] = r, u, b
+        m[:3, 3] = -m[:3, :3] @ e
+        return m
+
+    def near_far(self) -> tuple[float, float]:
+        near = max(self.distance - 2.0 * self.scene_radius, self.distance * 1e-3, 1e-6)
+        far = self.distance + 2.0 * self.scene_radius
+        return near, max(far, near * 10)
+
+    def projection(self, aspect: float) -> np.ndarray:
+        """(4, 4) Vulkan perspective (y down in NDC, depth 0..1)."""
+        n, f = self.near_far()
+        t = 1.0 / math.tan(math.radians(self.fov_deg) / 2)
+        p = np.zeros((4, 4))
+        p[0, 0] = t / aspect
+        p[1, 1] = -t
+        p[2, 2] = f / (n - f)
+        p[2, 3] = n * f / (n - f)
+        p[3, 2] = -1.0
+        return p
+
+    def view_projection(self, w: int, h: int) -> np.ndarray:
+        return self.projection(w / max(h, 1)) @ self.view()
+
+    # ------------------------------------------------------------ projections
+    def project(self, points: np.ndarray, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
+        """Pixel coordinates (n, 2) and camera-space depths (n,) (positive in
+        front of the camera) of world points (n, 3)."""
+        pts = np.atleast_2d(np.asarray(points, float))
+        v = self.view()
+        cam = pts @ v[:3, :3].T + v[:3, 3]
+        depth = -cam[:, 2]
+        t = 1.0 / math.tan(math.radians(self.fov_deg) / 2)
+        aspect = w / max(h, 1)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ndc_x = (t / aspect) * cam[:, 0] / depth
+            ndc_y = -t * cam[:, 1] / depth
+        px = np.stack([(ndc_x + 1) * 0.5 * w, (ndc_y + 1) * 0.5 * h], axis=1)
+        return px, depth
+
+    def pixel_ray(self, x: float, y: float, w: int, h: int) -> tuple[np.ndarray, np.ndarray]:
+        """(origin, unit direction) of the ray through pixel (x, y)."""
+        r, u, b = self.basis()
+        t = math.tan(math.radians(self.fov_deg) / 2)
+        aspect = w / max(h, 1)
+        nx = (2.0 * x / w - 1.0) * t * aspect
+        ny = (1.0 - 2.0 * y / h) * t
+        return self.eye, _normalize(nx * r + ny * u - b)
+
+    def world_per_pixel(self, depth: float, h: int) -> float:
+        """World length of one pixel at camera depth ``depth``."""
+        return 2.0 * depth * math.tan(math.radians(self.fov_deg) / 2) / max(h, 1)
+
+    def point_at_depth(self, x: float, y: float, w: int, h: int, depth: float) -> np.ndarray:
+        """The world point under pixel (x, y) at camera depth ``depth``."""
+        o, d = self.pixel_ray(x, y, w, h)
+        back = self.basis()[2]
+        cos = -float(d @ back)
+        return o + d * (depth / max(cos, 1e-9))
+
+    # --------------------------------------------------------------- motion
+    def orbit(self, dx_px: float, dy_px: float) -> None:
+        """Turntable orbit about ``target`` by a mouse motion in pixels."""
+        self.yaw -= dx_px * ORBIT_RAD_PER_PX
+        self.pitch = float(np.clip(self.pitch + dy_px * ORBIT_RAD_PER_PX, -PITCH_LIMIT, PITCH_LIMIT))
+
+    def pan(self, dx_px: float, dy_px: float, h: int) -> None:
+        """Move the pivot in the view plane so the pivot plane follows the mouse."""
+        r, u, _ = self.basis()
+        s = self.world_per_pixel(self.distance, h)
+        self.target = np.asarray(self.target, float) - r * dx_px * s + u * dy_px * s
+
+    def dolly(self, steps: float, x: float | None = None, y: float | None = None,
+              w: int = 1, h: int = 1, depth: float | None = None) -> None:
+        """Zoom by ``DOLLY_STEP ** steps`` (positive = closer).  With a cursor
+        position, the world point under the cursor (at ``depth``, default the
+        pivot's depth) stays under the cursor (dolly to cursor)."""
+        f = DOLLY_STEP ** steps
+        new_dist = float(np.clip(self.distance * f, MIN_DIST_REL * self.scene_radius,
+                                 MAX_DIST_REL * self.scene_radius))
+        f = new_dist / self.distance
+        if x is None or y is None:
+            self.distance = new_dist
+            return
+        p = self.point_at_depth(x, y, w, h, self.distance if depth is None else depth)
+        # scaling the eye and target about p keeps p's pixel (the view direction is unchanged)
+        self.target = p + (np.asarray(self.target, float) - p) * f
+        self.distance = new_dist
+
+    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = 1.1) -> None:
+        """Look at a sphere (``center``, ``radius``) so it fills the view."""
+        self.target = np.asarray(center, float).copy()
+        half_v = math.radians(self.fov_deg) / 2
+        half_h = math.atan(math.tan(half_v) * aspect)
+        half = min(half_v, half_h)
+        self.distance = max(radius, 1e-9) * margin / math.sin(half)
+
+    def frame_points(self, points: np.ndarray, aspect: float = 1.0) -> None:
+        """Frame the bounding sphere of ``points`` (n, 3)."""
+        pts = np.atleast_2d(np.asarray(points, float))
+        lo, hi = pts.min(0), pts.max(0)
+        c = (lo + hi) / 2
+        r = float(np.sqrt(((pts - c) ** 2).sum(1)).max()) if len(pts) else 1.0
+        self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect)
+
+    def state(self) -> tuple:
+        """A hashable snapshot (used to detect camera motion)."""
+        return (tuple(np.round(np.asarray(self.target, float), 12)), round(self.distance, 12),
+                round(self.yaw, 12), round(self.pitch, 12), self.fov_deg)

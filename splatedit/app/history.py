@@ -1,0 +1,115 @@
+"""Undo/redo of editor states.
+
+The editor's document state is small and immutable-by-convention: the base
+cloud (a :class:`SplatCloud` never modified in place), the support and handle
+masks and the list of committed edits.  :class:`History` keeps snapshots of
+those: ``push`` after every user action (a brush stroke, a clear, a commit),
+``undo``/``redo`` move along the list.  Clouds are shared between snapshots
+until an edit replaces them, so a selection step costs two bit-packed masks;
+a committed edit costs one cloud.  ``max_bytes`` bounds the memory held by
+old snapshots (the oldest are dropped first; the current one is always kept).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass, field
+
+import numpy as np
+
+
+@dataclass(frozen=True)
+class Snapshot:
+    cloud: object                 # SplatCloud
+    support: bytes                # np.packbits of the (n,) bool mask
+    handle: bytes
+    edits: tuple = ()             # committed script Edits, in order
+    label: str = ""
+    n: int = 0
+
+    @staticmethod
+    def make(cloud, support: np.ndarray, handle: np.ndarray, edits=(), label: str = "") -> "Snapshot":
+        return Snapshot(cloud, np.packbits(support).tobytes(), np.packbits(handle).tobytes(),
+                        tuple(edits), label, len(support))
+
+    def masks(self) -> tuple[np.ndarray, np.ndarray]:
+        s = np.unpackbits(np.frombuffer(self.support, np.uint8), count=self.n).astype(bool)
+        h = np.unpackbits(np.frombuffer(self.handle, np.uint8), count=self.n).astype(bool)
+        return s, h
+
+
+def _cloud_bytes(cloud) -> int:
+    return int(sum(getattr(cloud, a).nbytes for a in ("positions", "u", "v")))
+
+
+@dataclass
+class History:
+    max_bytes: int = 2 << 30
+    _states: list = field(default_factory=list)
+    _pos: int = -1
+    saved_pos: int = 0
+
+    def reset(self, snap: Snapshot) -> None:
+        self._states = [snap]
+        self._pos = 0
+        self.saved_pos = 0
+
+    @property
+    def current(self) -> Snapshot:
+        return self._states[self._pos]
+
+    def push(self, snap: Snapshot) -> None:
+        """Record a new state after the current one (drops the redo tail)."""
+        del self._states[self._pos + 1:]
+        if self.saved_pos > self._pos:
+            self.saved_pos = -1
+        self._states.append(snap)
+        self._pos += 1
+        self._trim()
+
+    def _trim(self) -> None:
+        while len(self._states) > 1 and self._memory() > self.max_bytes and self._pos > 0:
+            self._states.pop(0)
+            self._pos -= 1
+            self.saved_pos -= 1
+
+    def _memory(self) -> int:
+        seen, total = set(), 0
+        for s in self._states:
+            if id(s.cloud) not in seen:
+                seen.add(id(s.cloud))
+                total += _cloud_bytes(s.cloud)
+            total += len(s.support) + len(s.handle)
+        return total
+
+    @property
+    def can_undo(self) -> bool:
+        return self._pos > 0
+
+    @property
+    def can_redo(self) -> bool:
+        return self._pos + 1 < len(self._states)
+
+    def undo(self) -> Snapshot | None:
+        if not self.can_undo:
+            return None
+        self._pos -= 1
+        return self.current
+
+    def redo(self) -> Snapshot | None:
+        if not self.can_redo:
+            return None
+        self._pos += 1
+        return self.current
+
+    def mark_saved(self) -> None:
+        self.saved_pos = self._pos
+
+    @property
+    def geometry_dirty(self) -> bool:
+        """True when the current cloud differs from the last saved (or loaded) one."""
+        if 0 <= self.saved_pos < len(self._states):
+            return self._states[self.saved_pos].cloud is not self.current.cloud
+        return True
+
+    def __len__(self) -> int:
+        return len(self._states)

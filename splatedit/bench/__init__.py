@@ -1,0 +1,1 @@
+"""Benchmarks (JSON-line reports in the spirit of the paper's Table 1)."""

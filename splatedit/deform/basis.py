@@ -1,0 +1,350 @@
+"""Precomputed deformation bases B, Bx, By, Bz (paper Sect. 6 and 7).
+
+One :class:`TriharmonicRBF` is fitted with all 4h columns of the affine
+coordinates ``M`` (h handles) as right-hand sides at once (fixed band: 0).
+Evaluating it and its gradient at every support splat gives the (N, 4h)
+bases with which, for control-frame displacements ``dC`` (4h, 3):
+
+    p'      = p + B dC
+    J[i, j] = delta_ij + sum_k dC[k, i] * Bj[k],     Bj in (Bx, By, Bz)
+    u'      = J u,   v' = J v     (so the normal follows J^-T n)
+
+Free splats (support minus handles) use the RBF; handle splats use their exact
+affine coordinates (they move rigidly with their handle) and the constant
+gradient of those coordinates; splats outside the support are not in the basis
+(``indices`` lists the support splats, sorted) and are copied bitwise.
+
+CPU hot path (``apply``).  Per frame a splat needs only linear combinations of
+``dC``: ``p' = [B | p] @ [dC; I]``, ``u' = [Wu | u] @ [dC; I]`` with
+``Wu = u_x Bx + u_y By + u_z Bz`` (the tangent-axis basis) and likewise for
+``v``.  These three (N, 4h + 3) float64 arrays are built once per base cloud
+(lazily, on the first ``apply``), stored in the order of a run plan of the
+support indices (long runs of consecutive splat indices are written with a
+slice, the rest gathered into chunks and scattered), and each frame is then
+three chunked GEMMs written straight into the output arrays.  float64 is kept:
+float32 would break the bitwise identity/fixed guarantees for positions and
+saved nothing measurable (the run is memory bound either way).
+"""
+
+from __future__ import annotations
+
+import copy
+import time
+
+import numpy as np
+
+from splatedit.deform.constraints import (
+    Constraints,
+    affine_coordinate_gradients,
+    affine_coordinates,
+    build_constraints,
+)
+from splatedit.deform.rbf import TriharmonicRBF
+from splatedit.deform.transform import apply_affine, as_affine
+from splatedit.errors import ParameterError
+from splatedit.progress import report
+from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
+
+#: progress stage name of the basis evaluation
+PROGRESS_STAGE = "precomputing deformation basis"
+#: support splats per chunk when evaluating the RBF for the basis
+_BASIS_CHUNK = 65536
+#: rows per GEMM in the CPU apply (fits the L2 cache with its outputs)
+_APPLY_CHUNK = 16384
+#: runs of consecutive splat indices at least this long are written by slice
+_RUN_MIN = 2048
+
+
+def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
+    """Split sorted splat indices into segments ``(order_lo, order_hi, dest)``.
+
+    ``order`` (returned) permutes positions of ``index`` so that every segment
+    is a contiguous block ``order[order_lo:order_hi]``; ``dest`` is a slice of
+    splat rows (long runs of consecutive indices) or an index array (the
+    remaining splats, in chunks).
+    """
+    n = len(index)
+    if n == 0:
+        return np.zeros(0, np.intp), []
+    breaks = np.flatnonzero(np.diff(index) != 1) + 1
+    starts = np.concatenate([[0], breaks])
+    ends = np.concatenate([breaks, [n]])
+    long_mask = (ends - starts) >= run_min
+    segments, order_parts, pos = [], [], 0
+    for s, e in zip(starts[long_mask], ends[long_mask]):
+        for cs in range(s, e, chunk):
+            ce = min(e, cs + chunk)
+            order_parts.append(np.arange(cs, ce))
+            segments.append((pos, pos + ce - cs, slice(int(index[cs]), int(index[cs]) + ce - cs)))
+            pos += ce - cs
+    short = np.ones(n, dtype=bool)
+    for s, e in zip(starts[long_mask], ends[long_mask]):
+        short[s:e] = False
+    rest = np.flatnonzero(short)
+    for cs in range(0, len(rest), chunk):
+        part = rest[cs:cs + chunk]
+        order_parts.append(part)
+        segments.append((pos, pos + len(part), index[part]))
+        pos += len(part)
+    order = np.concatenate(order_parts) if order_parts else np.zeros(0, np.intp)
+    return order, segments
+
+
+class DeformationBasis:
+    """Precomputed linear deformation bases of one edit (support + handles).
+
+    Attributes:
+        constraints: the :class:`~splatedit.deform.constraints.Constraints`.
+        rbf: the fitted :class:`~splatedit.deform.rbf.TriharmonicRBF`
+            (k = 4h outputs: the affine-coordinate fields).
+        indices: (N,) sorted cloud indices of the support splats (basis rows).
+        B, Bx, By, Bz: (N, 4h) float64 bases (views of one packed array).
+        control_frames: (h, 4, 3) control frames C.
+        stats: dict of fit statistics: ``n_constraints`` (m), ``n_centers``,
+            ``residual``, ``method``, ``polynomial``, ``fit_seconds``,
+            ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
+            ``n_handle_band``, ``spacing``, ``message``.
+    """
+
+    def __init__(self, constraints: Constraints, rbf, pack: np.ndarray, stats: dict):
+        self.constraints = constraints
+        self.rbf = rbf
+        self.indices = constraints.support_index
+        self._pack = pack  # (N, 4, K): B, Bx, By, Bz
+        self.stats = stats
+        self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
+
+    # ------------------------------------------------------------ building
+    @classmethod
+    def fit(cls, cloud, support, handles, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
+            max_centers: int | None = None, rings: float = BAND_RINGS,
+            spacing: float | None = None, progress=None) -> "DeformationBasis":
+        """Build constraints, fit one RBF to all handle columns, evaluate bases.
+
+        Args:
+            cloud: the base :class:`~splatedit.model.cloud.SplatCloud`.
+            support, handles: masks (see :func:`build_constraints`).
+            method, tol, max_centers: passed to :meth:`TriharmonicRBF.fit`
+                ("auto" = exact LU up to AUTO_EXACT_MAX_CONSTRAINTS, else IQR).
+            rings, spacing: band thickness (see :func:`build_constraints`).
+            progress: optional ``progress(stage, fraction)``.
+        Raises:
+            ParameterError / SolverError from the constraints and the fit.
+        """
+        t0 = time.perf_counter()
+        con = build_constraints(cloud, support, handles, rings=rings, spacing=spacing)
+        rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
+                                 max_centers=max_centers, progress=progress)
+        t1 = time.perf_counter()
+
+        pos = cloud.positions
+        idx = con.support_index
+        n_sup, k = len(idx), con.n_columns
+        pack = np.zeros((n_sup, 4, k))
+        # handle splats: exact affine coordinates and their constant gradients
+        for g, grp in enumerate(con.groups):
+            cols = con.columns(g)
+            rows = np.searchsorted(idx, grp.member_index)
+            pack[rows, 0, cols] = affine_coordinates(pos[grp.member_index], grp.controls)
+            grad = affine_coordinate_gradients(grp.controls)  # (4, 3)
+            for d in range(3):
+                pack[rows, 1 + d, cols] = grad[:, d]
+        # free splats: the RBF and its gradient
+        free_rows = np.searchsorted(idx, con.free_index)
+        n_free = len(free_rows)
+        report(progress, PROGRESS_STAGE, 0.0)
+        for s in range(0, n_free, _BASIS_CHUNK):
+            r = free_rows[s:s + _BASIS_CHUNK]
+            val, grad = rbf.value_and_gradient(pos[idx[r]])
+            pack[r, 0, :] = val
+            pack[r, 1:, :] = grad.transpose(0, 2, 1)
+            report(progress, PROGRESS_STAGE, (s + len(r)) / n_free)
+        t2 = time.perf_counter()
+        stats = dict(
+            n_constraints=con.n_constraints, n_centers=int(rbf.n_centers),
+            residual=float(rbf.residual), method=rbf.method, polynomial=bool(rbf.polynomial),
+            fit_seconds=t1 - t0, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
+            n_fixed_band=int(len(con.fixed_index)),
+            n_handle_band=[int(len(b)) for b in con.handle_band_index],
+            spacing=float(con.spacing), message=getattr(rbf, "message", ""),
+        )
+        return cls(con, rbf, pack, stats)
+
+    # ------------------------------------------------------------ accessors
+    @property
+    def B(self) -> np.ndarray:
+        return self._pack[:, 0, :]
+
+    @property
+    def Bx(self) -> np.ndarray:
+        return self._pack[:, 1, :]
+
+    @property
+    def By(self) -> np.ndarray:
+        return self._pack[:, 2, :]
+
+    @property
+    def Bz(self) -> np.ndarray:
+        return self._pack[:, 3, :]
+
+    @property
+    def n_handles(self) -> int:
+        return len(self.constraints.groups)
+
+    @property
+    def n_columns(self) -> int:
+        return self._pack.shape[2]
+
+    @property
+    def control_frames(self) -> np.ndarray:
+        return self.constraints.control_frames
+
+    def columns_for_handle(self, i: int) -> slice:
+        """Columns of B (and rows of dC) belonging to handle ``i``."""
+        return self.constraints.columns(i)
+
+    def rows_for_gpu(self, handle: int | None = None):
+        """``(indices, B, Bx, By, Bz)`` as contiguous float64 arrays.
+
+        ``handle=None``: every support splat, all 4h columns.  ``handle=i``:
+        only handle i's 4 columns, and only the splats they move (the splats
+        of the *other* handles have all-zero rows there and are dropped).
+        The renderer converts to float32.
+        """
+        if handle is None:
+            sub = self._pack
+            keep = slice(None)
+            ind = self.indices
+        else:
+            sub = self._pack[:, :, self.columns_for_handle(handle)]
+            keep = np.flatnonzero(np.any(sub != 0.0, axis=(1, 2)))
+            sub = sub[keep]
+            ind = self.indices[keep]
+        return (np.array(ind, dtype=np.int64),) + tuple(
+            np.ascontiguousarray(sub[:, j, :]) for j in range(4))
+
+    # ----------------------------------------------------------- per frame
+    def displacement(self, transforms) -> np.ndarray:
+        """Control-frame displacements ``dC`` (4h, 3) for one affine map per
+        handle: ``C'_i = m_i(C_i)``, ``dC = C' - C``.
+
+        ``transforms``: a list of h (4, 4) matrices (None = identity); a single
+        matrix is accepted when there is one handle.
+        """
+        if isinstance(transforms, np.ndarray) and transforms.ndim == 2:
+            transforms = [transforms]
+        transforms = list(transforms)
+        if len(transforms) != self.n_handles:
+            raise ParameterError("transforms", f"need one matrix per handle "
+                                 f"({self.n_handles}), got {len(transforms)}")
+        dc = np.zeros((self.n_columns, 3))
+        for i, (t, grp) in enumerate(zip(transforms, self.constraints.groups)):
+            if t is None:
+                continue
+            m = as_affine(t, name=f"transforms[{i}]")
+            dc[self.columns_for_handle(i)] = apply_affine(m, grp.controls) - grp.controls
+        return dc
+
+    def _check_dc(self, dC) -> np.ndarray:
+        d = np.asarray(dC, dtype=np.float64)
+        if d.shape != (self.n_columns, 3):
+            raise ParameterError("dC", f"expected shape ({self.n_columns}, 3), got {d.shape}")
+        if not np.isfinite(d).all():
+            raise ParameterError("dC", "must be finite")
+        return d
+
+    def displacements(self, dC) -> np.ndarray:
+        """(N, 3) displacements ``B dC`` of the support splats."""
+        return self.B @ self._check_dc(dC)
+
+    def jacobians(self, dC) -> np.ndarray:
+        """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats."""
+        d = self._check_dc(dC)
+        jt = np.einsum("njk,ki->nji", self._pack[:, 1:, :], d)  # jt[n, j, i] = (J - I)[i, j]
+        out = jt.transpose(0, 2, 1).copy()
+        out += np.eye(3)
+        return out
+
+    def _check_cloud(self, cloud):
+        n = self.constraints.n_points
+        if len(cloud.positions) != n:
+            raise ParameterError("cloud", f"has {len(cloud.positions)} splats, the basis was "
+                                 f"built for {n}")
+
+    def _cpu_arrays(self, cloud):
+        """Hot-path arrays ``[B|p], [Wu|u], [Wv|v]`` in run-plan order, cached
+        per base cloud (the cache holds the arrays it was built from)."""
+        c = self._cpu
+        if (c is not None and c["positions"] is cloud.positions and c["u"] is cloud.u
+                and c["v"] is cloud.v):
+            return c
+        idx = self.indices
+        order, segments = _run_plan(idx)
+        rows = idx[order]
+        pk = self._pack[order]
+        k = self.n_columns
+        arrays = []
+        for name in ("positions", "u", "v"):
+            src = getattr(cloud, name)[rows]
+            a = np.empty((len(rows), k + 3))
+            if name == "positions":
+                a[:, :k] = pk[:, 0, :]
+            else:
+                np.einsum("nj,njk->nk", src, pk[:, 1:, :], out=a[:, :k])
+            a[:, k:] = src
+            arrays.append(a)
+        # complement (splats outside the support): copied by the same kind of plan
+        comp = np.setdiff1d(np.arange(len(cloud.positions)), idx, assume_unique=True)
+        _, csegs = _run_plan(comp)
+        self._cpu = dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
+                         segments=segments, comp_segments=[d for _, _, d in csegs])
+        return self._cpu
+
+    def release_cpu_cache(self) -> None:
+        """Drop the hot-path arrays (about 24 (4h + 3) bytes per support splat)."""
+        self._cpu = None
+
+    def apply_arrays(self, cloud, dC):
+        """Deformed ``(positions, u, v)`` (n, 3) float64 of ``cloud`` (the
+        base cloud the basis was built on).  Splats outside the support are
+        copied bitwise; ``dC == 0`` returns bitwise copies."""
+        self._check_cloud(cloud)
+        d = self._check_dc(dC)
+        srcs = (cloud.positions, cloud.u, cloud.v)
+        if not d.any():
+            return tuple(s.copy() for s in srcs)
+        c = self._cpu_arrays(cloud)
+        outs = tuple(np.empty_like(s) for s in srcs)
+        for dest in c["comp_segments"]:
+            for s, o in zip(srcs, outs):
+                o[dest] = s[dest]
+        mx = np.vstack([d, np.eye(3)])
+        for lo, hi, dest in c["segments"]:
+            for a, o in zip(c["arrays"], outs):
+                if isinstance(dest, slice):
+                    np.matmul(a[lo:hi], mx, out=o[dest])
+                else:
+                    o[dest] = a[lo:hi] @ mx
+        return outs
+
+    def apply(self, cloud, dC, *, validate: bool = False):
+        """The deformed cloud (a new :class:`SplatCloud`; colours, faces and
+        name shared with ``cloud``).  ``validate=True`` re-checks the splat
+        invariants (an extreme deformation can flatten splats)."""
+        p, u, v = self.apply_arrays(cloud, dC)
+        out = copy.copy(cloud)  # no __init__: skips the O(n) validation on the hot path
+        out.positions, out.u, out.v = p, u, v
+        if validate:
+            out.validate()
+        return out
+
+    def commit(self, cloud, dC, *, validate: bool = True):
+        """Apply ``dC`` and return the deformed cloud as the new base for the
+        next edit (build a new basis on it to chain edits).  Validated by
+        default: a committed cloud must satisfy the model invariants."""
+        return self.apply(cloud, dC, validate=validate)
+
+    def __repr__(self) -> str:
+        s = self.stats
+        return (f"DeformationBasis(N={s['n_support']}, handles={self.n_handles}, "
+                f"m={s['n_constraints']}, centers={s['n_centers']}, method={s['method']!r})")

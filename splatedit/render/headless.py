@@ -1,0 +1,76 @@
+"""One-shot offscreen rendering to a PNG (what the CLI calls)."""
+
+from __future__ import annotations
+
+import os
+import tempfile
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from splatedit.errors import ParameterError
+from splatedit.model.cloud import SplatCloud
+from splatedit.render.camera import Camera
+from splatedit.render.renderer import Renderer
+
+
+def _atomic_write(path: Path, write) -> None:
+    path.parent.mkdir(parents=True, exist_ok=True)
+    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
+    os.close(fd)
+    try:
+        write(tmp)
+        os.replace(tmp, path)
+    except BaseException:
+        if os.path.exists(tmp):
+            os.unlink(tmp)
+        raise
+
+
+def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
+                  basis=None, dC=None, selection=None, buffers_path=None,
+                  device_name: str | None = None) -> Path:
+    """Render ``cloud`` offscreen and save an RGBA PNG (atomically: temp file + rename).
+
+    Args:
+        size: (width, height) in pixels.
+        camera: default ``Camera.frame`` of the cloud's bounds.
+        basis: optional ``(indices, B, Bx, By, Bz)`` deformation basis rows
+            (see :meth:`Renderer.set_basis`); applied on the GPU with ``dC``
+            ((K, 3) control-frame displacement, default zeros).  Chained edits
+            are committed on the CPU by the caller: pass the final cloud and
+            the last edit's basis.
+        selection: optional ``(support_mask, handle_mask)`` to tint.
+        buffers_path: also save the float buffers (depth, normal, weight,
+            colour; see :meth:`Renderer.render_buffers`) to this ``.npz``.
+    Returns the PNG path.
+    """
+    try:
+        w, h = (int(s) for s in size)
+    except (TypeError, ValueError):
+        raise ParameterError("size", f"must be (width, height), got {size!r}") from None
+    if dC is not None and basis is None:
+        raise ParameterError("dC", "given without a basis")
+    out_png = Path(out_png)
+    if camera is None:
+        camera = Camera.frame(*cloud.bounds(), aspect=w / h)
+    with Renderer(device_name=device_name) as r:
+        r.set_cloud(cloud)
+        if selection is not None:
+            r.set_selection(*selection)
+        if basis is not None:
+            idx, B, Bx, By, Bz = basis
+            r.set_basis(idx, B, Bx, By, Bz)
+            r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
+        img = r.render(camera, w, h)
+        bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None
+    _atomic_write(out_png, lambda tmp: Image.fromarray(img, "RGBA").save(tmp, format="PNG"))
+    if bufs is not None:
+        bp = Path(buffers_path)
+
+        def save(tmp):
+            with open(tmp, "wb") as f:
+                np.savez_compressed(f, **bufs)
+        _atomic_write(bp, save)
+    return out_png

@@ -1,0 +1,617 @@
+"""EWA surface-splat renderer with GPU deformation (Botsch & Kobbelt 2005, Sect. 7).
+
+Three passes per frame (Botsch, Hornung, Zwicker, Kobbelt 2005):
+
+1. visibility: depth only, splats pushed back by epsilon along the view ray;
+2. attributes: depth test against pass 1 without depth writes, additive
+   blending of weight*colour, weight*normal, weight*depth and weight into
+   float targets;
+3. shading: full-screen normalisation, deferred Phong with a headlight,
+   background, gamma; it writes a :class:`RenderTarget` (an offscreen RGBA8
+   image here; a swapchain image for the editor).
+
+One vertex shader (``shaders_glsl/splat_vs.glsl``) serves both splat passes
+and the picking pass; it applies the deformation p' = p + B dC, u' = J u,
+v' = J v of splats that carry a basis row.
+
+Only :mod:`splatedit.render.vk` calls Vulkan.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from splatedit.errors import ParameterError
+from splatedit.model.cloud import SplatCloud
+from splatedit.render import vk as V
+from splatedit.render.camera import Camera
+from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
+                                  RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
+                                  RENDER_MIN_WEIGHT, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
+                                  RENDER_VISIBILITY_EPS_RADII)
+
+#: per-splat flag bits (shaders_glsl/frame.glsl)
+FLAG_SUPPORT = 1
+FLAG_HANDLE = 2
+FLAG_DEFORMED = 4
+
+_UBO_BYTES = 272
+_GEOM_STRIDE = 36           # centre, u, v as float32
+_MAX_SIZE = 16384
+
+_SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"),)
+_RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(1, "sampled", "frag"),
+                V.Binding(2, "sampled", "frag"))
+
+_RP_DEPTH = V.RenderPassDesc(depth=V.Attachment("d32f", "clear", final="depth"))
+_RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
+                            depth=V.Attachment("d32f", "clear", final="transfer_src"))
+
+
+def _rp_attr(fmt: str, final: str) -> V.RenderPassDesc:
+    return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final=final),
+                                    V.Attachment(fmt, "clear", final=final)),
+                            depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
+
+
+class RenderTarget:
+    """Where the shading pass writes: anything with ``view``, ``layout``,
+    ``width``, ``height``, a format name and the layout to leave it in
+    (``final``: ``"transfer_src"`` for readback, ``"present"`` for a swapchain)."""
+
+    def __init__(self, attachment, fmt: str, final: str, apply_gamma: bool = True):
+        self.attachment = attachment
+        self.format = fmt
+        self.final = final
+        self.apply_gamma = apply_gamma
+
+    @property
+    def width(self):
+        return self.attachment.width
+
+    @property
+    def height(self):
+        return self.attachment.height
+
+
+class _Targets:
+    """Per-size images and framebuffers."""
+
+    def __init__(self, r: "Renderer", width: int, height: int):
+        dev = r.dev
+        self.width, self.height = width, height
+        self.objects = []
+
+        def img(fmt, usage):
+            im = V.Image(dev, width, height, fmt, usage)
+            self.objects.append(im)
+            return im
+
+        self.depth = img("d32f", ("depth", "transfer_src"))
+        self.accum_color = img(r.accum_format, ("color", "sampled", "transfer_src"))
+        self.accum_normal = img(r.accum_format, ("color", "sampled", "transfer_src"))
+        self.out = img("rgba8", ("color", "transfer_src"))
+        self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
+        rp_depth = r.cache.render_pass(_RP_DEPTH)
+        rp_attr = r.cache.render_pass(_rp_attr(r.accum_format, "shader_read"))
+        self.fb_depth = self._fb(dev, rp_depth, [self.depth])
+        self.fb_attr = self._fb(dev, rp_attr, [self.accum_color, self.accum_normal, self.depth])
+        self.resolve_set = V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET))
+        self.objects.append(self.resolve_set)
+        self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
+        self.target_fbs = {}      # id(target) -> (target, framebuffer)
+        self.pick_index = self.pick_depth = self.fb_pick = None
+        self._r = r
+
+    def _fb(self, dev, rp, atts):
+        fb = V.Framebuffer(dev, rp, atts, self.width, self.height)
+        self.objects.append(fb)
+        return fb
+
+    def target_fb(self, target: RenderTarget):
+        hit = self.target_fbs.get(id(target))
+        if hit is None or hit[0] is not target:
+            rp = self._r.cache.render_pass(_rp_resolve(target))
+            fb = self._fb(self._r.dev, rp, [target.attachment])
+            hit = self.target_fbs[id(target)] = (target, fb)
+        return hit[1]
+
+    def ensure_pick(self):
+        if self.fb_pick is None:
+            dev = self._r.dev
+            self.pick_index = V.Image(dev, self.width, self.height, "r32ui", ("color", "transfer_src"))
+            self.objects.append(self.pick_index)
+            self.pick_depth = V.Image(dev, self.width, self.height, "d32f", ("depth", "transfer_src"))
+            self.objects.append(self.pick_depth)
+            self.fb_pick = self._fb(dev, self._r.cache.render_pass(_RP_PICK), [self.pick_index, self.pick_depth])
+
+    def destroy(self):
+        for o in reversed(self.objects):
+            o.destroy()
+        self.objects.clear()
+        self.target_fbs.clear()
+
+
+def _rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
+    return V.RenderPassDesc(colors=(V.Attachment(target.format, "dont_care", final=target.final),))
+
+
+def _srgb_to_linear(c):
+    return np.asarray(c, dtype=np.float64) ** 2.2
+
+
+class Renderer:
+    """Offscreen EWA splat renderer owning its Vulkan device.
+
+    Use as a context manager or call :meth:`close`.  Typical use::
+
+        with Renderer() as r:
+            r.set_cloud(cloud)
+            img = r.render(Camera.frame(*cloud.bounds(), 1.0), 256, 256)
+
+    Args:
+        device_name: substring of the Vulkan device name (default: env var
+            ``SPLATEDIT_DEVICE`` or the first GPU / lavapipe).
+        validation: Vulkan validation layer on/off (default: env var
+            ``SPLATEDIT_VALIDATION``).
+        accum_format: ``"rgba16f"`` or ``"rgba32f"`` attribute accumulators.
+        backface_culling: skip splats whose normal faces away from the eye.
+        background: sRGB background colour (3 floats in 0..1).
+        device: share an existing :class:`splatedit.render.vk.Device` (then
+            the renderer does not close it).
+    """
+
+    def __init__(self, *, device_name: str | None = None, validation: bool | None = None,
+                 accum_format: str = "rgba16f", backface_culling: bool = True,
+                 background=RENDER_BACKGROUND, device: V.Device | None = None):
+        if accum_format not in ("rgba16f", "rgba32f"):
+            raise ParameterError("accum_format", f"must be 'rgba16f' or 'rgba32f', got {accum_format!r}")
+        self.accum_format = accum_format
+        self.backface_culling = bool(backface_culling)
+        self.background = tuple(float(x) for x in background)
+        self._own_device = device is None
+        self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
+        self._closed = False
+        self.cache = self.sampler = self.ubo = self.splat_set = None
+        self._targets = None
+        self._cloud_bufs = []
+        self._basis_buf = None
+        self._dummy_basis = {}
+        self.cloud = None
+        self.n = 0
+        self._basis_cols = 4
+        self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._dC = np.zeros((4, 3))
+        self.last_timings_ms: dict[str, float] = {}
+        self._query = None
+        try:
+            self.cache = V.PipelineCache(self.dev)
+            self.sampler = V.Sampler(self.dev)
+            self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
+            self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
+            self.splat_set.write({0: self.ubo})
+            self._query = V.QueryPool(self.dev, 8)
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------ lifecycle
+    def close(self) -> None:
+        """Destroy every Vulkan object (reverse creation order); idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        if self.dev.device is not None:
+            self.dev.wait_idle()
+        self._free_cloud()
+        if self._targets is not None:
+            self._targets.destroy()
+            self._targets = None
+        for obj in (self._query, self.splat_set, self.ubo, self.sampler):
+            if obj is not None:
+                obj.destroy()
+        if self.cache is not None:
+            self.cache.destroy()
+        if self._own_device:
+            self.dev.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _check_open(self):
+        if self._closed:
+            raise ParameterError("renderer", "is closed")
+
+    # -------------------------------------------------------------- scene
+    def _free_cloud(self):
+        for b in self._cloud_bufs:
+            b.destroy()
+        self._cloud_bufs = []
+        if self._basis_buf is not None:
+            self._basis_buf.destroy()
+            self._basis_buf = None
+        for b in self._dummy_basis.values():
+            b.destroy()
+        self._dummy_basis = {}
+        self.cloud = None
+        self.n = 0
+
+    def set_cloud(self, cloud: SplatCloud) -> None:
+        """Upload a cloud (float32 relative to its bounding-box centre); clears
+        selection and basis."""
+        self._check_open()
+        if not isinstance(cloud, SplatCloud):
+            raise ParameterError("cloud", f"must be a SplatCloud, got {type(cloud).__name__}")
+        self._free_cloud()
+        n = cloud.n
+        lo, hi = cloud.bounds()
+        self.origin = 0.5 * (lo + hi)
+        r = cloud.radii
+        self.bounds = (lo - r.max(), hi + r.max())
+        geom = np.empty((n, 9), dtype=np.float32)
+        geom[:, 0:3] = cloud.positions - self.origin
+        geom[:, 3:6] = cloud.u
+        geom[:, 6:9] = cloud.v
+        colors = cloud.colors if cloud.colors is not None else np.tile(
+            np.asarray(RENDER_DEFAULT_COLOR, np.uint8), (n, 1))
+        self._geom = V.Buffer(self.dev, geom.nbytes, ("vertex", "storage"))
+        self._cloud_bufs.append(self._geom)
+        self._geom.upload(geom)
+        self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
+        self._cloud_bufs.append(self._color)
+        self._color.upload(np.ascontiguousarray(colors, dtype=np.uint8))
+        self._flags = V.Buffer(self.dev, 4 * n, ("vertex", "storage"), host_visible=True)
+        self._cloud_bufs.append(self._flags)
+        self._flags.view(np.uint32)[:] = 0
+        self.cloud = cloud
+        self.n = n
+        self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_cols = 4
+        self._dC = np.zeros((4, 3))
+
+    def _require_cloud(self):
+        if self.cloud is None:
+            raise ParameterError("cloud", "no cloud set (call set_cloud first)")
+
+    def _mask(self, name, mask):
+        if mask is None:
+            return np.zeros(self.n, dtype=bool)
+        m = np.asarray(mask)
+        if m.dtype == bool:
+            if m.shape != (self.n,):
+                raise ParameterError(name, f"boolean mask must have shape ({self.n},), got {m.shape}")
+            return m
+        idx = m.astype(np.int64).reshape(-1)
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
+            raise ParameterError(name, f"indices must be in 0..{self.n - 1}")
+        out = np.zeros(self.n, dtype=bool)
+        out[idx] = True
+        return out
+
+    def set_selection(self, support_mask=None, handle_mask=None) -> None:
+        """Tint the support region (blue) and handle (green); boolean masks of
+        shape (n,) or index arrays; None clears."""
+        self._check_open()
+        self._require_cloud()
+        s = self._mask("support_mask", support_mask)
+        h = self._mask("handle_mask", handle_mask)
+        f = self._flags.view(np.uint32)
+        f &= np.uint32(FLAG_DEFORMED)
+        f |= (s.astype(np.uint32) * FLAG_SUPPORT) | (h.astype(np.uint32) * FLAG_HANDLE)
+
+    def set_basis(self, indices, B, Bx, By, Bz) -> None:
+        """Deformation basis rows for the splats ``indices`` (N,); B, Bx, By, Bz
+        are (N, K) with K a multiple of 4, at most ``RENDER_MAX_BASIS_COLUMNS``.
+        Other splats are not deformed.  Only the given rows (and the rows of
+        the previous basis, which are cleared) are written to the GPU."""
+        self._check_open()
+        self._require_cloud()
+        idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+        mats = []
+        for name, m in (("B", B), ("Bx", Bx), ("By", By), ("Bz", Bz)):
+            a = np.asarray(m, dtype=np.float64)
+            if a.ndim != 2 or a.shape[0] != len(idx):
+                raise ParameterError(name, f"must have shape ({len(idx)}, K), got {a.shape}")
+            mats.append(a)
+        k = mats[0].shape[1]
+        if any(a.shape[1] != k for a in mats):
+            raise ParameterError("B", "B, Bx, By, Bz must have the same number of columns")
+        if k == 0 or k % 4 or k > RENDER_MAX_BASIS_COLUMNS:
+            raise ParameterError("B", f"basis must have 4..{RENDER_MAX_BASIS_COLUMNS} columns in multiples "
+                                      f"of 4 (one control frame = 4), got {k}")
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
+            raise ParameterError("indices", f"must be in 0..{self.n - 1}")
+        if len(np.unique(idx)) != len(idx):
+            raise ParameterError("indices", "must not repeat")
+        if not all(np.isfinite(a).all() for a in mats):
+            raise ParameterError("B", "basis rows must be finite")
+        g = k // 4
+        row_bytes = 64 * g
+        if self._basis_buf is None or self._basis_cols != k:
+            if self._basis_buf is not None:
+                self._basis_buf.destroy()
+                self._basis_buf = None
+            self._basis_buf = V.Buffer(self.dev, self.n * row_bytes, ("vertex", "storage"), host_visible=True)
+            self._basis_buf.view(np.float32)[:] = 0.0
+            self._basis_rows = np.zeros(0, dtype=np.int64)
+            self._basis_cols = k
+            if self._dC.shape[0] != k:
+                self._dC = np.zeros((k, 3))
+        rows = np.empty((len(idx), g, 4, 4), dtype=np.float32)
+        for j, a in enumerate(mats):
+            rows[:, :, j, :] = a.reshape(len(idx), g, 4)
+        view = self._basis_buf.view(np.float32).reshape(self.n, 16 * g)
+        flags = self._flags.view(np.uint32)
+        stale = np.setdiff1d(self._basis_rows, idx, assume_unique=True)
+        if len(stale):
+            view[stale] = 0.0
+            flags[stale] &= np.uint32(~FLAG_DEFORMED & 0xFFFFFFFF)
+        view[idx] = rows.reshape(len(idx), 16 * g)
+        flags[idx] |= np.uint32(FLAG_DEFORMED)
+        self._basis_rows = idx
+
+    def clear_basis(self) -> None:
+        """Drop the deformation basis (every splat undeformed)."""
+        self._check_open()
+        if self.cloud is None or self._basis_buf is None:
+            return
+        flags = self._flags.view(np.uint32)
+        flags[self._basis_rows] &= np.uint32(~FLAG_DEFORMED & 0xFFFFFFFF)
+        self._basis_buf.view(np.float32).reshape(self.n, -1)[self._basis_rows] = 0.0
+        self._basis_rows = np.zeros(0, dtype=np.int64)
+
+    def set_displacement(self, dC) -> None:
+        """Control-frame displacement dC (K, 3), K = the basis' column count."""
+        self._check_open()
+        a = np.asarray(dC, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols or not np.isfinite(a).all():
+            raise ParameterError("dC", f"must be a finite ({self._basis_cols}, 3) array, got shape {a.shape}")
+        self._dC = a.copy()
+
+    def _push_dC(self) -> np.ndarray:
+        g = self._basis_cols // 4
+        out = np.zeros((g, 3, 4), dtype=np.float32)
+        for gi in range(g):
+            out[gi] = self._dC[4 * gi:4 * gi + 4].T
+        return out.reshape(-1)
+
+    # ---------------------------------------------------------- pipelines
+    def _vertex_layout(self, basis_stride: int):
+        g = self._basis_cols // 4
+        bindings = (V.VertexBinding(0, _GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
+                    V.VertexBinding(3, basis_stride))
+        attrs = [V.VertexAttribute(0, 0, "vec3", 0), V.VertexAttribute(1, 0, "vec3", 12),
+                 V.VertexAttribute(2, 0, "vec3", 24), V.VertexAttribute(3, 1, "unorm8x4", 0),
+                 V.VertexAttribute(4, 2, "uint", 0)]
+        attrs += [V.VertexAttribute(5 + i, 3, "vec4", 16 * i) for i in range(4 * g)]
+        return bindings, tuple(attrs)
+
+    def _splat_pipeline(self, kind: str):
+        g = self._basis_cols // 4
+        deformed = self._basis_buf is not None and len(self._basis_rows) > 0
+        bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
+        layout = V.LayoutDesc(sets=(_SPLAT_SET,), push_bytes=48 * g, push_stages="vert")
+        vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
+        if kind == "depth":
+            desc = V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, bindings=bindings,
+                                  attributes=attrs, depth_test=True, depth_write=True, depth_compare="less")
+        elif kind == "attr":
+            desc = V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"), layout,
+                                  bindings=bindings, attributes=attrs, depth_test=True, depth_write=False,
+                                  depth_compare="less_equal", blend_add=(True, True))
+        else:
+            desc = V.GraphicsDesc(vert, "splat_pick.frag", _RP_PICK, layout, bindings=bindings,
+                                  attributes=attrs, depth_test=True, depth_write=True, depth_compare="less")
+        return self.cache.pipeline(desc)
+
+    def _basis_binding(self):
+        if self._basis_buf is not None and len(self._basis_rows) > 0:
+            return self._basis_buf
+        g = self._basis_cols // 4
+        buf = self._dummy_basis.get(g)
+        if buf is None:
+            buf = self._dummy_basis[g] = V.Buffer(self.dev, 64 * g, ("vertex",), host_visible=True)
+            buf.view(np.float32)[:] = 0.0
+        return buf
+
+    def _resolve_pipeline(self, target: RenderTarget):
+        layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
+        desc = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _rp_resolve(target), layout,
+                              topology="triangle_list")
+        return self.cache.pipeline(desc)
+
+    # ------------------------------------------------------------- frames
+    def _targets_for(self, width: int, height: int) -> _Targets:
+        for name, v in (("width", width), ("height", height)):
+            if not isinstance(v, (int, np.integer)) or not 1 <= v <= _MAX_SIZE:
+                raise ParameterError(name, f"must be an integer in 1..{_MAX_SIZE}, got {v!r}")
+        t = self._targets
+        if t is None or (t.width, t.height) != (width, height):
+            if t is not None:
+                self.dev.wait_idle()
+                t.destroy()
+                self._targets = None
+            self._targets = _Targets(self, int(width), int(height))
+        return self._targets
+
+    def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
+        if not isinstance(camera, Camera):
+            raise ParameterError("camera", f"must be a Camera, got {type(camera).__name__}")
+        near, far = camera.clip_range(*self.bounds)
+        view = camera.view_matrix()
+        view = view @ _translate(self.origin)       # model stored relative to origin
+        proj = camera.projection_matrix(width / height, near, far)
+        p00, p11 = proj[0, 0], proj[1, 1]
+        f = np.zeros(_UBO_BYTES // 4, dtype=np.float32)
+        f[0:16] = view.T.reshape(-1)
+        f[16:32] = proj.T.reshape(-1)
+        f[32:36] = (width, height, 1.0 / width, 1.0 / height)
+        f[36:40] = (2.0 / (width * p00), -1.0 / p00, 2.0 / (height * p11), -1.0 / p11)
+        f[40:44] = (near, far, RENDER_VISIBILITY_EPS_RADII, RENDER_LOWPASS_RADIUS_PX)
+        f[44:48] = RENDER_TINT_SUPPORT
+        f[48:52] = RENDER_TINT_HANDLE
+        f[52:56] = (*self.background[:3], 1.0)
+        f[56:60] = RENDER_LIGHT
+        f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT, 0.0)
+        opts = f[64:68].view(np.uint32)
+        opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 0, 0)
+        self.ubo.write(f)
+        self._near_far = (near, far)
+
+    def _record_splats(self, cb, pipeline):
+        cb.bind_pipeline(pipeline)
+        cb.bind_descriptor_set(pipeline, self.splat_set)
+        cb.bind_vertex_buffers(0, [self._geom, self._color, self._flags, self._basis_binding()])
+        cb.push_constants(pipeline, self._push_dC())
+        cb.draw(4, self.n)
+
+    def _record_passes_12(self, cb, t: _Targets, attr_final: str):
+        cb.timestamp(self._query, 0, bottom=False)
+        cb.begin_render_pass(self.cache.render_pass(_RP_DEPTH), t.fb_depth, [1.0])
+        self._record_splats(cb, self._splat_pipeline("depth"))
+        cb.end_render_pass()
+        cb.timestamp(self._query, 1)
+        rp_attr = self.cache.render_pass(_rp_attr(self.accum_format, attr_final))
+        cb.begin_render_pass(rp_attr, t.fb_attr if attr_final == "shader_read" else self._fb_attr_readback(t),
+                             [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None])
+        self._record_splats(cb, self._splat_pipeline("attr"))
+        cb.end_render_pass()
+        cb.timestamp(self._query, 2)
+
+    def _fb_attr_readback(self, t: _Targets):
+        if getattr(t, "fb_attr_rb", None) is None:
+            rp = self.cache.render_pass(_rp_attr(self.accum_format, "transfer_src"))
+            t.fb_attr_rb = t._fb(self.dev, rp, [t.accum_color, t.accum_normal, t.depth])
+        return t.fb_attr_rb
+
+    def record_frame(self, cb, camera: Camera, target: RenderTarget):
+        """Record the three passes into ``cb`` writing ``target`` (used by
+        :meth:`render`; the editor calls it with a swapchain target)."""
+        self._require_cloud()
+        t = self._targets_for(target.width, target.height)
+        self._write_ubo(camera, target.width, target.height, target.apply_gamma)
+        cb.reset_queries(self._query)
+        self._record_passes_12(cb, t, "shader_read")
+        pipe = self._resolve_pipeline(target)
+        cb.begin_render_pass(self.cache.render_pass(_rp_resolve(target)), t.target_fb(target), [None])
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, t.resolve_set)
+        cb.draw(3)
+        cb.end_render_pass()
+        cb.timestamp(self._query, 3)
+
+    def _read_timings(self, names):
+        ts = self._query.results_ns(len(names) + 1)
+        self.last_timings_ms = {n: float(ts[i + 1] - ts[i]) * 1e-6 for i, n in enumerate(names)}
+        self.last_timings_ms["total"] = float(ts[len(names)] - ts[0]) * 1e-6
+
+    # ---------------------------------------------------------- public API
+    def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
+        """Render offscreen; returns (height, width, 4) uint8 RGBA (sRGB)."""
+        self._check_open()
+        self._require_cloud()
+        t = self._targets_for(width, height)
+        rb = V.Buffer(self.dev, width * height * 4, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                self.record_frame(cb, camera, t.offscreen)
+                cb.copy_image_to_buffer(t.out, rb)
+                cb.host_read_barrier()
+            self.dev.submit(rec)
+            out = rb.read().reshape(height, width, 4)
+        finally:
+            rb.destroy()
+        self._read_timings(("visibility", "attributes", "shading"))
+        return out
+
+    def render_buffers(self, camera: Camera, width: int, height: int) -> dict[str, np.ndarray]:
+        """Float buffers of one frame, (height, width[, c]) float32:
+
+        * ``depth``: eye-space distance along the view axis, NaN for background;
+        * ``normal``: unit eye-space normal (x right, y up, z towards the eye), NaN background;
+        * ``weight``: accumulated splat weight (0 for background);
+        * ``color``: normalised linear RGB (selection tint included), NaN background.
+        """
+        self._check_open()
+        self._require_cloud()
+        t = self._targets_for(width, height)
+        texel = 8 if self.accum_format == "rgba16f" else 16
+        plane = width * height * texel
+        rb = V.Buffer(self.dev, 2 * plane, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                self._write_ubo(camera, width, height)
+                cb.reset_queries(self._query)
+                self._record_passes_12(cb, t, "transfer_src")
+                cb.copy_image_to_buffer(t.accum_color, rb)
+                cb.copy_image_to_buffer(t.accum_normal, rb, buf_offset=plane)
+                cb.host_read_barrier()
+            self.dev.submit(rec)
+            raw = rb.read()
+        finally:
+            rb.destroy()
+        self._read_timings(("visibility", "attributes"))
+        a = V.readback_array(raw[:plane], self.accum_format, width, height).astype(np.float32)
+        b = V.readback_array(raw[plane:], self.accum_format, width, height).astype(np.float32)
+        w = a[..., 3]
+        fg = w >= RENDER_MIN_WEIGHT
+        with np.errstate(invalid="ignore", divide="ignore"):
+            color = np.where(fg[..., None], a[..., :3] / w[..., None], np.nan)
+            depth = np.where(fg, b[..., 3] / w, np.nan)
+            nrm = b[..., :3] / np.linalg.norm(b[..., :3], axis=-1, keepdims=True)
+            nrm = np.where(fg[..., None], nrm, np.nan)
+        return {"depth": depth.astype(np.float32), "normal": nrm.astype(np.float32),
+                "weight": np.where(fg, w, 0.0).astype(np.float32), "color": color.astype(np.float32)}
+
+    def pick(self, camera: Camera, width: int, height: int, rect=None):
+        """Splat index per pixel (-1 background) and eye-space depth along the
+        view axis (NaN background) of the nearest splat, for the whole image
+        or ``rect`` = (x, y, w, h) in pixels (clipped to the image)."""
+        self._check_open()
+        self._require_cloud()
+        t = self._targets_for(width, height)
+        t.ensure_pick()
+        if rect is None:
+            x, y, w, h = 0, 0, width, height
+        else:
+            x, y, w, h = (int(v) for v in rect)
+            x0, y0 = max(x, 0), max(y, 0)
+            x1, y1 = min(x + w, width), min(y + h, height)
+            if x1 <= x0 or y1 <= y0:
+                raise ParameterError("rect", f"{tuple(rect)} does not overlap the {width}x{height} image")
+            x, y, w, h = x0, y0, x1 - x0, y1 - y0
+        nbytes = w * h * 4
+        rb = V.Buffer(self.dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                self._write_ubo(camera, width, height)
+                cb.reset_queries(self._query)
+                cb.timestamp(self._query, 0, bottom=False)
+                cb.begin_render_pass(self.cache.render_pass(_RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
+                self._record_splats(cb, self._splat_pipeline("pick"))
+                cb.end_render_pass()
+                cb.timestamp(self._query, 1)
+                cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
+                cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
+                cb.host_read_barrier()
+            self.dev.submit(rec)
+            raw = rb.read()
+        finally:
+            rb.destroy()
+        self._read_timings(("pick",))
+        idx = raw[:nbytes].view(np.uint32).reshape(h, w).astype(np.int64) - 1
+        d = raw[nbytes:].view(np.float32).reshape(h, w).astype(np.float64)
+        near, far = self._near_far
+        with np.errstate(divide="ignore", invalid="ignore"):
+            depth = near / (1.0 - d * (far - near) / far)
+        depth[idx < 0] = np.nan
+        return idx, depth
+
+
+def _translate(t) -> np.ndarray:
+    m = np.eye(4)
+    m[:3, 3] = t
+    return m

@@ -1,0 +1,97 @@
+"""Orbit camera math: projection consistency, orbit, pan, dolly to cursor, framing."""
+
+import math
+
+import numpy as np
+import pytest
+
+from splatedit.app.camera_control import OrbitCamera
+
+
+def make_cam():
+    return OrbitCamera(target=np.array([0.1, -0.2, 0.3]), distance=4.0, yaw=0.4, pitch=0.3,
+                       fov_deg=45.0, scene_radius=1.0)
+
+
+def test_view_is_rigid_and_eye_maps_to_origin():
+    cam = make_cam()
+    v = cam.view()
+    assert np.allclose(v[:3, :3] @ v[:3, :3].T, np.eye(3))
+    assert np.allclose(v[:3, :3] @ cam.eye + v[:3, 3], 0)
+    # the target is straight ahead at the camera distance
+    t = v[:3, :3] @ cam.target + v[:3, 3]
+    assert np.allclose(t, [0, 0, -4.0])
+
+
+def test_project_matches_projection_matrix_and_ray():
+    cam = make_cam()
+    w, h = 640, 480
+    pts = np.random.default_rng(0).normal(size=(20, 3)) * 0.5
+    px, depth = cam.project(pts, w, h)
+    clip = (cam.view_projection(w, h) @ np.c_[pts, np.ones(20)].T).T
+    ndc = clip[:, :2] / clip[:, 3:4]
+    assert np.allclose(px[:, 0], (ndc[:, 0] + 1) * w / 2)
+    assert np.allclose(px[:, 1], (ndc[:, 1] + 1) * h / 2)
+    assert np.all((clip[:, 2] / clip[:, 3] > 0) & (clip[:, 2] / clip[:, 3] < 1))
+    # the pixel ray through a projected point passes through it
+    for p, q, d in zip(pts[:3], px[:3], depth[:3]):
+        back = cam.point_at_depth(q[0], q[1], w, h, d)
+        assert np.allclose(back, p, atol=1e-9)
+
+
+def test_target_projects_to_centre():
+    cam = make_cam()
+    px, _ = cam.project(cam.target, 800, 600)
+    assert np.allclose(px[0], [400, 300])
+
+
+def test_orbit_keeps_distance_and_clamps_pitch():
+    cam = make_cam()
+    t0 = cam.target.copy()
+    cam.orbit(100, 0)
+    assert np.isclose(np.linalg.norm(cam.eye - t0), 4.0)
+    cam.orbit(0, 1e6)
+    assert cam.pitch < math.pi / 2
+    r, u, b = cam.basis()
+    assert np.isclose(np.linalg.norm(np.cross(r, u) - b), 0)
+
+
+def test_pan_moves_target_pixel_with_mouse():
+    cam = make_cam()
+    w, h = 640, 480
+    p = cam.target.copy()  # a world point at the pivot depth
+    cam.pan(30, -20, h)
+    px, _ = cam.project(p, w, h)
+    assert np.allclose(px[0], [320 + 30, 240 - 20], atol=1e-6)
+
+
+def test_dolly_to_cursor_keeps_point_under_cursor():
+    cam = make_cam()
+    w, h = 640, 480
+    x, y = 500.0, 100.0
+    p = cam.point_at_depth(x, y, w, h, cam.distance)
+    d0 = cam.distance
+    cam.dolly(2, x, y, w, h)
+    assert cam.distance < d0
+    px, _ = cam.project(p, w, h)
+    assert np.allclose(px[0], [x, y], atol=1e-6)
+
+
+def test_frame_fits_sphere():
+    cam = make_cam()
+    cam.frame([1, 2, 3], 0.5, aspect=16 / 9)
+    w, h = 1600, 900
+    # points on the sphere's silhouette stay on screen
+    r, u, _ = cam.basis()
+    for d in (r, -r, u, -u):
+        px, depth = cam.project(np.array([1, 2, 3]) + 0.5 * d, w, h)
+        assert 0 <= px[0, 0] <= w and 0 <= px[0, 1] <= h and depth[0] > 0
+    assert np.allclose(cam.target, [1, 2, 3])
+
+
+def test_frame_points():
+    cam = make_cam()
+    pts = np.array([[0, 0, 0], [2, 0, 0], [0, 2, 0]], float)
+    cam.frame_points(pts, 1.0)
+    px, _ = cam.project(pts, 500, 500)
+    assert (px >= 0).all() and (px <= 500).all()
