@@ -17,9 +17,10 @@ NORMAL_NEIGHBOURS = 16
 ORIENT_NEIGHBOURS = 8
 #: splat radius = this factor * distance to the SPACING_NEIGHBOUR-th neighbour.
 #: 1.0 leaves pin holes on uniformly random samples (largest empty circles);
-#: 1.2 closed every hole in 1M surface probes of a 200k random sphere sample,
-#: 1.25 keeps a margin (see splatedit.model.estimate.splat_radii)
-SPLAT_RADIUS_FACTOR = 1.25
+#: over 12 random sphere samples (1k-200k points, 200k-2M surface probes) the
+#: largest factor any probe needed was 1.30; 1.5 keeps a margin (see
+#: splatedit.model.estimate.splat_radii)
+SPLAT_RADIUS_FACTOR = 1.5
 SPACING_NEIGHBOUR = 6
 #: points per chunk of the batched 3x3 covariance / eigen-decomposition
 #: (bounds memory to about ESTIMATE_CHUNK_POINTS * NORMAL_NEIGHBOURS * 24 bytes)
@@ -42,6 +43,10 @@ FALLBACK_SPLAT_RADIUS = 1.0
 #: 1/sqrt(3) just closes the surface; the 1.2 margin makes neighbouring EWA
 #: kernels overlap instead of touching.  See splatedit.model.mesh.
 MESH_SPLAT_RADIUS_FACTOR = 1.2 / 3 ** 0.5
+#: an area-weighted vertex normal shorter than this times the squared
+#: incident edge length (faces cancel or are all degenerate) is replaced by a
+#: PCA normal
+MESH_NORMAL_MIN_REL = 1e-12
 
 # --- file input ---------------------------------------------------------
 #: text files (XYZ, OFF) are tokenised in blocks of about this many bytes
@@ -76,6 +81,9 @@ LU_MIN_RCOND = 1e-15
 #: the incremental QR adds a note ("weights may be inaccurate") when
 #: min |R_ii| / max |R_ii| of the used columns falls below this
 IQR_R_DIAG_RTOL = 1e-13
+#: method="lu" refuses more constraints than this: the dense (m+10)^2 system
+#: and its LU copy would need 2 * 8 * m^2 bytes (6.4 GB at 20000)
+LU_MAX_CONSTRAINTS = 20000
 
 # --- constraints --------------------------------------------------------
 #: thickness of the fixed and handle bands, in point spacings ("three rings")
@@ -117,3 +125,6 @@ RENDER_TINT_HANDLE = (0.1, 0.8, 0.15, 0.7)
 #: deformation basis columns: multiples of 4, at most this many in the vertex
 #: shader path (dC takes 3 vec4 per 4 columns of the 128-byte push constants)
 RENDER_MAX_BASIS_COLUMNS = 8
+#: splats whose projected ellipse bound is at most this many pixels wide (<= 1)
+#: are drawn as one-pixel points (hole-free: radius <= half a pixel)
+RENDER_POINT_SPLAT_MAX_PX = 1.0

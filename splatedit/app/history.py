@@ -101,8 +101,14 @@ class History:
         self._pos += 1
         return self.current
 
-    def mark_saved(self) -> None:
-        self.saved_pos = self._pos
+    @property
+    def position(self) -> int:
+        return self._pos
+
+    def mark_saved(self, position: int | None = None) -> None:
+        """Remember the current state (or the one at ``position``, as returned
+        by :attr:`position` when a background save started) as saved."""
+        self.saved_pos = self._pos if position is None else position
 
     @property
     def geometry_dirty(self) -> bool:

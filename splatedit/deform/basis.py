@@ -21,9 +21,11 @@ CPU hot path (``apply``).  Per frame a splat needs only linear combinations of
 (lazily, on the first ``apply``), stored in the order of a run plan of the
 support indices (long runs of consecutive splat indices are written with a
 slice, the rest gathered into chunks and scattered), and each frame is then
-three chunked GEMMs written straight into the output arrays.  float64 is kept:
-float32 would break the bitwise identity/fixed guarantees for positions and
-saved nothing measurable (the run is memory bound either way).
+three chunked GEMMs written straight into the output arrays; the splats
+outside the support are copied bitwise (one plain copy of the cloud, or only
+the complement's runs when the support is most of the cloud).  float64 is kept:
+float32 would lose positional accuracy (p is part of the GEMM) and showed no
+reliable gain in measurements here (the product is memory- and call-bound).
 """
 
 from __future__ import annotations
@@ -49,10 +51,13 @@ from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 PROGRESS_STAGE = "precomputing deformation basis"
 #: support splats per chunk when evaluating the RBF for the basis
 _BASIS_CHUNK = 65536
-#: rows per GEMM in the CPU apply (fits the L2 cache with its outputs)
-_APPLY_CHUNK = 16384
+#: rows per GEMM in the CPU apply: small enough that OpenBLAS runs it on
+#: one thread (its threads only add contention for so thin a product; measured
+#: 2-4x slower at 16384 rows on a loaded 2-core machine) and the chunk stays
+#: in L2; large enough that the Python loop is negligible
+_APPLY_CHUNK = 4096
 #: runs of consecutive splat indices at least this long are written by slice
-_RUN_MIN = 2048
+_RUN_MIN = 512
 
 
 def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
@@ -293,11 +298,15 @@ class DeformationBasis:
                 np.einsum("nj,njk->nk", src, pk[:, 1:, :], out=a[:, :k])
             a[:, k:] = src
             arrays.append(a)
-        # complement (splats outside the support): copied by the same kind of plan
-        comp = np.setdiff1d(np.arange(len(cloud.positions)), idx, assume_unique=True)
-        _, csegs = _run_plan(comp)
+        # when the support is most of the cloud, copy only its complement
+        # (long runs by slice, the rest by index); otherwise one plain copy
+        comp_segments = None
+        n_all = len(cloud.positions)
+        if 2 * len(idx) > n_all:
+            comp = np.setdiff1d(np.arange(n_all), idx, assume_unique=True)
+            comp_segments = [d for _, _, d in _run_plan(comp, chunk=1 << 30)[1]]
         self._cpu = dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
-                         segments=segments, comp_segments=[d for _, _, d in csegs])
+                         segments=segments, comp_segments=comp_segments)
         return self._cpu
 
     def release_cpu_cache(self) -> None:
@@ -314,10 +323,14 @@ class DeformationBasis:
         if not d.any():
             return tuple(s.copy() for s in srcs)
         c = self._cpu_arrays(cloud)
-        outs = tuple(np.empty_like(s) for s in srcs)
-        for dest in c["comp_segments"]:
-            for s, o in zip(srcs, outs):
-                o[dest] = s[dest]
+        # splats outside the support: bitwise copies (never recomputed)
+        if c["comp_segments"] is None:
+            outs = tuple(s.copy() for s in srcs)
+        else:
+            outs = tuple(np.empty_like(s) for s in srcs)
+            for dest in c["comp_segments"]:
+                for s, o in zip(srcs, outs):
+                    o[dest] = s[dest]
         mx = np.vstack([d, np.eye(3)])
         for lo, hi, dest in c["segments"]:
             for a, o in zip(c["arrays"], outs):

@@ -48,6 +48,7 @@ from splatedit.tolerances import (
     IQR_DEFAULT_TOL,
     IQR_PANEL_COLUMNS,
     IQR_R_DIAG_RTOL,
+    LU_MAX_CONSTRAINTS,
     LU_MIN_RCOND,
     POLY_RANK_RTOL,
 )
@@ -168,10 +169,10 @@ class IncrementalQR:
     Fortran-contiguous column block of the transpose, so step 1 runs
     ``dgemqrt(side="R")`` on the transpose in place, without copies.
 
-    Storage: the reflector blocks ``V_p`` (trapezoidal, about half of the used
-    columns of A) and R in an (max_cols, max_cols) Fortran array allocated
-    with ``np.empty`` -- only the touched upper part of the used columns is
-    ever backed by memory.
+    Storage: the reflector blocks ``V_p`` (trapezoidal, the used columns of
+    A below the diagonal), their ``T`` factors, and R as per-panel column
+    blocks ``R[:j1, j0:j1]``; nothing is allocated for columns never used, so
+    memory is O(n_rows * n) for n used columns.
     """
 
     def __init__(self, n_rows: int, max_cols: int, rhs: np.ndarray):
@@ -179,7 +180,7 @@ class IncrementalQR:
             raise ValueError("IncrementalQR needs max_cols <= n_rows")
         self.n_rows = n_rows
         self.max_cols = max_cols
-        self.r = np.empty((max_cols, max_cols), dtype=np.float64, order="F")
+        self.r_blocks = []  # column blocks R[:j1, j0:j1] of the upper triangle
         self.qtb = np.array(rhs, dtype=np.float64, order="F", copy=True)
         if self.qtb.ndim != 2 or self.qtb.shape[0] != n_rows:
             raise ValueError("rhs must have shape (n_rows, k)")
@@ -216,11 +217,10 @@ class IncrementalQR:
             if not np.shares_memory(out, blk):  # pragma: no cover - f2py copied
                 blk[...] = out
         # 2. factor the part on and below the diagonal
-        self.r[:j0, j0:j1] = c[:j0]
         v, t, info = lapack.dgeqrt(width, np.asfortranarray(c[j0:]), overwrite_a=1)
         if info != 0:  # pragma: no cover
             raise SolverError(f"LAPACK dgeqrt failed (info={info})")
-        self.r[j0:j1, j0:j1] = np.triu(v[:width])
+        self.r_blocks.append(np.vstack([c[:j0], np.triu(v[:width])]))
         self.panels.append((j0, v, t))
         # 3. update Q^T b
         y = np.asfortranarray(self.qtb[j0:])
@@ -235,15 +235,29 @@ class IncrementalQR:
         return np.sqrt(tails_sq[: width + 1])
 
     def r_factor(self, n: Optional[int] = None) -> np.ndarray:
-        """The upper-triangular n x n factor R (a copy)."""
+        """The upper-triangular n x n factor R (a new Fortran array)."""
         n = self.n_cols if n is None else n
-        return np.triu(self.r[:n, :n])
+        if not 0 <= n <= self.n_cols:
+            raise ValueError(f"n must be in [0, {self.n_cols}]")
+        r = np.zeros((n, n), order="F")
+        for (j0, _, _), blk in zip(self.panels, self.r_blocks):
+            if j0 >= n:
+                break
+            w = min(blk.shape[1], n - j0)
+            r[: min(blk.shape[0], n), j0:j0 + w] = blk[:n, :w]
+        return r
+
+    def r_diagonal(self, n: Optional[int] = None) -> np.ndarray:
+        """The first ``n`` diagonal entries of R."""
+        n = self.n_cols if n is None else n
+        d = [np.diag(blk[j0:]) for (j0, _, _), blk in zip(self.panels, self.r_blocks)]
+        return np.concatenate(d)[:n] if d else np.zeros(0)
 
     def solve(self, n: int) -> np.ndarray:
         """Least-squares solution using the first ``n`` columns: R x = (Q^T b)[:n]."""
         if n == 0:
             return np.zeros((0, self.qtb.shape[1]))
-        x, info = lapack.dtrtrs(self.r[:, :n], self.qtb[:n])
+        x, info = lapack.dtrtrs(self.r_factor(n), self.qtb[:n])
         if info > 0:
             raise SolverError(
                 f"the least-squares system is singular: R[{info - 1},{info - 1}] = 0 "
@@ -464,6 +478,10 @@ class TriharmonicRBF:
             raise ParameterError(
                 "max_centers", f"method='lu' uses all {m} constraints as centers; "
                 f"max_centers={max_centers} needs method='iqr'")
+        if method == "lu" and m > LU_MAX_CONSTRAINTS:
+            raise ParameterError(
+                "method", f"method='lu' with {m} constraints needs a dense {m + N_POLY}^2 system "
+                f"(> {LU_MAX_CONSTRAINTS} constraints); use method='iqr' or 'auto'")
         head: list = []
         if method == "auto":
             if m <= AUTO_EXACT_MAX_CONSTRAINTS and (max_centers is None or max_centers >= m):
@@ -669,7 +687,7 @@ def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
         elif tol > 0:
             notes.append(f"all {m} centers used and tol {tol:g} still not reached "
                          "(rounding limits the residual)")
-    diag = np.abs(np.diag(qr.r[:stop_cols, :stop_cols])) if stop_cols else np.zeros(0)
+    diag = np.abs(qr.r_diagonal(stop_cols))
     if diag.size and diag.min() < IQR_R_DIAG_RTOL * diag.max():
         notes.append(f"R is nearly singular (min/max |diag| = {diag.min() / diag.max():.1e}); "
                      "weights may be inaccurate")

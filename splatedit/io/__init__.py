@@ -1,1 +1,120 @@
-"""splatedit.io"""
+"""Reading and writing splat clouds: PLY, XYZ text, OFF meshes.
+
+Public API::
+
+    read(path, *, progress=None) -> SplatCloud
+    write(path, cloud, *, overwrite=False, binary=True, axes=True, progress=None) -> Path
+    convert(in_path, out_path, *, overwrite=False, binary=True, progress=None) -> SplatCloud
+
+The format follows the file extension (case-insensitive): ``.ply``;
+``.xyz``, ``.txt``, ``.pts`` (XYZ text); ``.off``.  Splats come from the file
+(our ``ux..vz`` PLY properties) or are derived: see
+:func:`splatedit.io._build.build_cloud`.  Every problem with an input file is
+an :class:`~splatedit.errors.InputError` naming the file.
+
+Writing is atomic: the data go to a temporary file in the target directory
+that replaces the target only when complete, so a failed write leaves any old
+file intact.  An existing file is replaced only with ``overwrite=True``.
+"""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+from splatedit.errors import InputError
+from splatedit.io.atomic import atomic_open, check_writable_target
+from splatedit.io.off import read_off, write_off
+from splatedit.io.ply import read_ply, write_ply
+from splatedit.io.xyz import read_xyz, write_xyz
+from splatedit.model.cloud import SplatCloud
+from splatedit.progress import report
+
+__all__ = ["read", "write", "convert", "READ_EXTENSIONS", "WRITE_EXTENSIONS"]
+
+_READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_xyz,
+            ".off": read_off}
+#: extensions :func:`read` understands
+READ_EXTENSIONS = tuple(_READERS)
+#: extensions :func:`write` understands (.ply is the lossless splat format;
+#: .xyz keeps positions and normals, .off positions and faces)
+WRITE_EXTENSIONS = (".ply", ".xyz", ".off")
+
+
+def _ext(path, allowed, what) -> str:
+    ext = Path(path).suffix.lower()
+    if ext not in allowed:
+        raise InputError(f"unsupported file extension {ext or '(none)'!r} for {what}; "
+                         f"supported: {', '.join(allowed)}", path=str(path))
+    return ext
+
+
+def read(path, *, progress=None) -> SplatCloud:
+    """Read a splat cloud, point cloud or mesh.
+
+    Args:
+        path: a ``.ply``, ``.xyz``/``.txt``/``.pts`` or ``.off`` file.
+        progress: optional ``progress(stage, fraction)`` callback.
+    Returns:
+        SplatCloud with ``name`` = file name and ``source`` = path.
+    Raises:
+        InputError: unknown extension, unreadable or malformed file.
+    """
+    reader = _READERS[_ext(path, READ_EXTENSIONS, "reading")]
+    if Path(path).is_dir():
+        raise InputError("is a directory, not a file", path=str(path))
+    return reader(path, progress=progress)
+
+
+def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = True,
+          axes: bool = True, progress=None) -> Path:
+    """Save ``cloud`` atomically (:func:`splatedit.io.atomic.atomic_open`).
+
+    Args:
+        path: target ``.ply`` (lossless), ``.xyz`` or ``.off``.
+        overwrite: replace an existing file (by default that is refused).
+        binary: PLY only: binary little endian (default) or ascii.
+        axes: PLY only: store normals and splat axes (default); False
+            stores positions, colours and faces only.
+    Returns:
+        the path written.
+    Raises:
+        InputError: the file exists and ``overwrite`` is False, unsupported
+            extension, missing directory, write failure.
+    """
+    path = Path(path)
+    ext = _ext(path, WRITE_EXTENSIONS, "writing")
+    check_writable_target(path, overwrite=overwrite)
+    report(progress, "writing", 0.0)
+    mode = path.stat().st_mode & 0o777 if path.exists() else 0o644
+    try:
+        with atomic_open(path, "wb") as fh:
+            os.fchmod(fh.fileno(), mode)          # mkstemp creates 0600 files
+            if ext == ".ply":
+                write_ply(fh, cloud, binary=binary, axes=axes,
+                          comment=f"written by splatedit from {cloud.name or 'a splat cloud'}")
+            elif ext == ".xyz":
+                write_xyz(fh, cloud)
+            else:
+                write_off(fh, cloud)
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror or exc}", path=str(path)) from None
+    report(progress, "writing", 1.0)
+    return path
+
+
+def convert(in_path, out_path, *, overwrite: bool = False, binary: bool = True,
+            progress=None) -> SplatCloud:
+    """Read ``in_path`` and write it to ``out_path`` (format from the
+    extension).  The output is checked before the (possibly long) read, so an
+    existing output without ``overwrite=True`` fails at once.
+
+    Returns:
+        the cloud that was written.
+    """
+    out = Path(out_path)
+    _ext(out, WRITE_EXTENSIONS, "writing")
+    check_writable_target(out, overwrite=overwrite, protect=in_path)
+    cloud = read(in_path, progress=progress)
+    write(out, cloud, overwrite=overwrite, binary=binary, progress=progress)
+    return cloud

@@ -43,18 +43,25 @@ class NumberTable:
         return len(self.count)
 
 
-def _bad_token(block: bytes, first_line: int, path) -> InputError:
-    """Slow pass over a block that failed to parse: find the first bad token."""
+def _bad_token(block: bytes, first_line: int, rows_before: int, path) -> InputError:
+    """Slow pass over a block that failed to parse: find the first bad token.
+
+    ``rows_before`` is the number of non-blank lines before the block, so the
+    error carries the 0-based data row as well as the 1-based file line.
+    """
+    row = rows_before
     for i, raw in enumerate(block.split(b"\n")):
-        for j, tok in enumerate(raw.split()):
+        toks = raw.split()
+        for j, tok in enumerate(toks):
             try:
                 float(tok)
             except ValueError:
                 shown = tok.decode("utf-8", "replace")
-                err = InputError(f"line {first_line + i}: column {j + 1}: not a number: {shown!r}",
-                                 path=path)
+                err = InputError(f"column {j + 1}: not a number: {shown!r} "
+                                 f"(line {first_line + i})", path=path, row=row)
                 err.line = first_line + i
                 return err
+        row += bool(toks)
     err = InputError(f"unparseable text near line {first_line}", path=path)
     err.line = first_line
     return err
@@ -72,7 +79,7 @@ def scan_numbers(data: bytes, path, *, first_line: int = 1, progress=None,
             that is not a number.
     """
     values, starts, counts, lines = [], [], [], []
-    pos, line0, total, nval = 0, first_line, max(len(data), 1), 0
+    pos, line0, total, nval, nrows = 0, first_line, max(len(data), 1), 0, 0
     while pos < len(data):
         end = min(pos + TEXT_BLOCK_BYTES, len(data))
         if end < len(data):
@@ -91,11 +98,12 @@ def scan_numbers(data: bytes, path, *, first_line: int = 1, progress=None,
         tok_line = np.searchsorted(newlines, tok)
         cnt = np.bincount(tok_line, minlength=nlines_block)
         try:
-            vals = np.fromstring(block.decode("latin-1"), dtype=np.float64, sep=" ")
+            vals = (np.fromstring(block.decode("latin-1"), dtype=np.float64, sep=" ")
+                    if len(tok) else np.zeros(0))
         except ValueError:
-            raise _bad_token(block, line0, path) from None
+            raise _bad_token(block, line0, nrows, path) from None
         if len(vals) != len(tok):  # defensive: must never happen
-            raise _bad_token(block, line0, path)
+            raise _bad_token(block, line0, nrows, path)
         keep = np.flatnonzero(cnt)
         c = cnt[keep].astype(np.int64)
         s = np.zeros(len(c), dtype=np.int64)
@@ -105,6 +113,7 @@ def scan_numbers(data: bytes, path, *, first_line: int = 1, progress=None,
         counts.append(c)
         lines.append(keep.astype(np.int64) + line0)
         nval += len(vals)
+        nrows += len(keep)
         line0 += len(newlines)
         pos = end
         report(progress, stage, pos / total)

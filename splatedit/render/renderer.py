@@ -27,7 +27,7 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
-                                  RENDER_MIN_WEIGHT, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
+                                  RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
                                   RENDER_VISIBILITY_EPS_RADII)
 
 #: per-splat flag bits (shaders_glsl/frame.glsl)
@@ -40,10 +40,23 @@ _GEOM_STRIDE = 36           # centre, u, v as float32
 _MAX_SIZE = 16384
 
 _SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"),)
+#: compute pre-pass + prepared draws: frame UBO, cloud (geometry, colours,
+#: flags, basis), records A/B, indirect draw commands
+_PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
+             V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
+             V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "vert|comp"),
+             V.Binding(7, "storage", "comp"))
+_REC_A_BYTES = 48
+_REC_B_BYTES = 32
+_WORKGROUP = 64
+#: the pre-pass packs quad bounds as 12.4 fixed-point pixels
+_PREP_MAX_SIZE = 4095
 _RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(1, "sampled", "frag"),
                 V.Binding(2, "sampled", "frag"))
 
 _RP_DEPTH = V.RenderPassDesc(depth=V.Attachment("d32f", "clear", final="depth"))
+_RP_POINTS = V.RenderPassDesc(colors=(V.Attachment("rgba8", "clear", final="color"),),
+                              depth=V.Attachment("d32f", "clear", final="depth"))
 _RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
                             depth=V.Attachment("d32f", "clear", final="transfer_src"))
 
@@ -157,17 +170,32 @@ class Renderer:
         accum_format: ``"rgba16f"`` or ``"rgba32f"`` attribute accumulators.
         backface_culling: skip splats whose normal faces away from the eye.
         background: sRGB background colour (3 floats in 0..1).
+        point_splats: draw tiny splats (projected ellipse bound at most
+            ``RENDER_POINT_SPLAT_MAX_PX`` = 1 pixel, i.e. radius <= half a
+            pixel) as one-pixel POINT_LIST points at their projected centre
+            (one vertex and one fragment instead of a 4-vertex strip; same
+            fragment shader, still hole-free), the others as quads.
+        prepass: do the per-splat work (deformation, culling, screen setup)
+            once per frame in a compute pre-pass that writes compact records;
+            both splat passes then draw them indirectly with a fetch-only
+            vertex shader (``prepared.vert``).  Off: every vertex of both
+            passes runs ``splat.vert``.  Falls back to off when a buffer
+            exceeds the device's storage-buffer range.
         device: share an existing :class:`splatedit.render.vk.Device` (then
             the renderer does not close it).
     """
 
     def __init__(self, *, device_name: str | None = None, validation: bool | None = None,
                  accum_format: str = "rgba16f", backface_culling: bool = True,
-                 background=RENDER_BACKGROUND, device: V.Device | None = None):
+                 background=RENDER_BACKGROUND, point_splats: bool = True, prepass: bool = True,
+                 device: V.Device | None = None):
         if accum_format not in ("rgba16f", "rgba32f"):
             raise ParameterError("accum_format", f"must be 'rgba16f' or 'rgba32f', got {accum_format!r}")
         self.accum_format = accum_format
         self.backface_culling = bool(backface_culling)
+        self.point_splats = bool(point_splats)
+        self.prepass = bool(prepass)
+        self._prep = None             # (set, recA, recB, draws) of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         self._own_device = device is None
         self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
@@ -184,6 +212,7 @@ class Renderer:
         self._dC = np.zeros((4, 3))
         self.last_timings_ms: dict[str, float] = {}
         self._query = None
+        self._max_point_size = float(self.dev.limits.pointSizeRange[1]) if self.dev.features.largePoints else 1.0
         try:
             self.cache = V.PipelineCache(self.dev)
             self.sampler = V.Sampler(self.dev)
@@ -226,7 +255,14 @@ class Renderer:
             raise ParameterError("renderer", "is closed")
 
     # -------------------------------------------------------------- scene
+    def _free_prep(self):
+        if self._prep is not None:
+            for obj in reversed(self._prep):
+                obj.destroy()
+            self._prep = None
+
     def _free_cloud(self):
+        self._free_prep()
         for b in self._cloud_bufs:
             b.destroy()
         self._cloud_bufs = []
@@ -334,6 +370,7 @@ class Renderer:
             if self._basis_buf is not None:
                 self._basis_buf.destroy()
                 self._basis_buf = None
+            self._free_prep()
             self._basis_buf = V.Buffer(self.dev, self.n * row_bytes, ("vertex", "storage"), host_visible=True)
             self._basis_buf.view(np.float32)[:] = 0.0
             self._basis_rows = np.zeros(0, dtype=np.int64)
@@ -389,22 +426,23 @@ class Renderer:
         attrs += [V.VertexAttribute(5 + i, 3, "vec4", 16 * i) for i in range(4 * g)]
         return bindings, tuple(attrs)
 
-    def _splat_pipeline(self, kind: str):
+    def _splat_pipeline(self, kind: str, mode: int = 0):
         g = self._basis_cols // 4
         deformed = self._basis_buf is not None and len(self._basis_rows) > 0
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
         layout = V.LayoutDesc(sets=(_SPLAT_SET,), push_bytes=48 * g, push_stages="vert")
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
+        common = dict(bindings=bindings, attributes=attrs, depth_test=True, spec=((0, mode),),
+                      topology="point_list" if mode == 2 else "triangle_strip")
         if kind == "depth":
-            desc = V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, bindings=bindings,
-                                  attributes=attrs, depth_test=True, depth_write=True, depth_compare="less")
+            desc = V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
+                                  depth_compare="less", **common)
         elif kind == "attr":
             desc = V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"), layout,
-                                  bindings=bindings, attributes=attrs, depth_test=True, depth_write=False,
-                                  depth_compare="less_equal", blend_add=(True, True))
+                                  depth_write=False, depth_compare="less_equal", blend_add=(True, True), **common)
         else:
-            desc = V.GraphicsDesc(vert, "splat_pick.frag", _RP_PICK, layout, bindings=bindings,
-                                  attributes=attrs, depth_test=True, depth_write=True, depth_compare="less")
+            desc = V.GraphicsDesc(vert, "splat_pick.frag", _RP_PICK, layout, depth_write=True,
+                                  depth_compare="less", **common)
         return self.cache.pipeline(desc)
 
     def _basis_binding(self):
@@ -413,7 +451,7 @@ class Renderer:
         g = self._basis_cols // 4
         buf = self._dummy_basis.get(g)
         if buf is None:
-            buf = self._dummy_basis[g] = V.Buffer(self.dev, 64 * g, ("vertex",), host_visible=True)
+            buf = self._dummy_basis[g] = V.Buffer(self.dev, 64 * g, ("vertex", "storage"), host_visible=True)
             buf.view(np.float32)[:] = 0.0
         return buf
 
@@ -455,31 +493,118 @@ class Renderer:
         f[48:52] = RENDER_TINT_HANDLE
         f[52:56] = (*self.background[:3], 1.0)
         f[56:60] = RENDER_LIGHT
-        f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT, 0.0)
+        f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
+                    min(RENDER_POINT_SPLAT_MAX_PX, self._max_point_size) if self.point_splats else -1.0)
         opts = f[64:68].view(np.uint32)
         opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 0, 0)
         self.ubo.write(f)
         self._near_far = (near, far)
 
-    def _record_splats(self, cb, pipeline):
-        cb.bind_pipeline(pipeline)
-        cb.bind_descriptor_set(pipeline, self.splat_set)
-        cb.bind_vertex_buffers(0, [self._geom, self._color, self._flags, self._basis_binding()])
-        cb.push_constants(pipeline, self._push_dC())
-        cb.draw(4, self.n)
+    def _use_prepass(self) -> bool:
+        if not self.prepass:
+            return False
+        t = self._targets
+        if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
+            return False
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        sizes = [self.n * _REC_A_BYTES, self.n * _REC_B_BYTES, self._geom.size, self._basis_binding().size]
+        return max(sizes) <= limit
+
+    def _prep_objects(self):
+        if self._prep is None:
+            dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET))
+            objs = [dset]
+            try:
+                rec_a = V.Buffer(self.dev, self.n * _REC_A_BYTES, ("storage",))
+                objs.append(rec_a)
+                rec_b = V.Buffer(self.dev, self.n * _REC_B_BYTES, ("storage",))
+                objs.append(rec_b)
+                draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
+                objs.append(draws)
+                dset.write({0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: self._basis_binding(),
+                            5: rec_a, 6: rec_b, 7: draws})
+            except BaseException:
+                for o in reversed(objs):
+                    o.destroy()
+                raise
+            self._prep = (dset, rec_a, rec_b, draws)
+        return self._prep
+
+    def _record_prepass(self, cb):
+        """Compute pre-pass: records + indirect draw counts for this frame's camera."""
+        dset, _, _, draws = self._prep_objects()
+        g = self._basis_cols // 4
+        comp = "prepare.comp" if g == 1 else f"prepare_k{4 * g}.comp"
+        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=48 * g + 4, push_stages="comp")
+        pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
+        cb.fill_buffer(draws, 0)
+        cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, dset)
+        push = np.concatenate([self._push_dC().view(np.uint32), np.array([self.n], np.uint32)])
+        cb.push_constants(pipe, push)
+        cb.dispatch((self.n + _WORKGROUP - 1) // _WORKGROUP)
+        cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
+                          "indirect_read|shader_read")
+
+    def _prepared_pipeline(self, kind: str, mode: int):
+        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=4, push_stages="vert")
+        common = dict(depth_test=True, spec=((0, mode),),
+                      topology="point_list" if mode == 2 else "triangle_strip")
+        if kind == "depth":
+            desc = V.GraphicsDesc("prepared.vert", "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
+                                  depth_compare="less", **common)
+        elif kind == "attr":
+            desc = V.GraphicsDesc("prepared.vert", "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"),
+                                  layout, depth_write=False, depth_compare="less_equal", blend_add=(True, True),
+                                  **common)
+        else:
+            desc = V.GraphicsDesc("prepared.vert", "splat_pick.frag", _RP_PICK, layout, depth_write=True,
+                                  depth_compare="less", **common)
+        return self.cache.pipeline(desc)
+
+    def _record_splats(self, cb, kind: str, prepared: bool = False):
+        """Draw every splat: as quads, or (point_splats) tiny ones as points + the others as quads."""
+        if prepared:
+            dset, _, _, draws = self._prep_objects()
+            n = np.array([self.n], np.uint32)
+            for mode, offset in ((1, 0), (2, 16)):
+                pipeline = self._prepared_pipeline(kind, mode)
+                cb.bind_pipeline(pipeline)
+                cb.bind_descriptor_set(pipeline, dset)
+                cb.push_constants(pipeline, n)
+                cb.draw_indirect(draws, offset)
+            return
+        modes = ((1, 4), (2, 1)) if self.point_splats else ((0, 4),)
+        bufs = [self._geom, self._color, self._flags, self._basis_binding()]
+        dC = self._push_dC()
+        for mode, verts in modes:
+            pipeline = self._splat_pipeline(kind, mode)
+            cb.bind_pipeline(pipeline)
+            cb.bind_descriptor_set(pipeline, self.splat_set)
+            cb.bind_vertex_buffers(0, bufs)
+            cb.push_constants(pipeline, dC)
+            if verts == 4:
+                cb.draw(4, self.n)
+            else:
+                cb.draw(1, self.n)
 
     def _record_passes_12(self, cb, t: _Targets, attr_final: str):
         cb.timestamp(self._query, 0, bottom=False)
-        cb.begin_render_pass(self.cache.render_pass(_RP_DEPTH), t.fb_depth, [1.0])
-        self._record_splats(cb, self._splat_pipeline("depth"))
-        cb.end_render_pass()
+        prepared = self._use_prepass()
+        if prepared:
+            self._record_prepass(cb)
         cb.timestamp(self._query, 1)
+        cb.begin_render_pass(self.cache.render_pass(_RP_DEPTH), t.fb_depth, [1.0])
+        self._record_splats(cb, "depth", prepared)
+        cb.end_render_pass()
+        cb.timestamp(self._query, 2)
         rp_attr = self.cache.render_pass(_rp_attr(self.accum_format, attr_final))
         cb.begin_render_pass(rp_attr, t.fb_attr if attr_final == "shader_read" else self._fb_attr_readback(t),
                              [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None])
-        self._record_splats(cb, self._splat_pipeline("attr"))
+        self._record_splats(cb, "attr", prepared)
         cb.end_render_pass()
-        cb.timestamp(self._query, 2)
+        cb.timestamp(self._query, 3)
 
     def _fb_attr_readback(self, t: _Targets):
         if getattr(t, "fb_attr_rb", None) is None:
@@ -501,7 +626,7 @@ class Renderer:
         cb.bind_descriptor_set(pipe, t.resolve_set)
         cb.draw(3)
         cb.end_render_pass()
-        cb.timestamp(self._query, 3)
+        cb.timestamp(self._query, 4)
 
     def _read_timings(self, names):
         ts = self._query.results_ns(len(names) + 1)
@@ -524,7 +649,7 @@ class Renderer:
             out = rb.read().reshape(height, width, 4)
         finally:
             rb.destroy()
-        self._read_timings(("visibility", "attributes", "shading"))
+        self._read_timings(("prepass", "visibility", "attributes", "shading"))
         return out
 
     def render_buffers(self, camera: Camera, width: int, height: int) -> dict[str, np.ndarray]:
@@ -553,7 +678,7 @@ class Renderer:
             raw = rb.read()
         finally:
             rb.destroy()
-        self._read_timings(("visibility", "attributes"))
+        self._read_timings(("prepass", "visibility", "attributes"))
         a = V.readback_array(raw[:plane], self.accum_format, width, height).astype(np.float32)
         b = V.readback_array(raw[plane:], self.accum_format, width, height).astype(np.float32)
         w = a[..., 3]
@@ -565,6 +690,38 @@ class Renderer:
             nrm = np.where(fg[..., None], nrm, np.nan)
         return {"depth": depth.astype(np.float32), "normal": nrm.astype(np.float32),
                 "weight": np.where(fg, w, 0.0).astype(np.float32), "color": color.astype(np.float32)}
+
+    def render_points_floor(self, camera: Camera, width: int, height: int) -> float:
+        """Benchmark floor: draw the splat centres as one-pixel POINT_LIST points
+        (colour + depth test, no splatting); returns the GPU time in ms."""
+        self._check_open()
+        self._require_cloud()
+        t = self._targets_for(width, height)
+        if getattr(t, "fb_points", None) is None:
+            t.points_color = V.Image(self.dev, width, height, "rgba8", ("color",))
+            t.objects.append(t.points_color)
+            t.points_depth = V.Image(self.dev, width, height, "d32f", ("depth",))
+            t.objects.append(t.points_depth)
+            t.fb_points = t._fb(self.dev, self.cache.render_pass(_RP_POINTS), [t.points_color, t.points_depth])
+        desc = V.GraphicsDesc("points.vert", "points.frag", _RP_POINTS, V.LayoutDesc(sets=(_SPLAT_SET,)),
+                              topology="point_list", bindings=(V.VertexBinding(0, _GEOM_STRIDE, per_instance=False),),
+                              attributes=(V.VertexAttribute(0, 0, "vec3", 0),), depth_test=True, depth_write=True)
+        pipe = self.cache.pipeline(desc)
+
+        def rec(cb):
+            self._write_ubo(camera, width, height)
+            cb.reset_queries(self._query)
+            cb.timestamp(self._query, 0, bottom=False)
+            cb.begin_render_pass(self.cache.render_pass(_RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
+            cb.bind_pipeline(pipe)
+            cb.bind_descriptor_set(pipe, self.splat_set)
+            cb.bind_vertex_buffers(0, [self._geom])
+            cb.draw(self.n)
+            cb.end_render_pass()
+            cb.timestamp(self._query, 1)
+        self.dev.submit(rec)
+        self._read_timings(("points",))
+        return self.last_timings_ms["points"]
 
     def pick(self, camera: Camera, width: int, height: int, rect=None):
         """Splat index per pixel (-1 background) and eye-space depth along the
@@ -590,8 +747,11 @@ class Renderer:
                 self._write_ubo(camera, width, height)
                 cb.reset_queries(self._query)
                 cb.timestamp(self._query, 0, bottom=False)
+                prepared = self._use_prepass()
+                if prepared:
+                    self._record_prepass(cb)
                 cb.begin_render_pass(self.cache.render_pass(_RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
-                self._record_splats(cb, self._splat_pipeline("pick"))
+                self._record_splats(cb, "pick", prepared)
                 cb.end_render_pass()
                 cb.timestamp(self._query, 1)
                 cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))

@@ -1,0 +1,89 @@
+// Compute pre-pass (once per splat per frame): deformation, eye transform,
+// culling and the screen-space setup of prepare_splat(), written as compact
+// records for the two splat passes (drawn by prepared.vert with indirect
+// draws): quads fill slots 0.. upwards, one-pixel points slots n-1 downwards.
+// The including file defines BASIS_GROUPS.
+
+#include "frame.glsl"
+
+layout(local_size_x = 64) in;
+
+shared uint s_count[2];   // quads, points in this workgroup
+shared uint s_base[2];
+
+layout(push_constant) uniform Push {
+    vec4 dC[3 * BASIS_GROUPS];
+    uint n;
+} P;
+
+layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // 9 floats per splat
+layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8
+layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };
+layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat
+layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // 3 per slot
+layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // 2 per slot
+layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };             // 2 VkDrawIndirectCommand
+
+#include "splat_math.glsl"
+
+// bound corner in pixels, 16.16 -> 12.4 fixed point (1/16 pixel), rounded outwards
+uint pack_px(vec2 ndc, float dir) {
+    vec2 px = clamp((ndc * 0.5 + 0.5) * F.viewport.xy, vec2(0.0), F.viewport.xy);
+    vec2 q = dir < 0.0 ? floor(px * 16.0) : ceil(px * 16.0);
+    uvec2 u = uvec2(q);
+    return u.x | (u.y << 16);
+}
+
+vec2 oct_encode(vec3 n) {
+    n /= abs(n.x) + abs(n.y) + abs(n.z);
+    vec2 e = n.xy;
+    if (n.z < 0.0) e = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return e;
+}
+
+void main() {
+    uint i = gl_GlobalInvocationID.x;
+    if (i == 0u) { draws[0] = 4u; draws[4] = 1u; }
+    int kind = SPLAT_CULLED;
+    Splat S;
+    if (i < P.n) {
+        vec3 p = vec3(geom[9 * i], geom[9 * i + 1], geom[9 * i + 2]);
+        vec3 u = vec3(geom[9 * i + 3], geom[9 * i + 4], geom[9 * i + 5]);
+        vec3 v = vec3(geom[9 * i + 6], geom[9 * i + 7], geom[9 * i + 8]);
+        uint fl = flags[i];
+        if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
+            vec3 dp = vec3(0.0);
+            mat3 Jm = mat3(0.0);
+            uint b = uint(4 * BASIS_GROUPS) * i;
+            for (int g = 0; g < BASIS_GROUPS; ++g)
+                deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
+                             dp, Jm);
+            p += dp;
+            u += Jm * u;
+            v += Jm * v;
+        }
+        kind = prepare_splat(p, u, v, unpackUnorm4x8(colors[i]).rgb, fl, S);
+    }
+    // workgroup-aggregated slot allocation (one global atomic per workgroup and list)
+    if (gl_LocalInvocationIndex == 0u) { s_count[0] = 0u; s_count[1] = 0u; }
+    barrier();
+    uint local = 0u;
+    if (kind == SPLAT_QUAD) local = atomicAdd(s_count[0], 1u);
+    else if (kind == SPLAT_POINT) local = atomicAdd(s_count[1], 1u);
+    barrier();
+    if (gl_LocalInvocationIndex == 0u) {
+        s_base[0] = s_count[0] > 0u ? atomicAdd(draws[1], s_count[0]) : 0u;
+        s_base[1] = s_count[1] > 0u ? atomicAdd(draws[5], s_count[1]) : 0u;
+    }
+    barrier();
+    if (kind == SPLAT_CULLED) return;
+    uint slot = kind == SPLAT_QUAD ? s_base[0] + local : P.n - 1u - (s_base[1] + local);
+    recA[3 * slot] = S.ms_cn;
+    recA[3 * slot + 1] = S.mt_tc;
+    recA[3 * slot + 2] = S.mw_r;
+    vec2 pos = kind == SPLAT_QUAD ? S.lo : S.cc;
+    recB[2 * slot] = uvec4(floatBitsToUint(S.center.x), floatBitsToUint(S.center.y), floatBitsToUint(S.center.w),
+                           i + 1u);
+    recB[2 * slot + 1] = uvec4(kind == SPLAT_QUAD ? pack_px(S.lo, -1.0) : 0u, kind == SPLAT_QUAD ? pack_px(S.hi, 1.0) : 0u,
+                               packUnorm4x8(vec4(S.color, 1.0)), packSnorm2x16(oct_encode(S.normal)));
+}

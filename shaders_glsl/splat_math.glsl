@@ -1,0 +1,103 @@
+// Per-splat math shared by the splat vertex shader (splat_vs.glsl) and the
+// compute pre-pass (prepare.comp).  Requires frame.glsl and a push-constant
+// block P with vec4 dC[3 * BASIS_GROUPS].
+
+struct Splat {
+    vec4 ms_cn, mt_tc, mw_r;   // screen -> tangent mapping (see splat_varyings.glsl)
+    vec4 center;               // centre (pixels), 1/lowpass^2, visibility epsilon
+    vec3 color;                // linear rgb with selection tint
+    vec3 normal;               // unit eye-space normal facing the viewer
+    vec2 lo, hi;               // screen bound (NDC)
+    vec2 cc;                   // projected centre (NDC)
+};
+
+const int SPLAT_CULLED = 0;
+const int SPLAT_QUAD = 1;
+const int SPLAT_POINT = 2;
+
+// p' = p + sum_k B_k dC_k;  J_ij = delta_ij + sum_k dC_k[i] B{j}_k;  u' = J u, v' = J v
+// (one group of 4 columns; dp and Jm = J - I accumulate over groups)
+void deform_group(int g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inout mat3 Jm) {
+    vec4 dx = P.dC[3 * g], dy = P.dC[3 * g + 1], dz = P.dC[3 * g + 2];
+    dp += vec3(dot(B, dx), dot(B, dy), dot(B, dz));
+    Jm[0] += vec3(dot(dx, Bx), dot(dy, Bx), dot(dz, Bx));
+    Jm[1] += vec3(dot(dx, By), dot(dy, By), dot(dz, By));
+    Jm[2] += vec3(dot(dx, Bz), dot(dy, Bz), dot(dz, Bz));
+}
+
+// Offset of the screen-space extent of the projected ellipse along one axis,
+// relative to the projected centre: a' = (U.x - xc U.w, V.x - xc V.w), wxy = (U.w, V.w).
+// Tangent lines of the conic h^T diag(1,1,-1) h = 0 (cancellation-free form).
+vec2 extent(vec2 ap, vec2 wxy, float cw) {
+    float wDw = dot(wxy, wxy) - cw * cw;                  // < 0: ellipse in front of the eye
+    float aDw = dot(ap, wxy);
+    float cr = ap.x * wxy.y - ap.y * wxy.x;
+    float disc = max(dot(ap, ap) * cw * cw - cr * cr, 0.0);
+    float sq = sqrt(disc);
+    float e0 = (aDw + sq) / wDw, e1 = (aDw - sq) / wDw;
+    return vec2(min(e0, e1), max(e0, e1));
+}
+
+// Everything a splat needs on screen, from its (deformed) model-space centre
+// and axes.  Returns SPLAT_CULLED (outside the frustum, back-facing with
+// culling on, degenerate), SPLAT_POINT (ellipse bound <= F.misc.w pixels) or
+// SPLAT_QUAD.
+int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
+    S.ms_cn = vec4(0.0); S.mt_tc = vec4(0.0); S.mw_r = vec4(0.0); S.center = vec4(0.0);
+    S.color = vec3(0.0); S.normal = vec3(0.0); S.lo = vec2(0.0); S.hi = vec2(0.0); S.cc = vec2(0.0);
+    mat3 R3 = mat3(F.view);
+    vec3 c = (F.view * vec4(p, 1.0)).xyz;
+    vec3 ue = R3 * u, ve = R3 * v;
+    vec3 nraw = cross(ue, ve);
+    float area = length(nraw);
+    float rad = max(length(ue), length(ve));
+    if (!(area > 0.0)) return SPLAT_CULLED;
+    vec3 n = nraw / area;
+    float cn = dot(c, n);
+    if (F.options.x != 0u && cn > 0.0) return SPLAT_CULLED;   // back-facing
+
+    float near = F.depth_params.x, far = F.depth_params.y;
+    vec4 U = F.proj * vec4(ue, 0.0), V = F.proj * vec4(ve, 0.0), C = F.proj * vec4(c, 1.0);
+    vec2 wxy = vec2(U.w, V.w);
+    float wr = length(wxy);
+    if (C.w + wr < near || C.w - wr > far) return SPLAT_CULLED;   // in front of near / beyond far
+
+    vec2 px_ndc = 2.0 * F.viewport.zw;                   // one pixel in NDC
+    float lp = F.depth_params.w;
+    bool small = false;
+    if (C.w - wr < near * 1.001) {
+        S.lo = vec2(-1.0); S.hi = vec2(1.0);             // crosses the near plane: full viewport
+    } else {
+        vec2 cc = C.xy / C.w;
+        vec2 ex = extent(vec2(U.x - cc.x * U.w, V.x - cc.x * V.w), wxy, C.w);
+        vec2 ey = extent(vec2(U.y - cc.y * U.w, V.y - cc.y * V.w), wxy, C.w);
+        vec2 lpr = lp * px_ndc;
+        // exact bound of the ellipse and the low-pass disc; fragments are
+        // sampled at pixel centres, so only a rounding margin is needed
+        vec2 lo = cc + min(vec2(ex.x, ey.x), -lpr) - 0.02 * px_ndc;
+        vec2 hi = cc + max(vec2(ex.y, ey.y), lpr) + 0.02 * px_ndc;
+        if (any(greaterThan(lo, vec2(1.0))) || any(lessThan(hi, vec2(-1.0)))) return SPLAT_CULLED;
+        S.lo = max(lo, vec2(-1.0) - px_ndc);
+        S.hi = min(hi, vec2(1.0) + px_ndc);
+        vec2 sz = vec2(ex.y - ex.x, ey.y - ey.x) * 0.5 * F.viewport.xy;   // ellipse bound, pixels
+        small = max(sz.x, sz.y) <= F.misc.w;
+    }
+    S.cc = C.xy / C.w;
+
+    vec3 ud = cross(ve, n) / area, vd = cross(n, ue) / area;   // dual basis: ud.ue = 1, ud.ve = 0
+    vec3 As = cn * ud - dot(ud, c) * n;
+    vec3 At = cn * vd - dot(vd, c) * n;
+    float D00 = F.pix_to_ray.x, D02 = F.pix_to_ray.y, D11 = F.pix_to_ray.z, D12 = F.pix_to_ray.w;
+    S.ms_cn = vec4(D00 * As.x, D11 * As.y, D02 * As.x + D12 * As.y - As.z, cn);
+    S.mt_tc = vec4(D00 * At.x, D11 * At.y, D02 * At.x + D12 * At.y - At.z, -c.z);
+    S.mw_r = vec4(D00 * n.x, D11 * n.y, D02 * n.x + D12 * n.y - n.z, rad);
+    vec2 cpx = (S.cc * 0.5 + 0.5) * F.viewport.xy;
+    S.center = vec4(cpx, 1.0 / (lp * lp), F.depth_params.z * rad);
+
+    vec3 col = pow(srgb, vec3(2.2));
+    if ((flags & FLAG_SUPPORT) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
+    if ((flags & FLAG_HANDLE) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
+    S.color = col;
+    S.normal = cn > 0.0 ? -n : n;
+    return small ? SPLAT_POINT : SPLAT_QUAD;
+}

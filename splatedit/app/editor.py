@@ -1,0 +1,886 @@
+"""The interactive editor: ``splatedit edit [FILE]``.
+
+A glfw window presenting through a Vulkan swapchain
+(:mod:`splatedit.render.vk.swapchain`); frames come from the EWA splat
+renderer (:mod:`splatedit.app.viewport`), the overlay is composited on the
+CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
+worker threads; the loop polls them and stays responsive.
+
+Entry point: :func:`run_editor`.  The controls are in :data:`CONTROLS`.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+import os
+import sys
+import threading
+import time
+import traceback
+from pathlib import Path
+
+import numpy as np
+
+from splatedit.app import overlay as ov
+from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, stroke_points
+from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.session import GRAB, ROTATE, SCALE, Session, ViewInfo
+from splatedit.errors import SplatEditError
+from splatedit.tolerances import IQR_DEFAULT_TOL
+
+CONTROLS = """\
+Camera
+  Middle drag            orbit around the pivot          (laptop: Alt + left drag)
+  Shift + middle drag    pan                             (laptop: Alt + Shift + left drag)
+  Ctrl + middle drag     dolly
+  Wheel                  zoom to the cursor
+  Home                   frame the whole model
+  F  or  numpad .        frame the selection (handle, else support)
+  Numpad 1 / 3 / 7       front / right / top view
+Selection (paper Sect. 3: support = blue, handle = green)
+  Left drag              paint with the brush (only visible splats)
+  Ctrl + left drag       erase with the brush            (E toggles erase mode)
+  1 / 2  or  Tab         brush paints the support / the handle (handle stays inside the support)
+  [ / ]  or  Ctrl+wheel  brush radius
+  C / Shift+C            clear the selection / clear the handle
+Deformation (after the handle is painted the basis is fitted in the background)
+  Left drag on handle    move the handle in the view plane, release applies
+  G / R / S              grab / rotate / scale the handle with the mouse
+    X / Y / Z            constrain to that world axis (again: free)
+    0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)
+    Enter or left click  apply (the result becomes the new base, selection kept)
+    Esc or right click   cancel
+File and history
+  Ctrl+Z / Ctrl+Shift+Z  undo / redo (edits and selections; Ctrl+Y also redoes)
+  Ctrl+S                 save <name>-edited.ply (+ <name>-edited.edits.json edit script)
+  Ctrl+Shift+S           save as: type a path, Enter
+  Ctrl+E                 export only the edit script
+  F1  or  H              show / hide this help
+  Q  or  Esc             quit (asks first when there are unsaved changes: Y, Q or Esc again quits, N stays)
+"""
+
+#: the brush radius range (pixels)
+BRUSH_MIN, BRUSH_MAX = 2, 400
+#: seconds without motion after which the full-quality frame is drawn
+REFINE_DELAY = 0.2
+#: models with more splats than this get a level-of-detail pyramid
+LOD_MIN_SPLATS = 150_000
+
+
+# ------------------------------------------------------------ worker jobs
+class Job:
+    """A function run in a daemon thread with progress and a result."""
+
+    def __init__(self, name: str, fn, wake=None):
+        self.name = name
+        self.stage = name
+        self.fraction = 0.0
+        self.result = None
+        self.error: BaseException | None = None
+        self.done = False
+        self.started = time.perf_counter()
+        self._wake = wake
+
+        def run():
+            try:
+                self.result = fn(self.progress)
+            except BaseException as exc:  # noqa: BLE001 - reported in the overlay
+                self.error = exc
+                if not isinstance(exc, SplatEditError):
+                    traceback.print_exc()
+            self.done = True
+            if self._wake:
+                self._wake()
+
+        self.thread = threading.Thread(target=run, name=f"splatedit-{name}", daemon=True)
+        self.thread.start()
+
+    def progress(self, stage: str, fraction: float) -> None:
+        self.stage, self.fraction = stage, fraction
+
+
+def _default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
+    stem = Path(name).stem if name else (src.stem if src else "model")
+    folder = Path.cwd()
+    if src is not None and not bundled and os.access(src.parent, os.W_OK):
+        folder = src.parent
+    p = folder / f"{stem}-edited.ply"
+    k = 2
+    while p.exists():
+        p = folder / f"{stem}-edited-{k}.ply"
+        k += 1
+    return p
+
+
+def script_path_for(ply: Path) -> Path:
+    return ply.with_suffix("").with_name(ply.with_suffix("").name + ".edits.json")
+
+
+# ------------------------------------------------------------------ editor
+class Editor:
+    def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
+                 tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
+                 budget_ms=100.0, lod=True, bundled=False, max_seconds=None):
+        import glfw
+        from splatedit.render.vk.swapchain import SwapchainPresenter
+        from splatedit.render.vk.window import Window
+        self.g = glfw
+        self.path = Path(path) if path is not None else None
+        self.bundled = bundled
+        self.save_as = Path(save_as) if save_as else None
+        self.method, self.tol, self.max_centers = method, tol, max_centers
+        self.status_file = Path(status_file) if status_file else None
+        self.use_lod = lod
+        self.max_seconds = max_seconds
+        self.window = Window("splatedit", *size)
+        self.presenter = None
+        self.viewport = None
+        try:
+            self.presenter = SwapchainPresenter(self.window.handle, vsync=vsync)
+            from splatedit.app.viewport import Viewport
+            self.viewport = Viewport(budget_ms=budget_ms)
+        except BaseException:
+            self.close()
+            raise
+        self.cam = OrbitCamera()
+        self.session: Session | None = None
+        self.cloud_name = self.path.name if self.path else "model"
+        self.jobs: dict[str, Job] = {}
+        self.running = True
+        self.exit_code = 0
+        # view / interaction state
+        self.brush_radius = 24.0
+        self.erase_toggle = False
+        self.show_help = False
+        self.confirm_quit = False
+        self.prompt: str | None = None      # save-as path being typed
+        self.drag = None                     # orbit/pan/dolly/paint/manip
+        self.drag_last = (0.0, 0.0)
+        self.stroke_changed = False
+        self.manip_by_drag = False
+        self.mouse = (0.0, 0.0)
+        self.picker = None
+        self.picker_key = None
+        self.message = ""
+        self.message_time = 0.0
+        # frames
+        self.scene = None
+        self.scene_key = None
+        self.scene_interactive = False
+        self.last_motion = 0.0
+        self.frame_ms = 0.0
+        self.frames = 0
+        self.saved_path: Path | None = None
+        self.saved_script: Path | None = None
+        self.validation_count = 0
+        self._status_last = None
+        self.panel_box = (0, 0, 0, 0)
+        self.sel_version_seen = -1
+        self.start_time = time.perf_counter()
+
+    # ---------------------------------------------------------------- utils
+    def wake(self) -> None:
+        try:
+            self.window.post_empty_event()
+        except Exception:  # noqa: BLE001 - window closing
+            pass
+
+    def say(self, text: str) -> None:
+        self.message = text
+        self.message_time = time.perf_counter()
+        print(f"splatedit: {text}", file=sys.stderr)
+
+    @property
+    def size(self) -> tuple[int, int]:
+        return self.window.framebuffer_size()
+
+    def motion(self) -> None:
+        self.last_motion = time.perf_counter()
+
+    # -------------------------------------------------------------- loading
+    def start_load(self) -> None:
+        path = self.path
+
+        def work(progress):
+            from splatedit.io import read
+            cloud = read(str(path), progress=progress)
+            if not cloud.name:
+                cloud.name = path.name
+            return cloud
+
+        self.jobs["load"] = Job("loading", work, self.wake)
+
+    def on_loaded(self, cloud) -> None:
+        self.cloud_name = cloud.name or self.cloud_name
+        self.session = Session(cloud, method=self.method, tol=self.tol, max_centers=self.max_centers,
+                               on_change=self.wake)
+        self.viewport.set_cloud(cloud)
+        r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
+        self.cam.scene_radius = max(r, 1e-9)
+        self.frame_all()
+        self.window.set_title(f"splatedit - {self.cloud_name}")
+        if self.use_lod and cloud.n >= LOD_MIN_SPLATS:
+            def work(progress):
+                from splatedit.model.lod import LodPyramid
+                return LodPyramid(cloud, progress=progress)
+            self.jobs["lod"] = Job("levels of detail", work, self.wake)
+        self.say(f"loaded {self.cloud_name}: {cloud.n:,} splats")
+
+    def poll_jobs(self) -> None:
+        for name, job in list(self.jobs.items()):
+            if not job.done:
+                continue
+            del self.jobs[name]
+            if job.error is not None:
+                if name == "load":
+                    self.say(f"cannot open {self.path}: {job.error}")
+                    self.exit_code = 2
+                    self.running = False
+                else:
+                    self.say(f"{job.name} failed: {job.error}")
+                continue
+            if name == "load":
+                self.on_loaded(job.result)
+            elif name == "lod":
+                self.viewport.set_pyramid(job.result)
+                counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
+                self.say(f"levels of detail ready ({counts} splats)")
+            elif name == "save":
+                ply, script, pos = job.result
+                self.session.history.mark_saved(pos)
+                self.saved_path, self.saved_script = ply, script
+                self.say(f"saved {ply} and {script.name}")
+            elif name == "export":
+                self.saved_script = job.result
+                self.say(f"edit script written to {job.result}")
+
+    # --------------------------------------------------------------- camera
+    def frame_all(self) -> None:
+        if self.session is None:
+            return
+        w, h = self.size
+        lo, hi = self.session.cloud.bounds()
+        c = (lo + hi) / 2
+        self.cam.frame(c, float(np.linalg.norm(hi - lo)) / 2, w / max(h, 1))
+        self.motion()
+
+    def frame_selection(self) -> None:
+        s = self.session
+        if s is None:
+            return
+        m = s.selection.handle if s.selection.handle.any() else s.selection.support
+        if not m.any():
+            self.frame_all()
+            return
+        w, h = self.size
+        self.cam.frame_points(s.cloud.positions[m], w / max(h, 1))
+        self.motion()
+
+    def view_preset(self, yaw: float, pitch: float) -> None:
+        self.cam.yaw, self.cam.pitch = yaw, pitch
+        self.motion()
+
+    def view_info(self) -> ViewInfo:
+        w, h = self.size
+        r, u, b = self.cam.basis()
+        piv = self.session.handle_centroid()
+        px, depth = self.cam.project(piv, w, h)
+        return ViewInfo(r, u, b, (float(px[0, 0]), float(px[0, 1])),
+                        self.cam.world_per_pixel(max(float(depth[0]), 1e-9), h))
+
+    # -------------------------------------------------------------- picking
+    def get_picker(self) -> BrushPicker:
+        w, h = self.size
+        s = self.session
+        key = (self.cam.state(), w, h, id(s.cloud))
+        if self.picker is None or self.picker_key != key:
+            idx, _ = self.viewport.pick(self.cam, w, h)
+            px, depth = self.cam.project(s.cloud.positions, w, h)
+            self.picker = BrushPicker(idx, px, depth, s.cloud.radii)
+            self.picker_key = key
+        return self.picker
+
+    def splat_under(self, x: float, y: float) -> int:
+        p = self.get_picker().pick
+        ix, iy = int(x), int(y)
+        if 0 <= iy < p.shape[0] and 0 <= ix < p.shape[1]:
+            return int(p[iy, ix])
+        return -1
+
+    def paint_at(self, points) -> None:
+        s = self.session
+        erase = self.erase_toggle or bool(self.window.mods() & self.g.MOD_CONTROL)
+        picker = self.get_picker()
+        changed = False
+        for x, y in points:
+            changed |= s.paint(picker.query(x, y, self.brush_radius), erase=erase)
+        if changed:
+            self.stroke_changed = True
+            self.motion()
+
+    # ---------------------------------------------------------------- input
+    def handle_events(self, events) -> None:
+        for e in events:
+            try:
+                getattr(self, f"on_{e.kind}")(e)
+            except SplatEditError as exc:
+                self.say(str(exc))
+
+    def on_resize(self, e) -> None:
+        self.scene_key = None
+        self.motion()
+
+    def on_iconify(self, e) -> None:
+        self.scene_key = None
+
+    def on_close(self, e) -> None:
+        self.request_quit()
+
+    def on_char(self, e) -> None:
+        if self.prompt is not None and e.char.isprintable():
+            self.prompt += e.char
+
+    def on_scroll(self, e) -> None:
+        if self.session is None:
+            return
+        if e.mods & self.g.MOD_CONTROL:
+            self.brush_radius = float(np.clip(self.brush_radius * (1.15 ** e.dy), BRUSH_MIN, BRUSH_MAX))
+            return
+        w, h = self.size
+        depth = None
+        try:
+            i = self.splat_under(e.x, e.y) if self.drag is None and self.session.manip is None else -1
+        except Exception:  # noqa: BLE001 - picking is best effort here
+            i = -1
+        if i >= 0:
+            _, d = self.cam.project(self.session.cloud.positions[i], w, h)
+            depth = float(d[0])
+        self.cam.dolly(e.dy, e.x, e.y, w, h, depth)
+        self.motion()
+
+    def on_move(self, e) -> None:
+        x, y = e.x, e.y
+        lx, ly = self.drag_last
+        dx, dy = x - lx, y - ly
+        self.mouse = (x, y)
+        w, h = self.size
+        s = self.session
+        if self.drag == "orbit":
+            self.cam.orbit(dx, dy)
+            self.motion()
+        elif self.drag == "pan":
+            self.cam.pan(dx, dy, h)
+            self.motion()
+        elif self.drag == "dolly":
+            self.cam.dolly(-dy / 20.0)
+            self.motion()
+        elif self.drag == "paint" and s is not None:
+            self.paint_at(stroke_points(lx, ly, x, y, self.brush_radius))
+        if s is not None and s.manip is not None:
+            s.manip.mouse = (x, y)
+            self.motion()
+        self.drag_last = (x, y)
+
+    def on_button(self, e) -> None:
+        g = self.g
+        s = self.session
+        x, y = e.x, e.y
+        self.mouse = (x, y)
+        if e.action == g.RELEASE:
+            if self.drag == "paint" and s is not None:
+                s.end_stroke(self.stroke_changed)
+                self.stroke_changed = False
+            if self.drag == "manip" and s is not None and s.manip is not None:
+                self.commit()
+            self.drag = None
+            return
+        if e.action != g.PRESS or s is None or self.prompt is not None or self.confirm_quit:
+            return
+        self.drag_last = (x, y)
+        alt = bool(e.mods & g.MOD_ALT)
+        shift = bool(e.mods & g.MOD_SHIFT)
+        ctrl = bool(e.mods & g.MOD_CONTROL)
+        if s.manip is not None:
+            if e.button == g.MOUSE_BUTTON_LEFT:
+                self.commit()
+            elif e.button == g.MOUSE_BUTTON_RIGHT:
+                s.cancel()
+                self.motion()
+            return
+        if e.button == g.MOUSE_BUTTON_MIDDLE or (e.button == g.MOUSE_BUTTON_LEFT and alt):
+            self.drag = "pan" if shift else ("dolly" if ctrl and not alt else "orbit")
+            return
+        if e.button == g.MOUSE_BUTTON_LEFT:
+            if s.basis is not None and not ctrl and not self.erase_toggle:
+                i = self.splat_under(x, y)
+                if i >= 0 and s.selection.handle[i]:
+                    if s.begin(GRAB, self.view_info(), (x, y)):
+                        self.drag = "manip"
+                        self.motion()
+                        return
+            self.drag = "paint"
+            self.stroke_changed = False
+            self.paint_at([(x, y)])
+
+    def on_key(self, e) -> None:
+        g = self.g
+        if e.action not in (g.PRESS, g.REPEAT):
+            return
+        k, mods = e.key, e.mods
+        ctrl, shift = bool(mods & g.MOD_CONTROL), bool(mods & g.MOD_SHIFT)
+        s = self.session
+        if self.prompt is not None:
+            if k in (g.KEY_ENTER, g.KEY_KP_ENTER):
+                path, self.prompt = self.prompt.strip(), None
+                if path:
+                    self.save(Path(path).expanduser())
+            elif k == g.KEY_ESCAPE:
+                self.prompt = None
+            elif k == g.KEY_BACKSPACE:
+                self.prompt = self.prompt[:-1]
+            return
+        if self.confirm_quit:
+            if k in (g.KEY_Y, g.KEY_Q, g.KEY_ESCAPE):
+                self.running = False
+            else:
+                self.confirm_quit = False
+            return
+        if k in (g.KEY_F1, g.KEY_H) and not ctrl:
+            self.show_help = not self.show_help
+            return
+        if s is None:
+            if k in (g.KEY_Q, g.KEY_ESCAPE):
+                self.running = False
+            return
+        # ---- manipulation in progress
+        if s.manip is not None:
+            m = s.manip
+            if k in (g.KEY_X, g.KEY_Y, g.KEY_Z):
+                m.set_axis({g.KEY_X: 0, g.KEY_Y: 1, g.KEY_Z: 2}[k])
+            elif k in (g.KEY_ENTER, g.KEY_KP_ENTER):
+                self.commit()
+            elif k == g.KEY_ESCAPE:
+                s.cancel()
+                self.drag = None
+            elif k == g.KEY_BACKSPACE:
+                m.backspace()
+            elif k in (g.KEY_G, g.KEY_R, g.KEY_S):
+                m.mode = {g.KEY_G: GRAB, g.KEY_R: ROTATE, g.KEY_S: SCALE}[k]
+                m.typed = ""
+            else:
+                ch = _typed_char(g, k)
+                if ch is not None:
+                    m.type_char(ch)
+            self.motion()
+            return
+        # ---- idle
+        if ctrl:
+            if k == g.KEY_Z:
+                ok = s.redo() if shift else s.undo()
+                self.say(("redo" if shift else "undo") + ("" if ok else ": nothing to do"))
+            elif k == g.KEY_Y:
+                self.say("redo" if s.redo() else "redo: nothing to do")
+            elif k == g.KEY_S:
+                if shift:
+                    self.prompt = str(self.save_target())
+                else:
+                    self.save(self.save_target())
+            elif k == g.KEY_E:
+                self.export_script()
+            self.motion()
+            return
+        if k in (g.KEY_G, g.KEY_R, g.KEY_S):
+            if s.basis is None:
+                self.say("paint a support region and a handle first" if not s.selection.handle.any()
+                         else "the deformation is still being fitted")
+            else:
+                s.begin({g.KEY_G: GRAB, g.KEY_R: ROTATE, g.KEY_S: SCALE}[k], self.view_info(), self.mouse)
+                self.motion()
+        elif k == g.KEY_TAB:
+            s.brush_target = HANDLE if s.brush_target == SUPPORT else SUPPORT
+        elif k in (g.KEY_1, g.KEY_2):
+            s.brush_target = SUPPORT if k == g.KEY_1 else HANDLE
+        elif k == g.KEY_E:
+            self.erase_toggle = not self.erase_toggle
+        elif k == g.KEY_C:
+            s.clear(HANDLE if shift else None)
+        elif k == g.KEY_LEFT_BRACKET:
+            self.brush_radius = max(BRUSH_MIN, self.brush_radius / 1.2)
+        elif k == g.KEY_RIGHT_BRACKET:
+            self.brush_radius = min(BRUSH_MAX, self.brush_radius * 1.2)
+        elif k == g.KEY_HOME:
+            self.frame_all()
+        elif k in (g.KEY_F, g.KEY_KP_DECIMAL):
+            self.frame_selection()
+        elif k == g.KEY_KP_1:
+            self.view_preset(0.0, 0.0)
+        elif k == g.KEY_KP_3:
+            self.view_preset(math.pi / 2, 0.0)
+        elif k == g.KEY_KP_7:
+            self.view_preset(0.0, math.radians(89.0))
+        elif k in (g.KEY_Q, g.KEY_ESCAPE):
+            self.request_quit()
+        self.motion()
+
+    # -------------------------------------------------------------- actions
+    def commit(self) -> None:
+        s = self.session
+        self.drag = None
+        try:
+            if s.commit():
+                st = s.stats()
+                self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
+                del st
+        except SplatEditError as exc:
+            s.cancel()
+            self.say(f"edit not applied: {exc}")
+        self.motion()
+
+    def save_target(self) -> Path:
+        if self.save_as is not None:
+            return self.save_as
+        if self.saved_path is not None:
+            return self.saved_path
+        self.save_as = _default_save_path(self.path, self.cloud_name, self.bundled)
+        return self.save_as
+
+    def save(self, path: Path) -> None:
+        s = self.session
+        if "save" in self.jobs:
+            self.say("a save is already running")
+            return
+        cloud, script, pos = s.cloud, s.edit_script(), s.history.position
+        self.save_as = path
+        spath = script_path_for(path)
+
+        def work(progress):
+            from splatedit.io import write
+            progress("saving", 0.0)
+            write(str(path), cloud, overwrite=True)
+            script.save(spath)
+            return path, spath, pos
+
+        self.jobs["save"] = Job("saving", work, self.wake)
+        self.say(f"saving {path} ...")
+
+    def export_script(self) -> None:
+        s = self.session
+        script = s.edit_script()
+        spath = script_path_for(self.save_target())
+
+        def work(progress):
+            script.save(spath)
+            return spath
+
+        self.jobs["export"] = Job("exporting", work, self.wake)
+
+    def request_quit(self) -> None:
+        s = self.session
+        if s is not None and s.dirty and not self.confirm_quit:
+            self.confirm_quit = True
+            self.say("unsaved changes: press Y (or Q/Esc) to quit without saving, N to stay")
+        else:
+            self.running = False
+
+    # ---------------------------------------------------------------- frame
+    def sync_document(self) -> None:
+        s = self.session
+        vp = self.viewport
+        if vp.cloud is not s.cloud:
+            vp.set_cloud(s.cloud)
+            self.picker = None
+        if self.sel_version_seen != s.version:
+            vp.set_selection(s.selection.support, s.selection.handle, s.version)
+            self.sel_version_seen = s.version
+        if vp.basis is not s.basis:
+            vp.set_basis(s.basis)
+        vp.set_dc(s.current_dc() if (s.basis is not None and s.manip is not None) else None)
+
+    def scene_state(self) -> tuple:
+        s = self.session
+        dc = None if self.viewport.dc is None else self.viewport.dc.tobytes()
+        return (self.cam.state(), self.size, id(s.cloud), s.version, id(s.basis), dc)
+
+    def draw(self) -> None:
+        w, h = self.size
+        if w == 0 or h == 0 or self.window.iconified():
+            return
+        t0 = time.perf_counter()
+        if self.session is None:
+            frame = np.full((h, w, 4), 255, np.uint8)
+        else:
+            self.sync_document()
+            key = self.scene_state()
+            moving = time.perf_counter() - self.last_motion < REFINE_DELAY or self.drag is not None
+            if self.scene is None or key != self.scene_key or (self.scene_interactive and not moving):
+                self.scene = self.viewport.render(self.cam, w, h, interactive=moving)
+                self.scene_key = key
+                self.scene_interactive = moving and (self.viewport.last_info.get("lod")
+                                                     or self.viewport.last_info.get("div", 1) > 1)
+            frame = self.scene.copy()
+            if frame.shape[:2] != (h, w):
+                fr = np.full((h, w, 4), 255, np.uint8)
+                hh, ww = min(h, frame.shape[0]), min(w, frame.shape[1])
+                fr[:hh, :ww] = frame[:hh, :ww]
+                frame = fr
+        for p in self.overlay_patches(w, h):
+            ov.blend(frame, p)
+        self.presenter.present(frame)
+        self.frames += 1
+        self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    # -------------------------------------------------------------- overlay
+    def overlay_patches(self, w: int, h: int) -> list:
+        patches = []
+        s = self.session
+        if s is not None:
+            patches.extend(self.gizmo_patches(w, h))
+            if self.drag not in ("orbit", "pan", "dolly") and s.manip is None and self.prompt is None:
+                col = (230, 60, 60) if (self.erase_toggle or self.window.mods() & self.g.MOD_CONTROL) else \
+                    (ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB)
+                img = ov.ring(int(round(self.brush_radius)), col)
+                patches.append(ov.Patch(int(self.mouse[0]) - img.shape[1] // 2,
+                                        int(self.mouse[1]) - img.shape[0] // 2, img))
+        panel = ov.text_panel(tuple(self.panel_lines()))
+        self.panel_box = (8, 8, panel.shape[1], panel.shape[0])
+        patches.append(ov.Patch(8, 8, panel))
+        y = 8 + panel.shape[0] + 6
+        for job in self.jobs.values():
+            bar = ov.progress_bar(360, job.fraction, f"{job.stage} {job.fraction * 100:3.0f}%")
+            patches.append(ov.Patch(8, y, bar))
+            y += bar.shape[0] + 4
+        if s is not None and s.fit_job is not None:
+            j = s.fit_job
+            bar = ov.progress_bar(360, j.fraction, f"{j.stage} {j.fraction * 100:3.0f}%")
+            patches.append(ov.Patch(8, y, bar))
+        if self.show_help:
+            img = ov.text_panel(tuple(CONTROLS.rstrip().splitlines()), size=13, bg=(10, 12, 18, 225))
+            patches.append(ov.Patch(max((w - img.shape[1]) // 2, 0), max((h - img.shape[0]) // 2, 0), img))
+        center_msg = None
+        if self.confirm_quit:
+            center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
+                          "(Ctrl+S saves)")
+        elif self.prompt is not None:
+            center_msg = ("Save as (Enter: save, Esc: cancel):", self.prompt + "_")
+        if center_msg:
+            img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
+            patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))
+        return patches
+
+    def gizmo_patches(self, w: int, h: int) -> list:
+        s = self.session
+        if not s.selection.handle.any():
+            return []
+        piv = s.handle_centroid()
+        m = s.current_matrix()
+        cur = m[:3, :3] @ piv + m[:3, 3]
+        out = []
+        px, depth = self.cam.project(np.vstack([piv, cur]), w, h)
+        if depth.min() <= 0:
+            return []
+        if s.manip is not None and s.manip.axis is not None:
+            a = np.zeros(3)
+            a[s.manip.axis] = self.cam.scene_radius
+            ends, d2 = self.cam.project(np.vstack([cur - a, cur + a]), w, h)
+            if d2.min() > 0:
+                p = ov.line_patch(ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1)
+                if p:
+                    out.append(p)
+        if s.manip is not None:
+            p = ov.line_patch(px[0], px[1], (255, 255, 255), 1)
+            if p:
+                out.append(p)
+        out.append(ov.cross_patch(px[1], ov.HANDLE_RGB if s.basis is not None else (200, 200, 200)))
+        return out
+
+    def panel_lines(self) -> list:
+        s = self.session
+        if s is None:
+            return [f"splatedit - opening {self.path}", "F1: help"]
+        st = s.stats()
+        lines = [f"{self.cloud_name}   {s.cloud.n:,} splats"]
+        tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
+        erase = "  ERASE" if self.erase_toggle else ""
+        lines.append((f"brush: {tgt}{erase}  radius {self.brush_radius:.0f} px   (Tab, E, [ ])",
+                      ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
+        lines.append(f"support {st['support']:,}   handle {st['handle']:,}")
+        state = st["state"]
+        if state == "fitting":
+            lines.append(f"solver: {st.get('stage', 'fitting')} {st.get('fraction', 0) * 100:.0f}% "
+                         f"({st.get('elapsed', 0):.1f} s)")
+        elif "centers" in st:
+            lines.append(f"solver: {st['method']}, {st['centers']} centers / {st['constraints']} "
+                         f"constraints, residual {st['residual']:.1e}")
+            lines.append(f"        precompute {st['fit_seconds']:.2f} s fit + {st['basis_seconds']:.2f} s basis")
+        elif state == "error":
+            lines.append((f"solver: {st['error'][:90]}", (255, 120, 120)))
+        else:
+            lines.append("solver: paint a support (1) then a handle (2)")
+        if s.manip is not None:
+            lines.append((s.manip.describe(), (255, 230, 120)))
+        info = self.viewport.last_info
+        if info:
+            what = f"{info['splats']:,} splats" + (" LOD" if info.get("lod") else "") + \
+                (f" 1/{info['div']} res" if info.get("div", 1) > 1 else "")
+            lines.append(f"frame: render {info['ms']:.0f} ms ({what}), total {self.frame_ms:.0f} ms")
+        lines.append(f"edits {len(s.edits)}{'  unsaved' if s.dirty else ''}   undo {s.history.position}"
+                     f"/{len(s.history) - 1}")
+        if self.message and time.perf_counter() - self.message_time < 8:
+            lines.append((self.message[:100], (255, 220, 140)))
+        lines.append("F1: help")
+        return lines
+
+    # --------------------------------------------------------------- status
+    def write_status(self) -> None:
+        if self.status_file is None:
+            return
+        s = self.session
+        msgs = self.validation_count + len(self.presenter.validation_messages)
+        st = {"loaded": s is not None, "frames_presented": self.presenter.frames_presented,
+              "running": self.running, "jobs": sorted(self.jobs), "validation_messages": msgs,
+              "confirm_quit": self.confirm_quit, "prompt": self.prompt, "help": self.show_help,
+              "window": list(self.size), "panel_box": list(self.panel_box),
+              "saved": str(self.saved_path) if self.saved_path else None,
+              "script": str(self.saved_script) if self.saved_script else None}
+        if s is not None:
+            ss = s.stats()
+            st.update(n=s.cloud.n, state=ss["state"], support=ss["support"], handle=ss["handle"],
+                      edits=len(s.edits), dirty=s.dirty, undo_position=s.history.position,
+                      history=len(s.history), manip=None if s.manip is None else s.manip.mode,
+                      brush=s.brush_target, fit_error=ss.get("error"))
+            idle = (not self.jobs and s.fit_job is None and self.drag is None and s.manip is None
+                    and not self.scene_interactive and self.scene_key == self.scene_state())
+            st["idle"] = bool(idle)
+        text = json.dumps(st, sort_keys=True)
+        if text != self._status_last:
+            tmp = self.status_file.with_suffix(".tmp")
+            tmp.write_text(text)
+            os.replace(tmp, self.status_file)
+            self._status_last = text
+
+    def collect_validation(self) -> None:
+        try:
+            from splatedit.render.vk import drain_validation_messages
+            msgs = drain_validation_messages()
+        except Exception:  # noqa: BLE001
+            msgs = []
+        for m in msgs:
+            print(f"splatedit: vulkan validation: {m}", file=sys.stderr)
+        self.validation_count += len(msgs)
+
+    # ----------------------------------------------------------------- loop
+    def run(self) -> int:
+        if self.path is None:
+            raise SplatEditError("no model to open")
+        self.start_load()
+        try:
+            while self.running:
+                s = self.session
+                busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
+                pending = (self.scene_key is None or self.scene_interactive or self.drag is not None
+                           or (s is not None and self.scene_key != self.scene_state()))
+                timeout = 0.0 if pending else (0.05 if busy else 0.5)
+                events = self.window.poll(timeout)
+                self.handle_events(events)
+                self.poll_jobs()
+                if self.session is not None:
+                    self.session.poll()
+                if not self.running:
+                    break
+                self.draw()
+                self.collect_validation()
+                self.write_status()
+                if self.max_seconds is not None and time.perf_counter() - self.start_time > self.max_seconds:
+                    self.say("time limit reached")
+                    break
+        finally:
+            self.running = False
+            self.write_status()
+        return self.exit_code
+
+    def close(self) -> None:
+        if self.session is not None:
+            self.session.close()
+        for j in list(self.jobs.values()):
+            if j.name == "saving":
+                j.thread.join()     # never leave a half-written file behind
+        if self.viewport is not None:
+            self.viewport.close()
+            self.viewport = None
+        if self.presenter is not None:
+            self.presenter.close()
+            self.presenter = None
+        if self.window is not None:
+            self.window.close()
+            self.window = None
+        self.collect_validation()
+
+
+def _typed_char(g, k) -> str | None:
+    if g.KEY_0 <= k <= g.KEY_9:
+        return str(k - g.KEY_0)
+    if g.KEY_KP_0 <= k <= g.KEY_KP_9:
+        return str(k - g.KEY_KP_0)
+    if k in (g.KEY_PERIOD, g.KEY_KP_DECIMAL, g.KEY_COMMA):
+        return "."
+    if k in (g.KEY_MINUS, g.KEY_KP_SUBTRACT):
+        return "-"
+    return None
+
+
+def run_editor(path=None, **options) -> int:
+    """Open the interactive editor on ``path`` (None: the bundled model).
+
+    Options: ``size`` (w, h), ``save_as`` (default save path), ``method``,
+    ``tol``, ``max_centers`` (solver settings, also written to the exported
+    edit script), ``vsync`` (default True), ``status_file`` (test hook: a JSON
+    file rewritten whenever the editor's state changes; also read from the
+    environment variable ``SPLATEDIT_EDITOR_STATUS``), ``budget_ms`` (frame
+    budget while moving, default 100 ms = 10 fps), ``lod`` (default True),
+    ``max_seconds`` (quit after this long; tests).
+    Returns the process exit code.
+    """
+    bundled = False
+    if path is None:
+        from splatedit.data import default_model_path
+        path = default_model_path()
+        bundled = True
+    if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
+        options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
+    if not Path(path).exists():
+        raise SplatEditError(f"{path}: no such file")
+    editor = Editor(path, bundled=bundled, **options)
+    try:
+        return editor.run()
+    finally:
+        editor.close()
+
+
+def main(argv=None) -> int:
+    """``python -m splatedit.app.editor [FILE] [--save-as PATH] ...`` (the CLI's ``edit``)."""
+    import argparse
+    p = argparse.ArgumentParser(prog="splatedit edit", description="interactive editor",
+                                epilog=CONTROLS, formatter_class=argparse.RawDescriptionHelpFormatter)
+    p.add_argument("file", nargs="?")
+    p.add_argument("--save-as", help="save path (default <name>-edited.ply)")
+    p.add_argument("--size", default="1280x720", help="window size WxH")
+    p.add_argument("--method", default="auto", choices=("auto", "lu", "iqr"))
+    p.add_argument("--tol", type=float, default=IQR_DEFAULT_TOL)
+    p.add_argument("--no-vsync", action="store_true")
+    p.add_argument("--no-lod", action="store_true")
+    p.add_argument("--budget-ms", type=float, default=100.0)
+    p.add_argument("--status-file", help="test hook: JSON status file")
+    a = p.parse_args(argv)
+    w, h = (int(v) for v in a.size.lower().split("x"))
+    try:
+        return run_editor(a.file, size=(w, h), save_as=a.save_as, method=a.method, tol=a.tol,
+                          vsync=not a.no_vsync, lod=not a.no_lod, budget_ms=a.budget_ms,
+                          status_file=a.status_file)
+    except SplatEditError as exc:
+        print(f"splatedit: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

@@ -1,0 +1,14 @@
+"""Data shipped with splatedit: the default model (see PROVENANCE.md)."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+_HERE = Path(__file__).resolve().parent
+
+
+def default_model_path() -> Path:
+    """Path of the embedded default model, ``bunny.ply`` (the Stanford bunny
+    as a triangle mesh; :func:`splatedit.io.read` turns it into vertex splats
+    and keeps its faces)."""
+    return _HERE / "bunny.ply"

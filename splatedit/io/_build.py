@@ -1,0 +1,151 @@
+"""Shared by the readers: column checks, colours, polygon triangulation, and
+the rule that turns whatever attributes a file has into splats."""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+import numpy as np
+
+from splatedit.errors import InputError
+from splatedit.model.cloud import SplatCloud
+from splatedit.model.estimate import estimate_splats
+from splatedit.model.mesh import cloud_from_mesh
+
+
+def _located(message, path, element, row, prop, lines=None) -> InputError:
+    if lines is not None:
+        message = f"{message} (line {int(lines[row])})"
+    err = InputError(message, path=path, element=element, row=row, prop=prop)
+    if lines is not None:
+        err.line = int(lines[row])
+    return err
+
+
+def check_finite(columns: dict, path, element: str = "vertex", lines=None) -> None:
+    """Raise InputError naming the first row/property holding NaN or inf.
+
+    Args:
+        columns: property name -> (n,) numeric array.
+        lines: optional (n,) 1-based file line numbers of the rows (text files).
+    """
+    first = None
+    for name, col in columns.items():
+        bad = ~np.isfinite(col)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            if first is None or row < first[0]:
+                first = (row, name, col[row])
+    if first is not None:
+        row, name, val = first
+        what = "NaN" if np.isnan(val) else "infinite"
+        raise _located(f"value is {what}", path, element, row, name, lines)
+
+
+def colors_from_columns(cols: list, names: list, path, element: str = "vertex",
+                        lines=None) -> np.ndarray:
+    """RGBA uint8 (n, 4) from 3 or 4 colour columns.
+
+    Integer columns must lie in 0..255.  Float columns in 0..1 are scaled by
+    255 and rounded; float columns with values above 1 (some tools write 0..255
+    floats) must lie in 0..255 and are rounded.  A missing alpha is 255.
+    """
+    n = len(cols[0])
+    out = np.full((n, 4), 255, dtype=np.uint8)
+    for j, (col, name) in enumerate(zip(cols, names)):
+        col = np.asarray(col)
+        if col.dtype.kind in "iu":
+            bad = (col < 0) | (col > 255)
+            if bad.any():
+                row = int(np.flatnonzero(bad)[0])
+                raise _located(f"colour {col[row]} outside 0..255", path, element, row, name, lines)
+            out[:, j] = col
+            continue
+        col = col.astype(np.float64)
+        check_finite({name: col}, path, element, lines)
+        scale = 255.0 if (len(col) == 0 or col.max() <= 1.0) else 1.0
+        bad = (col < 0) | (col > 255.0 / scale)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise _located(f"colour {col[row]} outside 0..1 (or 0..255)", path, element, row,
+                           name, lines)
+        out[:, j] = np.rint(col * scale).astype(np.uint8)
+    return out
+
+
+def triangulate(flat, lengths, n_vertices: int, path, element: str = "face",
+                prop: str = "vertex_indices", lines=None) -> np.ndarray:
+    """Fan-triangulate polygons given as concatenated vertex indices.
+
+    Args:
+        flat: (sum(lengths),) integer vertex indices of every polygon in turn.
+        lengths: (m,) vertices per polygon (each >= 3).
+        n_vertices: number of vertices, for the range check.
+    Returns:
+        (sum(lengths - 2), 3) int64 triangles ``(p0, p_i, p_{i+1})``, in
+        polygon order.
+    Raises:
+        InputError naming the polygon row with fewer than 3 vertices or an
+        index outside 0..n_vertices-1.
+    """
+    flat = np.asarray(flat, dtype=np.int64)
+    lengths = np.asarray(lengths, dtype=np.int64)
+    m = len(lengths)
+    if m == 0:
+        return np.zeros((0, 3), dtype=np.int64)
+    short = lengths < 3
+    if short.any():
+        row = int(np.flatnonzero(short)[0])
+        raise _located(f"polygon with {lengths[row]} vertices (need at least 3)", path, element,
+                       row, prop, lines)
+    off = np.zeros(m, dtype=np.int64)
+    np.cumsum(lengths[:-1], out=off[1:])
+    bad = (flat < 0) | (flat >= n_vertices)
+    if bad.any():
+        pos = int(np.flatnonzero(bad)[0])
+        row = int(np.searchsorted(off, pos, side="right") - 1)
+        raise _located(f"vertex index {flat[pos]} out of range 0..{n_vertices - 1}", path,
+                       element, row, prop, lines)
+    if (lengths == 3).all():
+        return flat.reshape(-1, 3)
+    ntri = lengths - 2
+    face = np.repeat(np.arange(m), ntri)
+    tstart = np.zeros(m, dtype=np.int64)
+    np.cumsum(ntri[:-1], out=tstart[1:])
+    j = np.arange(len(face)) - tstart[face]
+    base = off[face]
+    return np.stack([flat[base], flat[base + j + 1], flat[base + j + 2]], axis=1)
+
+
+def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
+                faces=None, progress=None) -> SplatCloud:
+    """Apply the axes rule (first match wins):
+
+    1. ``u`` and ``v`` given (our ``ux..vz`` properties): used as they are;
+    2. normals and radius: a tangent frame of that radius;
+    3. faces: vertex splats of the mesh (:func:`cloud_from_mesh`), using the
+       file's normals where present;
+    4. normals only: sized from the neighbour spacing;
+    5. nothing: normals estimated, oriented and sized
+       (:func:`estimate_splats`).
+
+    Faces are kept in every case.
+    """
+    name, source = Path(path).name, str(path)
+    if len(positions) == 0:
+        raise InputError("zero vertices: the file holds no points", path=source, element="vertex")
+    if faces is not None and len(faces) == 0:
+        faces = None
+    if u is not None and v is not None:
+        return SplatCloud(positions, u, v, colors, faces, name=name, source=source)
+    if radius is not None:
+        bad = ~(radius > 0)
+        if bad.any():
+            row = int(np.flatnonzero(bad)[0])
+            raise InputError(f"radius must be > 0, got {radius[row]}", path=source,
+                             element="vertex", row=row, prop="radius")
+    if faces is not None and not (normals is not None and radius is not None):
+        return cloud_from_mesh(positions, faces, normals=normals, colors=colors, name=name,
+                               source=source, progress=progress)
+    return estimate_splats(positions, normals, colors, progress, radius=radius, faces=faces,
+                           name=name, source=source)

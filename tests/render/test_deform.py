@@ -1,0 +1,103 @@
+"""GPU deformation (vertex shader, basis rows + dC) against the CPU-deformed cloud."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from splatedit.errors import ParameterError
+from splatedit.render.camera import Camera
+from tests.render.deform_util import cpu_deform, gaussian_basis
+from tests.render.scenes import sphere, torus
+
+W = H = 192
+#: GPU vs CPU deformed image: both paths use float32 on the GPU, differences are
+#: rounding only; allow a few flipped edge pixels
+MEAN_TOL = 0.25          # mean |diff| over RGB, 0..255 units
+BAD_SHARE = 0.002        # share of pixels off by more than 16
+DEPTH_TOL = 1e-3         # relative, median over pixels covered in both
+
+
+def _compare(renderer, base, deformed, cam, setup):
+    renderer.set_cloud(deformed)
+    ref = renderer.render(cam, W, H)
+    ref_buf = renderer.render_buffers(cam, W, H)
+    renderer.set_cloud(base)
+    setup()
+    img = renderer.render(cam, W, H)
+    buf = renderer.render_buffers(cam, W, H)
+    diff = np.abs(img.astype(int) - ref.astype(int))[..., :3]
+    assert diff.mean() < MEAN_TOL, diff.mean()
+    assert (diff.max(axis=2) > 16).mean() < BAD_SHARE
+    both = (ref_buf["weight"] > 0) & (buf["weight"] > 0)
+    rel = np.abs(buf["depth"][both] - ref_buf["depth"][both]) / ref_buf["depth"][both]
+    assert np.median(rel) < DEPTH_TOL
+    return img
+
+
+@pytest.mark.parametrize("k", [4, 8])
+def test_gpu_deformation_matches_cpu(renderer, k):
+    base = torus(100, 40)
+    rng = np.random.default_rng(k)
+    idx = np.flatnonzero(base.positions[:, 0] > -0.3)               # a support region
+    B, Bx, By, Bz = gaussian_basis(base.positions[idx], k=k, seed=k)
+    dC = rng.normal(scale=0.25, size=(k, 3))
+    deformed = cpu_deform(base, idx, B, Bx, By, Bz, dC)
+    cam = Camera.frame(*deformed.bounds(), 1.0, direction=(0.4, -0.8, 1.0))
+
+    def setup():
+        renderer.set_basis(idx, B, Bx, By, Bz)
+        renderer.set_displacement(dC)
+    img = _compare(renderer, base, deformed, cam, setup)
+    assert (img[..., :3] < 250).any()
+
+
+def test_basis_replacement_clears_old_rows(renderer):
+    base = sphere(6000, overlap=1.2)
+    rng = np.random.default_rng(3)
+    first = np.arange(0, 3000)
+    second = np.arange(2000, 6000)
+    B1 = gaussian_basis(base.positions[first], seed=1)
+    B2 = gaussian_basis(base.positions[second], seed=2)
+    dC = rng.normal(scale=0.3, size=(4, 3))
+    deformed = cpu_deform(base, second, *B2, dC)
+    cam = Camera.frame(*base.bounds(), 1.0, direction=(1, 0.3, 0.2))
+
+    def setup():
+        renderer.set_basis(first, *B1)
+        renderer.set_basis(second, *B2)    # rows 0..1999 must become undeformed again
+        renderer.set_displacement(dC)
+    _compare(renderer, base, deformed, cam, setup)
+
+
+def test_zero_displacement_is_identity(renderer):
+    base = sphere(3000)
+    cam = Camera.frame(*base.bounds(), 1.0)
+    renderer.set_cloud(base)
+    plain = renderer.render(cam, 96, 96)
+    idx = np.arange(base.n)
+    renderer.set_basis(idx, *gaussian_basis(base.positions))
+    renderer.set_displacement(np.zeros((4, 3)))
+    # (the pre-pass fills records in a non-deterministic order: additive
+    # blending may round differently by one unit)
+    assert np.abs(renderer.render(cam, 96, 96).astype(int) - plain).max() <= 2
+    renderer.clear_basis()
+    assert np.abs(renderer.render(cam, 96, 96).astype(int) - plain).max() <= 2
+
+
+def test_basis_errors(renderer):
+    base = sphere(500)
+    renderer.set_cloud(base)
+    idx = np.arange(10)
+    good = np.zeros((10, 4))
+    with pytest.raises(ParameterError, match="multiples of 4"):
+        renderer.set_basis(idx, np.zeros((10, 5)), np.zeros((10, 5)), np.zeros((10, 5)), np.zeros((10, 5)))
+    with pytest.raises(ParameterError, match="columns"):
+        z = np.zeros((10, 12))
+        renderer.set_basis(idx, z, z, z, z)
+    with pytest.raises(ParameterError, match="shape"):
+        renderer.set_basis(idx, np.zeros((9, 4)), good, good, good)
+    with pytest.raises(ParameterError, match="indices"):
+        renderer.set_basis(idx + 495, good, good, good, good)
+    with pytest.raises(ParameterError, match="dC"):
+        renderer.set_displacement(np.zeros((3, 3)))
