@@ -5,21 +5,28 @@
 // The including file defines BASIS_GROUPS.
 
 #include "frame.glsl"
+#define DEFORM_BINDING 8
+#include "deform.glsl"
 
 layout(local_size_x = 64) in;
 
 shared uint s_count[2];   // quads, points in this workgroup
 shared uint s_base[2];
 
+// The dispatch covers splats base .. base + count - 1 (the basis binding is a
+// window starting at row base: a 16-column basis takes 256 bytes per splat and
+// maxStorageBufferRange is 128 MiB on lavapipe, so large clouds are dispatched
+// in chunks); n = all splats (record slots).
 layout(push_constant) uniform Push {
-    vec4 dC[3 * BASIS_GROUPS];
+    uint base;
+    uint count;
     uint n;
 } P;
 
 layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // 9 floats per splat
 layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8
 layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };
-layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat
+layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat, from row P.base
 layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // 3 per slot
 layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // 2 per slot
 layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };             // 2 VkDrawIndirectCommand
@@ -42,11 +49,12 @@ vec2 oct_encode(vec3 n) {
 }
 
 void main() {
-    uint i = gl_GlobalInvocationID.x;
+    uint li = gl_GlobalInvocationID.x;          // row in the basis window
+    uint i = P.base + li;                       // splat index
     if (i == 0u) { draws[0] = 4u; draws[4] = 1u; }
     int kind = SPLAT_CULLED;
     Splat S;
-    if (i < P.n) {
+    if (li < P.count) {
         vec3 p = vec3(geom[9 * i], geom[9 * i + 1], geom[9 * i + 2]);
         vec3 u = vec3(geom[9 * i + 3], geom[9 * i + 4], geom[9 * i + 5]);
         vec3 v = vec3(geom[9 * i + 6], geom[9 * i + 7], geom[9 * i + 8]);
@@ -54,7 +62,7 @@ void main() {
         if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
-            uint b = uint(4 * BASIS_GROUPS) * i;
+            uint b = uint(4 * BASIS_GROUPS) * li;
             for (int g = 0; g < BASIS_GROUPS; ++g)
                 deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
                              dp, Jm);

@@ -1,6 +1,5 @@
 // Per-splat math shared by the splat vertex shader (splat_vs.glsl) and the
-// compute pre-pass (prepare.comp).  Requires frame.glsl and a push-constant
-// block P with vec4 dC[3 * BASIS_GROUPS].
+// compute pre-pass (prepare_cs.glsl).  Requires frame.glsl and deform.glsl.
 
 struct Splat {
     vec4 ms_cn, mt_tc, mw_r;   // screen -> tangent mapping (see splat_varyings.glsl)
@@ -18,7 +17,7 @@ const int SPLAT_POINT = 2;
 // p' = p + sum_k B_k dC_k;  J_ij = delta_ij + sum_k dC_k[i] B{j}_k;  u' = J u, v' = J v
 // (one group of 4 columns; dp and Jm = J - I accumulate over groups)
 void deform_group(int g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inout mat3 Jm) {
-    vec4 dx = P.dC[3 * g], dy = P.dC[3 * g + 1], dz = P.dC[3 * g + 2];
+    vec4 dx = D.dC[3 * g], dy = D.dC[3 * g + 1], dz = D.dC[3 * g + 2];
     dp += vec3(dot(B, dx), dot(B, dy), dot(B, dz));
     Jm[0] += vec3(dot(dx, Bx), dot(dy, Bx), dot(dz, Bx));
     Jm[1] += vec3(dot(dx, By), dot(dy, By), dot(dz, By));

@@ -1,9 +1,11 @@
-// Splat vertex shader body (included by splat.vert / splat_k8.vert, which
-// define BASIS_GROUPS = number of 4-column groups of the deformation basis).
+// Splat vertex shader body (included by splat.vert / splat_k8.vert /
+// splat_k12.vert / splat_k16.vert, which define BASIS_GROUPS = number of
+// 4-column groups of the deformation basis, zero-padded).
 //
 // Per instance: centre p, tangent semi-axes u, v, colour, flags and the basis
-// rows B, Bx, By, Bz (one vec4 each per group of 4 columns).  Per frame: dC in
-// push constants as rows dC[3g + i] = (dC_{4g..4g+3})[i], i = x, y, z.
+// rows B, Bx, By, Bz (one vec4 each per group of 4 columns; at most 16 vertex
+// attributes for 16 columns, 21 in all: lavapipe has maxVertexInputAttributes
+// = 32).  Per frame: dC in the Deform uniform block (deform.glsl, binding 1).
 //   p' = p + sum_k B_k dC_k
 //   J  = I + sum_k dC_k (Bx_k, By_k, Bz_k)^T,  i.e.  J_ij = delta_ij + sum_k dC_k[i] B{j}_k
 //   u' = J u,  v' = J v            (Botsch & Kobbelt 2005, Sect. 6-7)
@@ -14,6 +16,8 @@
 #define VARYING out
 #include "frame.glsl"
 #include "splat_varyings.glsl"
+#define DEFORM_BINDING 1
+#include "deform.glsl"
 
 layout(location = 0) in vec3 in_center;
 layout(location = 1) in vec3 in_u;
@@ -26,10 +30,6 @@ layout(location = 5) in vec4 in_basis[4 * BASIS_GROUPS];  // per group: B, Bx, B
 // point threshold (F.misc.w <= 1 pixel) as quads; 2: only the others, as
 // one-pixel points (POINT_LIST).  Modes 1 + 2 together draw every splat.
 layout(constant_id = 0) const int PRIM_MODE = 0;
-
-layout(push_constant) uniform Push {
-    vec4 dC[3 * BASIS_GROUPS];
-} P;
 
 void cull() {
     gl_Position = vec4(-4.0, -4.0, 0.5, 1.0);   // all corners equal: zero-area, off screen

@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-from splatedit.errors import SplatEditError
+from splatedit.errors import ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
 
@@ -123,14 +123,74 @@ def cmd_deform(args) -> int:
     return 0
 
 
+def _camera_from_args(args, cloud):
+    """The camera of ``splatedit render``: framing the model, then the flags override."""
+    from splatedit.render.camera import Camera
+    w, h = args.size
+    lo, hi = cloud.bounds()
+    base = Camera.frame(lo, hi, aspect=w / h)
+    if args.fov is not None and not 0.0 < args.fov < 179.0:
+        raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
+    fov = base.fov_deg if args.fov is None else args.fov
+    if args.eye is None and args.target is None and args.up is None and args.fov is None:
+        return base
+    if args.eye is None and args.fov is not None and args.target is None and args.up is None:
+        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov)
+    target = base.target if args.target is None else args.target
+    eye = base.eye if args.eye is None else args.eye
+    up = base.up if args.up is None else args.up
+    try:
+        return Camera(eye, target, up=up, fov_deg=fov)
+    except ParameterError as exc:
+        raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+
+
 def cmd_render(args) -> int:
     from splatedit.io import read
-    from splatedit.render.headless import render_file
+    from splatedit.io.atomic import check_writable_target
+    from splatedit.render.headless import render_to_png
+    for target in (args.output, args.buffers):
+        if target is not None:
+            check_writable_target(target, overwrite=args.force, protect=args.input)
     cloud = read(args.input, progress=args.progress)
-    render_file(cloud, args.output, size=args.size, eye=args.eye, target=args.target, up=args.up,
-                fov=args.fov, edit_script=args.edit, buffers_path=args.buffers, overwrite=args.force,
-                progress=args.progress, log=print)
+    camera = _camera_from_args(args, cloud)
+    basis_rows = d_c = None
+    if args.edit is not None:
+        cloud, basis_rows, d_c = _gpu_edit(args, cloud)
+    render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
+                  buffers_path=args.buffers)
+    print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
+          + (", deformed on the GPU" if basis_rows is not None else "") + ")"
+          + (f" and {args.buffers}" if args.buffers else ""))
     return 0
+
+
+def _gpu_edit(args, cloud):
+    """Apply an edit script for rendering: every edit but the last is committed
+    on the CPU (each edit's result is the next one's base); the last edit goes
+    to the GPU as basis rows plus its control-frame displacement dC.
+
+    Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC).
+    """
+    import dataclasses
+    from splatedit.deform.basis import DeformationBasis
+    from splatedit.script import load_script, resolve_edit, run_script
+    script = load_script(args.edit)
+    source = str(args.edit)
+    if len(script.edits) > 1:
+        head = dataclasses.replace(script, edits=script.edits[:-1])
+        cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
+                              on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+    last = script.edits[-1]
+    support, handles, matrices = resolve_edit(cloud, last, source)
+    basis = DeformationBasis.fit(cloud, support, handles, method=script.solver.method,
+                                 tol=script.solver.tol, max_centers=script.solver.max_centers,
+                                 progress=args.progress)
+    args.progress.close()
+    st = basis.stats
+    print(f"edit {len(script.edits) - 1}: support {int(support.sum())} splats, {st['method']} with "
+          f"{st['n_centers']} centers (residual {st['residual']:.2e}), basis uploaded to the GPU")
+    return cloud, basis.rows_for_gpu(), basis.displacement(matrices)
 
 
 def cmd_demo(args) -> int:

@@ -1,6 +1,6 @@
 """The headless demo: the paper's Bunny edit (Fig. 6) on the bundled model.
 
-Bends the bunny's right ear, then lifts its head, writing the result next to
+Bends the bunny's tall ear, then lifts and tilts its head, writing the result next to
 the user: ``bunny-demo.ply`` (the deformed splats), ``bunny-demo.json`` (the
 edit script, replayable with ``splatedit deform``) and, when a Vulkan device
 is present, ``bunny-before.png`` / ``bunny-demo.png``.
@@ -19,17 +19,15 @@ DEMO_SCRIPT = {
     "version": 1,
     "solver": {"method": "auto", "tol": 1e-7},
     "edits": [
-        {   # bend the tall ear forward and outward
-            "support": {"sphere": {"center": [-0.045, 0.40, -0.09], "radius": 0.16}},
-            "handle": {"sphere": {"center": [-0.01, 0.47, -0.11], "radius": 0.045}},
-            "transform": {"rotate": {"axis": [1, 0, 0], "degrees": 35, "center": [-0.05, 0.33, -0.08]},
-                          "translate": [0.03, 0.0, 0.0]},
+        {   # bend the tall ear backwards about its base
+            "support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},
+            "handle": {"sphere": {"center": [0.0, 0.47, -0.1], "radius": 0.06}},
+            "transform": {"rotate": {"axis": [0, 0, 1], "degrees": -40, "center": [-0.15, 0.26, 0.0]}},
         },
-        {   # lift and turn the head
-            "support": {"sphere": {"center": [-0.30, 0.20, 0.0], "radius": 0.42}},
-            "handle": {"sphere": {"center": [-0.33, 0.26, 0.05], "radius": 0.16}},
-            "transform": {"translate": [0.0, 0.06, 0.02],
-                          "rotate": {"axis": [0, 1, 0], "degrees": -15}},
+        {   # lift the head (with both ears) and tilt it back
+            "support": {"box": {"min": [-0.55, -0.08, -0.45], "max": [0.2, 0.55, 0.45]}},
+            "handle": {"box": {"min": [-0.55, 0.14, -0.45], "max": [0.06, 0.55, 0.45]}},
+            "transform": {"translate": [0.0, 0.04, 0.0], "rotate": {"axis": [0, 0, 1], "degrees": -10}},
         },
     ],
 }
@@ -64,11 +62,19 @@ def run_demo(output_dir: Path, *, progress=None, log=print, render: bool = True,
     script.save(out_json)
     log(f"wrote {out_ply} and {out_json} (replay: splatedit deform {src} --edit {out_json} -o OUT.ply)")
     if render:
+        from splatedit.render.camera import Camera
+        from splatedit.render.headless import render_to_png
+        from splatedit.render.vk import VulkanError
+        size = (960, 720)
+        lo, hi = cloud.bounds()
+        # the same three-quarter view for both images, framed on the original model
+        camera = Camera.frame(lo, hi, aspect=size[0] / size[1], direction=(-0.45, 0.25, 1.0))
         try:
-            from splatedit.render.headless import render_cloud_png
             for cl, name in ((cloud, "bunny-before.png"), (deformed, "bunny-demo.png")):
-                render_cloud_png(cl, output_dir / name, size=(960, 720), camera_cloud=cloud)
-                log(f"wrote {output_dir / name}")
-        except Exception as exc:  # no Vulkan device or driver: the edit itself still succeeded
-            log(f"skipped the PNG renders: {exc}")
+                target = output_dir / name
+                check_writable_target(target, overwrite=overwrite)
+                render_to_png(cl, target, size=size, camera=camera)
+                log(f"wrote {target}")
+        except VulkanError as exc:  # no Vulkan driver/device: the edit itself still succeeded
+            log(f"skipped the PNG renders (no usable Vulkan device): {exc}")
     return out_ply

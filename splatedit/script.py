@@ -426,9 +426,10 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         new = basis.apply(cloud, d_c)
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
-        rep = EditReport(i, int(support.sum()), [int(h.sum()) for h in handles], stats.n_constraints,
-                         stats.n_centers, stats.residual, stats.method, stats.fit_seconds,
-                         stats.basis_seconds + (time.perf_counter() - t0), disp, list(stats.notes))
+        rep = EditReport(i, int(support.sum()), [int(h.sum()) for h in handles], stats["n_constraints"],
+                         stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
+                         stats["basis_seconds"] + (time.perf_counter() - t0), disp,
+                         [stats["message"]] if stats.get("message") else [])
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)

@@ -122,9 +122,10 @@ RENDER_BACKGROUND = (1.0, 1.0, 1.0)
 #: green handle (Botsch & Kobbelt 2005, Fig. 1)
 RENDER_TINT_SUPPORT = (0.15, 0.3, 1.0, 0.55)
 RENDER_TINT_HANDLE = (0.1, 0.8, 0.15, 0.7)
-#: deformation basis columns: multiples of 4, at most this many in the vertex
-#: shader path (dC takes 3 vec4 per 4 columns of the 128-byte push constants)
-RENDER_MAX_BASIS_COLUMNS = 8
+#: deformation basis columns: any count 1..this (zero-padded to groups of 4 on
+#: the GPU; 16 columns = 16 vertex attributes + 5 of lavapipe's 32, dC in a
+#: 192-byte uniform block)
+RENDER_MAX_BASIS_COLUMNS = 16
 #: splats whose projected ellipse bound is at most this many pixels wide (<= 1)
 #: are drawn as one-pixel points (hole-free: radius <= half a pixel)
 RENDER_POINT_SPLAT_MAX_PX = 1.0

@@ -160,6 +160,7 @@ class Editor:
         self.stroke_changed = False
         self.manip_by_drag = False
         self.mouse = (0.0, 0.0)
+        self.cursor_inside = True
         self.picker = None
         self.picker_key = None
         self.message = ""
@@ -331,6 +332,9 @@ class Editor:
         self.scene_key = None
         self.motion()
 
+    def on_enter(self, e) -> None:
+        self.cursor_inside = bool(e.action)
+
     def on_iconify(self, e) -> None:
         self.scene_key = None
 
@@ -364,6 +368,7 @@ class Editor:
         lx, ly = self.drag_last
         dx, dy = x - lx, y - ly
         self.mouse = (x, y)
+        self.cursor_inside = True
         w, h = self.size
         s = self.session
         if self.drag == "orbit":
@@ -636,7 +641,8 @@ class Editor:
         s = self.session
         if s is not None:
             patches.extend(self.gizmo_patches(w, h))
-            if self.drag not in ("orbit", "pan", "dolly") and s.manip is None and self.prompt is None:
+            if (self.drag not in ("orbit", "pan", "dolly") and s.manip is None and self.prompt is None
+                    and self.cursor_inside):
                 col = (230, 60, 60) if (self.erase_toggle or self.window.mods() & self.g.MOD_CONTROL) else \
                     (ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB)
                 img = ov.ring(int(round(self.brush_radius)), col)

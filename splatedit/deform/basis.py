@@ -1,9 +1,12 @@
 """Precomputed deformation bases B, Bx, By, Bz (paper Sect. 6 and 7).
 
-One :class:`TriharmonicRBF` is fitted with all 4h columns of the affine
-coordinates ``M`` (h handles) as right-hand sides at once (fixed band: 0).
-Evaluating it and its gradient at every support splat gives the (N, 4h)
-bases with which, for control-frame displacements ``dC`` (4h, 3):
+One :class:`TriharmonicRBF` is fitted with all K columns of the affine
+weights ``M`` as right-hand sides at once (fixed band: 0): 4 per rigid handle
+(its frame's affine coordinates), k + 1 per control curve (the B-spline
+weights of its samples, paper Sect. 6 end), in the block layout of the
+constraint groups (handles first, then curves).  Evaluating it and its
+gradient at every support splat gives the (N, K) bases with which, for
+control-point displacements ``dC`` (K, 3):
 
     p'      = p + B dC
     J[i, j] = delta_ij + sum_k dC[k, i] * Bj[k],     Bj in (Bx, By, Bz)
@@ -11,8 +14,10 @@ bases with which, for control-frame displacements ``dC`` (4h, 3):
 
 Free splats (support minus handles) use the RBF; handle splats use their exact
 affine coordinates (they move rigidly with their handle) and the constant
-gradient of those coordinates; splats outside the support are not in the basis
-(``indices`` lists the support splats, sorted) and are copied bitwise.
+gradient of those coordinates, and zeros in every other group's columns;
+splats outside the support are not in the basis (``indices`` lists the
+support splats, sorted) and are copied bitwise.  Curves have no member splats:
+their samples are constraint points only.
 
 CPU hot path (``apply``).  Per frame a splat needs only linear combinations of
 ``dC``: ``p' = [B | p] @ [dC; I]``, ``u' = [Wu | u] @ [dC; I]`` with
@@ -96,19 +101,22 @@ def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CH
 
 
 class DeformationBasis:
-    """Precomputed linear deformation bases of one edit (support + handles).
+    """Precomputed linear deformation bases of one edit (support + handles
+    and/or control curves).
 
     Attributes:
         constraints: the :class:`~splatedit.deform.constraints.Constraints`.
         rbf: the fitted :class:`~splatedit.deform.rbf.TriharmonicRBF`
-            (k = 4h outputs: the affine-coordinate fields).
+            (K outputs: the affine-weight fields).
         indices: (N,) sorted cloud indices of the support splats (basis rows).
-        B, Bx, By, Bz: (N, 4h) float64 bases (views of one packed array).
-        control_frames: (h, 4, 3) control frames C.
+        B, Bx, By, Bz: (N, K) float64 bases (views of one packed array),
+            K = 4 h + sum over curves of (k + 1).
+        control_frames: (h, 4, 3) control frames C of the handles.
         stats: dict of fit statistics: ``n_constraints`` (m), ``n_centers``,
             ``residual``, ``method``, ``polynomial``, ``fit_seconds``,
             ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
-            ``n_handle_band``, ``spacing``, ``message``.
+            ``n_handle_band``, ``n_curve_samples``, ``n_curve_dropped``,
+            ``spacing``, ``message``.
     """
 
     def __init__(self, constraints: Constraints, rbf, pack: np.ndarray, stats: dict):
@@ -121,14 +129,17 @@ class DeformationBasis:
 
     # ------------------------------------------------------------ building
     @classmethod
-    def fit(cls, cloud, support, handles, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
-            max_centers: int | None = None, rings: float = BAND_RINGS,
-            spacing: float | None = None, progress=None) -> "DeformationBasis":
-        """Build constraints, fit one RBF to all handle columns, evaluate bases.
+    def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
+            tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
+            rings: float = BAND_RINGS, spacing: float | None = None,
+            progress=None) -> "DeformationBasis":
+        """Build constraints, fit one RBF to all group columns, evaluate bases.
 
         Args:
             cloud: the base :class:`~splatedit.model.cloud.SplatCloud`.
             support, handles: masks (see :func:`build_constraints`).
+            curves: :class:`~splatedit.deform.curves.ControlCurve` objects (or
+                (k + 1, 3) picked points), see :func:`build_constraints`.
             method, tol, max_centers: passed to :meth:`TriharmonicRBF.fit`
                 ("auto" = exact LU up to AUTO_EXACT_MAX_CONSTRAINTS, else IQR).
             rings, spacing: band thickness (see :func:`build_constraints`).
@@ -137,7 +148,8 @@ class DeformationBasis:
             ParameterError / SolverError from the constraints and the fit.
         """
         t0 = time.perf_counter()
-        con = build_constraints(cloud, support, handles, rings=rings, spacing=spacing)
+        con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
+                                spacing=spacing)
         rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
                                  max_centers=max_centers, progress=progress)
         t1 = time.perf_counter()
@@ -148,6 +160,8 @@ class DeformationBasis:
         pack = np.zeros((n_sup, 4, k))
         # handle splats: exact affine coordinates and their constant gradients
         for g, grp in enumerate(con.groups):
+            if grp.kind != "handle":
+                continue  # curves have no member splats
             cols = con.columns(g)
             rows = np.searchsorted(idx, grp.member_index)
             pack[rows, 0, cols] = affine_coordinates(pos[grp.member_index], grp.controls)
@@ -171,6 +185,8 @@ class DeformationBasis:
             fit_seconds=t1 - t0, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
             n_fixed_band=int(len(con.fixed_index)),
             n_handle_band=[int(len(b)) for b in con.handle_band_index],
+            n_curve_samples=[int(len(c.points)) for c in con.curves],
+            n_curve_dropped=[int(c.n_dropped) for c in con.curves],
             spacing=float(con.spacing), message=getattr(rbf, "message", ""),
         )
         return cls(con, rbf, pack, stats)
@@ -193,8 +209,20 @@ class DeformationBasis:
         return self._pack[:, 3, :]
 
     @property
-    def n_handles(self) -> int:
+    def n_groups(self) -> int:
+        """Number of constraint groups (handles + curves)."""
         return len(self.constraints.groups)
+
+    @property
+    def n_handles(self) -> int:
+        """Number of constraint groups (handles + curves; kept for the
+        handle-only callers, see :attr:`n_groups`)."""
+        return len(self.constraints.groups)
+
+    @property
+    def group_kinds(self) -> list[str]:
+        """``"handle"`` or ``"curve"`` per group, in column-block order."""
+        return [g.kind for g in self.constraints.groups]
 
     @property
     def n_columns(self) -> int:
@@ -204,17 +232,22 @@ class DeformationBasis:
     def control_frames(self) -> np.ndarray:
         return self.constraints.control_frames
 
+    def columns_for_group(self, i: int) -> slice:
+        """Columns of B (and rows of dC) belonging to group ``i`` (handles
+        first, then curves)."""
+        return self.constraints.columns(i)
+
     def columns_for_handle(self, i: int) -> slice:
-        """Columns of B (and rows of dC) belonging to handle ``i``."""
+        """Alias of :meth:`columns_for_group` (group ``i``, handle or curve)."""
         return self.constraints.columns(i)
 
     def rows_for_gpu(self, handle: int | None = None):
         """``(indices, B, Bx, By, Bz)`` as contiguous float64 arrays.
 
-        ``handle=None``: every support splat, all 4h columns.  ``handle=i``:
-        only handle i's 4 columns, and only the splats they move (the splats
-        of the *other* handles have all-zero rows there and are dropped).
-        The renderer converts to float32.
+        ``handle=None``: every support splat, all K columns.  ``handle=i``:
+        only group i's columns (4 for a handle, k + 1 for a curve), and only
+        the splats they move (the splats of the *other* handles have all-zero
+        rows there and are dropped).  The renderer converts to float32.
         """
         if handle is None:
             sub = self._pack

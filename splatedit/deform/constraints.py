@@ -24,10 +24,23 @@ handle, zero in other handles' blocks and in the fixed band.
 
 Constraint groups.  A handle is one *group*: a set of constraint points, a
 (p, k) matrix of weight rows and k control points whose affine combination
-(weights) gives the points.  A rigid handle has k = 4 (its affine frame);
-a non-rigid control curve (paper Sect. 3, not implemented yet) would be a
-group of curve samples ``c(t_i)`` with B-spline weights ``B_j(t_i)`` and
-k + 1 control points.  The fixed band is not a group (its value is 0).
+(weights) gives the points.  A rigid handle has k = 4 (its affine frame).
+A non-rigid **control curve** (paper Sect. 3 end and Sect. 6 end; see
+:mod:`splatedit.deform.curves`) is a group of curve samples ``c(t_i)`` with
+B-spline weights ``N_j(t_i)`` (p, k + 1) and its k + 1 spline control points.
+Groups are ordered handles first, then curves; their column blocks follow
+the same order.  The fixed band is not a group (its value is 0).
+
+Curves (decisions).  Curve samples are extra constraint points (not splats)
+anywhere in space; they do not change the free region (support minus
+handles), and a curve with the fixed band alone defines an edit.  A sample
+closer than one point spacing to another group's constraint -- a fixed-band
+splat, any splat of a handle, or a kept sample of an earlier curve -- would
+ask for two different displacements almost at one point (an ill-conditioned,
+oscillating fit), so it is **dropped** (counted in
+``ConstraintGroup.n_dropped``); a curve that loses every sample raises
+SolverError.  Self-intersecting curves are left to the solver's duplicate
+check.
 
 Control frame (decision).  ``a`` = centroid of the handle splats,
 ``b, c, d = a + r e_x, a + r e_y, a + r e_z`` with ``r`` = RMS distance of
@@ -112,14 +125,19 @@ class ConstraintGroup:
     """Constraint points that are an affine combination of control points.
 
     Attributes:
-        kind: ``"handle"`` (rigid control handle, k = 4); later ``"curve"``.
+        kind: ``"handle"`` (rigid control handle, k = 4) or ``"curve"``
+            (control curve, k = its number of control points).
         points: (p, 3) constraint positions (model units).
         weights: (p, k) rows of affine weights, ``points == weights @ controls``.
-        controls: (k, 3) control points (the handle's frame C).
+        controls: (k, 3) control points (the handle's frame C, or the curve's
+            B-spline control points b_j).
         band_index: (p,) cloud indices of the constraint points (the handle
             band), or None for samples that are not splats (curves).
         member_index: (q,) cloud indices of every splat that moves with the
             group as a whole (all handle splats), empty for curves.
+        curve: the :class:`~splatedit.deform.curves.ControlCurve` (curves only).
+        params: (p,) curve parameters ``t_i`` of the kept samples (curves only).
+        n_dropped: curve samples dropped next to other constraints.
     """
 
     kind: str
@@ -128,6 +146,9 @@ class ConstraintGroup:
     controls: np.ndarray
     band_index: np.ndarray | None = None
     member_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    curve: object = None
+    params: np.ndarray | None = None
+    n_dropped: int = 0
 
     @property
     def n_columns(self) -> int:
@@ -142,10 +163,11 @@ class Constraints:
         points: (m, 3) constraint points: fixed band first, then each group's
             band in order.
         values: (m, K) right-hand sides, K = sum of group columns (4 per
-            handle); block column ``columns(g)`` holds group g's weights on its
-            own rows, zeros elsewhere.
+            handle, k + 1 per curve); block column ``columns(g)`` holds group
+            g's weights on its own rows, zeros elsewhere.
         fixed_index: (f,) cloud indices of the fixed band.
-        groups: the constraint groups (handles), in the order given.
+        groups: the constraint groups: the handles, then the curves, each in
+            the order given.
         spacing: point spacing used (model units).
         band_width: ``rings * spacing`` (model units).
         support_index: (N,) sorted cloud indices of the support.
@@ -180,6 +202,18 @@ class Constraints:
         return [g for g in self.groups if g.kind == "handle"]
 
     @property
+    def curves(self) -> list[ConstraintGroup]:
+        return [g for g in self.groups if g.kind == "curve"]
+
+    @property
+    def n_handles(self) -> int:
+        return len(self.handles)
+
+    @property
+    def n_curves(self) -> int:
+        return len(self.curves)
+
+    @property
     def handle_band_index(self) -> list[np.ndarray]:
         """Cloud indices of each handle's band."""
         return [g.band_index for g in self.handles]
@@ -200,7 +234,7 @@ class Constraints:
     def columns(self, group: int) -> slice:
         """Column block of ``values`` belonging to group ``group``."""
         if not 0 <= group < len(self.groups):
-            raise ParameterError("handle", f"index {group} out of range 0..{len(self.groups) - 1}")
+            raise ParameterError("group", f"index {group} out of range 0..{len(self.groups) - 1}")
         start = sum(g.n_columns for g in self.groups[:group])
         return slice(start, start + self.groups[group].n_columns)
 
@@ -256,7 +290,7 @@ def _near(query: np.ndarray, reference: np.ndarray, width: float,
     return out
 
 
-def build_constraints(cloud, support, handles, *, rings: float = BAND_RINGS,
+def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = BAND_RINGS,
                       spacing: float | None = None) -> Constraints:
     """Constraints of an edit (see the module docstring).
 
@@ -265,15 +299,21 @@ def build_constraints(cloud, support, handles, *, rings: float = BAND_RINGS,
         support: (n,) bool mask (or index array) of the splats the edit may move.
         handles: list of (n,) bool masks (or index arrays), each inside the
             support, pairwise disjoint, in the order of their column blocks.
+        curves: list of :class:`~splatedit.deform.curves.ControlCurve` (or
+            (k + 1, 3) arrays of picked points); their groups follow the
+            handles.  Sampled at the point spacing unless the curve fixes
+            its sample count.
         rings: band thickness in point spacings (default ``BAND_RINGS`` = 3).
         spacing: point spacing in model units; default: median nearest-
             neighbour distance of the support splats.
     Raises:
-        ParameterError: bad masks (shape, empty support or handle, no handles,
-            handle outside the support, overlapping handles, no free splats,
-            rings <= 0).
+        ParameterError: bad masks (shape, empty support or handle, neither
+            handles nor curves, handle outside the support, overlapping
+            handles, no free splats, rings <= 0), bad curve points.
         SolverError: a handle with no splat within the band width of the free
-            region (the handle is not next to anything the edit can bend).
+            region (the handle is not next to anything the edit can bend); a
+            curve all of whose samples lie within a point spacing of other
+            constraints.
     """
     pos = cloud.positions
     n = len(pos)
@@ -285,8 +325,10 @@ def build_constraints(cloud, support, handles, *, rings: float = BAND_RINGS,
     if isinstance(handles, np.ndarray) and handles.ndim == 1:
         handles = [handles]
     handles = list(handles)
-    if not handles:
-        raise ParameterError("handles", "at least one handle is needed")
+    from splatedit.deform.curves import as_curve  # curves imports nothing from here
+    curve_objs = [as_curve(c, f"curves[{i}]") for i, c in enumerate(curves)]
+    if not handles and not curve_objs:
+        raise ParameterError("handles", "at least one handle or curve is needed")
     hmasks = []
     covered = np.zeros(n, dtype=bool)
     for i, h in enumerate(handles):
@@ -348,6 +390,23 @@ def build_constraints(cloud, support, handles, *, rings: float = BAND_RINGS,
         groups.append(ConstraintGroup(kind="handle", points=pos[band],
                                       weights=affine_coordinates(pos[band], frame),
                                       controls=frame, band_index=band, member_index=hidx))
+
+    # curves: samples, minus those within one spacing of other constraints
+    taken = [pos[fixed_index]] + [pos[g.member_index] for g in groups]
+    drop_width = h * (1.0 + _BAND_SLACK_REL)
+    for i, curve in enumerate(curve_objs):
+        t, w, samples = curve.sample(spacing=h)
+        ref = np.concatenate(taken, axis=0)
+        near = _near(samples, ref, drop_width)
+        keep = ~near
+        if not keep.any():
+            raise SolverError(f"curve {i}: all {len(samples)} samples lie within one point spacing "
+                              f"({h:.4g} model units) of the fixed band, a handle or an earlier "
+                              "curve; move the curve into the free part of the support")
+        groups.append(ConstraintGroup(kind="curve", points=samples[keep], weights=w[keep],
+                                      controls=curve.controls.copy(), curve=curve,
+                                      params=t[keep], n_dropped=int(near.sum())))
+        taken.append(samples[keep])
 
     pts = np.concatenate([pos[fixed_index]] + [g.points for g in groups], axis=0)
     if len(np.unique(pts, axis=0)) != len(pts):

@@ -19,7 +19,6 @@ file intact.  An existing file is replaced only with ``overwrite=True``.
 
 from __future__ import annotations
 
-import os
 from pathlib import Path
 
 from splatedit.errors import InputError
@@ -86,10 +85,8 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
     ext = _ext(path, WRITE_EXTENSIONS, "writing")
     check_writable_target(path, overwrite=overwrite)
     report(progress, "writing", 0.0)
-    mode = path.stat().st_mode & 0o777 if path.exists() else 0o644
     try:
         with atomic_open(path, "wb") as fh:
-            os.fchmod(fh.fileno(), mode)          # mkstemp creates 0600 files
             if ext == ".ply":
                 write_ply(fh, cloud, binary=binary, axes=axes,
                           comment=f"written by splatedit from {cloud.name or 'a splat cloud'}")

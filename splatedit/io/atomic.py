@@ -31,6 +31,19 @@ def check_writable_target(path: str | Path, *, overwrite: bool, protect: str | P
     return p
 
 
+def _current_umask() -> int:
+    """The process umask, read without changing it (os.umask would race with
+    other threads creating files); falls back to 0o022."""
+    try:
+        with open("/proc/self/status", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("Umask:"):
+                    return int(line.split()[1], 8)
+    except (OSError, ValueError, IndexError):
+        pass
+    return 0o022
+
+
 @contextlib.contextmanager
 def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
     """Open a temp file beside ``path``; on success rename it onto ``path``.
@@ -41,8 +54,15 @@ def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
     directory = p.parent if str(p.parent) else Path(".")
     if not directory.is_dir():
         raise InputError("directory does not exist", path=str(directory))
+    # keep an existing file's permissions; new files get the usual 0666 & ~umask
+    # (mkstemp itself creates 0600 files)
+    if p.exists():
+        perms = p.stat().st_mode & 0o777
+    else:
+        perms = 0o666 & ~_current_umask()
     fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=directory)
     try:
+        os.fchmod(fd, perms)
         with os.fdopen(fd, mode) as fh:
             yield fh
             fh.flush()

@@ -39,13 +39,17 @@ _UBO_BYTES = 272
 _GEOM_STRIDE = 36           # centre, u, v as float32
 _MAX_SIZE = 16384
 
-_SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"),)
+#: dC of up to 16 columns as 3 vec4 per group of 4 (shaders_glsl/deform.glsl)
+_MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
+_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS
+#: vertex path: frame UBO, deformation UBO
+_SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"), V.Binding(1, "uniform", "vert"))
 #: compute pre-pass + prepared draws: frame UBO, cloud (geometry, colours,
-#: flags, basis), records A/B, indirect draw commands
+#: flags, basis), records A/B, indirect draw commands, deformation UBO
 _PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
              V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
              V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "vert|comp"),
-             V.Binding(7, "storage", "comp"))
+             V.Binding(7, "storage", "comp"), V.Binding(8, "uniform", "comp"))
 _REC_A_BYTES = 48
 _REC_B_BYTES = 32
 _WORKGROUP = 64
@@ -145,6 +149,15 @@ class _Targets:
         self.target_fbs.clear()
 
 
+class _Prep:
+    """Buffers and descriptor sets of the compute pre-pass (one set per basis window)."""
+
+    def __init__(self, objects, dset, rec_a, rec_b, draws, chunks):
+        self.objects = objects
+        self.dset, self.rec_a, self.rec_b, self.draws = dset, rec_a, rec_b, draws
+        self.chunks = chunks          # (descriptor set, first splat, count)
+
+
 def _rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
     return V.RenderPassDesc(colors=(V.Attachment(target.format, "dont_care", final=target.final),))
 
@@ -195,7 +208,7 @@ class Renderer:
         self.backface_culling = bool(backface_culling)
         self.point_splats = bool(point_splats)
         self.prepass = bool(prepass)
-        self._prep = None             # (set, recA, recB, draws) of the compute pre-pass
+        self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         self._own_device = device is None
         self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
@@ -210,6 +223,8 @@ class Renderer:
         self._basis_cols = 4
         self._basis_rows = np.zeros(0, dtype=np.int64)
         self._dC = np.zeros((4, 3))
+        self._dC_dirty = True
+        self.dC_ubo = None
         self.last_timings_ms: dict[str, float] = {}
         self._query = None
         self._max_point_size = float(self.dev.limits.pointSizeRange[1]) if self.dev.features.largePoints else 1.0
@@ -217,8 +232,10 @@ class Renderer:
             self.cache = V.PipelineCache(self.dev)
             self.sampler = V.Sampler(self.dev)
             self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
+            self.dC_ubo = V.Buffer(self.dev, _DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
+            self.dC_ubo.view(np.float32)[:] = 0.0
             self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
-            self.splat_set.write({0: self.ubo})
+            self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 8)
         except BaseException:
             self.close()
@@ -236,7 +253,7 @@ class Renderer:
         if self._targets is not None:
             self._targets.destroy()
             self._targets = None
-        for obj in (self._query, self.splat_set, self.ubo, self.sampler):
+        for obj in (self._query, self.splat_set, self.dC_ubo, self.ubo, self.sampler):
             if obj is not None:
                 obj.destroy()
         if self.cache is not None:
@@ -257,7 +274,7 @@ class Renderer:
     # -------------------------------------------------------------- scene
     def _free_prep(self):
         if self._prep is not None:
-            for obj in reversed(self._prep):
+            for obj in reversed(self._prep.objects):
                 obj.destroy()
             self._prep = None
 
@@ -307,6 +324,12 @@ class Renderer:
         self._basis_rows = np.zeros(0, dtype=np.int64)
         self._basis_cols = 4
         self._dC = np.zeros((4, 3))
+        self._dC_dirty = True
+
+    @property
+    def _basis_groups(self) -> int:
+        """Groups of 4 columns of the (zero-padded) basis."""
+        return (self._basis_cols + 3) // 4
 
     def _require_cloud(self):
         if self.cloud is None:
@@ -340,9 +363,12 @@ class Renderer:
 
     def set_basis(self, indices, B, Bx, By, Bz) -> None:
         """Deformation basis rows for the splats ``indices`` (N,); B, Bx, By, Bz
-        are (N, K) with K a multiple of 4, at most ``RENDER_MAX_BASIS_COLUMNS``.
-        Other splats are not deformed.  Only the given rows (and the rows of
-        the previous basis, which are cleared) are written to the GPU."""
+        are (N, K) with any K in 1..``RENDER_MAX_BASIS_COLUMNS`` (16), e.g.
+        4 per rigid handle or k+1 spline control points; they are zero-padded
+        to a multiple of 4 columns internally.  Other splats are not deformed.
+        Only the given rows (and the rows of the previous basis, which are
+        cleared) are written to the GPU.  A new K resets the displacement to
+        zeros (K, 3)."""
         self._check_open()
         self._require_cloud()
         idx = np.asarray(indices, dtype=np.int64).reshape(-1)
@@ -355,18 +381,18 @@ class Renderer:
         k = mats[0].shape[1]
         if any(a.shape[1] != k for a in mats):
             raise ParameterError("B", "B, Bx, By, Bz must have the same number of columns")
-        if k == 0 or k % 4 or k > RENDER_MAX_BASIS_COLUMNS:
-            raise ParameterError("B", f"basis must have 4..{RENDER_MAX_BASIS_COLUMNS} columns in multiples "
-                                      f"of 4 (one control frame = 4), got {k}")
+        if not 1 <= k <= RENDER_MAX_BASIS_COLUMNS:
+            raise ParameterError("B", f"basis must have 1..{RENDER_MAX_BASIS_COLUMNS} columns "
+                                      f"(RENDER_MAX_BASIS_COLUMNS), got {k}")
         if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
             raise ParameterError("indices", f"must be in 0..{self.n - 1}")
         if len(np.unique(idx)) != len(idx):
             raise ParameterError("indices", "must not repeat")
         if not all(np.isfinite(a).all() for a in mats):
             raise ParameterError("B", "basis rows must be finite")
-        g = k // 4
+        g = (k + 3) // 4
         row_bytes = 64 * g
-        if self._basis_buf is None or self._basis_cols != k:
+        if self._basis_buf is None or self._basis_groups != g:
             if self._basis_buf is not None:
                 self._basis_buf.destroy()
                 self._basis_buf = None
@@ -374,12 +400,16 @@ class Renderer:
             self._basis_buf = V.Buffer(self.dev, self.n * row_bytes, ("vertex", "storage"), host_visible=True)
             self._basis_buf.view(np.float32)[:] = 0.0
             self._basis_rows = np.zeros(0, dtype=np.int64)
+        if self._basis_cols != k:
             self._basis_cols = k
-            if self._dC.shape[0] != k:
-                self._dC = np.zeros((k, 3))
-        rows = np.empty((len(idx), g, 4, 4), dtype=np.float32)
+        if self._dC.shape[0] != k:
+            self._dC = np.zeros((k, 3))
+            self._dC_dirty = True
+        rows = np.zeros((len(idx), g, 4, 4), dtype=np.float32)
         for j, a in enumerate(mats):
-            rows[:, :, j, :] = a.reshape(len(idx), g, 4)
+            padded = np.zeros((len(idx), 4 * g))
+            padded[:, :k] = a
+            rows[:, :, j, :] = padded.reshape(len(idx), g, 4)
         view = self._basis_buf.view(np.float32).reshape(self.n, 16 * g)
         flags = self._flags.view(np.uint32)
         stale = np.setdiff1d(self._basis_rows, idx, assume_unique=True)
@@ -401,23 +431,28 @@ class Renderer:
         self._basis_rows = np.zeros(0, dtype=np.int64)
 
     def set_displacement(self, dC) -> None:
-        """Control-frame displacement dC (K, 3), K = the basis' column count."""
+        """Control-frame displacement dC (K, 3), K = the basis' column count
+        (K = 4 before any :meth:`set_basis`).  Only dC (192 bytes) is uploaded
+        to the GPU, when the next frame is recorded."""
         self._check_open()
         a = np.asarray(dC, dtype=np.float64)
-        if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols or not np.isfinite(a).all():
-            raise ParameterError("dC", f"must be a finite ({self._basis_cols}, 3) array, got shape {a.shape}")
+        if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols:
+            raise ParameterError("dC", f"must have shape ({self._basis_cols}, 3) (the basis has "
+                                       f"{self._basis_cols} columns), got {a.shape}")
+        if not np.isfinite(a).all():
+            raise ParameterError("dC", "must be finite")
         self._dC = a.copy()
+        self._dC_dirty = True
 
-    def _push_dC(self) -> np.ndarray:
-        g = self._basis_cols // 4
-        out = np.zeros((g, 3, 4), dtype=np.float32)
-        for gi in range(g):
-            out[gi] = self._dC[4 * gi:4 * gi + 4].T
-        return out.reshape(-1)
+    def _dC_block(self) -> np.ndarray:
+        """dC zero-padded to 16 columns, as rows dC[3g + i] = (dC_{4g..4g+3})[i] (deform.glsl)."""
+        pad = np.zeros((4 * _MAX_GROUPS, 3))
+        pad[:len(self._dC)] = self._dC
+        return np.ascontiguousarray(pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1), dtype=np.float32).reshape(-1)
 
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):
-        g = self._basis_cols // 4
+        g = self._basis_groups
         bindings = (V.VertexBinding(0, _GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
                     V.VertexBinding(3, basis_stride))
         attrs = [V.VertexAttribute(0, 0, "vec3", 0), V.VertexAttribute(1, 0, "vec3", 12),
@@ -427,10 +462,10 @@ class Renderer:
         return bindings, tuple(attrs)
 
     def _splat_pipeline(self, kind: str, mode: int = 0):
-        g = self._basis_cols // 4
+        g = self._basis_groups
         deformed = self._basis_buf is not None and len(self._basis_rows) > 0
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
-        layout = V.LayoutDesc(sets=(_SPLAT_SET,), push_bytes=48 * g, push_stages="vert")
+        layout = V.LayoutDesc(sets=(_SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
         common = dict(bindings=bindings, attributes=attrs, depth_test=True, spec=((0, mode),),
                       topology="point_list" if mode == 2 else "triangle_strip")
@@ -448,7 +483,7 @@ class Renderer:
     def _basis_binding(self):
         if self._basis_buf is not None and len(self._basis_rows) > 0:
             return self._basis_buf
-        g = self._basis_cols // 4
+        g = self._basis_groups
         buf = self._dummy_basis.get(g)
         if buf is None:
             buf = self._dummy_basis[g] = V.Buffer(self.dev, 64 * g, ("vertex", "storage"), host_visible=True)
@@ -498,6 +533,9 @@ class Renderer:
         opts = f[64:68].view(np.uint32)
         opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 0, 0)
         self.ubo.write(f)
+        if self._dC_dirty:
+            self.dC_ubo.write(self._dC_block())
+            self._dC_dirty = False
         self._near_far = (near, far)
 
     def _use_prepass(self) -> bool:
@@ -506,14 +544,33 @@ class Renderer:
         t = self._targets
         if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
             return False
+        # the basis is bound in windows (chunked dispatches), so only the
+        # per-slot records and the geometry must fit one storage binding:
+        # 48 bytes per splat -> 2,796,202 splats with lavapipe's 128 MiB
         limit = int(self.dev.limits.maxStorageBufferRange)
-        sizes = [self.n * _REC_A_BYTES, self.n * _REC_B_BYTES, self._geom.size, self._basis_binding().size]
+        sizes = [self.n * _REC_A_BYTES, self.n * _REC_B_BYTES, self._geom.size]
         return max(sizes) <= limit
+
+    def _basis_chunks(self, basis) -> list[tuple[int, int, int, int]]:
+        """(first splat, splat count, byte offset, byte range) windows of the
+        basis buffer that each fit one storage binding."""
+        row_bytes = 64 * self._basis_groups
+        if basis.size < self.n * row_bytes:          # the dummy (nothing deformed): one window
+            return [(0, self.n, 0, basis.size)]
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
+        per = max(limit // row_bytes // _WORKGROUP * _WORKGROUP, _WORKGROUP)
+        while (per * row_bytes) % align:
+            per -= _WORKGROUP
+        out = []
+        for base in range(0, self.n, per):
+            cnt = min(per, self.n - base)
+            out.append((base, cnt, base * row_bytes, cnt * row_bytes))
+        return out
 
     def _prep_objects(self):
         if self._prep is None:
-            dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET))
-            objs = [dset]
+            objs = []
             try:
                 rec_a = V.Buffer(self.dev, self.n * _REC_A_BYTES, ("storage",))
                 objs.append(rec_a)
@@ -521,29 +578,38 @@ class Renderer:
                 objs.append(rec_b)
                 draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
                 objs.append(draws)
-                dset.write({0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: self._basis_binding(),
-                            5: rec_a, 6: rec_b, 7: draws})
+                basis = self._basis_binding()
+                chunks = []
+                for base, cnt, off, rng in self._basis_chunks(basis):
+                    dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET))
+                    objs.append(dset)
+                    dset.write({0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: (basis, off, rng),
+                                5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo})
+                    chunks.append((dset, base, cnt))
             except BaseException:
                 for o in reversed(objs):
                     o.destroy()
                 raise
-            self._prep = (dset, rec_a, rec_b, draws)
+            self._prep = _Prep(objs, chunks[0][0], rec_a, rec_b, draws, chunks)
         return self._prep
 
     def _record_prepass(self, cb):
-        """Compute pre-pass: records + indirect draw counts for this frame's camera."""
-        dset, _, _, draws = self._prep_objects()
-        g = self._basis_cols // 4
+        """Compute pre-pass: records + indirect draw counts for this frame's camera
+        (one dispatch per basis window)."""
+        prep = self._prep_objects()
+        g = self._basis_groups
         comp = "prepare.comp" if g == 1 else f"prepare_k{4 * g}.comp"
-        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=48 * g + 4, push_stages="comp")
+        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=12, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
-        cb.fill_buffer(draws, 0)
+        cb.fill_buffer(prep.draws, 0)
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
-        cb.bind_descriptor_set(pipe, dset)
-        push = np.concatenate([self._push_dC().view(np.uint32), np.array([self.n], np.uint32)])
-        cb.push_constants(pipe, push)
-        cb.dispatch((self.n + _WORKGROUP - 1) // _WORKGROUP)
+        for j, (dset, base, cnt) in enumerate(prep.chunks):
+            if j:
+                cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
+            cb.bind_descriptor_set(pipe, dset)
+            cb.push_constants(pipe, np.array([base, cnt, self.n], np.uint32))
+            cb.dispatch((cnt + _WORKGROUP - 1) // _WORKGROUP)
         cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
                           "indirect_read|shader_read")
 
@@ -566,7 +632,8 @@ class Renderer:
     def _record_splats(self, cb, kind: str, prepared: bool = False):
         """Draw every splat: as quads, or (point_splats) tiny ones as points + the others as quads."""
         if prepared:
-            dset, _, _, draws = self._prep_objects()
+            prep = self._prep_objects()
+            dset, draws = prep.dset, prep.draws
             n = np.array([self.n], np.uint32)
             for mode, offset in ((1, 0), (2, 16)):
                 pipeline = self._prepared_pipeline(kind, mode)
@@ -577,13 +644,11 @@ class Renderer:
             return
         modes = ((1, 4), (2, 1)) if self.point_splats else ((0, 4),)
         bufs = [self._geom, self._color, self._flags, self._basis_binding()]
-        dC = self._push_dC()
         for mode, verts in modes:
             pipeline = self._splat_pipeline(kind, mode)
             cb.bind_pipeline(pipeline)
             cb.bind_descriptor_set(pipeline, self.splat_set)
             cb.bind_vertex_buffers(0, bufs)
-            cb.push_constants(pipeline, dC)
             if verts == 4:
                 cb.draw(4, self.n)
             else:

@@ -35,7 +35,7 @@ def _compare(renderer, base, deformed, cam, setup):
     return img
 
 
-@pytest.mark.parametrize("k", [4, 8])
+@pytest.mark.parametrize("k", [1, 4, 5, 8, 12, 16])
 def test_gpu_deformation_matches_cpu(renderer, k):
     base = torus(100, 40)
     rng = np.random.default_rng(k)
@@ -50,6 +50,46 @@ def test_gpu_deformation_matches_cpu(renderer, k):
         renderer.set_displacement(dC)
     img = _compare(renderer, base, deformed, cam, setup)
     assert (img[..., :3] < 250).any()
+
+
+@pytest.mark.parametrize("k", [1, 5, 12, 16])
+def test_vertex_path_deformation_matches_cpu(renderer, k):
+    """The same with the all-in-vertex-shader path (basis rows as 4 * ceil(K/4) vertex attributes)."""
+    saved = renderer.prepass
+    renderer.prepass = False
+    try:
+        test_gpu_deformation_matches_cpu(renderer, k)
+    finally:
+        renderer.prepass = saved
+
+
+def test_prepass_basis_windows(renderer, monkeypatch):
+    """A basis larger than one storage binding is dispatched in windows (here
+    forced small: 3 windows) with the same result."""
+    base = torus(100, 40)
+    k = 16
+    idx = np.flatnonzero(base.positions[:, 1] > -0.5)
+    B, Bx, By, Bz = gaussian_basis(base.positions[idx], k=k, seed=4)
+    dC = np.random.default_rng(4).normal(scale=0.2, size=(k, 3))
+    deformed = cpu_deform(base, idx, B, Bx, By, Bz, dC)
+    cam = Camera.frame(*deformed.bounds(), 1.0, direction=(0.4, -0.8, 1.0))
+    limits = renderer.dev.limits
+
+    class Small:
+        def __getattr__(self, name):
+            return getattr(limits, name)
+        maxStorageBufferRange = 256 * (base.n // 3 + 64)
+
+    def setup():
+        renderer.set_basis(idx, B, Bx, By, Bz)
+        renderer.set_displacement(dC)
+        monkeypatch.setattr(renderer.dev, "limits", Small())
+    try:
+        _compare(renderer, base, deformed, cam, setup)
+        assert len(renderer._prep.chunks) == 3
+    finally:
+        monkeypatch.undo()
+        renderer.set_cloud(base)
 
 
 def test_basis_replacement_clears_old_rows(renderer):
@@ -90,14 +130,24 @@ def test_basis_errors(renderer):
     renderer.set_cloud(base)
     idx = np.arange(10)
     good = np.zeros((10, 4))
-    with pytest.raises(ParameterError, match="multiples of 4"):
-        renderer.set_basis(idx, np.zeros((10, 5)), np.zeros((10, 5)), np.zeros((10, 5)), np.zeros((10, 5)))
-    with pytest.raises(ParameterError, match="columns"):
-        z = np.zeros((10, 12))
+    with pytest.raises(ParameterError, match="1..16 columns .*RENDER_MAX_BASIS_COLUMNS.*got 17"):
+        z = np.zeros((10, 17))
         renderer.set_basis(idx, z, z, z, z)
+    with pytest.raises(ParameterError, match="got 0"):
+        z = np.zeros((10, 0))
+        renderer.set_basis(idx, z, z, z, z)
+    with pytest.raises(ParameterError, match="same number of columns"):
+        renderer.set_basis(idx, np.zeros((10, 5)), good, good, good)
     with pytest.raises(ParameterError, match="shape"):
         renderer.set_basis(idx, np.zeros((9, 4)), good, good, good)
     with pytest.raises(ParameterError, match="indices"):
         renderer.set_basis(idx + 495, good, good, good, good)
     with pytest.raises(ParameterError, match="dC"):
         renderer.set_displacement(np.zeros((3, 3)))
+    z5 = np.zeros((10, 5))
+    renderer.set_basis(idx, z5, z5, z5, z5)          # K = 5 (padded to 8 on the GPU)
+    with pytest.raises(ParameterError, match=r"shape \(5, 3\)"):
+        renderer.set_displacement(np.zeros((8, 3)))
+    with pytest.raises(ParameterError, match="finite"):
+        renderer.set_displacement(np.full((5, 3), np.nan))
+    renderer.set_displacement(np.zeros((5, 3)))

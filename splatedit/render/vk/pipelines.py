@@ -313,13 +313,16 @@ class DescriptorSet:
         self.handle = call(vk.vkAllocateDescriptorSets, device.device, ainfo)[0]
 
     def write(self, entries: dict):
-        """``entries``: binding -> Buffer (uniform/storage) or (Image, Sampler) (sampled)."""
+        """``entries``: binding -> Buffer or (Buffer, offset, range) (uniform/storage;
+        offset must be a multiple of the device's min offset alignment) or
+        (Image, Sampler) (sampled)."""
         writes, keep = [], []
         types = {b.binding: b.type for b in self.layout.bindings}
         for binding, res in entries.items():
             t = types[binding]
             if t in ("uniform", "storage"):
-                bi = vk.VkDescriptorBufferInfo(buffer=res.handle, offset=0, range=res.size)
+                buf, off, rng = res if isinstance(res, tuple) else (res, 0, res.size)
+                bi = vk.VkDescriptorBufferInfo(buffer=buf.handle, offset=int(off), range=int(rng))
                 keep.append(bi)
                 writes.append(vk.VkWriteDescriptorSet(dstSet=self.handle, dstBinding=binding, dstArrayElement=0,
                                                       descriptorCount=1, descriptorType=_DESC_TYPES[t],

@@ -18,7 +18,8 @@ class InputEvent:
 
     kind: "key" (key, action, mods), "char" (char), "button" (button, action,
     mods, x, y), "move" (x, y), "scroll" (dx, dy, x, y, mods), "resize"
-    (w, h: framebuffer size), "close", "iconify" (action 1 = minimized).
+    (w, h: framebuffer size), "close", "iconify" (action 1 = minimized),
+    "enter" (action 1 = the cursor entered the window, 0 = left it).
     Coordinates are framebuffer pixels, origin top-left.
     """
     kind: str
@@ -65,6 +66,7 @@ class Window:
         glfw.set_framebuffer_size_callback(self.handle, self._on_resize)
         glfw.set_window_close_callback(self.handle, self._on_close)
         glfw.set_window_iconify_callback(self.handle, self._on_iconify)
+        glfw.set_cursor_enter_callback(self.handle, self._on_enter)
 
     # ----------------------------------------------------------- callbacks
     def _update_scale(self) -> None:
@@ -98,6 +100,9 @@ class Window:
     def _on_close(self, win):
         self.glfw.set_window_should_close(self.handle, False)  # the editor decides
         self.events.append(InputEvent("close"))
+
+    def _on_enter(self, win, entered):
+        self.events.append(InputEvent("enter", action=int(entered)))
 
     def _on_iconify(self, win, iconified):
         self.events.append(InputEvent("iconify", action=int(iconified)))

@@ -1,0 +1,12 @@
+// Per-frame deformation parameters (std140 uniform block, set 0, binding
+// DEFORM_BINDING, defined by the including file).  dC of a basis with up to
+// RENDER_MAX_BASIS_COLUMNS = 16 columns, zero-padded to whole groups of 4:
+// dC[3g + i] = (dC_{4g}, .., dC_{4g+3})[i], i = x, y, z.  Only this 192-byte
+// block is uploaded when the displacement changes.
+// Mirrors splatedit/render/renderer.py:_DEFORM_UBO_BYTES.
+
+const int MAX_BASIS_GROUPS = 4;
+
+layout(std140, set = 0, binding = DEFORM_BINDING) uniform Deform {
+    vec4 dC[3 * MAX_BASIS_GROUPS];
+} D;
