@@ -137,7 +137,8 @@ def bench_qr(m: int, seed: int = 0, naive_max: int = 1000, repeat: int = 1) -> d
     return {
         "m": m,
         "matrix_rows": a.shape[0],
-        "threads_hint": os.environ.get("OMP_NUM_THREADS") or os.cpu_count(),
+        "blas_threads": (os.environ.get("OPENBLAS_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS")
+                         or f"default ({os.cpu_count()} cpus)"),
         "build_matrix_s": round(t_build, 4),
         "iqr_blocked_s": round(t_iqr, 4),
         "iqr_fit_s": round(t_fit_iqr, 4),

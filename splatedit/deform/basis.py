@@ -263,24 +263,42 @@ class DeformationBasis:
 
     # ----------------------------------------------------------- per frame
     def displacement(self, transforms) -> np.ndarray:
-        """Control-frame displacements ``dC`` (4h, 3) for one affine map per
-        handle: ``C'_i = m_i(C_i)``, ``dC = C' - C``.
+        """Control-point displacements ``dC`` (K, 3) from one input per group
+        (handles first, then curves, as in :attr:`group_kinds`):
 
-        ``transforms``: a list of h (4, 4) matrices (None = identity); a single
-        matrix is accepted when there is one handle.
+        * handle: a (4, 4) affine map ``m`` (or (3, 4)); ``dC = m(C) - C`` for
+          its control frame C;
+        * curve: a (k + 1, 3) array of B-spline control-point displacements
+          ``db`` (use ``ControlCurve.control_displacement(dq)`` to move the
+          picked points by ``dq`` instead);
+        * None: the group does not move.
+
+        A single 2-D array is accepted when there is one group.
         """
         if isinstance(transforms, np.ndarray) and transforms.ndim == 2:
             transforms = [transforms]
         transforms = list(transforms)
-        if len(transforms) != self.n_handles:
-            raise ParameterError("transforms", f"need one matrix per handle "
-                                 f"({self.n_handles}), got {len(transforms)}")
+        if len(transforms) != self.n_groups:
+            raise ParameterError("transforms", f"need one matrix per handle and one (k + 1, 3) "
+                                 f"displacement array per curve ({self.n_groups} groups: "
+                                 f"{', '.join(self.group_kinds)}), got {len(transforms)}")
         dc = np.zeros((self.n_columns, 3))
         for i, (t, grp) in enumerate(zip(transforms, self.constraints.groups)):
             if t is None:
                 continue
-            m = as_affine(t, name=f"transforms[{i}]")
-            dc[self.columns_for_handle(i)] = apply_affine(m, grp.controls) - grp.controls
+            cols = self.columns_for_group(i)
+            if grp.kind == "handle":
+                m = as_affine(t, name=f"transforms[{i}]")
+                dc[cols] = apply_affine(m, grp.controls) - grp.controls
+            else:
+                d = np.asarray(t, dtype=np.float64)
+                k = grp.n_columns
+                if d.shape != (k, 3):
+                    raise ParameterError(f"transforms[{i}]", f"curve {i} has {k} control points: "
+                                         f"expected a ({k}, 3) displacement array, got shape {d.shape}")
+                if not np.isfinite(d).all():
+                    raise ParameterError(f"transforms[{i}]", "must be finite")
+                dc[cols] = d
         return dc
 
     def _check_dc(self, dC) -> np.ndarray:

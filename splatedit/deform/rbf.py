@@ -407,11 +407,14 @@ class TriharmonicRBF:
             the first center count whose residual is below ``tol`` for every
             column.  "auto" — "lu" when m <= AUTO_EXACT_MAX_CONSTRAINTS and
             ``max_centers`` does not ask for fewer centers than m, else "iqr".
-            The threshold is where the dense solve stops being cheap: measured
-            here (2 cores, OpenBLAS) LU takes ~0.1 s at m=1000, ~0.45 s at
-            m=2000 and ~1.2 s at m=3000 incl. building the matrix, growing as
-            m^3 beyond; IQR at tol=1e-7 on surface bands typically needs a
-            few hundred centers and costs O(m n^2).
+            The threshold is where the dense solve stops being cheap and IQR
+            starts to win: measured here (2 cores, OpenBLAS, incl. building
+            the matrix) the LU fit takes 0.03-0.1 s at m=1000, 0.4 s at
+            m=3000 (1.3 s with the machine loaded) and 1.6-2.5 s at m=5000,
+            growing as m^3; IQR at tol=1e-7 on surface-like constraints
+            needed 585-800 centers and 0.05-0.27 s at m=1000-5000, O(m n^2).
+            Below ~3000 the exact answer costs under half a second, so it
+            is preferred; above it LU's m^3 dominates.
         tol : the paper's relative residual ``||Ax - b|| / (m ||b||)`` at which
             IQR stops (default 1e-7, Sect. 8).  0 means "use every center"
             (up to ``max_centers``).  Ignored by "lu".

@@ -1,0 +1,63 @@
+"""``splatedit bench WHAT``: run the benchmarks and yield one JSON-ready dict per case.
+
+Every case compares the hot path with the obvious alternative in the same run
+(LU vs IQR vs scipy; blocked QR vs scipy.linalg.qr vs a naive Householder QR;
+EWA frame vs the one-pixel point-list floor; apply vs a plain copy).
+Results are recorded in docs/PERFORMANCE.md.
+"""
+
+from __future__ import annotations
+
+from typing import Iterator
+
+
+def _solve(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.solve import bench_solve, standard_cases
+    for name, cloud, support, handles in standard_cases(large=not quick):
+        if quick and cloud.n > 300_000:
+            continue
+        out = {"bench": "solve"}
+        out.update(bench_solve(cloud, support, handles, name=name))
+        yield out
+
+
+def _groups(quick: bool, progress=None) -> Iterator[dict]:
+    try:
+        from splatedit.bench.solve import bench_groups
+    except ImportError:
+        return
+    for line in bench_groups(quick=quick):
+        yield {"bench": "groups", **line}
+
+
+def _qr(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.qr import bench_qr
+    for m in ((500, 1000) if quick else (1000, 3000, 5000)):
+        yield {"bench": "qr", **bench_qr(m)}
+
+
+def _render(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.render import bench_render
+    counts = (20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000)
+    size = (640, 360) if quick else (1280, 720)
+    yield from bench_render(counts=counts, size=size)
+
+
+def _editor(quick: bool, progress=None) -> Iterator[dict]:
+    try:
+        from splatedit.app.bench import bench_editor_frames
+    except ImportError:
+        return
+    counts = (100_000,) if quick else (100_000, 1_000_000, 2_000_000)
+    for line in bench_editor_frames(counts=counts):
+        yield {"bench": "editor", **line}
+
+
+BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "render": _render, "editor": _editor}
+
+
+def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
+    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all")."""
+    names = list(BENCHES) if what == "all" else [what]
+    for name in names:
+        yield from BENCHES[name](quick, progress)
