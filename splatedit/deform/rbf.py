@@ -26,7 +26,6 @@ from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-import scipy.linalg
 from scipy.linalg import lapack
 
 from splatedit.deform.centers import FarthestPointSampler
