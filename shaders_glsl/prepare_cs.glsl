@@ -1,7 +1,7 @@
 // Compute pre-pass (once per splat per frame): deformation, eye transform,
 // culling and the screen-space setup of prepare_splat(), written as compact
 // records for the two splat passes (drawn by prepared.vert with indirect
-// draws): quads fill slots 0.. upwards, one-pixel points slots n-1 downwards.
+// draws): quads fill slots 0.. upwards, square points slots n-1 downwards.
 // The including file defines BASIS_GROUPS.
 
 #include "frame.glsl"
@@ -92,6 +92,7 @@ void main() {
     vec2 pos = kind == SPLAT_QUAD ? S.lo : S.cc;
     recB[2 * slot] = uvec4(floatBitsToUint(S.center.x), floatBitsToUint(S.center.y), floatBitsToUint(S.center.w),
                            i + 1u);
-    recB[2 * slot + 1] = uvec4(kind == SPLAT_QUAD ? pack_px(S.lo, -1.0) : 0u, kind == SPLAT_QUAD ? pack_px(S.hi, 1.0) : 0u,
+    recB[2 * slot + 1] = uvec4(kind == SPLAT_QUAD ? pack_px(S.lo, -1.0) : floatBitsToUint(S.psize),
+                               kind == SPLAT_QUAD ? pack_px(S.hi, 1.0) : 0u,
                                packUnorm4x8(vec4(S.color, 1.0)), packSnorm2x16(oct_encode(S.normal)));
 }

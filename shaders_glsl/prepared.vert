@@ -2,7 +2,8 @@
 #extension GL_GOOGLE_include_directive : require
 // Splat vertex shader of the pre-pass path: fetches the record prepare.comp
 // wrote (deformation and screen setup done once per splat) and emits a quad
-// (PRIM_MODE 1, 4-vertex strip per instance) or a one-pixel point (PRIM_MODE 2).
+// (PRIM_MODE 1, 4-vertex strip per instance) or a square point (PRIM_MODE 2,
+// side in the record).
 
 #define VARYING out
 #include "frame.glsl"
@@ -35,7 +36,7 @@ void main() {
     v_color = vec4(unpackUnorm4x8(b1.z).rgb, 1.0);
     v_normal = vec4(oct_decode(unpackSnorm2x16(b1.w)), 0.0);
     if (PRIM_MODE == 2) {
-        gl_PointSize = 1.0;
+        gl_PointSize = uintBitsToFloat(b1.x);
         gl_Position = vec4(v_center.xy * 2.0 * F.viewport.zw - 1.0, 0.5, 1.0);
         return;
     }

@@ -8,6 +8,7 @@ struct Splat {
     vec3 normal;               // unit eye-space normal facing the viewer
     vec2 lo, hi;               // screen bound (NDC)
     vec2 cc;                   // projected centre (NDC)
+    float psize;               // SPLAT_POINT: side of the square point (pixels)
 };
 
 const int SPLAT_CULLED = 0;
@@ -39,11 +40,16 @@ vec2 extent(vec2 ap, vec2 wxy, float cw) {
 
 // Everything a splat needs on screen, from its (deformed) model-space centre
 // and axes.  Returns SPLAT_CULLED (outside the frustum, back-facing with
-// culling on, degenerate), SPLAT_POINT (ellipse bound <= F.misc.w pixels) or
-// SPLAT_QUAD.
+// culling on, degenerate), SPLAT_POINT or SPLAT_QUAD.
+// SPLAT_POINT: the footprint (projected ellipse and low-pass disc) lies within
+// F.misc.w pixels of the projected centre along x and y and the centre is on
+// screen: the splat is drawn as one square POINT_LIST point of side psize
+// centred there, which covers every pixel centre the quad would (the fragment
+// shader is the same), with one vertex instead of a 4-vertex strip.
 int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
     S.ms_cn = vec4(0.0); S.mt_tc = vec4(0.0); S.mw_r = vec4(0.0); S.center = vec4(0.0);
     S.color = vec3(0.0); S.normal = vec3(0.0); S.lo = vec2(0.0); S.hi = vec2(0.0); S.cc = vec2(0.0);
+    S.psize = 1.0;
     mat3 R3 = mat3(F.view);
     vec3 c = (F.view * vec4(p, 1.0)).xyz;
     vec3 ue = R3 * u, ve = R3 * v;
@@ -78,8 +84,11 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
         if (any(greaterThan(lo, vec2(1.0))) || any(lessThan(hi, vec2(-1.0)))) return SPLAT_CULLED;
         S.lo = max(lo, vec2(-1.0) - px_ndc);
         S.hi = min(hi, vec2(1.0) + px_ndc);
-        vec2 sz = vec2(ex.y - ex.x, ey.y - ey.x) * 0.5 * F.viewport.xy;   // ellipse bound, pixels
-        small = max(sz.x, sz.y) <= F.misc.w;
+        // largest distance of the footprint from the centre along x, y (pixels)
+        vec2 he = max(vec2(max(-ex.x, ex.y), max(-ey.x, ey.y)) * 0.5 * F.viewport.xy, vec2(lp)) + 0.02;
+        float h = max(he.x, he.y);
+        small = h <= F.misc.w && all(lessThan(abs(cc), vec2(1.0)));
+        S.psize = ceil(16.0 * h) * 0.125;                  // 2 h rounded up to the point-size granularity
     }
     S.cc = C.xy / C.w;
 

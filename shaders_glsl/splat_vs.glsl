@@ -26,9 +26,9 @@ layout(location = 3) in vec4 in_color;      // sRGB unorm8x4
 layout(location = 4) in uint in_flags;
 layout(location = 5) in vec4 in_basis[4 * BASIS_GROUPS];  // per group: B, Bx, By, Bz
 
-// 0: every splat as a quad; 1: only splats whose ellipse bound exceeds the
-// point threshold (F.misc.w <= 1 pixel) as quads; 2: only the others, as
-// one-pixel points (POINT_LIST).  Modes 1 + 2 together draw every splat.
+// 0: every splat as a quad; 1: only the SPLAT_QUAD ones (see prepare_splat);
+// 2: only the SPLAT_POINT ones, as square points (POINT_LIST).  Modes 1 + 2
+// together draw every splat.
 layout(constant_id = 0) const int PRIM_MODE = 0;
 
 void cull() {
@@ -60,8 +60,8 @@ void main() {
     v_color = vec4(S.color, 1.0);
     v_normal = vec4(S.normal, 0.0);
     v_index = uint(gl_InstanceIndex) + 1u;
-    if (PRIM_MODE == 2) {                     // tiny splat: one-pixel point at its centre
-        gl_PointSize = 1.0;
+    if (PRIM_MODE == 2) {                     // small splat: square point at its centre
+        gl_PointSize = S.psize;
         gl_Position = vec4(S.cc, 0.5, 1.0);
         return;
     }

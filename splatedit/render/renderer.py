@@ -207,6 +207,8 @@ class Renderer:
         self.accum_format = accum_format
         self.backface_culling = bool(backface_culling)
         self.point_splats = bool(point_splats)
+        #: point path threshold (pixels), see ``point_splats``
+        self.point_max_px = float(RENDER_POINT_SPLAT_MAX_PX)
         self.prepass = bool(prepass)
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
@@ -529,7 +531,7 @@ class Renderer:
         f[52:56] = (*self.background[:3], 1.0)
         f[56:60] = RENDER_LIGHT
         f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
-                    min(RENDER_POINT_SPLAT_MAX_PX, self._max_point_size) if self.point_splats else -1.0)
+                    min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
         opts = f[64:68].view(np.uint32)
         opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 0, 0)
         self.ubo.write(f)

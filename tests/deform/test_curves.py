@@ -1,0 +1,287 @@
+"""Non-rigid control curves: the interpolating spline, its affine sample
+weights, curve constraints, and curve (+ handle) deformations against the
+exact solve and an independent oracle."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+from scipy.interpolate import RBFInterpolator
+from scipy.spatial import cKDTree
+
+from splatedit.bench.solve import wavy_plane_cloud
+from splatedit.deform.basis import DeformationBasis
+from splatedit.deform.constraints import build_constraints
+from splatedit.deform.curves import ControlCurve, bspline_basis
+from splatedit.deform.transform import apply_affine, rotate, translate
+from splatedit.errors import ParameterError, SolverError
+
+
+def surface(xy, amplitude=0.15, waves=1.5):
+    """Points of the wavy plane of ``wavy_plane_cloud`` above ``xy``."""
+    xy = np.atleast_2d(xy)
+    w = waves * np.pi
+    return np.column_stack([xy, amplitude * np.sin(w * xy[:, 0]) * np.cos(w * xy[:, 1])])
+
+
+def disc(cloud, r, c=(0.0, 0.0)):
+    return np.linalg.norm(cloud.positions[:, :2] - np.asarray(c), axis=1) <= r
+
+
+def picked(n=5, x0=-0.4, x1=0.4):
+    s = np.linspace(x0, x1, n)
+    return surface(np.column_stack([s, 0.3 * np.sin(3 * s)]))
+
+
+@pytest.fixture(scope="module")
+def plane():
+    return wavy_plane_cloud(60)
+
+
+@pytest.fixture(scope="module")
+def curve_edit(plane):
+    sup = disc(plane, 0.7)
+    curve = ControlCurve.through(picked())
+    return plane, sup, curve, DeformationBasis.fit(plane, sup, curves=[curve], method="lu")
+
+
+def free_rows(basis):
+    return np.searchsorted(basis.indices, basis.constraints.free_index)
+
+
+# ------------------------------------------------------------ the spline
+@settings(max_examples=40, deadline=None)
+@given(st.integers(2, 17), st.integers(0, 10_000))
+def test_spline_interpolates_the_picked_points_with_affine_weights(n, seed):
+    q = np.random.default_rng(seed).normal(size=(n, 3))
+    c = ControlCurve.through(q)
+    assert c.n_controls == n and c.degree == min(3, n - 1)
+    np.testing.assert_allclose(c.evaluate(c.params), q, rtol=0, atol=1e-12)
+    t = np.linspace(0.0, 1.0, 97)
+    w = c.basis(t)
+    np.testing.assert_allclose(w.sum(axis=1), 1.0, rtol=0, atol=1e-14)
+    assert w.min() >= 0.0
+    np.testing.assert_allclose(c.evaluate(t)[[0, -1]], q[[0, -1]], atol=1e-12)
+    # moving the picked points by dq: the moved curve passes through q + dq
+    dq = np.random.default_rng(seed + 1).normal(size=(n, 3))
+    db = c.control_displacement(dq)
+    np.testing.assert_allclose(c.evaluate(c.params, c.controls + db), q + dq, atol=1e-11)
+    # and a common translation of the picked points translates the control points
+    np.testing.assert_allclose(c.control_displacement(np.tile([1.0, -2.0, 0.5], (n, 1))),
+                               np.tile([1.0, -2.0, 0.5], (n, 1)), atol=1e-12)
+
+
+def test_two_points_give_the_segment_and_four_a_cubic():
+    seg = ControlCurve.through([[0, 0, 0], [2, 0, 0]])
+    assert seg.degree == 1
+    np.testing.assert_allclose(seg.evaluate([0.25, 0.5]), [[0.5, 0, 0], [1, 0, 0]], atol=1e-15)
+    # collinear, equally spaced points on a cubic: the spline reproduces the
+    # polynomial curve (a cubic through 4 points is unique)
+    s = np.array([0.0, 1 / 3, 2 / 3, 1.0])
+    cub = ControlCurve.through(np.column_stack([s, s ** 3, s ** 2]))
+    assert cub.degree == 3 and len(cub.knots) == 8
+    t = np.linspace(0, 1, 11)
+    x = cub.evaluate(t)
+    np.testing.assert_allclose(x[:, 1], x[:, 0] ** 3, atol=1e-12)
+    np.testing.assert_allclose(x[:, 2], x[:, 0] ** 2, atol=1e-12)
+
+
+def test_bspline_basis_matches_the_recursion_definition_on_a_uniform_vector():
+    # uniform cubic B-spline on knots 0..7: at t = 3.5 (span 3) the
+    # non-zero values are 1/48, 23/48, 23/48, 1/48
+    w = bspline_basis([3.5], np.arange(8.0), 3)
+    np.testing.assert_allclose(w[0], [1 / 48, 23 / 48, 23 / 48, 1 / 48], atol=1e-15)
+
+
+def test_samples_are_equally_spaced_in_arc_length():
+    c = ControlCurve.through(picked(6))
+    t, w, p = c.sample(spacing=0.02)
+    gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
+    assert len(p) == int(np.ceil(c.length() / 0.02)) + 1
+    assert gaps.max() <= 0.02 and gaps.min() > 0.95 * gaps.max()
+    np.testing.assert_allclose(p, w @ c.controls, atol=1e-15)
+    t8, _, p8 = ControlCurve.through(picked(6), samples=8).sample(spacing=0.02)
+    assert len(p8) == 8 and t8[0] == 0.0 and t8[-1] == 1.0
+
+
+@pytest.mark.parametrize("points,samples,match", [
+    ([[0, 0, 0]], None, "at least 2 points"),
+    ([[0, 0, 0], [1, 0, 0], [1, 0, 0]], None, "points 1 and 2 coincide"),
+    ([[0, 0, 0], [np.nan, 0, 0]], None, "point 1 is not finite"),
+    ([[0, 0], [1, 0]], None, r"shape \(k \+ 1, 3\)"),
+    ([[0, 0, 0], [1, 0, 0]], 1, "samples"),
+])
+def test_curve_errors(points, samples, match):
+    with pytest.raises(ParameterError, match=match):
+        ControlCurve.through(points, samples=samples)
+
+
+# -------------------------------------------------------- constraints
+def test_curve_group_constraints(plane):
+    sup = disc(plane, 0.7)
+    curve = ControlCurve.through(picked())
+    con = build_constraints(plane, sup, curves=[curve])
+    assert [g.kind for g in con.groups] == ["curve"] and con.n_columns == 5
+    g = con.groups[0]
+    assert g.band_index is None and len(g.member_index) == 0 and g.n_dropped == 0
+    np.testing.assert_allclose(g.weights @ g.controls, g.points, atol=1e-14)
+    np.testing.assert_allclose(g.weights.sum(axis=1), 1.0, atol=1e-14)
+    # no handles: the free region is the whole support
+    np.testing.assert_array_equal(con.free_index, np.flatnonzero(sup))
+    np.testing.assert_array_equal(con.values[con.rows(0), con.columns(0)], g.weights)
+    assert not con.values[: len(con.fixed_index)].any()
+    # picked points as a plain array are accepted
+    con2 = build_constraints(plane, sup, curves=[picked()])
+    np.testing.assert_array_equal(con2.points, con.points)
+
+
+def test_samples_next_to_other_constraints_are_dropped(plane):
+    sup = disc(plane, 0.5)
+    # the curve runs from the centre out through the support boundary
+    curve = ControlCurve.through(surface(np.array([[0.0, 0.0], [0.35, 0.05], [0.8, 0.1]])))
+    hnd = disc(plane, 0.1, (-0.3, 0.0))
+    con = build_constraints(plane, sup, [hnd], curves=[curve])
+    g = con.groups[1]
+    assert g.kind == "curve" and g.n_dropped > 0
+    others = np.concatenate([plane.positions[con.fixed_index], plane.positions[hnd]])
+    d, _ = cKDTree(others).query(g.points)
+    assert d.min() > con.spacing
+    # kept + dropped = all samples, and the kept ones are the inner part
+    t, _, all_pts = curve.sample(spacing=con.spacing)
+    assert len(g.points) + g.n_dropped == len(all_pts)
+    assert np.all(np.linalg.norm(g.points[:, :2], axis=1) < 0.5)
+    # a second curve crossing the first loses its samples next to the first
+    cross = ControlCurve.through(surface(np.array([[0.2, -0.3], [0.2, 0.3]])))
+    con2 = build_constraints(plane, sup, curves=[curve, cross])
+    d2, _ = cKDTree(con2.groups[0].points).query(con2.groups[1].points)
+    assert con2.groups[1].n_dropped > 0 and d2.min() > con2.spacing
+
+
+def test_curve_entirely_in_the_fixed_band_is_an_error(plane):
+    sup = disc(plane, 0.5)
+    outside = ControlCurve.through(surface(np.array([[0.52, -0.05], [0.52, 0.05]])))
+    with pytest.raises(SolverError, match="curve 0: all .* samples lie within one point spacing"):
+        build_constraints(plane, sup, curves=[outside])
+    with pytest.raises(ParameterError, match="at least one handle or curve"):
+        build_constraints(plane, sup)
+    with pytest.raises(ParameterError, match=r"curves\[0\].*at least 2 points"):
+        build_constraints(plane, sup, curves=[[[0.0, 0.0, 0.0]]])
+
+
+# ------------------------------------------------------ deformation
+def test_curve_edit_matches_exact_solve_and_scipy(curve_edit):
+    cloud, sup, curve, lu = curve_edit
+    con = lu.constraints
+    iqr = DeformationBasis.fit(cloud, sup, curves=[curve], method="iqr", tol=1e-7)
+    dq = np.random.default_rng(1).normal(scale=0.05, size=(curve.n_controls, 3))
+    dc = lu.displacement([curve.control_displacement(dq)])
+    rows = free_rows(lu)
+    scale_ = np.abs(con.values @ dc).max()
+    err = np.linalg.norm(lu.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
+    assert err.max() / scale_ < 0.01
+    oracle = RBFInterpolator(con.points, con.values @ dc, kernel="cubic", degree=2)
+    theirs = oracle(cloud.positions[lu.indices[rows]])
+    assert np.abs(lu.displacements(dc)[rows] - theirs).max() / scale_ < 1e-8
+    # the field moves every kept sample onto the moved curve c'(t_i)
+    g = con.groups[0]
+    moved = curve.evaluate(g.params, curve.controls + dc[lu.columns_for_group(0)])
+    np.testing.assert_allclose(g.points + lu.rbf(g.points) @ dc, moved, atol=1e-10)
+
+
+def test_translating_all_control_points_translates_the_surface_near_the_curve(curve_edit):
+    cloud, sup, curve, b = curve_edit
+    shift = np.array([0.02, -0.01, 0.1])
+    out = b.apply(cloud, b.displacement([np.tile(shift, (curve.n_controls, 1))]))
+    d = out.positions - cloud.positions
+    dist, _ = cKDTree(b.constraints.groups[0].points).query(cloud.positions)
+    near = sup & (dist <= 0.5 * b.constraints.spacing)
+    assert near.sum() >= 10
+    # measured 1.9% of |shift| on this 60 x 60 plane
+    assert np.linalg.norm(d[near] - shift, axis=1).max() < 0.05 * np.linalg.norm(shift)
+    assert np.array_equal(out.positions[~sup], cloud.positions[~sup])
+
+
+def test_moving_no_control_point_changes_nothing(curve_edit):
+    cloud, sup, curve, b = curve_edit
+    for inputs in ([None], [np.zeros((curve.n_controls, 3))], np.zeros((curve.n_controls, 3))):
+        dc = b.displacement(inputs)
+        assert not dc.any()
+        out = b.apply(cloud, dc)
+        for name in ("positions", "u", "v"):
+            assert np.array_equal(getattr(out, name), getattr(cloud, name))
+
+
+def test_curve_jacobian_bases_match_finite_differences(curve_edit):
+    cloud, sup, curve, b = curve_edit
+    rows = free_rows(b)[::7]
+    ps = cloud.positions[b.indices[rows]]
+    eps = 1e-4 * b.constraints.spacing
+    cols = b.columns_for_group(0)
+    for d, bj in enumerate((b.Bx, b.By, b.Bz)):
+        e = np.zeros(3)
+        e[d] = eps
+        fd = (b.rbf(ps + e)[:, cols] - b.rbf(ps - e)[:, cols]) / (2 * eps)
+        np.testing.assert_allclose(bj[rows][:, cols], fd, rtol=0, atol=1e-6 * np.abs(fd).max())
+    # and the Jacobian of a curve edit is the derivative of p + B dC
+    dc = b.displacement([curve.control_displacement(
+        np.random.default_rng(2).normal(scale=0.05, size=(curve.n_controls, 3)))])
+    j = b.jacobians(dc)[rows]
+    for d in range(3):
+        e = np.zeros(3)
+        e[d] = eps
+        fd = ((ps + e + b.rbf(ps + e) @ dc) - (ps - e + b.rbf(ps - e) @ dc)) / (2 * eps)
+        np.testing.assert_allclose(j[:, :, d], fd, atol=1e-6)
+
+
+def test_curve_and_handle_in_one_edit(plane):
+    sup = disc(plane, 0.85)
+    hnd = disc(plane, 0.15, (0.45, 0.0))
+    curve = ControlCurve.through(surface(np.array([[-0.5, -0.3], [-0.45, 0.0], [-0.5, 0.3],
+                                                   [-0.4, 0.45]])))
+    b = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="lu")
+    assert b.group_kinds == ["handle", "curve"] and b.n_groups == 2
+    assert b.n_columns == 8 and b.columns_for_group(1) == slice(4, 8)
+    t = rotate([0, 1, 0], 20, plane.positions[hnd].mean(0))
+    dq = np.array([[0, 0, 0.05], [0, 0, 0.1], [0, 0, 0.05], [0, 0, 0]])
+    db = curve.control_displacement(dq)
+    dc = b.displacement([t, db])
+    out = b.apply(plane, dc)
+    np.testing.assert_allclose(out.positions[hnd], apply_affine(t, plane.positions[hnd]), atol=1e-13)
+    assert np.array_equal(out.positions[~sup], plane.positions[~sup])
+    g = b.constraints.groups[1]
+    np.testing.assert_allclose(g.points + b.rbf(g.points) @ dc,
+                               curve.evaluate(g.params, curve.controls + db), atol=1e-10)
+    # the handle splats do not move with the curve; superposition holds
+    only_curve = b.apply(plane, b.displacement([None, db]))
+    np.testing.assert_array_equal(only_curve.positions[hnd], plane.positions[hnd])
+    d_both = b.displacements(dc)
+    d_h = b.displacements(b.displacement([t, None]))
+    d_c = b.displacements(b.displacement([None, db]))
+    np.testing.assert_allclose(d_both, d_h + d_c, atol=1e-13)
+    # GPU rows of the curve: its 4 columns, the handle's splats dropped
+    ind, bb, *_ = b.rows_for_gpu(1)
+    assert bb.shape[1] == 4 and not np.isin(ind, np.flatnonzero(hnd)).any()
+    # errors: wrong shape for the curve, wrong number of inputs
+    with pytest.raises(ParameterError, match=r"curve 1 has 4 control points"):
+        b.displacement([t, np.zeros((5, 3))])
+    with pytest.raises(ParameterError, match="one matrix per handle"):
+        b.displacement([t])
+    # IQR on the combined edit matches the exact solve
+    iqr = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="iqr", tol=1e-7)
+    rows = free_rows(b)
+    err = np.linalg.norm(b.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
+    assert err.max() / np.abs(b.constraints.values @ dc).max() < 0.01
+    assert b.stats["n_curve_samples"] == [len(g.points)]
+
+
+def test_translate_handle_and_curve_together_translates_everything(plane):
+    """Whole-cloud support (no fixed band): the same translation on a handle
+    and a curve is reproduced everywhere (polynomial precision)."""
+    hnd = disc(plane, 0.15, (0.45, 0.0))
+    curve = ControlCurve.through(picked(4, -0.6, -0.1))
+    b = DeformationBasis.fit(plane, np.ones(len(plane), bool), [hnd], curves=[curve], method="lu")
+    shift = np.array([0.1, 0.0, -0.2])
+    out = b.apply(plane, b.displacement([translate(shift), np.tile(shift, (4, 1))]))
+    np.testing.assert_allclose(out.positions, plane.positions + shift, atol=1e-9)
