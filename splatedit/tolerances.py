@@ -62,6 +62,8 @@ IQR_PANEL_COLUMNS = 128
 #: rows of evaluation points per chunk (bounds memory of Phi_N to
 #: EVAL_CHUNK_ROWS * n_centers * 8 bytes)
 EVAL_CHUNK_ROWS = 8192
+#: threads that evaluate chunks of a fitted RBF in parallel (numpy releases the GIL)
+EVAL_THREADS = 2
 #: relative singular-value cutoff that declares the polynomial block rank
 #: deficient (constraints on a quadric)
 POLY_RANK_RTOL = 1e-9

@@ -179,6 +179,7 @@ class Editor:
         self.panel_box = (0, 0, 0, 0)
         self.sel_version_seen = -1
         self.start_time = time.perf_counter()
+        self.debug_enabled = os.environ.get("SPLATEDIT_EDITOR_DEBUG", "") not in ("", "0")
 
     # ---------------------------------------------------------------- utils
     def wake(self) -> None:
@@ -191,6 +192,10 @@ class Editor:
         self.message = text
         self.message_time = time.perf_counter()
         print(f"splatedit: {text}", file=sys.stderr)
+
+    def debug(self, text: str) -> None:
+        if self.debug_enabled:
+            print(f"splatedit: debug: {text}", file=sys.stderr, flush=True)
 
     @property
     def size(self) -> tuple[int, int]:
@@ -419,6 +424,8 @@ class Editor:
         if e.button == g.MOUSE_BUTTON_LEFT:
             if s.basis is not None and not ctrl and not self.erase_toggle:
                 i = self.splat_under(x, y)
+                self.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle "
+                           f"{bool(i >= 0 and s.selection.handle[i])}")
                 if i >= 0 and s.selection.handle[i]:
                     if s.begin(GRAB, self.view_info(), (x, y)):
                         self.drag = "manip"

@@ -34,13 +34,18 @@ the same order.  The fixed band is not a group (its value is 0).
 Curves (decisions).  Curve samples are extra constraint points (not splats)
 anywhere in space; they do not change the free region (support minus
 handles), and a curve with the fixed band alone defines an edit.  A sample
-closer than one point spacing to another group's constraint -- a fixed-band
-splat, any splat of a handle, or a kept sample of an earlier curve -- would
-ask for two different displacements almost at one point (an ill-conditioned,
-oscillating fit), so it is **dropped** (counted in
-``ConstraintGroup.n_dropped``); a curve that loses every sample raises
-SolverError.  Self-intersecting curves are left to the solver's duplicate
-check.
+is **dropped** (counted in ``ConstraintGroup.n_dropped``) when
+
+* its nearest splat is not a free splat (it sits over the fixed part of the
+  model, or on a handle, whose splats do not follow the curve), or
+* a splat outside the support, a handle splat, or a kept sample of an earlier
+  curve lies within one point spacing of it: two different displacements
+  almost at one point make an ill-conditioned, oscillating fit.
+
+So a curve may run past the support boundary or over a handle: only its part
+over the free region constrains the edit.  A curve that loses every sample
+raises SolverError.  Self-intersecting curves are left to the solver's
+duplicate check.
 
 Control frame (decision).  ``a`` = centroid of the handle splats,
 ``b, c, d = a + r e_x, a + r e_y, a + r e_z`` with ``r`` = RMS distance of
@@ -391,22 +396,35 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
                                       weights=affine_coordinates(pos[band], frame),
                                       controls=frame, band_index=band, member_index=hidx))
 
-    # curves: samples, minus those within one spacing of other constraints
-    taken = [pos[fixed_index]] + [pos[g.member_index] for g in groups]
+    # curves: keep the samples whose nearest splat is free and that have no
+    # outside splat, handle splat or earlier curve sample within one spacing
     drop_width = h * (1.0 + _BAND_SLACK_REL)
+    held = np.flatnonzero(~free)  # outside the support, or in a handle
+    held_pts = pos[held]
+    previous: list[np.ndarray] = []
     for i, curve in enumerate(curve_objs):
         t, w, samples = curve.sample(spacing=h)
-        ref = np.concatenate(taken, axis=0)
-        near = _near(samples, ref, drop_width)
-        keep = ~near
+        d_free, _ = free_tree.query(samples, k=1, workers=-1)
+        reach = max(float(d_free.max()), drop_width)
+        lo, hi = samples.min(axis=0) - reach, samples.max(axis=0) + reach
+        cand = held_pts[np.all((held_pts >= lo) & (held_pts <= hi), axis=1)]
+        if len(cand):
+            d_held, _ = cKDTree(cand).query(samples, k=1, workers=-1)
+        else:
+            d_held = np.full(len(samples), np.inf)
+        keep = (d_free < d_held) & (d_held > drop_width)
+        if previous:
+            keep &= ~_near(samples, np.concatenate(previous, axis=0), drop_width)
         if not keep.any():
-            raise SolverError(f"curve {i}: all {len(samples)} samples lie within one point spacing "
-                              f"({h:.4g} model units) of the fixed band, a handle or an earlier "
-                              "curve; move the curve into the free part of the support")
+            raise SolverError(f"curve {i}: none of its {len(samples)} samples is over the free "
+                              f"region (nearest splat free, no fixed or handle splat or earlier "
+                              f"curve within one point spacing = {h:.4g} model units); move the "
+                              "curve into the free part of the support")
+        near = ~keep
         groups.append(ConstraintGroup(kind="curve", points=samples[keep], weights=w[keep],
                                       controls=curve.controls.copy(), curve=curve,
                                       params=t[keep], n_dropped=int(near.sum())))
-        taken.append(samples[keep])
+        previous.append(samples[keep])
 
     pts = np.concatenate([pos[fixed_index]] + [g.points for g in groups], axis=0)
     if len(np.unique(pts, axis=0)) != len(pts):

@@ -22,6 +22,7 @@ from __future__ import annotations
 import math
 import numbers
 import time
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from typing import Optional
 
@@ -31,6 +32,8 @@ from scipy.linalg import lapack
 from splatedit.deform.centers import FarthestPointSampler
 from splatedit.deform.kernels import (
     N_POLY,
+    augmented_centers,
+    evaluation_squared_distances,
     kernel_matrix,
     poly_gradient,
     poly_matrix,
@@ -44,6 +47,7 @@ from splatedit.tolerances import (
     DUPLICATE_VALUE_RTOL,
     EVAL_CHUNK_MAX_BYTES,
     EVAL_CHUNK_ROWS,
+    EVAL_THREADS,
     IQR_DEFAULT_TOL,
     IQR_PANEL_COLUMNS,
     IQR_R_DIAG_RTOL,
@@ -363,6 +367,7 @@ class TriharmonicRBF:
         c = self._centers_n
         # [W, c_x W, c_y W, c_z W]: one GEMM with the distance matrix gives
         # sum_j w_j r_ij and sum_j w_j r_ij c_jd for the gradient
+        self._centers_aug = augmented_centers(self._centers_n)
         self._grad_weights = np.ascontiguousarray(np.concatenate(
             [self.weights] + [c[:, d:d + 1] * self.weights for d in range(3)], axis=1))
         self._k = k
@@ -535,35 +540,50 @@ class TriharmonicRBF:
         vals = np.empty((n_pts, k)) if want_values else None
         grads = np.empty((n_pts, k, 3)) if want_grad else None
         step = self._chunk_rows()
-        c = self._centers_n
-        for s in range(0, n_pts, step):
-            xc = xn[s:s + step]
-            if self.n_centers:
-                d2 = squared_distances(xc, c)
-                r = np.sqrt(d2)
-            if want_values:
-                v = vals[s:s + step]
-                if self.n_centers:
-                    d2 *= r  # Phi = r^3, in place
-                    np.matmul(d2, self.weights, out=v)
-                else:
-                    v[...] = 0.0
-                if self.poly_coeffs is not None:
-                    v += poly_matrix(xc) @ self.poly_coeffs
-            if want_grad:
-                g = grads[s:s + step]
-                if self.n_centers:
-                    # grad = 3 sum_j w_j r_ij (x_i - c_j) = 3 (x_i S0 - S_d)
-                    sums = r @ self._grad_weights  # (rows, 4k)
-                    for d in range(3):
-                        g[:, :, d] = 3.0 * (xc[:, d:d + 1] * sums[:, :k]
-                                            - sums[:, (d + 1) * k:(d + 2) * k])
-                else:
-                    g[...] = 0.0
-                if self.poly_coeffs is not None:
-                    g += np.einsum("ijd,jk->ikd", poly_gradient(xc), self.poly_coeffs)
-                g /= self.scale  # chain rule: d/dx = (1/scale) d/dxn
+        starts = list(range(0, n_pts, step))
+
+        def one_chunk(s):
+            self._eval_chunk(xn[s:s + step], None if vals is None else vals[s:s + step],
+                             None if grads is None else grads[s:s + step])
+
+        # numpy's element-wise passes run on one core and release the GIL, so
+        # chunks are spread over EVAL_THREADS threads (each writes its own rows)
+        workers = min(EVAL_THREADS, len(starts))
+        if workers > 1:
+            with ThreadPoolExecutor(max_workers=workers) as pool:
+                list(pool.map(one_chunk, starts))
+        else:
+            for s in starts:
+                one_chunk(s)
         return vals, grads
+
+    def _eval_chunk(self, xc, v, g):
+        """Fill values ``v`` (rows, k) and/or gradients ``g`` (rows, k, 3) at
+        normalised points ``xc`` (rows, 3)."""
+        k = self._k
+        if self.n_centers:
+            d2 = evaluation_squared_distances(xc, self._centers_aug)
+            r = np.sqrt(d2)
+        if v is not None:
+            if self.n_centers:
+                d2 *= r  # Phi = r^3, in place
+                np.matmul(d2, self.weights, out=v)
+            else:
+                v[...] = 0.0
+            if self.poly_coeffs is not None:
+                v += poly_matrix(xc) @ self.poly_coeffs
+        if g is not None:
+            if self.n_centers:
+                # grad = 3 sum_j w_j r_ij (x_i - c_j) = 3 (x_i S0 - S_d)
+                sums = r @ self._grad_weights  # (rows, 4k)
+                for d in range(3):
+                    g[:, :, d] = 3.0 * (xc[:, d:d + 1] * sums[:, :k]
+                                        - sums[:, (d + 1) * k:(d + 2) * k])
+            else:
+                g[...] = 0.0
+            if self.poly_coeffs is not None:
+                g += np.einsum("ijd,jk->ikd", poly_gradient(xc), self.poly_coeffs)
+            g /= self.scale  # chain rule: d/dx = (1/scale) d/dxn
 
     def __call__(self, x) -> np.ndarray:
         """Values at ``x`` (N, 3) -> (N, k), evaluated in bounded-memory chunks."""

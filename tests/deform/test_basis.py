@@ -338,3 +338,20 @@ def test_iqr_matches_exact_on_the_bunny_ear(shared_data):
     assert err.max() < 0.01
     out = lu.apply(cloud, lu.displacement([t]))
     assert np.array_equal(out.positions[~sup], cloud.positions[~sup])
+
+
+def test_two_handle_edit_matches_exact_solve_and_scipy(two):
+    """Several simultaneous rigid handles (paper Fig. 7 right): IQR within the
+    tolerance of the exact solve, and the exact solve equal to scipy's cubic
+    RBF with a quadratic polynomial on the same constraints."""
+    cloud, sup, (h1, h2), lu = two
+    t1 = compose(rotate([1, 0, 0], 15, cloud.positions[h1].mean(0)), translate([0, 0, 0.2]))
+    t2 = compose(scale(0.8, cloud.positions[h2].mean(0)), translate([0.05, 0.0, -0.1]))
+    _, iqr, err = iqr_vs_exact(cloud, sup, [h1, h2], [t1, t2])
+    assert err.max() < 0.01
+    con = lu.constraints
+    dc = lu.displacement([t1, t2])
+    rows = free_rows(lu)
+    oracle = RBFInterpolator(con.points, con.values @ dc, kernel="cubic", degree=2)
+    theirs = oracle(cloud.positions[lu.indices[rows]])
+    assert np.abs(lu.displacements(dc)[rows] - theirs).max() / np.abs(con.values @ dc).max() < 1e-8

@@ -77,15 +77,16 @@ def test_two_points_give_the_segment_and_four_a_cubic():
     seg = ControlCurve.through([[0, 0, 0], [2, 0, 0]])
     assert seg.degree == 1
     np.testing.assert_allclose(seg.evaluate([0.25, 0.5]), [[0.5, 0, 0], [1, 0, 0]], atol=1e-15)
-    # collinear, equally spaced points on a cubic: the spline reproduces the
-    # polynomial curve (a cubic through 4 points is unique)
-    s = np.array([0.0, 1 / 3, 2 / 3, 1.0])
-    cub = ControlCurve.through(np.column_stack([s, s ** 3, s ** 2]))
+    # four points: the cubic polynomial curve through them at the chord-length
+    # parameters (unique), i.e. Lagrange interpolation per coordinate
+    q = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, 0.2], [1.5, 1.5, -0.3], [3.0, 1.0, 0.4]])
+    cub = ControlCurve.through(q)
     assert cub.degree == 3 and len(cub.knots) == 8
+    chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    np.testing.assert_allclose(cub.params, np.concatenate([[0], np.cumsum(chords)]) / chords.sum())
     t = np.linspace(0, 1, 11)
-    x = cub.evaluate(t)
-    np.testing.assert_allclose(x[:, 1], x[:, 0] ** 3, atol=1e-12)
-    np.testing.assert_allclose(x[:, 2], x[:, 0] ** 2, atol=1e-12)
+    lagrange = np.column_stack([np.polyval(np.polyfit(cub.params, q[:, d], 3), t) for d in range(3)])
+    np.testing.assert_allclose(cub.evaluate(t), lagrange, atol=1e-12)
 
 
 def test_bspline_basis_matches_the_recursion_definition_on_a_uniform_vector():
@@ -145,15 +146,18 @@ def test_samples_next_to_other_constraints_are_dropped(plane):
     con = build_constraints(plane, sup, [hnd], curves=[curve])
     g = con.groups[1]
     assert g.kind == "curve" and g.n_dropped > 0
-    others = np.concatenate([plane.positions[con.fixed_index], plane.positions[hnd]])
-    d, _ = cKDTree(others).query(g.points)
-    assert d.min() > con.spacing
-    # kept + dropped = all samples, and the kept ones are the inner part
+    held = ~sup | hnd
+    d_held, _ = cKDTree(plane.positions[held]).query(g.points)
+    d_free, _ = cKDTree(plane.positions[sup & ~hnd]).query(g.points)
+    assert d_held.min() > con.spacing and np.all(d_free < d_held)
+    # kept + dropped = all samples; the part past the support boundary is gone
     t, _, all_pts = curve.sample(spacing=con.spacing)
     assert len(g.points) + g.n_dropped == len(all_pts)
-    assert np.all(np.linalg.norm(g.points[:, :2], axis=1) < 0.5)
+    assert np.all(np.linalg.norm(g.points[:, :2], axis=1) < 0.5 + con.spacing)
+    assert np.linalg.norm(all_pts[:, :2], axis=1).max() > 0.75
     # a second curve crossing the first loses its samples next to the first
-    cross = ControlCurve.through(surface(np.array([[0.2, -0.3], [0.2, 0.3]])))
+    mid = g.points[len(g.points) // 2]
+    cross = ControlCurve.through([mid - [0, 0.3, 0], mid, mid + [0, 0.3, 0.05]])
     con2 = build_constraints(plane, sup, curves=[curve, cross])
     d2, _ = cKDTree(con2.groups[0].points).query(con2.groups[1].points)
     assert con2.groups[1].n_dropped > 0 and d2.min() > con2.spacing
@@ -162,7 +166,7 @@ def test_samples_next_to_other_constraints_are_dropped(plane):
 def test_curve_entirely_in_the_fixed_band_is_an_error(plane):
     sup = disc(plane, 0.5)
     outside = ControlCurve.through(surface(np.array([[0.52, -0.05], [0.52, 0.05]])))
-    with pytest.raises(SolverError, match="curve 0: all .* samples lie within one point spacing"):
+    with pytest.raises(SolverError, match="curve 0: none of its .* samples is over the free region"):
         build_constraints(plane, sup, curves=[outside])
     with pytest.raises(ParameterError, match="at least one handle or curve"):
         build_constraints(plane, sup)

@@ -58,6 +58,10 @@ class Window:
         self._mods = 0
         self._scale = (1.0, 1.0)
         self._update_scale()
+        # Button and scroll events carry the position of the last motion event
+        # *in event order*: glfwGetCursorPos on X11 queries the pointer's
+        # current position, which is already ahead when events are queued.
+        self._last_pos = self.cursor()
         glfw.set_key_callback(self.handle, self._on_key)
         glfw.set_char_callback(self.handle, self._on_char)
         glfw.set_mouse_button_callback(self.handle, self._on_button)
@@ -82,15 +86,16 @@ class Window:
         self.events.append(InputEvent("char", char=chr(codepoint)))
 
     def _on_button(self, win, button, action, mods):
-        x, y = self.cursor()
+        x, y = self._last_pos
         self._mods = mods
         self.events.append(InputEvent("button", button=button, action=action, mods=mods, x=x, y=y))
 
     def _on_move(self, win, x, y):
-        self.events.append(InputEvent("move", x=x * self._scale[0], y=y * self._scale[1]))
+        self._last_pos = (x * self._scale[0], y * self._scale[1])
+        self.events.append(InputEvent("move", x=self._last_pos[0], y=self._last_pos[1]))
 
     def _on_scroll(self, win, dx, dy):
-        x, y = self.cursor()
+        x, y = self._last_pos
         self.events.append(InputEvent("scroll", dx=dx, dy=dy, x=x, y=y, mods=self.mods()))
 
     def _on_resize(self, win, w, h):

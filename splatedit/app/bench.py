@@ -1,0 +1,147 @@
+"""Editor frame times while idle and while dragging, for large models.
+
+``bench_editor_frames`` yields one dict per splat count.  Scene: the bundled
+bunny mesh resampled to ``n`` surface splats (uniform on the area, splat
+radius from the sampling density, ~2x overlap), framed in a 1280x720 view as
+the editor frames a model.  For each count it measures, through the editor's
+:class:`~splatedit.app.viewport.Viewport` (renderer + levels of detail):
+
+* ``idle_ms``: the full-quality frame (all splats, full resolution);
+* ``drag_ms``: frames while the handle is dragged (a new ``dC`` each frame,
+  interactive mode: level of detail / reduced resolution chosen to fit the
+  budget);
+* ``orbit_ms``: frames while the camera orbits (interactive mode);
+* ``compose_ms``: overlay compositing of one frame (CPU), to add to the above
+  with the ~2-5 ms of the swapchain copy and present;
+* the level used while moving, the LOD build time and the basis fit time.
+
+Validation is off (it adds per-call overhead unrelated to the editor).
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Iterator
+
+import numpy as np
+
+from splatedit.model.cloud import SplatCloud
+
+
+def bunny_surface_cloud(n: int, seed: int = 0, overlap: float = 2.0) -> SplatCloud:
+    """``n`` splats sampled uniformly on the bundled bunny mesh."""
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    mesh = read(default_model_path())
+    v, f = mesh.positions, mesh.faces
+    a, b, c = v[f[:, 0]], v[f[:, 1]], v[f[:, 2]]
+    cr = np.cross(b - a, c - a)
+    area = 0.5 * np.linalg.norm(cr, axis=1)
+    rng = np.random.default_rng(seed)
+    tri = rng.choice(len(f), size=n, p=area / area.sum())
+    r1 = np.sqrt(rng.random(n))
+    r2 = rng.random(n)
+    p = (1 - r1)[:, None] * a[tri] + (r1 * (1 - r2))[:, None] * b[tri] + (r1 * r2)[:, None] * c[tri]
+    nrm = cr[tri] / np.linalg.norm(cr[tri], axis=1, keepdims=True)
+    t1 = np.cross(nrm, np.where(np.abs(nrm[:, [0]]) < 0.9, [[1.0, 0, 0]], [[0, 1.0, 0]]))
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(nrm, t1)
+    r = np.sqrt(overlap * area.sum() / (np.pi * n))
+    return SplatCloud(p, t1 * r, t2 * r, None, name=f"bunny{n}")
+
+
+def _support_and_handle(cloud: SplatCloud, support_splats: int = 20000):
+    """A ball support of about ``support_splats`` splats around a surface point
+    and a handle ball of a quarter of its radius."""
+    p = cloud.positions
+    centre = p[np.argmax(p[:, 1])] * 0.6 + p.mean(0) * 0.4
+    d = np.linalg.norm(p - centre, axis=1)
+    k = min(support_splats, cloud.n // 4)
+    r = float(np.partition(d, k)[k])
+    sup = d <= r
+    hnd = d <= r / 4
+    return sup, hnd
+
+
+def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), frames: int = 6,
+                        budget_ms: float = 100.0, progress=None) -> Iterator[dict]:
+    from splatedit.app import overlay as ov
+    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.viewport import Viewport
+    from splatedit.deform.basis import DeformationBasis
+    from splatedit.model.lod import LodPyramid
+    from splatedit.render.renderer import Renderer
+
+    w, h = size
+    renderer = Renderer(validation=False)
+    vp = Viewport(budget_ms=budget_ms, renderer=renderer)
+    try:
+        for n in counts:
+            n = int(n)
+            cloud = bunny_surface_cloud(n)
+            t0 = time.perf_counter()
+            pyr = LodPyramid(cloud)
+            lod_s = time.perf_counter() - t0
+            vp.set_cloud(cloud)
+            vp.set_pyramid(pyr)
+            vp.ms_per_splat = None
+            sup, hnd = _support_and_handle(cloud)
+            vp.set_selection(sup, hnd, n)
+            cam = OrbitCamera(scene_radius=cloud.diagonal / 2, yaw=0.3, pitch=0.2)
+            lo, hi = cloud.bounds()
+            cam.frame((lo + hi) / 2, cloud.diagonal / 2, w / h)
+            t0 = time.perf_counter()
+            basis = DeformationBasis.fit(cloud, sup, [hnd])
+            fit_s = time.perf_counter() - t0
+            vp.set_basis(basis)
+            vp.set_dc(None)
+            vp.render(cam, w, h)                       # upload + warm-up
+            idle = [vp.render(cam, w, h) is not None and vp.last_info["ms"] for _ in range(2)]
+            # dragging the handle: a new dC every frame
+            piv = cloud.positions[hnd].mean(0)
+            drag, info = [], {}
+            vp.render(cam, w, h, interactive=True)    # warm-up of the level's renderer
+            for k in range(frames):
+                m = np.eye(4)
+                m[:3, 3] = np.array([0.0, 1.0, 0.5]) * 0.02 * (k + 1) * cloud.diagonal
+                vp.set_dc(basis.displacement([m]))
+                frame = vp.render(cam, w, h, interactive=True)
+                drag.append(vp.last_info["ms"])
+                info = dict(vp.last_info)
+            tc = time.perf_counter()
+            panel = ov.text_panel(tuple(f"line {i} of the status panel, 1234 ms" for i in range(9)))
+            for p in (ov.Patch(8, 8, panel), ov.Patch(600, 300, ov.ring(24))):
+                ov.blend(frame, p)
+            compose = (time.perf_counter() - tc) * 1e3
+            vp.set_dc(None)
+            orbit = []
+            for k in range(frames):
+                cam.orbit(15, 0)
+                vp.render(cam, w, h, interactive=True)
+                orbit.append(vp.last_info["ms"])
+            del piv
+            yield {"case": "editor_frames", "splats": n, "width": w, "height": h,
+                   "budget_ms": budget_ms,
+                   "idle_ms": round(float(np.median(idle)), 1),
+                   "drag_ms": round(float(np.median(drag)), 1),
+                   "orbit_ms": round(float(np.median(orbit)), 1),
+                   "drag_fps": round(1000.0 / float(np.median(drag)), 1),
+                   "moving_splats": int(info.get("splats", n)), "moving_lod": bool(info.get("lod")),
+                   "moving_resolution_divisor": int(info.get("div", 1)),
+                   "lod_levels": [lvl.n for lvl in pyr.levels], "lod_build_s": round(lod_s, 2),
+                   "support": int(sup.sum()), "handle": int(hnd.sum()),
+                   "fit_s": round(fit_s, 2), "compose_ms": round(compose, 2)}
+    finally:
+        vp.close()
+
+
+def main() -> None:  # pragma: no cover - manual runs
+    import json
+    import sys
+    counts = [int(x) for x in sys.argv[1:]] or [100_000, 1_000_000, 2_000_000]
+    for line in bench_editor_frames(counts):
+        print(json.dumps(line), flush=True)
+
+
+if __name__ == "__main__":  # pragma: no cover
+    main()
