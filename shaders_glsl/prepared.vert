@@ -10,9 +10,6 @@
 #include "splat_varyings.glsl"
 
 layout(constant_id = 0) const int PRIM_MODE = 1;
-// 0 visibility, 1 attributes, 2 picking: the depth of points (PRIM_MODE 2) in
-// passes 0 and 1, whose fragment shaders (*_pt.frag) do not write gl_FragDepth
-layout(constant_id = 1) const int SPLAT_PASS = 2;
 
 layout(push_constant) uniform Push {
     uint n;
@@ -20,14 +17,6 @@ layout(push_constant) uniform Push {
 
 layout(std430, set = 0, binding = 5) readonly buffer RecA { vec4 recA[]; };
 layout(std430, set = 0, binding = 6) readonly buffer RecB { uvec4 recB[]; };
-
-// window depth of a point: its centre (along the view axis), pushed back by
-// the visibility epsilon in pass 0 (splat_fs.glsl writes the same mapping)
-float point_depth(float tc, float eps) {
-    float near = F.depth_params.x, far = F.depth_params.y;
-    float depth = SPLAT_PASS == 0 ? tc + eps : tc;
-    return far / (far - near) * (1.0 - near / depth);
-}
 
 vec3 oct_decode(vec2 e) {
     vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
@@ -48,7 +37,7 @@ void main() {
     v_normal = vec4(oct_decode(unpackSnorm2x16(b1.w)), 0.0);
     if (PRIM_MODE == 2) {
         gl_PointSize = uintBitsToFloat(b1.x);
-        gl_Position = vec4(v_center.xy * 2.0 * F.viewport.zw - 1.0, point_depth(v_mt_tc.w, v_center.w), 1.0);
+        gl_Position = vec4(v_center.xy * 2.0 * F.viewport.zw - 1.0, 0.5, 1.0);
         return;
     }
     vec2 lo = vec2(float(b1.x & 0xFFFFu), float(b1.x >> 16)) * (1.0 / 16.0);   // pixels, 12.4 fixed point

@@ -2,21 +2,11 @@
 //   0 visibility (depth only, pushed back by epsilon along the view ray)
 //   1 attributes (additive weight*colour, weight*normal/depth, weight)
 //   2 picking (splat index + 1, exact depth)
-// and may define SPLAT_EXACT_DEPTH 0 (the point variants *_pt.frag of passes 0
-// and 1): the depth test then uses the depth the vertex shader gave the point
-// (its centre, pushed back by epsilon in pass 0) instead of writing the
-// per-pixel ray depth to gl_FragDepth, which lets lavapipe test depth before
-// running the shader.  Points cover at most a few pixels, so the per-pixel
-// depth differs from the centre's by a fraction of the splat radius, well
-// inside the visibility epsilon (one radius).
 // Ray-splat intersection in eye space through the projective screen->tangent
 // mapping; EWA screen-space low-pass approximation r^2 = min(r3d^2, r2d^2)
 // (Botsch, Hornung, Zwicker, Kobbelt 2005, "High-Quality Surface Splatting on
 // Today's GPUs", Sect. 4); Gaussian weight exp(-k r^2) with cutoff r^2 <= 1.
 
-#ifndef SPLAT_EXACT_DEPTH
-#define SPLAT_EXACT_DEPTH 1
-#endif
 #define VARYING in
 #include "frame.glsl"
 #include "splat_varyings.glsl"
@@ -43,14 +33,12 @@ void main() {
     float tc = v_mt_tc.w, rad = v_mw_r.w;
     float depth = v_ms_cn.w / den;                       // along the view axis
     if (!(r3 <= 1.0) || !(abs(depth - tc) <= rad)) depth = clamp(depth, tc - rad, tc + rad);
-#if SPLAT_EXACT_DEPTH
 #if SPLAT_PASS == 0
     depth += v_center.w;
 #endif
     float near = F.depth_params.x, far = F.depth_params.y;
     if (depth < near || depth > far) discard;
     gl_FragDepth = far / (far - near) * (1.0 - near / depth);
-#endif
 
 #if SPLAT_PASS == 1
     float w = exp(-F.misc.x * r);

@@ -30,8 +30,6 @@ layout(location = 5) in vec4 in_basis[4 * BASIS_GROUPS];  // per group: B, Bx, B
 // 2: only the SPLAT_POINT ones, as square points (POINT_LIST).  Modes 1 + 2
 // together draw every splat.
 layout(constant_id = 0) const int PRIM_MODE = 0;
-// 0 visibility, 1 attributes, 2 picking: the depth of points (see prepared.vert)
-layout(constant_id = 1) const int SPLAT_PASS = 2;
 
 void cull() {
     gl_Position = vec4(-4.0, -4.0, 0.5, 1.0);   // all corners equal: zero-area, off screen
@@ -64,9 +62,7 @@ void main() {
     v_index = uint(gl_InstanceIndex) + 1u;
     if (PRIM_MODE == 2) {                     // small splat: square point at its centre
         gl_PointSize = S.psize;
-        float near = F.depth_params.x, far = F.depth_params.y;
-        float depth = SPLAT_PASS == 0 ? S.mt_tc.w + S.center.w : S.mt_tc.w;
-        gl_Position = vec4(S.cc, far / (far - near) * (1.0 - near / depth), 1.0);
+        gl_Position = vec4(S.cc, 0.5, 1.0);
         return;
     }
     int corner = gl_VertexIndex & 3;

@@ -7,7 +7,8 @@ Format (version 1)::
      "edits": [
        {"support": REGION,
         "handle": REGION,                    # or "handles": [REGION, ...]
-        "transform": TRANSFORM}]}            # or "transforms": [TRANSFORM, ...]
+        "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
+        "curves": [CURVE, ...]}]}            # optional; see below
 
     REGION    = {"sphere": {"center": [x,y,z], "radius": r}}
               | {"box": {"min": [x,y,z], "max": [x,y,z]}}
@@ -17,11 +18,26 @@ Format (version 1)::
                  "rotate": {"axis": [ax,ay,az], "degrees": a, "center": [x,y,z]},
                  "scale": s | {"factor": s, "center": [x,y,z]}}     (any subset)
 
+    CURVE     = {"points": [[x,y,z], ...],      (k + 1 >= 2 picked points, consecutive ones distinct)
+                 "move": [[dx,dy,dz], ...],      (one displacement per picked point)
+                 "samples": n}                   (optional integer >= 2; default: one per point spacing)
+
+An edit needs at least one handle or curve: exactly one of ``handle`` /
+``handles`` (with ``transform`` / ``transforms``), and/or ``curves``.  A curve
+is the interpolating spline through its ``points`` (cubic from 4 points on,
+quadratic through 3, a segment through 2; see splatedit.deform.curves); the
+edit moves the *picked points* by ``move`` and the spline follows (its
+control points move by ``A^-1 move``), so the moved curve passes through
+``points + move``.  The curve need not lie on the surface; only its samples
+over the free part of the support constrain the edit.  Curves take the
+column blocks after the handles.
+
 A handle region is intersected with its support.  A TRS transform applies
 scale, then rotation, then translation; the rotation and scale centres default
 to the handle's centroid.  Edits run one after another: each edit's result is
 the base of the next (the paper's Bunny: ears, then head).  Every error names
-the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis``.
+the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis`` or
+``$.edits[1].curves[0].move[2]``.
 """
 
 from __future__ import annotations
@@ -83,12 +99,28 @@ Transform = TRS | Matrix
 
 
 @dataclass(frozen=True)
+class Curve:
+    """A control curve of an edit: picked points, their displacements, and
+    an optional sample count (None = one sample per point spacing)."""
+    points: tuple[tuple[float, float, float], ...]
+    move: tuple[tuple[float, float, float], ...]
+    samples: int | None = None
+
+    def control_curve(self):
+        """The :class:`~splatedit.deform.curves.ControlCurve` through ``points``."""
+        from splatedit.deform.curves import ControlCurve
+        return ControlCurve.through(np.array(self.points, dtype=np.float64), samples=self.samples)
+
+
+@dataclass(frozen=True)
 class Edit:
-    """One edit: a support region, one or more handles and their transforms."""
+    """One edit: a support region, zero or more handles with their transforms,
+    and zero or more control curves (at least one handle or curve)."""
     support: Region
     handles: tuple[Region, ...]
     transforms: tuple[Transform, ...]
     json_path: str = "$"
+    curves: tuple[Curve, ...] = ()
 
 
 @dataclass(frozen=True)
@@ -130,15 +162,24 @@ class EditScript:
         solver: dict[str, Any] = {"method": self.solver.method, "tol": self.solver.tol}
         if self.solver.max_centers is not None:
             solver["max_centers"] = self.solver.max_centers
+        def curve(c: Curve) -> dict:
+            out: dict[str, Any] = {"points": [list(p) for p in c.points],
+                                   "move": [list(d) for d in c.move]}
+            if c.samples is not None:
+                out["samples"] = c.samples
+            return out
+
         edits = []
         for e in self.edits:
             item: dict[str, Any] = {"support": region(e.support)}
             if len(e.handles) == 1:
                 item["handle"] = region(e.handles[0])
                 item["transform"] = transform(e.transforms[0])
-            else:
+            elif e.handles:
                 item["handles"] = [region(h) for h in e.handles]
                 item["transforms"] = [transform(t) for t in e.transforms]
+            if e.curves:
+                item["curves"] = [curve(c) for c in e.curves]
             edits.append(item)
         return {"version": SCRIPT_VERSION, "solver": solver, "edits": edits}
 
@@ -273,6 +314,40 @@ def _transform(ctx: _Ctx, value, jp: str) -> Transform:
     return TRS(translate, axis, degrees, rcenter, scale, scenter)
 
 
+def _curves(ctx: _Ctx, value, jp: str) -> tuple[Curve, ...]:
+    from splatedit.deform.curves import _MIN_CHORD_REL
+    if not isinstance(value, list) or not value:
+        raise ctx.fail(jp, f"must be a non-empty list of curves, got {_kind(value)}")
+    out = []
+    for j, c in enumerate(value):
+        cjp = f"{jp}[{j}]"
+        c = ctx.obj(c, cjp, required=("points", "move"), allowed=("points", "move", "samples"))
+        pts_in = c["points"]
+        if not isinstance(pts_in, list) or len(pts_in) < 2:
+            raise ctx.fail(f"{cjp}.points", f"must be a list of at least 2 points [x, y, z], "
+                           f"got {_kind(pts_in)}")
+        pts = tuple(ctx.vec3(p, f"{cjp}.points[{k}]") for k, p in enumerate(pts_in))
+        arr = np.array(pts)
+        extent = max(float(np.ptp(arr, axis=0).max()), float(np.abs(arr).max()), 1e-300)
+        for k in range(1, len(pts)):
+            if np.linalg.norm(arr[k] - arr[k - 1]) <= _MIN_CHORD_REL * extent:
+                raise ctx.fail(f"{cjp}.points[{k}]", f"coincides with points[{k - 1}]; "
+                               "consecutive curve points must be distinct")
+        mv = c["move"]
+        if not isinstance(mv, list) or len(mv) != len(pts):
+            raise ctx.fail(f"{cjp}.move", f"must be a list with one [dx, dy, dz] per point "
+                           f"({len(pts)}), got {_kind(mv)}")
+        move = tuple(ctx.vec3(d, f"{cjp}.move[{k}]") for k, d in enumerate(mv))
+        samples = None
+        if c.get("samples") is not None:
+            n = c["samples"]
+            if isinstance(n, bool) or not isinstance(n, int) or n < 2:
+                raise ctx.fail(f"{cjp}.samples", f"must be an integer >= 2, got {_kind(n)}")
+            samples = n
+        out.append(Curve(pts, move, samples))
+    return tuple(out)
+
+
 def parse_script(data: Any, source: str | None = None) -> EditScript:
     """Validate a decoded JSON document and build an :class:`EditScript`.
 
@@ -304,11 +379,20 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
     for i, e in enumerate(edits_in):
         jp = f"$.edits[{i}]"
         e = ctx.obj(e, jp, required=("support",),
-                    allowed=("support", "handle", "handles", "transform", "transforms"))
+                    allowed=("support", "handle", "handles", "transform", "transforms", "curves"))
         support = _region(ctx, e["support"], f"{jp}.support")
-        if ("handle" in e) == ("handles" in e):
+        curves = _curves(ctx, e["curves"], f"{jp}.curves") if "curves" in e else ()
+        if "handle" in e and "handles" in e:
             raise ctx.fail(jp, "needs exactly one of 'handle' or 'handles'")
-        if "handle" in e:
+        if "handle" not in e and "handles" not in e:
+            if not curves:
+                raise ctx.fail(jp, "needs at least one handle or curve: exactly one of 'handle' or "
+                               "'handles', and/or 'curves'")
+            for key in ("transform", "transforms"):
+                if key in e:
+                    raise ctx.fail(f"{jp}.{key}", "is given without 'handle' or 'handles'")
+            handles, transforms = (), ()
+        elif "handle" in e:
             handles = (_region(ctx, e["handle"], f"{jp}.handle"),)
             if "transform" not in e:
                 raise ctx.fail(jp, "missing key 'transform'")
@@ -324,7 +408,7 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             if not isinstance(ts, list) or len(ts) != len(hs):
                 raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
             transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
-        edits.append(Edit(support, handles, transforms, jp))
+        edits.append(Edit(support, handles, transforms, jp, curves))
     return EditScript(tuple(edits), solver)
 
 
@@ -358,11 +442,15 @@ class EditReport:
     basis_seconds: float
     max_displacement: float
     notes: list[str] = field(default_factory=list)
+    #: per curve: (picked points, kept samples)
+    curves: list[tuple[int, int]] = field(default_factory=list)
 
     def line(self) -> str:
         hs = "+".join(map(str, self.handles))
         notes = f" ({'; '.join(self.notes)})" if self.notes else ""
-        return (f"edit {self.index}: support {self.support} splats, handle {hs}, "
+        groups = [f"handle {hs}"] if self.handles else []
+        groups += [f"curve {k} points/{n} samples" for k, n in self.curves]
+        return (f"edit {self.index}: support {self.support} splats, {', '.join(groups)}, "
                 f"{self.constraints} constraints, {self.method} with {self.centers} centers "
                 f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
                 f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
@@ -400,6 +488,52 @@ def resolve_edit(cloud, edit: Edit, source: str | None = None):
     return support, handles, matrices
 
 
+@dataclass
+class ResolvedEdit:
+    """One edit resolved on a cloud: everything ``DeformationBasis.fit`` and
+    ``DeformationBasis.displacement`` need.
+
+    Attributes:
+        support: (n,) bool mask.
+        handles: list of (n,) bool masks (inside the support).
+        matrices: one (4, 4) affine matrix per handle.
+        curves: one :class:`~splatedit.deform.curves.ControlCurve` per curve.
+        curve_moves: per curve, the (k + 1, 3) control-point displacements
+            that move its picked points by the script's ``move``.
+    """
+    support: np.ndarray
+    handles: list
+    matrices: list
+    curves: list
+    curve_moves: list
+
+    @property
+    def inputs(self) -> list:
+        """Per-group inputs of ``DeformationBasis.displacement`` (handles, then curves)."""
+        return list(self.matrices) + list(self.curve_moves)
+
+
+def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> ResolvedEdit:
+    """Masks, matrices and control curves of one edit on ``cloud``.
+
+    Raises:
+        EditScriptError: a region selects nothing or indexes past the cloud;
+            a bad curve (JSON path of the curve).
+    """
+    from splatedit.deform.curves import ControlCurve
+    support, handles, matrices = resolve_edit(cloud, edit, source)
+    curves, moves = [], []
+    for j, c in enumerate(edit.curves):
+        try:
+            cc = ControlCurve.through(np.array(c.points, dtype=np.float64), samples=c.samples)
+            moves.append(cc.control_displacement(np.array(c.move, dtype=np.float64)))
+        except SplatEditError as exc:
+            raise EditScriptError(str(exc), json_path=f"{edit.json_path}.curves[{j}]",
+                                  path=source) from None
+        curves.append(cc)
+    return ResolvedEdit(support, handles, matrices, curves, moves)
+
+
 def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
                source: str | None = None, progress=None,
                on_edit: Callable[[EditReport], None] | None = None):
@@ -415,13 +549,15 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
     tol = script.solver.tol if tol is None else tol
     reports = []
     for i, edit in enumerate(script.edits):
-        support, handles, matrices = resolve_edit(cloud, edit, source)
+        r = resolve_edit_inputs(cloud, edit, source)
+        support, handles = r.support, r.handles
         try:
-            basis = DeformationBasis.fit(cloud, support, handles, method=method, tol=tol,
-                                         max_centers=script.solver.max_centers, progress=progress)
+            basis = DeformationBasis.fit(cloud, support, handles, curves=r.curves, method=method,
+                                         tol=tol, max_centers=script.solver.max_centers,
+                                         progress=progress)
         except SplatEditError as exc:
             raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
-        d_c = basis.displacement(matrices)
+        d_c = basis.displacement(r.inputs)
         t0 = time.perf_counter()
         new = basis.apply(cloud, d_c)
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
@@ -429,7 +565,8 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         rep = EditReport(i, int(support.sum()), [int(h.sum()) for h in handles], stats["n_constraints"],
                          stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
                          stats["basis_seconds"] + (time.perf_counter() - t0), disp,
-                         [stats["message"]] if stats.get("message") else [])
+                         [stats["message"]] if stats.get("message") else [],
+                         [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))])
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)

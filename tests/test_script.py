@@ -9,7 +9,16 @@ import numpy as np
 import pytest
 
 from splatedit.errors import EditScriptError
-from splatedit.script import EditScript, Matrix, TRS, load_script, parse_script
+from splatedit.script import (
+    Curve,
+    EditScript,
+    Matrix,
+    TRS,
+    load_script,
+    parse_script,
+    resolve_edit_inputs,
+    run_script,
+)
 from splatedit.select import Box, Indices, Sphere
 
 GOOD = {
@@ -25,6 +34,15 @@ GOOD = {
          "handles": [{"indices": [1, 2, 3]}, {"indices": [7]}],
          "transforms": [{"matrix": [[1, 0, 0, 0.1], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]]},
                         {"translate": [0, 0, 1]}]},
+        {"support": {"sphere": {"center": [0, 0, 0], "radius": 0.7}},
+         "curves": [{"points": [[-0.4, 0, 0], [0, 0.1, 0], [0.4, 0, 0]],
+                     "move": [[0, 0, 0], [0, 0, 0.1], [0, 0, 0]]},
+                    {"points": [[0, -0.3, 0], [0, 0.3, 0.05]], "move": [[0, 0, 0.05], [0, 0, 0.05]],
+                     "samples": 12}]},
+        {"support": {"sphere": {"center": [0, 0, 0], "radius": 0.9}},
+         "handle": {"sphere": {"center": [0.5, 0, 0], "radius": 0.1}},
+         "transform": {"translate": [0, 0, 0.1]},
+         "curves": [{"points": [[-0.5, -0.2, 0], [-0.5, 0.2, 0]], "move": [[0, 0, 0.1], [0, 0, 0.1]]}]},
     ],
 }
 
@@ -67,6 +85,22 @@ BAD_SCRIPTS = [
     (["edits", 1, "transforms", 0, "matrix", 3], [0, 0, 1, 1], "$.edits[1].transforms[0].matrix[3]", "last row"),
     (["edits", 1, "transforms", 0, "matrix"], [[0] * 4] * 3 + [[0, 0, 0, 1]], "$.edits[1].transforms[0].matrix", "singular"),
     (["edits", 1, "transforms", 0, "matrix", 0], [1, 0, 0], "$.edits[1].transforms[0].matrix[0]", "4 numbers"),
+    # control curves
+    (["edits", 2, "curves"], [], "$.edits[2].curves", "non-empty list of curves"),
+    (["edits", 2, "curves"], _DELETE, "$.edits[2]", "at least one handle or curve"),
+    (["edits", 2, "transform"], {"translate": [0, 0, 1]}, "$.edits[2].transform", "without 'handle'"),
+    (["edits", 2, "curves", 0, "points"], [[0, 0, 0]], "$.edits[2].curves[0].points", "at least 2 points"),
+    (["edits", 2, "curves", 0, "points", 1], [0, 0], "$.edits[2].curves[0].points[1]", "3 numbers"),
+    (["edits", 2, "curves", 0, "points", 2], [0, 0.1, 0], "$.edits[2].curves[0].points[2]",
+     "coincides with points[1]"),
+    (["edits", 2, "curves", 0, "move"], [[0, 0, 0]], "$.edits[2].curves[0].move", "one [dx, dy, dz] per point (3)"),
+    (["edits", 2, "curves", 0, "move", 1, 2], "up", "$.edits[2].curves[0].move[1][2]", "must be a number"),
+    (["edits", 2, "curves", 0, "move", 1, 2], float("inf"), "$.edits[2].curves[0].move[1][2]", "finite"),
+    (["edits", 2, "curves", 0, "move"], _DELETE, "$.edits[2].curves[0]", "missing key 'move'"),
+    (["edits", 2, "curves", 1, "samples"], 1, "$.edits[2].curves[1].samples", "integer >= 2"),
+    (["edits", 2, "curves", 1, "samples"], 2.5, "$.edits[2].curves[1].samples", "integer >= 2"),
+    (["edits", 2, "curves", 1, "knots"], [0, 1], "$.edits[2].curves[1].knots", "unknown key"),
+    (["edits", 3, "curves", 0], [[0, 0, 0]], "$.edits[3].curves[0]", "must be an object"),
 ]
 
 
@@ -83,15 +117,83 @@ def test_bad_script_value_is_reported_with_its_json_path(path, value, json_path,
 def test_good_script_parses_into_regions_and_transforms():
     s = parse_script(GOOD)
     assert s.solver.method == "iqr"
-    e0, e1 = s.edits
+    e0, e1 = s.edits[:2]
     assert isinstance(e0.support, Sphere) and isinstance(e0.transforms[0], TRS)
     assert isinstance(e1.support, Box) and isinstance(e1.handles[0], Indices)
     assert isinstance(e1.transforms[0], Matrix)
+    e2, e3 = s.edits[2:]
+    assert e2.handles == () and len(e2.curves) == 2 and e2.curves[1].samples == 12
+    assert isinstance(e2.curves[0], Curve) and e2.curves[0].move[1] == (0.0, 0.0, 0.1)
+    assert len(e3.handles) == 1 and len(e3.curves) == 1 and e3.curves[0].samples is None
+    # the existing handle-only format is unchanged
+    assert s.edits[0].curves == () and s.edits[1].curves == ()
 
 
 def test_script_json_round_trip_is_identity():
     s = parse_script(GOOD)
-    assert parse_script(json.loads(json.dumps(s.to_json()))) == s
+    out = s.to_json()
+    assert parse_script(json.loads(json.dumps(out))) == s
+    assert "handle" not in out["edits"][2] and "handles" not in out["edits"][2]
+    assert "samples" not in out["edits"][2]["curves"][0] and out["edits"][2]["curves"][1]["samples"] == 12
+
+
+# ------------------------------------------------------------- running curves
+def _on_surface(xy):
+    """Points of ``wavy_plane_cloud``'s surface (default amplitude and waves) above ``xy``."""
+    xy = np.asarray(xy, dtype=np.float64)
+    w = 1.5 * np.pi
+    return np.column_stack([xy, 0.15 * np.sin(w * xy[:, 0]) * np.cos(w * xy[:, 1])]).tolist()
+
+
+def test_run_curve_script_moves_the_surface_with_the_curve():
+    from scipy.spatial import cKDTree
+
+    from splatedit.bench.solve import wavy_plane_cloud
+    from splatedit.deform.basis import DeformationBasis
+
+    cloud = wavy_plane_cloud(50)
+    pts = _on_surface([[-0.4, -0.1], [-0.1, 0.1], [0.2, 0.0], [0.4, 0.1]])
+    lift = [0.0, 0.0, 0.08]
+    doc = {"version": 1, "solver": {"method": "lu"},
+           "edits": [{"support": {"sphere": {"center": [0, 0, 0], "radius": 0.7}},
+                      "curves": [{"points": pts, "move": [lift] * 4}]},
+                     {"support": {"sphere": {"center": [0, 0, 0], "radius": 0.9}},
+                      "handle": {"sphere": {"center": [0.6, 0, 0], "radius": 0.12}},
+                      "transform": {"translate": [0, 0, -0.05]},
+                      "curves": [{"points": _on_surface([[-0.6, -0.2], [-0.6, 0.2]]),
+                                  "move": [[0, 0, 0.05], [0, 0, 0.1]], "samples": 20}]}]}
+    script = parse_script(doc)
+    first_only = EditScript(script.edits[:1], script.solver)
+    out1, reps1 = run_script(cloud, first_only)
+    # the same edit through the API: identical result
+    r = resolve_edit_inputs(cloud, script.edits[0])
+    b = DeformationBasis.fit(cloud, r.support, r.handles, curves=r.curves, method="lu")
+    np.testing.assert_array_equal(b.apply(cloud, b.displacement(r.inputs)).positions, out1.positions)
+    # splats right at the curve are lifted with it; outside the support nothing moves
+    d = out1.positions - cloud.positions
+    dist, _ = cKDTree(b.constraints.groups[0].points).query(cloud.positions)
+    near = r.support & (dist < 0.5 * b.constraints.spacing)
+    assert near.sum() >= 5
+    assert np.abs(d[near] - lift).max() < 0.05 * 0.08
+    assert np.array_equal(out1.positions[~r.support], cloud.positions[~r.support])
+    assert reps1[0].handles == [] and reps1[0].curves[0][0] == 4
+    assert "curve 4 points/" in reps1[0].line()
+    # handle + curve edit after it
+    out2, reps2 = run_script(cloud, script)
+    assert reps2[1].curves == [(2, 20)] and len(reps2[1].handles) == 1
+    assert "handle" in reps2[1].line() and "curve 2 points/20 samples" in reps2[1].line()
+    hnd = np.linalg.norm(out1.positions - [0.6, 0, 0], axis=1) <= 0.12
+    np.testing.assert_allclose(out2.positions[hnd], out1.positions[hnd] + [0, 0, -0.05], atol=1e-12)
+
+
+def test_curve_entirely_outside_the_free_region_is_reported_with_the_edit_path():
+    from splatedit.bench.solve import wavy_plane_cloud
+    cloud = wavy_plane_cloud(30)
+    doc = {"version": 1, "edits": [{"support": {"sphere": {"center": [0, 0, 0], "radius": 0.3}},
+                                    "curves": [{"points": [[0.8, 0.8, 0.0], [0.9, 0.8, 0.0]],
+                                                "move": [[0, 0, 0.1]] * 2}]}]}
+    with pytest.raises(EditScriptError, match=r"\$\.edits\[0\]: curve 0: none of its"):
+        run_script(cloud, parse_script(doc))
 
 
 def test_trs_matrix_scales_then_rotates_then_translates():

@@ -54,7 +54,8 @@ def _support_and_handle(cloud: SplatCloud, support_splats: int = 20000):
     """A ball support of about ``support_splats`` splats around a surface point
     and a handle ball of a quarter of its radius."""
     p = cloud.positions
-    centre = p[np.argmax(p[:, 1])] * 0.6 + p.mean(0) * 0.4
+    guess = p[np.argmax(p[:, 1])] * 0.6 + p.mean(0) * 0.4
+    centre = p[np.argmin(np.linalg.norm(p - guess, axis=1))]     # a surface point
     d = np.linalg.norm(p - centre, axis=1)
     k = min(support_splats, cloud.n // 4)
     r = float(np.partition(d, k)[k])

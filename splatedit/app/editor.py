@@ -793,6 +793,9 @@ class Editor:
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
                 pending = (self.scene_key is None or self.scene_interactive or self.drag is not None
                            or (s is not None and self.scene_key != self.scene_state()))
+                w, h = self.size
+                if w == 0 or h == 0 or self.window.iconified():
+                    pending = False          # minimized: nothing to draw, do not spin
                 timeout = 0.0 if pending else (0.05 if busy else 0.5)
                 events = self.window.poll(timeout)
                 self.handle_events(events)

@@ -79,7 +79,6 @@ class Viewport:
 
     # ------------------------------------------------------------- syncing
     def _sync(self, slot: _Slot, level=None) -> None:
-        r = self.full.r
         cloud = self.cloud
         if level is not None:
             src = self.pyramid.source
@@ -98,6 +97,8 @@ class Viewport:
                 if level is not None:
                     s, h = level.masks(s, h)
                 slot.r.set_selection(s, h)
+            else:
+                slot.r.set_selection(None, None)
             slot.sel = (self.sel_version, id(cloud))
         basis = self.basis
         if slot.basis is not basis:
@@ -116,7 +117,6 @@ class Viewport:
             if slot.dc is None or not np.array_equal(slot.dc, dc):
                 slot.r.set_displacement(dc)
                 slot.dc = dc.copy()
-        del r
 
     def _lod_slot(self) -> _Slot:
         if self.lod_slot is None:

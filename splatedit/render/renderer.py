@@ -50,8 +50,6 @@ _PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", 
              V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
              V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "vert|comp"),
              V.Binding(7, "storage", "comp"), V.Binding(8, "uniform", "comp"))
-#: specialization constant 1 (SPLAT_PASS) of the splat vertex shaders
-_PASS_IDS = {"depth": 0, "attr": 1, "pick": 2}
 _REC_A_BYTES = 48
 _REC_B_BYTES = 32
 _WORKGROUP = 64
@@ -211,8 +209,6 @@ class Renderer:
         self.point_splats = bool(point_splats)
         #: point path threshold (pixels), see ``point_splats``
         self.point_max_px = float(RENDER_POINT_SPLAT_MAX_PX)
-        #: points test the depth of their centre, without gl_FragDepth (see splat_fs.glsl)
-        self.point_depth_from_centre = True
         self.prepass = bool(prepass)
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
@@ -473,14 +469,13 @@ class Renderer:
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
         layout = V.LayoutDesc(sets=(_SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
-        common = dict(bindings=bindings, attributes=attrs, depth_test=True, spec=((0, mode), (1, _PASS_IDS[kind])),
+        common = dict(bindings=bindings, attributes=attrs, depth_test=True, spec=((0, mode),),
                       topology="point_list" if mode == 2 else "triangle_strip")
-        pt = "_pt" if mode == 2 and self.point_depth_from_centre else ""
         if kind == "depth":
-            desc = V.GraphicsDesc(vert, f"splat_depth{pt}.frag", _RP_DEPTH, layout, depth_write=True,
+            desc = V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
                                   depth_compare="less", **common)
         elif kind == "attr":
-            desc = V.GraphicsDesc(vert, f"splat_attr{pt}.frag", _rp_attr(self.accum_format, "shader_read"), layout,
+            desc = V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"), layout,
                                   depth_write=False, depth_compare="less_equal", blend_add=(True, True), **common)
         else:
             desc = V.GraphicsDesc(vert, "splat_pick.frag", _RP_PICK, layout, depth_write=True,
@@ -622,14 +617,13 @@ class Renderer:
 
     def _prepared_pipeline(self, kind: str, mode: int):
         layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=4, push_stages="vert")
-        common = dict(depth_test=True, spec=((0, mode), (1, _PASS_IDS[kind])),
+        common = dict(depth_test=True, spec=((0, mode),),
                       topology="point_list" if mode == 2 else "triangle_strip")
-        pt = "_pt" if mode == 2 and self.point_depth_from_centre else ""
         if kind == "depth":
-            desc = V.GraphicsDesc("prepared.vert", f"splat_depth{pt}.frag", _RP_DEPTH, layout, depth_write=True,
+            desc = V.GraphicsDesc("prepared.vert", "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
                                   depth_compare="less", **common)
         elif kind == "attr":
-            desc = V.GraphicsDesc("prepared.vert", f"splat_attr{pt}.frag", _rp_attr(self.accum_format, "shader_read"),
+            desc = V.GraphicsDesc("prepared.vert", "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"),
                                   layout, depth_write=False, depth_compare="less_equal", blend_add=(True, True),
                                   **common)
         else:

@@ -105,3 +105,38 @@ def test_grazing_plane_hole_free(renderer):
     holes = inside & ~(bufs["weight"] > 0)
     assert holes.sum() == 0, f"{holes.sum()} holes in the grazing plane"
     # back-face culling off must give the same coverage from below? (two-sided splats)
+
+
+def test_million_splat_sphere_hole_free_1280x720(renderer):
+    """1M splats at 1280x720: nearly all are drawn as square points (footprint
+    within RENDER_POINT_SPLAT_MAX_PX of the centre); the silhouette has no
+    holes and the coverage equals that of the all-quads path."""
+    n = 1_000_000
+    cloud = sphere(n, overlap=1.0)
+    w, h = 1280, 720
+    cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))
+    renderer.set_cloud(cloud)
+    bufs = renderer.render_buffers(cam, w, h)
+    draws = renderer._prep.draws.read().view(np.uint32)
+    assert draws[5] > 0.9 * (draws[1] + draws[5]), draws          # the point path is exercised
+    saved = renderer.point_splats
+    try:
+        renderer.point_splats = False
+        quads = renderer.render_buffers(cam, w, h)
+    finally:
+        renderer.point_splats = saved
+    # analytic silhouette of the unit sphere
+    p = cam.projection_matrix(w / h, 0.1, 100.0)
+    X, Y = np.meshgrid(((np.arange(w) + 0.5) * 2.0 / w - 1.0) / p[0, 0], ((np.arange(h) + 0.5) * 2.0 / h - 1.0) / p[1, 1])
+    d = np.stack([X, Y, -np.ones_like(X)], axis=-1)
+    c = (cam.view_matrix() @ np.r_[0.0, 0.0, 0.0, 1.0])[:3]
+    a = np.einsum("hwi,hwi->hw", d, d)
+    b = d @ c
+    hit = b * b - a * (c @ c - 1.0) > 0
+    inner = ndimage.binary_erosion(hit, iterations=2)
+    fg = bufs["weight"] > 0
+    assert inner.sum() > 0.1 * w * h
+    assert (inner & ~fg).sum() == 0, f"{(inner & ~fg).sum()} holes inside the silhouette"
+    assert (fg != (quads["weight"] > 0)).sum() <= 0.0005 * fg.sum()
+    both = fg & (quads["weight"] > 0)
+    np.testing.assert_allclose(bufs["weight"][both], quads["weight"][both], rtol=2e-2, atol=1e-2)

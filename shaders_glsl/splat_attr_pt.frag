@@ -1,6 +1,0 @@
-#version 450
-#extension GL_GOOGLE_include_directive : require
-// Pass 1 for square points: depth from the vertex shader (see splat_fs.glsl).
-#define SPLAT_PASS 1
-#define SPLAT_EXACT_DEPTH 0
-#include "splat_fs.glsl"
