@@ -87,7 +87,10 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
         // largest distance of the footprint from the centre along x, y (pixels)
         vec2 he = max(vec2(max(-ex.x, ex.y), max(-ey.x, ey.y)) * 0.5 * F.viewport.xy, vec2(lp)) + 0.02;
         float h = max(he.x, he.y);
-        small = h <= F.misc.w && all(lessThan(abs(cc), vec2(1.0)));
+        // (beyond 1 pixel only for round-ish footprints: a square around an
+        // elongated one would shade many more pixels than its quad)
+        small = h <= F.misc.w && (h <= 1.0 || 2.0 * min(he.x, he.y) >= h)
+                && all(lessThan(abs(cc), vec2(1.0)));
         S.psize = ceil(16.0 * h) * 0.125;                  // 2 h rounded up to the point-size granularity
     }
     S.cc = C.xy / C.w;

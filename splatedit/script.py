@@ -520,12 +520,11 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
         EditScriptError: a region selects nothing or indexes past the cloud;
             a bad curve (JSON path of the curve).
     """
-    from splatedit.deform.curves import ControlCurve
     support, handles, matrices = resolve_edit(cloud, edit, source)
     curves, moves = [], []
     for j, c in enumerate(edit.curves):
         try:
-            cc = ControlCurve.through(np.array(c.points, dtype=np.float64), samples=c.samples)
+            cc = c.control_curve()
             moves.append(cc.control_displacement(np.array(c.move, dtype=np.float64)))
         except SplatEditError as exc:
             raise EditScriptError(str(exc), json_path=f"{edit.json_path}.curves[{j}]",

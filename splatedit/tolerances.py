@@ -128,6 +128,11 @@ RENDER_TINT_HANDLE = (0.1, 0.8, 0.15, 0.7)
 #: the GPU; 16 columns = 16 vertex attributes + 5 of lavapipe's 32, dC in a
 #: 192-byte uniform block)
 RENDER_MAX_BASIS_COLUMNS = 16
-#: splats whose projected ellipse bound is at most this many pixels wide (<= 1)
-#: are drawn as one-pixel points (hole-free: radius <= half a pixel)
-RENDER_POINT_SPLAT_MAX_PX = 1.0
+#: splats whose footprint (projected ellipse and low-pass disc) lies within this
+#: many pixels of the projected centre along x and y (and, beyond 1 pixel, with
+#: an x/y extent ratio <= 2) are drawn as one square POINT_LIST point of side
+#: 2 * extent through the same EWA fragment shader: the same pixels as the
+#: quad, hence hole-free, for one vertex instead of a 4-vertex strip.
+#: Measured at 1280x720 (lavapipe): 1M-splat sphere 1.5x faster than all
+#: quads, 100k 1.3x faster with 3 px than with 1 px
+RENDER_POINT_SPLAT_MAX_PX = 3.0

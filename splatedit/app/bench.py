@@ -85,7 +85,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
             lod_s = time.perf_counter() - t0
             vp.set_cloud(cloud)
             vp.set_pyramid(pyr)
-            vp.ms_per_splat = None
+            vp.assume_cost(None, 1)
             sup, hnd = _support_and_handle(cloud)
             vp.set_selection(sup, hnd, n)
             cam = OrbitCamera(scene_radius=cloud.diagonal / 2, yaw=0.3, pitch=0.2)

@@ -64,6 +64,8 @@ File and history
 BRUSH_MIN, BRUSH_MAX = 2, 400
 #: seconds without motion after which the full-quality frame is drawn
 REFINE_DELAY = 0.2
+#: full-quality frames predicted slower than this (ms) are drawn in the background
+ASYNC_REFINE_MS = 400.0
 #: models with more splats than this get a level-of-detail pyramid
 LOD_MIN_SPLATS = 150_000
 
@@ -155,6 +157,7 @@ class Editor:
         self.show_help = False
         self.confirm_quit = False
         self.prompt: str | None = None      # save-as path being typed
+        self.prompt_fresh = False            # the first key replaces the proposed path
         self.drag = None                     # orbit/pan/dolly/paint/manip
         self.drag_last = (0.0, 0.0)
         self.stroke_changed = False
@@ -169,6 +172,7 @@ class Editor:
         self.scene = None
         self.scene_key = None
         self.scene_interactive = False
+        self.refiner = None
         self.last_motion = 0.0
         self.frame_ms = 0.0
         self.frames = 0
@@ -348,7 +352,8 @@ class Editor:
 
     def on_char(self, e) -> None:
         if self.prompt is not None and e.char.isprintable():
-            self.prompt += e.char
+            self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
+            self.prompt_fresh = False
 
     def on_scroll(self, e) -> None:
         if self.session is None:
@@ -450,7 +455,8 @@ class Editor:
             elif k == g.KEY_ESCAPE:
                 self.prompt = None
             elif k == g.KEY_BACKSPACE:
-                self.prompt = self.prompt[:-1]
+                self.prompt = "" if self.prompt_fresh else self.prompt[:-1]
+                self.prompt_fresh = False
             return
         if self.confirm_quit:
             if k in (g.KEY_Y, g.KEY_Q, g.KEY_ESCAPE):
@@ -496,6 +502,7 @@ class Editor:
             elif k == g.KEY_S:
                 if shift:
                     self.prompt = str(self.save_target())
+                    self.prompt_fresh = True
                 else:
                     self.save(self.save_target())
             elif k == g.KEY_E:
@@ -625,11 +632,25 @@ class Editor:
             self.sync_document()
             key = self.scene_state()
             moving = time.perf_counter() - self.last_motion < REFINE_DELAY or self.drag is not None
-            if self.scene is None or key != self.scene_key or (self.scene_interactive and not moving):
-                self.scene = self.viewport.render(self.cam, w, h, interactive=moving)
-                self.scene_key = key
-                self.scene_interactive = moving and (self.viewport.last_info.get("lod")
-                                                     or self.viewport.last_info.get("div", 1) > 1)
+            stale = self.scene is None or key != self.scene_key
+            if stale or (self.scene_interactive and not moving):
+                vp = self.viewport
+                slow = (vp.ms_per_splat is not None
+                        and vp.ms_per_splat * self.session.cloud.n > ASYNC_REFINE_MS)
+                if not moving and slow:
+                    # a slow full-quality frame: drawn by the background refiner
+                    if stale:
+                        self.render_scene(key, interactive=True)
+                    if self.scene_interactive:
+                        self.request_refine(key)
+                else:
+                    self.render_scene(key, interactive=moving)
+            if self.refiner is not None and self.scene_interactive:
+                img = self.refiner.take(key)
+                if img is not None and img.shape[:2] == (h, w):
+                    self.scene, self.scene_interactive = img, False
+                    self.viewport.last_info = {"ms": self.refiner.last_ms, "splats": self.session.cloud.n,
+                                               "div": 1, "lod": False, "interactive": False}
             frame = self.scene.copy()
             if frame.shape[:2] != (h, w):
                 fr = np.full((h, w, 4), 255, np.uint8)
@@ -641,6 +662,26 @@ class Editor:
         self.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    def render_scene(self, key, interactive: bool) -> None:
+        w, h = self.size
+        self.scene = self.viewport.render(self.cam, w, h, interactive=interactive)
+        self.scene_key = key
+        info = self.viewport.last_info
+        self.scene_interactive = bool(interactive and (info.get("lod") or info.get("div", 1) > 1))
+
+    def request_refine(self, key) -> None:
+        from splatedit.app.viewport import BackgroundRefiner
+        if self.refiner is None:
+            self.refiner = BackgroundRefiner(self.wake, self.viewport.budget_ms)
+        s = self.session
+        w, h = self.size
+        cam = OrbitCamera(np.array(self.cam.target, float), self.cam.distance, self.cam.yaw,
+                          self.cam.pitch, self.cam.fov_deg, np.array(self.cam.up_axis, float),
+                          self.cam.scene_radius)
+        self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
+                                       handle=s.selection.handle.copy(), sel_version=s.version,
+                                       basis=s.basis, dc=self.viewport.dc, camera=cam, w=w, h=h))
 
     # -------------------------------------------------------------- overlay
     def overlay_patches(self, w: int, h: int) -> list:
@@ -675,7 +716,8 @@ class Editor:
             center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
                           "(Ctrl+S saves)")
         elif self.prompt is not None:
-            center_msg = ("Save as (Enter: save, Esc: cancel):", self.prompt + "_")
+            center_msg = ("Save as (type a path; Enter: save, Esc: cancel):",
+                          self.prompt + ("" if self.prompt_fresh else "_"))
         if center_msg:
             img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
             patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))
@@ -754,6 +796,11 @@ class Editor:
               "running": self.running, "jobs": sorted(self.jobs), "validation_messages": msgs,
               "confirm_quit": self.confirm_quit, "prompt": self.prompt, "help": self.show_help,
               "window": list(self.size), "panel_box": list(self.panel_box),
+              "interactive_frames": len(self.viewport.interactive_frames_ms),
+              "interactive_ms_median": (round(float(np.median(self.viewport.interactive_frames_ms[-30:])), 1)
+                                        if self.viewport.interactive_frames_ms else None),
+              "last_render": {k: (round(v, 1) if isinstance(v, float) else v)
+                              for k, v in self.viewport.last_info.items()},
               "saved": str(self.saved_path) if self.saved_path else None,
               "script": str(self.saved_script) if self.saved_script else None}
         if s is not None:
@@ -763,7 +810,8 @@ class Editor:
                       history=len(s.history), manip=None if s.manip is None else s.manip.mode,
                       brush=s.brush_target, fit_error=ss.get("error"))
             idle = (not self.jobs and s.fit_job is None and self.drag is None and s.manip is None
-                    and not self.scene_interactive and self.scene_key == self.scene_state())
+                    and not self.scene_interactive and self.scene_key == self.scene_state()
+                    and not (self.refiner is not None and self.refiner.busy))
             st["idle"] = bool(idle)
         text = json.dumps(st, sort_keys=True)
         if text != self._status_last:
@@ -791,8 +839,11 @@ class Editor:
             while self.running:
                 s = self.session
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
-                pending = (self.scene_key is None or self.scene_interactive or self.drag is not None
+                refining = self.refiner is not None and self.refiner.busy
+                pending = (self.scene_key is None or self.drag is not None
+                           or (self.scene_interactive and not refining)
                            or (s is not None and self.scene_key != self.scene_state()))
+                busy = busy or refining
                 w, h = self.size
                 if w == 0 or h == 0 or self.window.iconified():
                     pending = False          # minimized: nothing to draw, do not spin
@@ -821,6 +872,9 @@ class Editor:
         for j in list(self.jobs.values()):
             if j.name == "saving":
                 j.thread.join()     # never leave a half-written file behind
+        if self.refiner is not None:
+            self.refiner.close()
+            self.refiner = None
         if self.viewport is not None:
             self.viewport.close()
             self.viewport = None
@@ -873,26 +927,41 @@ def run_editor(path=None, **options) -> int:
         editor.close()
 
 
+def add_arguments(p) -> None:
+    """Add the ``splatedit edit`` options to an argparse parser."""
+    p.add_argument("file", nargs="?", help="model to open (default: the bundled bunny)")
+    p.add_argument("--save-as", help="save path (default: <name>-edited.ply next to the input, "
+                   "or in the current directory for the bundled model)")
+    p.add_argument("--size", default="1280x720", help="window size WxH (default 1280x720)")
+    p.add_argument("--method", default="auto", choices=("auto", "lu", "iqr"),
+                   help="solver (also written to the exported edit script)")
+    p.add_argument("--tol", type=float, default=IQR_DEFAULT_TOL, help="IQR relative tolerance")
+    p.add_argument("--no-vsync", action="store_true", help="present without vsync (MAILBOX/IMMEDIATE)")
+    p.add_argument("--no-lod", action="store_true", help="never draw a level of detail while moving")
+    p.add_argument("--budget-ms", type=float, default=100.0,
+                   help="frame-time budget while moving (default 100 ms = 10 fps)")
+    p.add_argument("--status-file", help="test hook: a JSON file rewritten when the state changes")
+
+
+def options_from_args(a) -> dict:
+    """The :func:`run_editor` keyword options of parsed :func:`add_arguments` arguments."""
+    try:
+        w, h = (int(v) for v in str(a.size).lower().split("x"))
+    except ValueError:
+        raise SplatEditError(f"--size must look like 1280x720, got {a.size!r}") from None
+    return dict(size=(w, h), save_as=a.save_as, method=a.method, tol=a.tol, vsync=not a.no_vsync,
+                lod=not a.no_lod, budget_ms=a.budget_ms, status_file=a.status_file)
+
+
 def main(argv=None) -> int:
-    """``python -m splatedit.app.editor [FILE] [--save-as PATH] ...`` (the CLI's ``edit``)."""
+    """``python -m splatedit.app.editor [FILE] [options]`` (same as ``splatedit edit``)."""
     import argparse
     p = argparse.ArgumentParser(prog="splatedit edit", description="interactive editor",
                                 epilog=CONTROLS, formatter_class=argparse.RawDescriptionHelpFormatter)
-    p.add_argument("file", nargs="?")
-    p.add_argument("--save-as", help="save path (default <name>-edited.ply)")
-    p.add_argument("--size", default="1280x720", help="window size WxH")
-    p.add_argument("--method", default="auto", choices=("auto", "lu", "iqr"))
-    p.add_argument("--tol", type=float, default=IQR_DEFAULT_TOL)
-    p.add_argument("--no-vsync", action="store_true")
-    p.add_argument("--no-lod", action="store_true")
-    p.add_argument("--budget-ms", type=float, default=100.0)
-    p.add_argument("--status-file", help="test hook: JSON status file")
+    add_arguments(p)
     a = p.parse_args(argv)
-    w, h = (int(v) for v in a.size.lower().split("x"))
     try:
-        return run_editor(a.file, size=(w, h), save_as=a.save_as, method=a.method, tol=a.tol,
-                          vsync=not a.no_vsync, lod=not a.no_lod, budget_ms=a.budget_ms,
-                          status_file=a.status_file)
+        return run_editor(a.file, **options_from_args(a))
     except SplatEditError as exc:
         print(f"splatedit: error: {exc}", file=sys.stderr)
         return 2

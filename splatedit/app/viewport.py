@@ -57,16 +57,25 @@ class Viewport:
         self.dc = None
         self.pyramid = None
         self.ms_per_splat = None     # measured on full-quality frames
+        self._ref_pixels = 1
+        self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
+        self._last_key = None
         self.last_info: dict = {}
         self.full_frames_ms: list[float] = []
         self.interactive_frames_ms: list[float] = []
 
     # ----------------------------------------------------------- document
     def set_cloud(self, cloud) -> None:
+        if self.cloud is not None and cloud is not None and cloud.n != self.cloud.n:
+            self._measured = {}
+            self._last_key = None
+            self.ms_per_splat = None
         self.cloud = cloud
 
     def set_pyramid(self, pyramid) -> None:
         self.pyramid = pyramid
+        self._measured = {k: v for k, v in self._measured.items() if k[0] is None}
+        self._last_key = None
 
     def set_selection(self, support, handle, version: int) -> None:
         self.support, self.handle, self.sel_version = support, handle, version
@@ -124,21 +133,54 @@ class Viewport:
         return self.lod_slot
 
     # ------------------------------------------------------------- drawing
+    def assume_cost(self, ms_per_splat: float | None, pixels: int) -> None:
+        """Forget the measured frame times and assume this full-quality cost
+        (tests and benchmarks: simulate a slower or faster device)."""
+        self._measured = {}
+        self._last_key = None
+        self.ms_per_splat = ms_per_splat
+        self._ref_pixels = pixels
+
+    def _configs(self):
+        """Interactive configurations, finest first: (level or None, divisor)."""
+        levels = self.pyramid.levels if self.pyramid is not None else []
+        out = [(None, 1)] + [(lvl, 1) for lvl in levels]
+        last = levels[-1] if levels else None
+        out += [(last, 2), (last, 3)]
+        return out
+
+    #: scaling law of lavapipe frame times between configurations (measured on
+    #: bunny resamplings: time ~ splats^0.7 (bigger LOD splats cost more fill)
+    #: and ~ divisor^-1.2 (fewer pixels, same splat setup))
+    COUNT_EXP, DIV_EXP = 0.7, 1.2
+
+    def _predict(self, cfg, pixels: int) -> float:
+        level, div = cfg
+        n = self.cloud.n
+        count = n if level is None else level.n
+        key = (id(level) if level is not None else None, div)
+        if key in self._measured:
+            ms, px, _ = self._measured[key]
+            return ms * pixels / max(px, 1)
+        if self._last_key is not None and self._last_key in self._measured:
+            # from the configuration measured last, with the scaling law
+            ms, px, c0 = self._measured[self._last_key]
+            d0 = self._last_key[1]
+            return (ms * pixels / max(px, 1) * (count / max(c0, 1)) ** self.COUNT_EXP
+                    * (d0 / div) ** self.DIV_EXP)
+        full = self.ms_per_splat * n * pixels / max(self._ref_pixels, 1)
+        return full * (count / n) ** self.COUNT_EXP * (1.0 / div) ** self.DIV_EXP
+
     def choose(self, interactive: bool, w: int, h: int):
-        """(level or None, resolution divisor) for the next frame."""
+        """(level or None, resolution divisor) for the next frame: the finest
+        configuration whose measured (or predicted) time fits the budget."""
         if not interactive or self.ms_per_splat is None or self.cloud is None:
             return None, 1
-        n = self.cloud.n
-        px_scale = (w * h) / self._ref_pixels if getattr(self, "_ref_pixels", None) else 1.0
-        if self.ms_per_splat * n * px_scale <= self.budget_ms:
-            return None, 1
-        fit = int(self.budget_ms / max(self.ms_per_splat * px_scale, 1e-9))
-        level = self.pyramid.level_for(fit) if self.pyramid is not None else None
-        count = n if level is None else level.n
-        div = 1
-        if self.ms_per_splat * count * px_scale > self.budget_ms:
-            div = 2
-        return level, div
+        configs = self._configs()
+        for cfg in configs:
+            if self._predict(cfg, w * h) <= self.budget_ms:
+                return cfg
+        return configs[-1]
 
     def render(self, cam: OrbitCamera, w: int, h: int, interactive: bool = False) -> np.ndarray:
         """An (h, w, 4) uint8 frame."""
@@ -148,18 +190,25 @@ class Viewport:
         self._sync(slot, level)
         rw, rh = max(1, w // div), max(1, h // div)
         img = slot.r.render(render_camera(cam), rw, rh)
-        ms = (time.perf_counter() - t0) * 1e3
-        count = self.cloud.n if level is None else level.n
         if div > 1:
             img = np.repeat(np.repeat(img, div, axis=0), div, axis=1)[:h, :w]
             if img.shape[0] < h or img.shape[1] < w:
                 pad = np.zeros((h, w, 4), np.uint8)
                 pad[:img.shape[0], :img.shape[1]] = img
                 img = pad
-        # cost model: ms per splat at this resolution (full-resolution frames only)
-        if div == 1:
-            est = ms / max(count, 1)
+        ms = (time.perf_counter() - t0) * 1e3
+        count = self.cloud.n if level is None else level.n
+        key = (id(level) if level is not None else None, div)
+        old = self._measured.get(key)
+        if old is not None and old[1] == w * h:
+            ms_avg = 0.5 * (old[0] + ms)
+        else:
+            ms_avg = ms
+        self._measured[key] = (ms_avg, w * h, count)
+        self._last_key = key
+        if level is None and div == 1:
             self._ref_pixels = w * h
+            est = ms / max(count, 1)
             self.ms_per_splat = est if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + est)
         (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
         self.last_info = {"ms": ms, "splats": count, "div": div, "lod": level is not None,
@@ -178,3 +227,95 @@ class Viewport:
         if self.full is not None:
             self.full.r.close()
             self.full = None
+
+
+class BackgroundRefiner:
+    """Draws full-quality frames in a worker thread with a renderer (and Vulkan
+    device) of its own, so a multi-second frame of a huge model never blocks
+    the window: the editor shows the interactive frame meanwhile and swaps in
+    the refined one when it arrives (if the scene has not changed since).
+
+    ``request(key, state)``: ``state`` holds everything the frame depends on
+    (cloud, masks, selection version, basis, dC, a camera copy, size); a newer
+    request replaces an older one not yet started.  ``take(key)`` returns the
+    image of ``key`` once it is ready.
+    """
+
+    def __init__(self, wake=None, budget_ms: float = 100.0):
+        import threading
+        self._wake = wake
+        self._budget = budget_ms
+        self._cv = threading.Condition()
+        self._req = None
+        self._result = None
+        self._stop = False
+        self.pending_key = None
+        self.last_ms = None
+        self.error = None
+        self.thread = threading.Thread(target=self._run, name="splatedit-refine", daemon=True)
+        self.thread.start()
+
+    def request(self, key, state: dict) -> None:
+        with self._cv:
+            if self.pending_key == key:
+                return
+            self._req = (key, state)
+            self.pending_key = key
+            self._cv.notify()
+
+    def take(self, key):
+        with self._cv:
+            if self._result is not None and self._result[0] == key:
+                img = self._result[1]
+                self._result = None
+                return img
+        return None
+
+    @property
+    def busy(self) -> bool:
+        return self.pending_key is not None
+
+    def cancel(self) -> None:
+        with self._cv:
+            self._req = None
+            self.pending_key = None
+            self._result = None
+
+    def _run(self) -> None:
+        vp = None
+        try:
+            while True:
+                with self._cv:
+                    while self._req is None and not self._stop:
+                        self._cv.wait()
+                    if self._stop:
+                        break
+                    key, st = self._req
+                    self._req = None
+                try:
+                    if vp is None:
+                        vp = Viewport(budget_ms=self._budget)
+                    vp.set_cloud(st["cloud"])
+                    vp.set_selection(st["support"], st["handle"], st["sel_version"])
+                    vp.set_basis(st["basis"])
+                    vp.set_dc(st["dc"])
+                    img = vp.render(st["camera"], st["w"], st["h"])
+                    self.last_ms = vp.last_info["ms"]
+                except Exception as exc:  # noqa: BLE001 - shown by the editor
+                    self.error = exc
+                    img = None
+                with self._cv:
+                    if self.pending_key == key:
+                        self._result = (key, img)
+                        self.pending_key = None if self._req is None else self._req[0]
+                if self._wake:
+                    self._wake()
+        finally:
+            if vp is not None:
+                vp.close()
+
+    def close(self) -> None:
+        with self._cv:
+            self._stop = True
+            self._cv.notify()
+        self.thread.join(timeout=30)

@@ -1,10 +1,13 @@
 """Renderer benchmark: per-pass GPU times (timestamp queries) of the EWA frame,
 the one-pixel point floor, and the deformation overhead.
 
-``bench_render`` yields one dict per splat count (the CLI prints each as a JSON
-line).  Scene: a Fibonacci-sampled unit sphere (splat radius = sampling
-spacing, ~2-3x overlap) framed to fill the view, back-face culling on,
-validation off.  Times are medians over ``repeats`` frames after a warm-up.
+``bench_render`` yields one dict per case (the CLI prints each as a JSON
+line; keys in its docstring): a Fibonacci-sampled unit sphere per splat count
+(splat radius = sampling spacing, ~2-3x overlap) framed to fill the view,
+then the bundled bunny model; back-face culling on, validation off.  Times
+are GPU timestamps, medians (and best) over ``repeats`` frames after a warm-up.
+lavapipe shares the CPU with everything else on the machine: compare
+``frame_over_floor`` (both measured in the same run) rather than raw times.
 """
 
 from __future__ import annotations
@@ -42,48 +45,114 @@ def _basis(points: np.ndarray):
     return B, g[..., 0], g[..., 1], g[..., 2]
 
 
-def _median_frame(r: Renderer, cam, w, h, repeats):
+def _frames(r: Renderer, cam, w, h, repeats):
+    """(median, best) per-pass GPU times over ``repeats`` frames after a warm-up."""
     r.render(cam, w, h)                          # warm-up (pipeline JIT)
     runs = []
     for _ in range(repeats):
         r.render(cam, w, h)
         runs.append(dict(r.last_timings_ms))
-    return {k: float(np.median([x[k] for x in runs])) for k in runs[0]}
+    med = {k: float(np.median([x[k] for x in runs])) for k in runs[0]}
+    best = min(runs, key=lambda x: x["total"])
+    return med, best
+
+
+def _point_share(r: Renderer) -> float:
+    """Share of the drawn splats of the last frame on the square-point path."""
+    if r._prep is None:
+        return float("nan")
+    d = r._prep.draws.read().view(np.uint32)
+    return float(d[5]) / max(int(d[1]) + int(d[5]), 1)
+
+
+def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: int) -> dict:
+    t0 = time.perf_counter()
+    n = cloud.n
+    r.set_cloud(cloud)
+    cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))
+    plain, plain_best = _frames(r, cam, w, h, repeats)
+    share = _point_share(r)
+    r.render_points_floor(cam, w, h)
+    floors = [r.render_points_floor(cam, w, h) for _ in range(repeats)]
+    pts, pts_best = float(np.median(floors)), float(min(floors))
+    lo, hi = cloud.bounds()
+    B = _basis((cloud.positions - 0.5 * (lo + hi)) / max(float(np.max(hi - lo)) / 2.0, 1e-12))
+    dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]])
+    dC = dC * 0.1 * float(np.max(hi - lo))
+    r.set_basis(np.arange(n), *B)
+    r.set_displacement(dC)
+    full, full_best = _frames(r, cam, w, h, repeats)
+    # a contiguous support region: the 10% of the splats nearest to one point
+    d2 = np.sum((cloud.positions - cloud.positions[0]) ** 2, axis=1)
+    idx = np.sort(np.argpartition(d2, max(n // 10 - 1, 0))[:max(n // 10, 1)])
+    r.set_basis(idx, *(m[idx] for m in B))
+    r.set_displacement(dC)
+    tenth, tenth_best = _frames(r, cam, w, h, repeats)
+    r.clear_basis()
+    return {
+        "bench": "render", "model": model, "device": r.dev.name, "splats": int(n), "width": w, "height": h,
+        "ms_prepass": round(plain["prepass"], 2), "ms_visibility": round(plain["visibility"], 2),
+        "ms_attributes": round(plain["attributes"], 2),
+        "ms_shading": round(plain["shading"], 2), "ms_frame": round(plain["total"], 2),
+        "splats_per_s": round(n / (plain["total"] * 1e-3)),
+        "ms_points_floor": round(pts, 2), "frame_over_floor": round(plain["total"] / pts, 3),
+        "ms_frame_best": round(plain_best["total"], 2), "ms_points_floor_best": round(pts_best, 2),
+        "frame_over_floor_best": round(plain_best["total"] / pts_best, 3),
+        "point_path_share": round(share, 4),
+        "ms_frame_deformed_all": round(full["total"], 2),
+        "deformed_all_over_plain": round(full["total"] / plain["total"], 3),
+        "ms_frame_deformed_10pct": round(tenth["total"], 2),
+        "deformed_10pct_over_plain": round(tenth["total"] / plain["total"], 3),
+        "deformed_all_over_plain_best": round(full_best["total"] / plain_best["total"], 3),
+        "deformed_10pct_over_plain_best": round(tenth_best["total"] / plain_best["total"], 3),
+        "loadavg_1min": _loadavg(),
+        "wall_s": round(time.perf_counter() - t0, 1),
+    }
+
+
+def _loadavg() -> float:
+    try:
+        with open("/proc/loadavg") as f:
+            return float(f.read().split()[0])
+    except (OSError, ValueError, IndexError):
+        return float("nan")
 
 
 def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repeats: int = 3,
-                 device_name: str | None = None) -> Iterator[dict]:
-    """Yield one dict per splat count: ms per pass and frame, splats/s, the
-    point-list floor, and deformed frames (all splats / 10% in the support)."""
+                 device_name: str | None = None, bunny: bool = True) -> Iterator[dict]:
+    """Yield one dict per case: a sphere per splat count in ``counts``, then
+    (``bunny``) the bundled bunny model (``splatedit.data.default_model_path()``
+    read with :func:`splatedit.io.read`), all at ``size``.
+
+    Every case has the same keys (times in ms are GPU timestamps; "median"
+    and "best" are over ``repeats`` frames after a warm-up frame):
+
+    * ``bench`` = "render", ``model`` ("sphere" / "bunny"), ``device``,
+      ``splats``, ``width``, ``height``;
+    * ``ms_prepass``, ``ms_visibility``, ``ms_attributes``, ``ms_shading``,
+      ``ms_frame``: median per pass and whole frame (undeformed);
+    * ``splats_per_s``: splats / median frame time;
+    * ``ms_points_floor``: median one-pixel POINT_LIST floor
+      (:meth:`Renderer.render_points_floor`); ``frame_over_floor`` = ms_frame
+      / ms_points_floor;
+    * ``ms_frame_best``, ``ms_points_floor_best``, ``frame_over_floor_best``:
+      the same with the fastest frame of each (less sensitive to machine load);
+    * ``point_path_share``: share of the drawn splats on the square-point path;
+    * ``ms_frame_deformed_all`` / ``deformed_all_over_plain``: median frame
+      with every splat carrying a 4-column basis row (Gaussian bumps,
+      displacement ~2% of the model size), and its ratio to ``ms_frame``;
+    * ``ms_frame_deformed_10pct`` / ``deformed_10pct_over_plain``: the same
+      with a contiguous support of 10% of the splats (the nearest to one splat);
+    * ``deformed_all_over_plain_best``, ``deformed_10pct_over_plain_best``:
+      the ratios of the fastest frames;
+    * ``loadavg_1min``: /proc/loadavg at the end of the case (NaN elsewhere);
+    * ``wall_s``: wall-clock seconds of the case.
+    """
     w, h = size
     with Renderer(device_name=device_name, validation=False) as r:
         for n in counts:
-            t0 = time.perf_counter()
-            cloud = sphere_cloud(int(n))
-            r.set_cloud(cloud)
-            cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))
-            plain = _median_frame(r, cam, w, h, repeats)
-            r.render_points_floor(cam, w, h)
-            pts = float(np.median([r.render_points_floor(cam, w, h) for _ in range(repeats)]))
-            B = _basis(cloud.positions)
-            dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]])
-            r.set_basis(np.arange(n), *B)
-            r.set_displacement(dC)
-            full = _median_frame(r, cam, w, h, repeats)
-            idx = np.arange(0, n, 10)
-            r.set_basis(idx, *(m[idx] for m in B))
-            r.set_displacement(dC)
-            tenth = _median_frame(r, cam, w, h, repeats)
-            r.clear_basis()
-            yield {
-                "bench": "render", "device": r.dev.name, "splats": int(n), "width": w, "height": h,
-                "ms_prepass": round(plain["prepass"], 2), "ms_visibility": round(plain["visibility"], 2), "ms_attributes": round(plain["attributes"], 2),
-                "ms_shading": round(plain["shading"], 2), "ms_frame": round(plain["total"], 2),
-                "splats_per_s": round(n / (plain["total"] * 1e-3)),
-                "ms_points_floor": round(pts, 2), "frame_over_floor": round(plain["total"] / pts, 3),
-                "ms_frame_deformed_all": round(full["total"], 2),
-                "deformed_all_over_plain": round(full["total"] / plain["total"], 3),
-                "ms_frame_deformed_10pct": round(tenth["total"], 2),
-                "deformed_10pct_over_plain": round(tenth["total"] / plain["total"], 3),
-                "wall_s": round(time.perf_counter() - t0, 1),
-            }
+            yield _case(r, sphere_cloud(int(n)), "sphere", w, h, repeats)
+        if bunny:
+            from splatedit.data import default_model_path
+            from splatedit.io import read
+            yield _case(r, read(default_model_path()), "bunny", w, h, repeats)

@@ -12,8 +12,13 @@
 * scipy's ``RBFInterpolator(kernel="cubic", degree=2)`` fit + evaluate on the
   same constraints (values at the support splats only, no gradients).
 
-Run ``python -m splatedit.bench.solve`` for the standard cases: one JSON line
-each on stdout.
+``bench_groups`` measures the constraint-group kinds (paper Sect. 3 and 6):
+precompute (constraints + fit + basis) and CPU per-frame ``apply`` for one
+control curve with 4, 8 and 16 picked points and for 1-4 simultaneous rigid
+handles, on a ~160k-splat wavy plane.
+
+Run ``python -m splatedit.bench.solve`` for the standard cases
+(``--groups`` for the group cases): one JSON line each on stdout.
 """
 
 from __future__ import annotations
@@ -27,6 +32,7 @@ import numpy as np
 
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import build_constraints
+from splatedit.deform.curves import ControlCurve
 from splatedit.deform.transform import compose, rotate, translate
 from splatedit.model.cloud import SplatCloud
 
@@ -182,6 +188,76 @@ def bench_solve(cloud: SplatCloud, support, handles, *, name: str, transforms=No
     return out
 
 
+# ---------------------------------------------------------------- groups
+def wavy_plane_point(xy, amplitude: float = 0.15, waves: float = 1.5) -> np.ndarray:
+    """Points (p, 3) of :func:`wavy_plane_cloud`'s surface above ``xy`` (p, 2)."""
+    xy = np.atleast_2d(np.asarray(xy, dtype=np.float64))
+    w = waves * np.pi
+    return np.column_stack([xy, amplitude * np.sin(w * xy[:, 0]) * np.cos(w * xy[:, 1])])
+
+
+def group_cases(cloud: SplatCloud, *, support_radius: float = 0.6,
+                curve_points=(4, 8, 16), handle_counts=(1, 2, 3, 4)):
+    """Yield ``(name, support, handles, curves, inputs)`` on a wavy plane:
+    one S-shaped curve through ``k + 1`` picked surface points (moved by a
+    smooth lift), and ``h`` disc handles (radius 0.1) on a circle of radius
+    0.35 (lifted and tilted by :func:`sample_transform`)."""
+    xy = cloud.positions[:, :2]
+    sup = np.linalg.norm(xy, axis=1) <= support_radius
+    for n in curve_points:
+        s = np.linspace(-0.4, 0.4, n)
+        curve = ControlCurve.through(wavy_plane_point(np.column_stack([s, 0.25 * np.sin(4 * s)])))
+        dq = np.zeros((n, 3))
+        dq[:, 2] = 0.1 * np.sin(np.linspace(0.0, np.pi, n))
+        yield f"curve-{n}", sup, [], [curve], [curve.control_displacement(dq)]
+    for h in handle_counts:
+        ang = 2 * np.pi * np.arange(h) / h
+        hs = [np.linalg.norm(xy - 0.35 * np.array([np.cos(a), np.sin(a)]), axis=1) <= 0.1
+              for a in ang]
+        yield f"handles-{h}", sup, hs, [], [sample_transform(cloud, m, sup) for m in hs]
+
+
+def bench_groups(cloud: SplatCloud | None = None, *, quick: bool = False, method: str = "iqr",
+                 apply_repeats: int = 5, fit_repeats: int = 1, **case_kw):
+    """Yield one JSON-ready dict per group case (see :func:`group_cases`):
+    ``m``, ``n_columns``, centers, ``precompute_s`` (= ``fit_s``, which
+    includes building the constraints and curve samples, + ``basis_s``), the
+    CPU per-frame ``apply_s`` (best of ``apply_repeats``) and a plain copy of
+    the output arrays for scale; the precompute is the best of ``fit_repeats``
+    fits (timings on a shared machine are noisy).  Default cloud: ``wavy_plane_cloud(400)``
+    (160k splats; ``quick``: 200, 40k)."""
+    if cloud is None:
+        cloud = wavy_plane_cloud(200 if quick else 400)
+    srcs = (cloud.positions, cloud.u, cloud.v)
+    t_copy = _best_of(lambda: [a.copy() for a in srcs], apply_repeats)
+    for name, sup, hs, curves, inputs in group_cases(cloud, **case_kw):
+        b = None
+        for _ in range(max(1, fit_repeats)):
+            nb = DeformationBasis.fit(cloud, sup, hs, curves=curves, method=method)
+            if b is None or (nb.stats["fit_seconds"] + nb.stats["basis_seconds"]
+                             < b.stats["fit_seconds"] + b.stats["basis_seconds"]):
+                b = nb
+            del nb
+        st = b.stats
+        dc = b.displacement(inputs)
+        t = time.perf_counter()
+        b.apply(cloud, dc)  # first frame builds the hot-path arrays
+        t_first = time.perf_counter() - t
+        t_apply = _best_of(lambda: b.apply(cloud, dc), apply_repeats)
+        yield dict(name=name, n_points=int(len(cloud)), n_support=st["n_support"],
+                   n_free=st["n_free"], n_handles=len(hs), n_curves=len(curves),
+                   curve_points=[c.n_controls for c in curves],
+                   curve_samples=st["n_curve_samples"], curve_dropped=st["n_curve_dropped"],
+                   n_columns=int(b.n_columns), m=st["n_constraints"], method=st["method"],
+                   centers=st["n_centers"], residual=st["residual"],
+                   fit_s=round(st["fit_seconds"], 4), basis_s=round(st["basis_seconds"], 4),
+                   precompute_s=round(st["fit_seconds"] + st["basis_seconds"], 4),
+                   first_apply_s=round(t_first, 5), apply_s=round(t_apply, 5),
+                   copy_s=round(t_copy, 5), apply_over_copy=round(t_apply / t_copy, 2),
+                   max_displacement=float(np.abs(b.displacements(dc)).max()))
+        del b
+
+
 # ------------------------------------------------------------ standard cases
 def _bundled_model():
     path = Path(__file__).resolve().parent.parent / "data" / "bunny.ply"
@@ -232,6 +308,10 @@ def standard_cases(large: bool = True):
 def main(argv=None) -> int:
     args = sys.argv[1:] if argv is None else argv
     large = "--small" not in args
+    if "--groups" in args:
+        for line in bench_groups(quick=not large):
+            print(json.dumps(line), flush=True)
+        return 0
     for name, cloud, sup, hs in standard_cases(large=large):
         print(json.dumps(bench_solve(cloud, sup, hs, name=name)), flush=True)
     return 0

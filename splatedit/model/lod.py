@@ -117,8 +117,8 @@ def build_level(cloud: SplatCloud, cell: float) -> LodLevel:
     rmem = np.maximum(np.linalg.norm(u, axis=1), np.linalg.norm(v, axis=1))
     rmin = np.minimum(np.sqrt(uu), np.sqrt(vv))
     need = ell + rmem / rmin
-    k = np.ones(m)
-    np.maximum.at(k, inv, need)
+    starts = np.flatnonzero(first)             # group starts in ``order`` (sorted by cluster)
+    k = np.maximum.reduceat(need[order], starts)
     k = np.clip(k, 1.0, MAX_ENLARGE)
     k[counts == 1] = 1.0
     colors = None if cloud.colors is None else cloud.colors[rep]
@@ -127,33 +127,63 @@ def build_level(cloud: SplatCloud, cell: float) -> LodLevel:
     return LodLevel(lvl_cloud, rep.astype(np.int64), inv.astype(np.int64), float(cell), k)
 
 
-def level_for_budget(cloud: SplatCloud, budget: int, max_iter: int = 12) -> LodLevel:
-    """A level with at most ``budget`` splats (grid cell grown until it fits)."""
-    n = cloud.n
+def level_for_budget(cloud: SplatCloud, budget: int, max_iter: int = 12,
+                     cell: float | None = None) -> LodLevel:
+    """A level with at most ``budget`` splats (grid cell grown until it fits).
+
+    ``cell``: a first guess of the cell size (default: from the bounding box).
+    Surface samples on a grid of cell ``c`` give about ``A / c^2`` clusters,
+    so each retry rescales the cell by ``sqrt(count / budget)``.
+    """
     lo, hi = cloud.bounds()
     ext = hi - lo
-    area = max(ext[0] * ext[1] + ext[1] * ext[2] + ext[0] * ext[2], 1e-30) * 2
-    # surface-like guess: budget cells of size cell^2 tile the bounding-box area / 2
-    cell = max(math.sqrt(area / 2 / max(budget, 1)), float(np.linalg.norm(ext)) * 1e-6)
+    if cell is None:
+        # surface area from the splats (pi |u| |v| each, overlapping about twice)
+        k = min(cloud.n, 100_000)
+        sample = np.linspace(0, cloud.n - 1, k).astype(np.int64)
+        disc = np.pi * np.linalg.norm(cloud.u[sample], axis=1) * np.linalg.norm(cloud.v[sample], axis=1)
+        area = float(np.median(disc)) * cloud.n / 2.0
+        cell = 1.08 * math.sqrt(max(area, 1e-30) / max(budget, 1))
+    cell = max(cell, float(np.linalg.norm(ext)) * 1e-6)
     level = build_level(cloud, cell)
     it = 0
     while level.n > budget and it < max_iter:
-        cell *= max(math.sqrt(level.n / budget), 1.05)
+        cell *= max(math.sqrt(level.n / budget) * 1.02, 1.05)
         level = build_level(cloud, cell)
         it += 1
     return level
+
+
+def _compose(fine: LodLevel, coarse: LodLevel, source: SplatCloud) -> LodLevel:
+    """A level of ``source`` from a level ``coarse`` built on ``fine.cloud``."""
+    rep = fine.rep[coarse.rep]
+    scale = fine.scale[coarse.rep] * coarse.scale
+    cl = coarse.cloud
+    return LodLevel(cl, rep, coarse.cluster[fine.cluster], coarse.cell, scale)
 
 
 class LodPyramid:
     """Coarser levels of a cloud, finest first (the full cloud is not a level)."""
 
     def __init__(self, cloud: SplatCloud, budgets=DEFAULT_BUDGETS, progress=None):
+        """Each level is clustered from the next finer level's splats (whose
+        enlarged axes already cover their members), so a coarse level costs
+        a fraction of clustering the full cloud; the cell size of the next
+        level is predicted from the previous one (count ~ 1 / cell^2)."""
         self.source = cloud
         self.levels: list[LodLevel] = []
         budgets = sorted((b for b in budgets if b <= cloud.n // 2), reverse=True)
+        prev, cell = None, None
         for i, b in enumerate(budgets):
             report(progress, PROGRESS_STAGE, i / max(len(budgets), 1))
-            self.levels.append(level_for_budget(cloud, b))
+            if prev is not None:
+                cell = prev.cell * math.sqrt(prev.n / b) * 1.02
+            base = cloud if prev is None else prev.cloud
+            lvl = level_for_budget(base, b, cell=cell)
+            if prev is not None:
+                lvl = _compose(prev, lvl, cloud)
+            self.levels.append(lvl)
+            prev = lvl
         report(progress, PROGRESS_STAGE, 1.0)
 
     def level_for(self, max_splats: int) -> LodLevel | None:

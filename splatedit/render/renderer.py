@@ -183,11 +183,13 @@ class Renderer:
         accum_format: ``"rgba16f"`` or ``"rgba32f"`` attribute accumulators.
         backface_culling: skip splats whose normal faces away from the eye.
         background: sRGB background colour (3 floats in 0..1).
-        point_splats: draw tiny splats (projected ellipse bound at most
-            ``RENDER_POINT_SPLAT_MAX_PX`` = 1 pixel, i.e. radius <= half a
-            pixel) as one-pixel POINT_LIST points at their projected centre
-            (one vertex and one fragment instead of a 4-vertex strip; same
-            fragment shader, still hole-free), the others as quads.
+        point_splats: draw small splats (footprint within
+            ``RENDER_POINT_SPLAT_MAX_PX`` pixels of the projected centre, see
+            splatedit.tolerances; the threshold is the attribute
+            ``point_max_px``) as one square POINT_LIST point each, of side
+            twice that extent, centred at the projected centre: one vertex
+            instead of a 4-vertex strip, the same fragment shader and the
+            same covered pixels as the quad (hole-free), the others as quads.
         prepass: do the per-splat work (deformation, culling, screen setup)
             once per frame in a compute pre-pass that writes compact records;
             both splat passes then draw them indirectly with a fetch-only

@@ -34,39 +34,6 @@ REFERENCE = Path(__file__).parent / "data" / "editor_after_edits.png"
 WINDOW = (960, 600)
 
 
-def _free_display() -> int:
-    for n in range(91, 200):
-        if not Path(f"/tmp/.X{n}-lock").exists() and not Path(f"/tmp/.X11-unix/X{n}").exists():
-            return n
-    raise RuntimeError("no free X display number")
-
-
-@pytest.fixture(scope="module")
-def xvfb(tmp_path_factory):
-    if shutil.which("Xvfb") is None:
-        pytest.skip("Xvfb is not installed (apt-get install xvfb)")
-    if shutil.which("xdotool") is None:
-        pytest.skip("xdotool is not installed (apt-get install xdotool)")
-    fbdir = tmp_path_factory.mktemp("xvfb")
-    n = _free_display()
-    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1280x800x24", "-fbdir", str(fbdir),
-                             "-nolisten", "tcp"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    sock = Path(f"/tmp/.X11-unix/X{n}")
-    t0 = time.time()
-    while not sock.exists() and time.time() - t0 < 10:
-        if proc.poll() is not None:
-            pytest.fail(f"Xvfb :{n} exited with code {proc.returncode}")
-        time.sleep(0.05)
-    try:
-        yield {"display": f":{n}", "screen": fbdir / "Xvfb_screen0"}
-    finally:
-        proc.terminate()
-        try:
-            proc.wait(5)
-        except subprocess.TimeoutExpired:
-            proc.kill()
-
-
 class EditorProcess:
     def __init__(self, xvfb, tmp: Path, *args):
         self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1")
@@ -203,6 +170,19 @@ def test_full_edit_session(xvfb, tmp_path):
         s = ed.idle(lambda s: s["saved"] and not s["dirty"], "saved")
         script_path = Path(s["script"])
         assert Path(s["saved"]) == out and out.exists() and script_path.exists()
+        # --- help overlay, save as (a typed path replaces the proposed one)
+        ed.xdo("key", "F1")
+        ed.wait(lambda s: s["help"], "help shown")
+        ed.xdo("key", "F1")
+        ed.wait(lambda s: not s["help"], "help hidden")
+        other = tmp_path / "typed.ply"
+        ed.xdo("key", "ctrl+shift+s")
+        ed.wait(lambda s: s["prompt"] == str(out), "save-as prompt")
+        ed.xdo("type", "--delay", "5", str(other))
+        ed.wait(lambda s: s["prompt"] == str(other), "path typed")
+        ed.xdo("key", "Return")
+        ed.idle(lambda s: s["saved"] == str(other), "saved as")
+        assert other.exists() and other.read_bytes() == out.read_bytes()
         # --- unsaved changes: quitting asks first
         ed.xdo("key", "ctrl+z")
         ed.idle(lambda s: s["edits"] == 1 and s["dirty"], "undo after save")

@@ -76,3 +76,15 @@ def test_rows_and_masks_follow_representatives():
     assert np.array_equal(np.flatnonzero(ms), li)
     d = lvl.deformed(c.positions + 1, c.u, c.v)
     assert np.allclose(d.positions, lvl.cloud.positions + 1)
+
+
+def test_pyramid_levels_cover_the_full_cloud():
+    c = sphere_cloud(20000)
+    pyr = LodPyramid(c, budgets=(6000, 1500, 400))
+    for lvl in pyr.levels:
+        assert lvl.cluster.shape == (c.n,) and lvl.cluster.max() == lvl.n - 1
+        # the level's splats are the representatives' splats, scaled
+        assert np.allclose(lvl.cloud.positions, c.positions[lvl.rep])
+        assert np.allclose(lvl.cloud.u, c.u[lvl.rep] * lvl.scale[:, None])
+        e = ellipse_norm(lvl.cloud, lvl.cluster, c.positions)
+        assert np.percentile(e, 99) <= 1.0 and e.max() <= 1.3
