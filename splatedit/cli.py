@@ -173,24 +173,21 @@ def _gpu_edit(args, cloud):
     Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC).
     """
     import dataclasses
-    from splatedit.deform.basis import DeformationBasis
-    from splatedit.script import load_script, resolve_edit, run_script
+    from splatedit.script import fit_edit, load_script, run_script
     script = load_script(args.edit)
     source = str(args.edit)
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
                               on_edit=lambda rep: (args.progress.close(), print(rep.line())))
-    last = script.edits[-1]
-    support, handles, matrices = resolve_edit(cloud, last, source)
-    basis = DeformationBasis.fit(cloud, support, handles, method=script.solver.method,
-                                 tol=script.solver.tol, max_centers=script.solver.max_centers,
-                                 progress=args.progress)
+    resolved, basis, d_c = fit_edit(cloud, script.edits[-1], script.solver, source=source,
+                                    progress=args.progress)
     args.progress.close()
     st = basis.stats
-    print(f"edit {len(script.edits) - 1}: support {int(support.sum())} splats, {st['method']} with "
-          f"{st['n_centers']} centers (residual {st['residual']:.2e}), basis uploaded to the GPU")
-    return cloud, basis.rows_for_gpu(), basis.displacement(matrices)
+    print(f"edit {len(script.edits) - 1}: support {int(resolved.support.sum())} splats, {st['method']} with "
+          f"{st['n_centers']} centers (residual {st['residual']:.2e}), {d_c.shape[0]} basis columns "
+          f"uploaded to the GPU")
+    return cloud, basis.rows_for_gpu(), d_c
 
 
 def cmd_demo(args) -> int:

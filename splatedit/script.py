@@ -533,6 +533,29 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
     return ResolvedEdit(support, handles, matrices, curves, moves)
 
 
+def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
+             tol: float | None = None, source: str | None = None, progress=None):
+    """Resolve one edit on ``cloud`` and fit its deformation basis.
+
+    ``method``/``tol`` override ``solver`` when given.
+    Returns:
+        (ResolvedEdit, DeformationBasis, dC (K, 3) control displacements)
+    Raises:
+        EditScriptError: bad regions/curves, or a fit that failed (JSON path of the edit).
+    """
+    from splatedit.deform.basis import DeformationBasis
+
+    r = resolve_edit_inputs(cloud, edit, source)
+    try:
+        basis = DeformationBasis.fit(cloud, r.support, r.handles, curves=r.curves,
+                                     method=method or solver.method,
+                                     tol=solver.tol if tol is None else tol,
+                                     max_centers=solver.max_centers, progress=progress)
+    except SplatEditError as exc:
+        raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
+    return r, basis, basis.displacement(r.inputs)
+
+
 def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
                source: str | None = None, progress=None,
                on_edit: Callable[[EditReport], None] | None = None):
@@ -542,26 +565,15 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
     Returns:
         (deformed SplatCloud, list of EditReport)
     """
-    from splatedit.deform.basis import DeformationBasis
-
-    method = method or script.solver.method
-    tol = script.solver.tol if tol is None else tol
     reports = []
     for i, edit in enumerate(script.edits):
-        r = resolve_edit_inputs(cloud, edit, source)
-        support, handles = r.support, r.handles
-        try:
-            basis = DeformationBasis.fit(cloud, support, handles, curves=r.curves, method=method,
-                                         tol=tol, max_centers=script.solver.max_centers,
-                                         progress=progress)
-        except SplatEditError as exc:
-            raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
-        d_c = basis.displacement(r.inputs)
+        r, basis, d_c = fit_edit(cloud, edit, script.solver, method=method, tol=tol,
+                                 source=source, progress=progress)
         t0 = time.perf_counter()
         new = basis.apply(cloud, d_c)
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
-        rep = EditReport(i, int(support.sum()), [int(h.sum()) for h in handles], stats["n_constraints"],
+        rep = EditReport(i, int(r.support.sum()), [int(h.sum()) for h in r.handles], stats["n_constraints"],
                          stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
                          stats["basis_seconds"] + (time.perf_counter() - t0), disp,
                          [stats["message"]] if stats.get("message") else [],

@@ -66,6 +66,8 @@ BRUSH_MIN, BRUSH_MAX = 2, 400
 REFINE_DELAY = 0.2
 #: full-quality frames predicted slower than this (ms) are drawn in the background
 ASYNC_REFINE_MS = 400.0
+#: seconds without motion before such a background frame is started
+ASYNC_REFINE_DELAY = 0.6
 #: models with more splats than this get a level-of-detail pyramid
 LOD_MIN_SPLATS = 150_000
 
@@ -634,14 +636,12 @@ class Editor:
             moving = time.perf_counter() - self.last_motion < REFINE_DELAY or self.drag is not None
             stale = self.scene is None or key != self.scene_key
             if stale or (self.scene_interactive and not moving):
-                vp = self.viewport
-                slow = (vp.ms_per_splat is not None
-                        and vp.ms_per_splat * self.session.cloud.n > ASYNC_REFINE_MS)
-                if not moving and slow:
-                    # a slow full-quality frame: drawn by the background refiner
+                if not moving and self.async_refine():
+                    # a slow full-quality frame: drawn by the background refiner, once the
+                    # view has been still for a while (a started frame cannot be aborted)
                     if stale:
                         self.render_scene(key, interactive=True)
-                    if self.scene_interactive:
+                    if self.scene_interactive and time.perf_counter() - self.last_motion >= ASYNC_REFINE_DELAY:
                         self.request_refine(key)
                 else:
                     self.render_scene(key, interactive=moving)
@@ -662,6 +662,11 @@ class Editor:
         self.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+
+    def async_refine(self) -> bool:
+        """True when full-quality frames are slow enough to be drawn in the background."""
+        vp = self.viewport
+        return vp.ms_per_splat is not None and vp.ms_per_splat * self.session.cloud.n > ASYNC_REFINE_MS
 
     def render_scene(self, key, interactive: bool) -> None:
         w, h = self.size
@@ -840,10 +845,12 @@ class Editor:
                 s = self.session
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
                 refining = self.refiner is not None and self.refiner.busy
+                async_refine = s is not None and self.async_refine()
                 pending = (self.scene_key is None or self.drag is not None
-                           or (self.scene_interactive and not refining)
+                           or (self.scene_interactive and not async_refine)
                            or (s is not None and self.scene_key != self.scene_state()))
-                busy = busy or refining
+                # waiting for a background refinement (or its start): poll at 20 Hz
+                busy = busy or refining or (self.scene_interactive and async_refine)
                 w, h = self.size
                 if w == 0 or h == 0 or self.window.iconified():
                     pending = False          # minimized: nothing to draw, do not spin

@@ -57,3 +57,23 @@ def test_gpu_edit_path_matches_rendering_the_cpu_deformed_file(tmp_path):
     assert diff.mean() < 0.5 and (diff > 24).mean() < 0.005, (diff.mean(), (diff > 24).mean())
     # and the edit is visible at all
     assert (np.abs(gpu - plain).max(axis=2) > 24).mean() > 0.005
+
+
+CURVE_EDIT = {"version": 1, "edits": [
+    {"support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},
+     "curves": [{"points": [[-0.12, 0.3, 0.0], [-0.07, 0.38, -0.05], [-0.02, 0.44, -0.09], [0.0, 0.48, -0.11]],
+                 "move": [[0, 0, 0], [0.01, 0, 0], [0.04, -0.02, 0], [0.08, -0.05, 0]]}]}]}
+
+
+def test_gpu_curve_edit_matches_rendering_the_cpu_deformed_file(tmp_path):
+    script = tmp_path / "curve.json"
+    script.write_text(json.dumps(CURVE_EDIT))
+    gpu_png, cpu_png, deformed = tmp_path / "gpu.png", tmp_path / "cpu.png", tmp_path / "deformed.ply"
+    res = run_cli("render", default_model_path(), "-o", gpu_png, "--edit", script, *CAMERA)
+    assert res.returncode == 0, res.stderr
+    assert "4 basis columns" in res.stdout
+    assert run_cli("deform", default_model_path(), "--edit", script, "-o", deformed).returncode == 0
+    assert run_cli("render", deformed, "-o", cpu_png, *CAMERA).returncode == 0
+    diff = np.abs(np.asarray(Image.open(gpu_png)).astype(float)
+                  - np.asarray(Image.open(cpu_png)).astype(float)).max(axis=2)
+    assert diff.mean() < 0.5 and (diff > 24).mean() < 0.005, (diff.mean(), (diff > 24).mean())
