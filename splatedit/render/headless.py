@@ -2,30 +2,16 @@
 
 from __future__ import annotations
 
-import os
-import tempfile
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
 from splatedit.errors import ParameterError
+from splatedit.io.atomic import atomic_open
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
-
-
-def _atomic_write(path: Path, write) -> None:
-    path.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=path.name + ".", suffix=".tmp", dir=path.parent)
-    os.close(fd)
-    try:
-        write(tmp)
-        os.replace(tmp, path)
-    except BaseException:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        raise
 
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
@@ -65,12 +51,11 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
         img = r.render(camera, w, h)
         bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None
-    _atomic_write(out_png, lambda tmp: Image.fromarray(img, "RGBA").save(tmp, format="PNG"))
+    out_png.parent.mkdir(parents=True, exist_ok=True)
+    with atomic_open(out_png, "wb") as fh:
+        Image.fromarray(img, "RGBA").save(fh, format="PNG")
     if bufs is not None:
-        bp = Path(buffers_path)
-
-        def save(tmp):
-            with open(tmp, "wb") as f:
-                np.savez_compressed(f, **bufs)
-        _atomic_write(bp, save)
+        Path(buffers_path).parent.mkdir(parents=True, exist_ok=True)
+        with atomic_open(Path(buffers_path), "wb") as fh:
+            np.savez_compressed(fh, **bufs)
     return out_png
