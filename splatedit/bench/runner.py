@@ -33,7 +33,7 @@ def _groups(quick: bool, progress=None) -> Iterator[dict]:
 def _qr(quick: bool, progress=None) -> Iterator[dict]:
     from splatedit.bench.qr import bench_qr
     for m in ((500, 1000) if quick else (1000, 3000, 5000)):
-        yield {"bench": "qr", **bench_qr(m)}
+        yield {"bench": "qr", **bench_qr(m, repeat=1 if quick else 3)}
 
 
 def _render(quick: bool, progress=None) -> Iterator[dict]:
