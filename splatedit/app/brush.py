@@ -9,7 +9,9 @@ Splats smaller than a pixel can be missing from the pick map although they
 are visible; with projected centres and depths (:class:`BrushPicker` given
 ``centers_px``/``depths``/``radii``) a splat whose centre falls in the circle
 is also painted when it is not behind the splat the pick map shows at that
-pixel (depth test with a tolerance of two splat radii).
+pixel (depth test against the front surface with a tolerance: the editor
+uses the larger of two splat radii and a few pixel footprints, so dense
+models give solid, hole-free selections of the visible surface).
 
 Selection semantics (the paper's Sect. 3): the *support* (blue) is painted
 first, then the *handle* (green) inside it; a handle splat is always a
@@ -68,12 +70,17 @@ class BrushPicker:
         pick: (h, w) int, splat index per pixel, -1 = background.
         centers_px: (n, 2) float pixel coordinates of the splat centres, or None.
         depths: (n,) camera-space depths (positive in front), or None.
-        radii: (n,) world radii of the splats (depth tolerance), or None.
+        tol: (n,) depth tolerances (model units): a splat whose centre falls on
+            a pixel is visible when it is at most this far behind the front
+            surface there; or None.
+        pick_depth: (h, w) depth of the front surface per pixel (NaN for the
+            background), or None to use the depth of the pixel's front splat.
     """
     pick: np.ndarray
     centers_px: np.ndarray | None = None
     depths: np.ndarray | None = None
-    radii: np.ndarray | None = None
+    tol: np.ndarray | None = None
+    pick_depth: np.ndarray | None = None
 
     def __post_init__(self):
         self.pick = np.asarray(self.pick)
@@ -81,16 +88,22 @@ class BrushPicker:
         if self.centers_px is not None:
             h, w = self.pick.shape
             px = self.centers_px
-            ok = (np.isfinite(px).all(1) & (px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0)
-                  & (px[:, 1] < h) & (self.depths > 0))
+            with np.errstate(invalid="ignore"):
+                ok = (np.isfinite(px).all(1) & (px[:, 0] >= 0) & (px[:, 0] < w) & (px[:, 1] >= 0)
+                      & (px[:, 1] < h) & (self.depths > 0))
             idx = np.flatnonzero(ok)
             ix = px[idx, 0].astype(np.int64)
             iy = px[idx, 1].astype(np.int64)
             front = self.pick[iy, ix]
-            vis = front == idx
             has = front >= 0
-            tol = 2.0 * (self.radii[idx] if self.radii is not None else 0.0)
-            vis |= has & (self.depths[idx] <= self.depths[np.where(has, front, 0)] + tol)
+            if self.pick_depth is not None:
+                fd = self.pick_depth[iy, ix]
+                has &= np.isfinite(fd)
+            else:
+                fd = self.depths[np.where(has, front, 0)]
+            tol = self.tol[idx] if self.tol is not None else 0.0
+            with np.errstate(invalid="ignore"):
+                vis = (front == idx) | (has & (self.depths[idx] <= fd + tol))
             idx = idx[vis]
             # bucket visible centres by row for fast circle queries
             rows = px[idx, 1].astype(np.int64)
@@ -173,3 +186,17 @@ class Selection:
     def key(self) -> tuple:
         """Hashable content key (to detect changes and stale fits)."""
         return (self.n, np.packbits(self.support).tobytes(), np.packbits(self.handle).tobytes())
+
+
+def picker_for_view(pick: np.ndarray, front_depth: np.ndarray | None, camera, positions: np.ndarray,
+                    radii: np.ndarray, tol_px: float = 6.0) -> BrushPicker:
+    """The editor's picker for one view: the renderer's pick map and front
+    depth plus every splat centre projected with ``camera`` (an
+    :class:`~splatedit.app.camera_control.OrbitCamera`); a centre counts as
+    visible when it lies at most ``max(2 radii, tol_px pixel footprints)``
+    behind the front surface."""
+    h, w = pick.shape
+    px, depth = camera.project(positions, w, h)
+    footprint = np.abs(depth) * (camera.world_per_pixel(1.0, h) * tol_px)
+    tol = np.maximum(2.0 * np.asarray(radii), footprint)
+    return BrushPicker(pick, px, depth, tol, front_depth)

@@ -23,7 +23,7 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.app import overlay as ov
-from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, stroke_points
+from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, picker_for_view, stroke_points
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.session import GRAB, ROTATE, SCALE, Session, ViewInfo
 from splatedit.errors import SplatEditError
@@ -46,6 +46,7 @@ Selection (paper Sect. 3: support = blue, handle = green)
   C / Shift+C            clear the selection / clear the handle
 Deformation (after the handle is painted the basis is fitted in the background)
   Left drag on handle    move the handle in the view plane, release applies
+  Left drag on an arrow  move the handle along that axis (gizmo: X red, Y green, Z blue)
   G / R / S              grab / rotate / scale the handle with the mouse
     X / Y / Z            constrain to that world axis (again: free)
     0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)
@@ -60,6 +61,10 @@ File and history
   Q  or  Esc             quit (asks first when there are unsaved changes: Y, Q or Esc again quits, N stays)
 """
 
+#: length of the translate gizmo's arrows (pixels)
+GIZMO_PX = 70
+#: depth tolerance of the brush's visibility test, in pixel footprints
+PICK_TOL_PX = 6.0
 #: the brush radius range (pixels)
 BRUSH_MIN, BRUSH_MAX = 2, 400
 #: seconds without motion after which the full-quality frame is drawn
@@ -68,6 +73,8 @@ REFINE_DELAY = 0.2
 ASYNC_REFINE_MS = 400.0
 #: seconds without motion before such a background frame is started
 ASYNC_REFINE_DELAY = 0.6
+#: assumed full-quality cost (ms per splat at the window size) before the first measurement
+GUESS_MS_PER_SPLAT = 6e-4
 #: models with more splats than this get a level-of-detail pyramid
 LOD_MIN_SPLATS = 150_000
 
@@ -166,6 +173,9 @@ class Editor:
         self.manip_by_drag = False
         self.mouse = (0.0, 0.0)
         self.cursor_inside = True
+        self.zoom_anchor = None
+        self._centre = None
+        self._centre_key = None
         self.picker = None
         self.picker_key = None
         self.message = ""
@@ -177,6 +187,10 @@ class Editor:
         self.refiner = None
         self.last_motion = 0.0
         self.frame_ms = 0.0
+        self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
+        self._rendered_interactive = False
+        self.budget_ms = float(budget_ms)
+        self.frame_overhead_ms = 10.0
         self.frames = 0
         self.saved_path: Path | None = None
         self.saved_script: Path | None = None
@@ -228,6 +242,11 @@ class Editor:
         self.session = Session(cloud, method=self.method, tol=self.tol, max_centers=self.max_centers,
                                on_change=self.wake)
         self.viewport.set_cloud(cloud)
+        if cloud.n >= LOD_MIN_SPLATS and self.viewport.ms_per_splat is None:
+            # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
+            # that a huge model's first full-quality frame is already drawn in the background
+            w, h = self.size
+            self.viewport.assume_cost(GUESS_MS_PER_SPLAT, max(w * h, 1))
         r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
         self.cam.scene_radius = max(r, 1e-9)
         self.frame_all()
@@ -293,6 +312,48 @@ class Editor:
         self.cam.yaw, self.cam.pitch = yaw, pitch
         self.motion()
 
+    def handle_centre(self) -> np.ndarray:
+        """Centroid of the handle (cached per document version)."""
+        s = self.session
+        key = (s.version, id(s.cloud))
+        if self._centre_key != key:
+            self._centre = s.handle_centroid() if s.selection.handle.any() else None
+            self._centre_key = key
+        return self._centre
+
+    def gizmo_axes(self, w: int, h: int) -> list:
+        """Screen segments ``(axis, p0, p1)`` of the translate gizmo's arrows
+        (shown when the basis is ready and nothing is being manipulated)."""
+        s = self.session
+        if s.basis is None or s.manip is not None:
+            return []
+        piv = self.handle_centre()
+        if piv is None:
+            return []
+        px, d = self.cam.project(piv, w, h)
+        if d[0] <= 0:
+            return []
+        length = self.cam.world_per_pixel(float(d[0]), h) * GIZMO_PX
+        ends, de = self.cam.project(piv + np.eye(3) * length, w, h)
+        out = []
+        for k in range(3):
+            if de[k] > 0 and float(np.hypot(*(ends[k] - px[0]))) > 12:
+                out.append((k, px[0], ends[k]))
+        return out
+
+    def gizmo_hit(self, x: float, y: float) -> int | None:
+        """The gizmo arrow under pixel (x, y) (outer three quarters, 7 px wide)."""
+        w, h = self.size
+        best, axis = 7.0, None
+        q = np.array([x, y])
+        for k, p0, p1 in self.gizmo_axes(w, h):
+            d = p1 - p0
+            t = float(np.clip((q - p0) @ d / (d @ d), 0.0, 1.0))
+            dist = float(np.linalg.norm(q - (p0 + t * d)))
+            if t >= 0.25 and dist <= best:
+                best, axis = dist, k
+        return axis
+
     def view_info(self) -> ViewInfo:
         w, h = self.size
         r, u, b = self.cam.basis()
@@ -302,14 +363,19 @@ class Editor:
                         self.cam.world_per_pixel(max(float(depth[0]), 1e-9), h))
 
     # -------------------------------------------------------------- picking
+    def pick_key(self) -> tuple:
+        w, h = self.size
+        return (self.cam.state(), w, h, id(self.session.cloud))
+
     def get_picker(self) -> BrushPicker:
         w, h = self.size
         s = self.session
-        key = (self.cam.state(), w, h, id(s.cloud))
+        key = self.pick_key()
         if self.picker is None or self.picker_key != key:
-            idx, _ = self.viewport.pick(self.cam, w, h)
-            px, depth = self.cam.project(s.cloud.positions, w, h)
-            self.picker = BrushPicker(idx, px, depth, s.cloud.radii)
+            ready = self.refiner.take_pick(key) if self.refiner is not None else None
+            idx, front = ready if ready is not None else self.viewport.pick(self.cam, w, h)
+            self.picker = picker_for_view(idx, front, self.cam, s.cloud.positions, s.cloud.radii,
+                                          PICK_TOL_PX)
             self.picker_key = key
         return self.picker
 
@@ -364,14 +430,20 @@ class Editor:
             self.brush_radius = float(np.clip(self.brush_radius * (1.15 ** e.dy), BRUSH_MIN, BRUSH_MAX))
             return
         w, h = self.size
-        depth = None
-        try:
-            i = self.splat_under(e.x, e.y) if self.drag is None and self.session.manip is None else -1
-        except Exception:  # noqa: BLE001 - picking is best effort here
-            i = -1
-        if i >= 0:
-            _, d = self.cam.project(self.session.cloud.positions[i], w, h)
-            depth = float(d[0])
+        # zoom to the surface point under the cursor: picked once (when the pick map of
+        # this view is at hand), then kept as an anchor while the cursor stays put
+        anchor = self.zoom_anchor
+        if anchor is None or abs(anchor[0] - e.x) > 2 or abs(anchor[1] - e.y) > 2:
+            point = None
+            if self.picker is not None and self.picker_key == self.pick_key() and self.drag is None:
+                i = self.splat_under(e.x, e.y)
+                if i >= 0:
+                    point = self.session.cloud.positions[i].copy()
+            if point is None:
+                point = self.cam.point_at_depth(e.x, e.y, w, h, self.cam.distance)
+            anchor = self.zoom_anchor = (e.x, e.y, point)
+        _, d = self.cam.project(anchor[2], w, h)
+        depth = float(d[0]) if d[0] > 0 else None
         self.cam.dolly(e.dy, e.x, e.y, w, h, depth)
         self.motion()
 
@@ -429,6 +501,12 @@ class Editor:
             self.drag = "pan" if shift else ("dolly" if ctrl and not alt else "orbit")
             return
         if e.button == g.MOUSE_BUTTON_LEFT:
+            axis = self.gizmo_hit(x, y) if s.basis is not None and not ctrl else None
+            if axis is not None and s.begin(GRAB, self.view_info(), (x, y)):
+                s.manip.set_axis(axis)
+                self.drag = "manip"
+                self.motion()
+                return
             if s.basis is not None and not ctrl and not self.erase_toggle:
                 i = self.splat_under(x, y)
                 self.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle "
@@ -550,9 +628,7 @@ class Editor:
         self.drag = None
         try:
             if s.commit():
-                st = s.stats()
                 self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
-                del st
         except SplatEditError as exc:
             s.cancel()
             self.say(f"edit not applied: {exc}")
@@ -662,6 +738,13 @@ class Editor:
         self.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+        if self._rendered_interactive:
+            self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
+            # the frame budget is for the whole frame: leave room for overlay + present
+            extra = max(self.frame_ms - self.viewport.last_info.get("ms", 0.0), 0.0)
+            self.frame_overhead_ms = 0.8 * self.frame_overhead_ms + 0.2 * extra
+            self.viewport.budget_ms = max(self.budget_ms - self.frame_overhead_ms, 0.3 * self.budget_ms)
+        self._rendered_interactive = False
 
     def async_refine(self) -> bool:
         """True when full-quality frames are slow enough to be drawn in the background."""
@@ -671,6 +754,7 @@ class Editor:
     def render_scene(self, key, interactive: bool) -> None:
         w, h = self.size
         self.scene = self.viewport.render(self.cam, w, h, interactive=interactive)
+        self._rendered_interactive = interactive
         self.scene_key = key
         info = self.viewport.last_info
         self.scene_interactive = bool(interactive and (info.get("lod") or info.get("div", 1) > 1))
@@ -686,7 +770,8 @@ class Editor:
                           self.cam.scene_radius)
         self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
                                        handle=s.selection.handle.copy(), sel_version=s.version,
-                                       basis=s.basis, dc=self.viewport.dc, camera=cam, w=w, h=h))
+                                       basis=s.basis, dc=self.viewport.dc, camera=cam, w=w, h=h,
+                                       pick_key=self.pick_key()))
 
     # -------------------------------------------------------------- overlay
     def overlay_patches(self, w: int, h: int) -> list:
@@ -695,7 +780,7 @@ class Editor:
         if s is not None:
             patches.extend(self.gizmo_patches(w, h))
             if (self.drag not in ("orbit", "pan", "dolly") and s.manip is None and self.prompt is None
-                    and self.cursor_inside):
+                    and not self.confirm_quit and self.cursor_inside):
                 col = (230, 60, 60) if (self.erase_toggle or self.window.mods() & self.g.MOD_CONTROL) else \
                     (ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB)
                 img = ov.ring(int(round(self.brush_radius)), col)
@@ -732,10 +817,14 @@ class Editor:
         s = self.session
         if not s.selection.handle.any():
             return []
-        piv = s.handle_centroid()
+        piv = self.handle_centre()
         m = s.current_matrix()
         cur = m[:3, :3] @ piv + m[:3, 3]
         out = []
+        for k, p0, p1 in self.gizmo_axes(w, h):
+            p = ov.line_patch(p0, p1, ov.AXIS_RGB[k], 3, dot=True)
+            if p:
+                out.append(p)
         px, depth = self.cam.project(np.vstack([piv, cur]), w, h)
         if depth.min() <= 0:
             return []
@@ -801,6 +890,11 @@ class Editor:
               "running": self.running, "jobs": sorted(self.jobs), "validation_messages": msgs,
               "confirm_quit": self.confirm_quit, "prompt": self.prompt, "help": self.show_help,
               "window": list(self.size), "panel_box": list(self.panel_box),
+              "camera": {"distance": round(self.cam.distance, 6), "yaw": round(self.cam.yaw, 6),
+                         "pitch": round(self.cam.pitch, 6),
+                         "target": [round(float(x), 6) for x in self.cam.target]},
+              "moving_frame_ms_median": (round(float(np.median(self.moving_frame_ms)), 1)
+                                         if self.moving_frame_ms else None),
               "interactive_frames": len(self.viewport.interactive_frames_ms),
               "interactive_ms_median": (round(float(np.median(self.viewport.interactive_frames_ms[-30:])), 1)
                                         if self.viewport.interactive_frames_ms else None),
@@ -818,6 +912,9 @@ class Editor:
                     and not self.scene_interactive and self.scene_key == self.scene_state()
                     and not (self.refiner is not None and self.refiner.busy))
             st["idle"] = bool(idle)
+            w, h = self.size
+            st["gizmo"] = [[k, *(round(float(v), 1) for v in (*p0, *p1))]
+                           for k, p0, p1 in self.gizmo_axes(w, h)] if w and h else []
         text = json.dumps(st, sort_keys=True)
         if text != self._status_last:
             tmp = self.status_file.with_suffix(".tmp")
@@ -862,7 +959,12 @@ class Editor:
                     self.session.poll()
                 if not self.running:
                     break
-                self.draw()
+                try:
+                    self.draw()
+                except SplatEditError as exc:       # e.g. a Vulkan error: report, keep the document
+                    self.say(f"drawing failed: {exc}")
+                    self.scene_key = self.scene_state() if self.session is not None else None
+                    time.sleep(0.2)
                 self.collect_validation()
                 self.write_status()
                 if self.max_seconds is not None and time.perf_counter() - self.start_time > self.max_seconds:

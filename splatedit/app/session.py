@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from splatedit.app.brush import HANDLE, SUPPORT, Selection
+from splatedit.app.brush import SUPPORT, Selection
 from splatedit.app.history import History, Snapshot
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import IQR_DEFAULT_TOL
@@ -189,7 +189,8 @@ class Manipulation:
 
     def describe(self) -> str:
         name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]
-        ax = f" along {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
+        prep = "about" if self.mode == ROTATE else "along"
+        ax = f" {prep} {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
         val = f"  value: {self.typed}" if self.typed else ""
         return f"{name}{ax}{val}   (Enter/click: apply, Esc/right click: cancel)"
 
@@ -433,7 +434,10 @@ class Session:
             return False
         t0 = time.perf_counter()
         dc = self.basis.displacement([m])
-        new = self.basis.commit(self.cloud, dc)
+        # the same arrays as ``splatedit deform`` (basis.apply); only the moved
+        # (support) splats are re-validated, the others are bitwise copies
+        new = self.basis.apply(self.cloud, dc)
+        new.subset(self.basis.indices)      # raises InputError on a degenerate splat
         self.last_commit_seconds = time.perf_counter() - t0
         sup = self.selection.support
         edit = Edit(Indices(tuple(int(i) for i in np.flatnonzero(sup))),

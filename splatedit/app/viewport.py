@@ -186,8 +186,8 @@ class Viewport:
         """An (h, w, 4) uint8 frame."""
         level, div = self.choose(interactive, w, h)
         slot = self.full if level is None else self._lod_slot()
+        self._sync(slot, level)          # uploads (new cloud, selection...) are not frame cost
         t0 = time.perf_counter()
-        self._sync(slot, level)
         rw, rh = max(1, w // div), max(1, h // div)
         img = slot.r.render(render_camera(cam), rw, rh)
         if div > 1:
@@ -200,10 +200,10 @@ class Viewport:
         count = self.cloud.n if level is None else level.n
         key = (id(level) if level is not None else None, div)
         old = self._measured.get(key)
-        if old is not None and old[1] == w * h:
-            ms_avg = 0.5 * (old[0] + ms)
+        if old is not None and old[1] == w * h and ms > old[0]:
+            ms_avg = 0.5 * (old[0] + ms)       # slower: average out one-off spikes
         else:
-            ms_avg = ms
+            ms_avg = ms                        # faster (or new size): trust it (warm-up is over)
         self._measured[key] = (ms_avg, w * h, count)
         self._last_key = key
         if level is None and div == 1:
@@ -252,6 +252,8 @@ class BackgroundRefiner:
         self.pending_key = None
         self.last_ms = None
         self.error = None
+        #: (key, index map, depth) of the last background pick
+        self.pick = None
         self.thread = threading.Thread(target=self._run, name="splatedit-refine", daemon=True)
         self.thread.start()
 
@@ -269,6 +271,13 @@ class BackgroundRefiner:
                 img = self._result[1]
                 self._result = None
                 return img
+        return None
+
+    def take_pick(self, key):
+        """(index map, depth) picked in the background for ``key``, or None."""
+        with self._cv:
+            if self.pick is not None and self.pick[0] == key:
+                return self.pick[1], self.pick[2]
         return None
 
     @property
@@ -301,6 +310,11 @@ class BackgroundRefiner:
                     vp.set_dc(st["dc"])
                     img = vp.render(st["camera"], st["w"], st["h"])
                     self.last_ms = vp.last_info["ms"]
+                    if st.get("pick_key") is not None and st.get("dc") is None:
+                        # the brush's pick map of the same view, while we are at it
+                        idx, depth = vp.pick(st["camera"], st["w"], st["h"])
+                        with self._cv:
+                            self.pick = (st["pick_key"], idx, depth)
                 except Exception as exc:  # noqa: BLE001 - shown by the editor
                     self.error = exc
                     img = None

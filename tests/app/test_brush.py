@@ -43,10 +43,17 @@ def test_picker_adds_subpixel_visible_splats_only():
     pick[:, :] = 0                      # splat 0 covers the screen at depth 1
     centers = np.array([[10, 10], [10.5, 10.5], [11, 11], [50, 50]], float)
     depths = np.array([1.0, 1.01, 5.0, 1.0])   # splat 2 is hidden behind splat 0
-    radii = np.full(4, 0.01)
-    bp = BrushPicker(pick, centers, depths, radii)
+    tol = np.full(4, 0.02)
+    bp = BrushPicker(pick, centers, depths, tol)
     got = bp.query(10, 10, 3).tolist()
     assert got == [0, 1]
+    # with the renderer's front depth per pixel instead of the front splat's depth
+    bp = BrushPicker(pick, centers, depths, tol, pick_depth=np.full((20, 20), 0.995))
+    assert bp.query(10, 10, 3).tolist() == [0, 1]
+    pd = np.full((20, 20), 0.9)
+    bp = BrushPicker(pick, centers, depths, tol, pick_depth=pd)
+    assert bp.query(10, 10, 3).tolist() == [0]     # both centres are behind the front surface
+
 
 
 def test_selection_rules():

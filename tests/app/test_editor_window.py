@@ -170,6 +170,24 @@ def test_full_edit_session(xvfb, tmp_path):
         s = ed.idle(lambda s: s["saved"] and not s["dirty"], "saved")
         script_path = Path(s["script"])
         assert Path(s["saved"]) == out and out.exists() and script_path.exists()
+        # --- camera: wheel zooms (to the cursor), Alt+left drag orbits, Shift+middle pans, Home frames
+        cam0 = s["camera"]
+        ed.xdo("mousemove", cx, cy, "click", "4", "click", "4")
+        s = ed.idle(lambda s: s["camera"]["distance"] < cam0["distance"] * 0.9, "wheel zoom")
+        ed.xdo("mousemove", cx, cy, "keydown", "alt", "mousedown", "1", "mousemove", cx + 40, cy,
+               "mousemove", cx + 80, cy + 10, "mouseup", "1", "keyup", "alt")
+        s = ed.idle(lambda s: abs(s["camera"]["yaw"] - cam0["yaw"]) > 0.3, "orbit")
+        ed.xdo("mousemove", cx, cy, "keydown", "shift", "mousedown", "2", "mousemove", cx + 80, cy + 40,
+               "mousemove", cx + 160, cy + 80, "mouseup", "2", "keyup", "shift")
+        orbited = s["camera"]["target"]
+        s = ed.idle(lambda s: float(np.linalg.norm(np.subtract(s["camera"]["target"], orbited)))
+                    > 0.1 * cam0["distance"], "pan")
+        ed.xdo("key", "Home")
+        panned = s["camera"]["target"]
+        # the (edited) model's box centre: close to the first framing, far from the panned pivot
+        near = lambda a, b, tol: float(np.linalg.norm(np.subtract(a, b))) < tol  # noqa: E731
+        s = ed.idle(lambda s: near(s["camera"]["target"], cam0["target"], 0.03 * cam0["distance"])
+                    and not near(s["camera"]["target"], panned, 0.06 * cam0["distance"]), "frame all")
         # --- help overlay, save as (a typed path replaces the proposed one)
         ed.xdo("key", "F1")
         ed.wait(lambda s: s["help"], "help shown")
@@ -183,9 +201,20 @@ def test_full_edit_session(xvfb, tmp_path):
         ed.xdo("key", "Return")
         ed.idle(lambda s: s["saved"] == str(other), "saved as")
         assert other.exists() and other.read_bytes() == out.read_bytes()
+        # --- the gizmo: dragging the X arrow moves the handle along X only (a third edit)
+        s = ed.idle(lambda s: s["state"] == "ready" and any(g[0] == 0 for g in s["gizmo"]), "gizmo shown")
+        _, x0, y0, x1, y1 = next(g for g in s["gizmo"] if g[0] == 0)
+        gx, gy = int(round(x0 + 0.8 * (x1 - x0))), int(round(y0 + 0.8 * (y1 - y0)))
+        ed.xdo("mousemove", gx, gy, "mousedown", "1", "mousemove", gx + 10, gy + 3,
+               "mousemove", gx + 30, gy + 6, "sleep", "0.2", "mouseup", "1")
+        s = ed.idle(lambda s: s["edits"] == 3 and s["dirty"], "gizmo edit")
+        gizmo_script = other.with_name("typed.edits.json")
+        gizmo_script.unlink()                  # written by the save as: Ctrl+E writes it again
+        ed.xdo("key", "ctrl+e")
+        ed.wait(lambda s: gizmo_script.exists() and not s["jobs"], "script exported")
+        m = np.asarray(json.loads(gizmo_script.read_text())["edits"][2]["transform"]["matrix"])
+        assert np.allclose(m[:3, :3], np.eye(3)) and m[0, 3] > 0 and m[1, 3] == 0 and m[2, 3] == 0
         # --- unsaved changes: quitting asks first
-        ed.xdo("key", "ctrl+z")
-        ed.idle(lambda s: s["edits"] == 1 and s["dirty"], "undo after save")
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation")
         time.sleep(0.3)
@@ -239,3 +268,16 @@ def test_full_edit_session(xvfb, tmp_path):
     assert np.allclose(again.positions, saved.positions, rtol=0, atol=1e-6)
     assert np.allclose(again.u, saved.u, rtol=1e-5, atol=1e-9)
     assert np.allclose(again.v, saved.v, rtol=1e-5, atol=1e-9)
+
+
+def test_unreadable_model_exits_with_an_error(xvfb, tmp_path):
+    bad = tmp_path / "broken.ply"
+    bad.write_bytes(b"ply\nformat binary_little_endian 1.0\nelement vertex 10\nproperty float x\nend_header\n\x00")
+    ed = EditorProcess(xvfb, tmp_path, str(bad))
+    try:
+        assert ed.proc.wait(60) == 2
+        log = ed.stderr_path.read_text()
+        assert "cannot open" in log and "broken.ply" in log
+        assert "Traceback" not in log
+    finally:
+        ed.close()

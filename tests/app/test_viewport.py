@@ -79,3 +79,41 @@ def test_pick_matches_projection(scene):
     px, d = cam.project(cloud.positions[idx[ys, xs]], 160, 120)
     err = np.hypot(px[:, 0] - xs - 0.5, px[:, 1] - ys - 0.5)
     assert np.median(err) < 3.0
+
+
+@pytest.mark.parametrize("n", [30000, 400000])
+def test_brush_paints_only_visible_splats_as_a_solid_patch(n):
+    """The brush on the real pick pass: a disc on the bunny selects the front
+    surface under it (no back-facing or hidden splats) without holes, also
+    when splats are much smaller than a pixel."""
+    from splatedit.app.brush import picker_for_view
+    from splatedit.app.viewport import Viewport
+    cloud = bunny_surface_cloud(n, seed=3)
+    w, h = 320, 240
+    cam = OrbitCamera(scene_radius=cloud.diagonal / 2)
+    lo, hi = cloud.bounds()
+    cam.frame((lo + hi) / 2, cloud.diagonal / 2, w / h)
+    vp = Viewport()
+    try:
+        vp.set_cloud(cloud)
+        idx, front = vp.pick(cam, w, h)
+    finally:
+        vp.close()
+    picker = picker_for_view(idx, front, cam, cloud.positions, cloud.radii)
+    ys, xs = np.nonzero(idx >= 0)
+    cx, cy = float(np.median(xs)), float(np.median(ys))
+    sel = picker.query(cx, cy, 15)
+    assert len(sel) > 0
+    # visible side only: every selected splat faces the camera and sits near the front surface
+    nrm = cloud.normals[sel]
+    to_eye = cam.eye - cloud.positions[sel]
+    assert (np.einsum("ij,ij->i", nrm, to_eye) > 0).mean() > 0.97
+    px, depth = cam.project(cloud.positions[sel], w, h)
+    assert depth.max() - depth.min() < 0.15 * cloud.diagonal
+    # solid: nearly every front-facing splat whose centre falls well inside the disc is selected
+    allpx, alld = cam.project(cloud.positions, w, h)
+    inner = np.hypot(allpx[:, 0] - cx, allpx[:, 1] - cy) < 10
+    inner &= alld < depth.max()
+    inner &= np.einsum("ij,ij->i", cloud.normals, cam.eye - cloud.positions) > 0
+    got = np.isin(np.flatnonzero(inner), sel).mean()
+    assert got > 0.95, got

@@ -201,6 +201,8 @@ class SwapchainPresenter:
         w, h = self._surface_extent()
         if w == 0 or h == 0:
             return False
+        if not caps.supportedUsageFlags & vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT:
+            raise PresentError("the window's swapchain images cannot be transfer destinations")
         formats = self._fn_inst["vkGetPhysicalDeviceSurfaceFormatsKHR"](self.physical, self.surface)
         fmt = None
         for want in (vk.VK_FORMAT_B8G8R8A8_UNORM, vk.VK_FORMAT_R8G8B8A8_UNORM):

@@ -1,0 +1,36 @@
+"""Editor helpers that need no window: save paths, options, controls text."""
+
+import argparse
+from pathlib import Path
+
+from splatedit.app.editor import CONTROLS, _default_save_path, add_arguments, options_from_args, script_path_for
+
+
+def test_default_save_path_next_to_input_never_the_input(tmp_path, monkeypatch):
+    src = tmp_path / "scan.ply"
+    src.write_bytes(b"x")
+    p = _default_save_path(src, "scan.ply", bundled=False)
+    assert p == tmp_path / "scan-edited.ply" and p != src
+    p.write_bytes(b"old")                       # an existing result is not clobbered
+    assert _default_save_path(src, "scan.ply", bundled=False) == tmp_path / "scan-edited-2.ply"
+
+
+def test_bundled_model_saves_to_current_dir(tmp_path, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    pkg = Path("/nonexistent/site-packages/splatedit/data/bunny.ply")
+    assert _default_save_path(pkg, "bunny.ply", bundled=True) == tmp_path / "bunny-edited.ply"
+
+
+def test_script_path_and_options():
+    assert script_path_for(Path("/a/b/x-edited.ply")) == Path("/a/b/x-edited.edits.json")
+    p = argparse.ArgumentParser()
+    add_arguments(p)
+    o = options_from_args(p.parse_args(["m.ply", "--size", "800x600", "--save-as", "o.ply", "--no-vsync"]))
+    assert o["size"] == (800, 600) and o["save_as"] == "o.ply" and o["vsync"] is False
+
+
+def test_controls_document_every_required_binding():
+    for needle in ("Middle drag", "Shift + middle", "Wheel", "Home", "numpad .", "Alt + left",
+                   "G / R / S", "X / Y / Z", "Ctrl+Z", "Ctrl+Shift+Z", "Ctrl+S", "Ctrl+Shift+S",
+                   "F1", "[ / ]", "Esc"):
+        assert needle in CONTROLS, needle
