@@ -198,23 +198,15 @@ def cmd_demo(args) -> int:
 
 
 def cmd_edit(args) -> int:
-    try:
-        from splatedit.app.editor import run_editor
-    except ImportError as exc:  # the interactive editor is optional at this stage
-        raise SplatEditError(f"the interactive editor is not available: {exc}") from None
-    return run_editor(args.file)
+    from splatedit.app.editor import options_from_args, run_editor
+    return run_editor(args.file, **options_from_args(args))
 
 
 def cmd_main(args) -> int:
     """No sub-command: the editor when a display is present, else the headless demo."""
     if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
-        try:
-            import splatedit.app.editor  # noqa: F401
-        except ImportError:
-            pass
-        else:
-            args.file = None
-            return cmd_edit(args)
+        from splatedit.app.editor import run_editor
+        return run_editor(None)
     args.output_dir = "."
     args.no_render = False
     args.force = True
@@ -272,6 +264,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
+
+    from splatedit.app.editor import CONTROLS, add_arguments
+    s = sub.add_parser("edit", help="interactive editor (a window; F1 in it lists the controls)",
+                       epilog=CONTROLS, formatter_class=argparse.RawDescriptionHelpFormatter)
+    add_arguments(s)
+    s.set_defaults(func=cmd_edit)
 
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
     s.add_argument("what", choices=("solve", "groups", "qr", "render", "editor", "all"))
