@@ -151,7 +151,7 @@ def bench_solve(cloud: SplatCloud, support, handles, *, name: str, transforms=No
             if best is None:
                 best = b
             else:
-                for key in ("fit_seconds", "basis_seconds"):
+                for key in ("constraints_seconds", "fit_seconds", "basis_seconds"):
                     best.stats[key] = min(best.stats[key], b.stats[key])
         return best
 

@@ -113,7 +113,8 @@ class DeformationBasis:
             K = 4 h + sum over curves of (k + 1).
         control_frames: (h, 4, 3) control frames C of the handles.
         stats: dict of fit statistics: ``n_constraints`` (m), ``n_centers``,
-            ``residual``, ``method``, ``polynomial``, ``fit_seconds``,
+            ``residual``, ``method``, ``polynomial``, ``constraints_seconds``
+            (bands and control frames), ``fit_seconds`` (the RBF solve),
             ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
             ``n_handle_band``, ``n_curve_samples``, ``n_curve_dropped``,
             ``spacing``, ``message``.
@@ -150,6 +151,7 @@ class DeformationBasis:
         t0 = time.perf_counter()
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
+        t_con = time.perf_counter()
         rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
                                  max_centers=max_centers, progress=progress)
         t1 = time.perf_counter()
@@ -182,7 +184,7 @@ class DeformationBasis:
         stats = dict(
             n_constraints=con.n_constraints, n_centers=int(rbf.n_centers),
             residual=float(rbf.residual), method=rbf.method, polynomial=bool(rbf.polynomial),
-            fit_seconds=t1 - t0, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
+            constraints_seconds=t_con - t0, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
             n_fixed_band=int(len(con.fixed_index)),
             n_handle_band=[int(len(b)) for b in con.handle_band_index],
             n_curve_samples=[int(len(c.points)) for c in con.curves],
