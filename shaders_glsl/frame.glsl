@@ -19,3 +19,4 @@ layout(std140, set = 0, binding = 0) uniform Frame {
 const uint FLAG_SUPPORT = 1u;
 const uint FLAG_HANDLE = 2u;
 const uint FLAG_DEFORMED = 4u;
+const uint FLAG_INACTIVE = 8u;   // an inactive handle of several: drawn darker

@@ -108,6 +108,7 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
     vec3 col = pow(srgb, vec3(2.2));
     if ((flags & FLAG_SUPPORT) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
     if ((flags & FLAG_HANDLE) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
+    if ((flags & FLAG_INACTIVE) != 0u) col *= 0.35;
     S.color = col;
     S.normal = cn > 0.0 ? -n : n;
     return small ? SPLAT_POINT : SPLAT_QUAD;

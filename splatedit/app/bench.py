@@ -13,7 +13,11 @@ the editor frames a model.  For each count it measures, through the editor's
 * ``orbit_ms``: frames while the camera orbits (interactive mode);
 * ``compose_ms``: overlay compositing of one frame (CPU), to add to the above
   with the ~2-5 ms of the swapchain copy and present;
-* the level used while moving, the LOD build time and the basis fit time.
+* the level used while moving, the LOD build time and the basis fit time;
+* with ``rigs=True`` (default) also ``drag4h_ms`` (four handles at once: a
+  16-column basis, all columns drawn with a new dC per frame) and
+  ``drag_curve16_ms`` (a 16-point control curve: 16 columns), with their fit
+  times and the full-quality frame ``idle16_ms`` with the 16-column basis.
 
 Validation is off (it adds per-call overhead unrelated to the editor).
 """
@@ -64,8 +68,38 @@ def _support_and_handle(cloud: SplatCloud, support_splats: int = 20000):
     return sup, hnd
 
 
+def _rigs(cloud: SplatCloud, sup: np.ndarray, hnd: np.ndarray):
+    """Four small handle balls and a 16-point curve inside the support."""
+    p = cloud.positions
+    ids = np.flatnonzero(sup)
+    c = p[hnd].mean(0)
+    d = p[ids] - c
+    r = float(np.linalg.norm(d, axis=1).max())
+    _, _, vt = np.linalg.svd(d - d.mean(0), full_matrices=False)
+    e1, e2 = vt[0], vt[1]
+    handles = []
+    for a in (e1, -e1, e2, -e2):
+        q = ids[np.argmin(np.linalg.norm(p[ids] - (c + 0.55 * r * a), axis=1))]
+        handles.append(sup & (np.linalg.norm(p - p[q], axis=1) <= r / 7))
+    # in the support's tangent plane (a curve need not lie on the surface)
+    t = np.linspace(-0.65, 0.65, 16)[:, None]
+    pts = c + t * r * e1 + 0.15 * r * np.sin(5 * t) * e2
+    return handles, pts
+
+
+def _drag_frames(vp, cam, w, h, basis, frames, scale):
+    out = []
+    vp.render(cam, w, h, interactive=True)
+    rng = np.random.default_rng(0)
+    for k in range(frames):
+        vp.set_dc(rng.normal(size=(basis.n_columns, 3)) * scale * (k + 1) / frames)
+        vp.render(cam, w, h, interactive=True)
+        out.append(vp.last_info["ms"])
+    return round(float(np.median(out)), 1)
+
+
 def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), frames: int = 6,
-                        budget_ms: float = 100.0, progress=None) -> Iterator[dict]:
+                        budget_ms: float = 100.0, progress=None, rigs: bool = True) -> Iterator[dict]:
     from splatedit.app import overlay as ov
     from splatedit.app.camera_control import OrbitCamera
     from splatedit.app.viewport import Viewport
@@ -121,6 +155,28 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
                 vp.render(cam, w, h, interactive=True)
                 orbit.append(vp.last_info["ms"])
             del piv
+            extra = {}
+            if rigs:
+                from splatedit.deform.curves import ControlCurve
+                handles, pts = _rigs(cloud, sup, hnd)
+                scale = 0.005 * cloud.diagonal
+                t0 = time.perf_counter()
+                b4 = DeformationBasis.fit(cloud, sup, handles)
+                extra["fit4h_s"] = round(time.perf_counter() - t0, 2)
+                vp.set_basis(b4)
+                vp.set_dc(None)
+                vp.render(cam, w, h)
+                vp.render(cam, w, h)
+                extra["idle16_ms"] = round(vp.last_info["ms"], 1)
+                extra["drag4h_ms"] = _drag_frames(vp, cam, w, h, b4, frames, scale)
+                del b4
+                t0 = time.perf_counter()
+                bc = DeformationBasis.fit(cloud, sup, [], curves=[ControlCurve.through(pts)])
+                extra["fit_curve16_s"] = round(time.perf_counter() - t0, 2)
+                vp.set_basis(bc)
+                extra["drag_curve16_ms"] = _drag_frames(vp, cam, w, h, bc, frames, scale)
+                vp.set_basis(None)
+                vp.set_dc(None)
             yield {"case": "editor_frames", "splats": n, "width": w, "height": h,
                    "budget_ms": budget_ms,
                    "idle_ms": round(float(np.median(idle)), 1),
@@ -131,7 +187,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
                    "moving_resolution_divisor": int(info.get("div", 1)),
                    "lod_levels": [lvl.n for lvl in pyr.levels], "lod_build_s": round(lod_s, 2),
                    "support": int(sup.sum()), "handle": int(hnd.sum()),
-                   "fit_s": round(fit_s, 2), "compose_ms": round(compose, 2)}
+                   "fit_s": round(fit_s, 2), "compose_ms": round(compose, 2), **extra}
     finally:
         vp.close()
 

@@ -38,20 +38,33 @@ Camera
   Home                   frame the whole model
   F  or  numpad .        frame the selection (handle, else support)
   Numpad 1 / 3 / 7       front / right / top view
-Selection (paper Sect. 3: support = blue, handle = green)
+Selection (paper Sect. 3: support = blue, handles = green, the active one brighter)
   Left drag              paint with the brush (only visible splats)
   Ctrl + left drag       erase with the brush            (E toggles erase mode)
-  1 / 2  or  Tab         brush paints the support / the handle (handle stays inside the support)
+  1 / 2                  brush paints the support / the active handle (inside the support)
+  Tab                    one handle: toggle support / handle brush; several: next handle (Shift: previous)
+  N                      new handle (becomes active; paint it with the handle brush)
+  Delete                 remove the active handle
   [ / ]  or  Ctrl+wheel  brush radius
-  C / Shift+C            clear the selection / clear the handle
-Deformation (after the handle is painted the basis is fitted in the background)
-  Left drag on handle    move the handle in the view plane, release applies
-  Left drag on an arrow  move the handle along that axis (gizmo: X red, Y green, Z blue)
-  G / R / S              grab / rotate / scale the handle with the mouse
+  C / Shift+C            clear the selection / clear the handles
+Deformation (the basis of all handles and the curve is fitted in the background;
+             at most 16 columns: 4 per handle + 1 per curve point)
+  Left drag on a handle  make it active and move it in the view plane
+  Left drag on an arrow  move the active handle along that axis (gizmo: X red, Y green, Z blue)
+  G / R / S              grab / rotate / scale the active handle with the mouse
     X / Y / Z            constrain to that world axis (again: free)
     0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)
-    Enter or left click  apply (the result becomes the new base, selection kept)
-    Esc or right click   cancel
+    Enter or left click  done (one handle, no curve: the edit is applied at once)
+    Esc or right click   cancel this move
+  With several handles or a curve the moves are kept (the other handles keep theirs):
+    Enter                apply all of them as one edit (the result becomes the new base)
+    Esc                  discard the pending moves
+Control curve (paper Sect. 3 end, Fig. 3 and 7)
+  K                      curve tool on / off (Shift+K: clear the curve)
+  Left click on support  add a curve point (2..16); the spline through them is drawn
+  Left drag on a dot     move that point in the view plane (X / Y / Z: along an axis)
+  Backspace              remove the last curve point
+  Enter / Esc            apply the bent curve as an edit (the curve is consumed) / discard moves
 File and history
   Ctrl+Z / Ctrl+Shift+Z  undo / redo (edits and selections; Ctrl+Y also redoes)
   Ctrl+S                 save <name>-edited.ply (+ <name>-edited.edits.json edit script)
@@ -61,6 +74,10 @@ File and history
   Q  or  Esc             quit (asks first when there are unsaved changes: Y, Q or Esc again quits, N stays)
 """
 
+#: a left press this close to a curve dot (pixels) drags it
+CURVE_DOT_PICK_PX = 10
+#: colour of the control curve and its dots
+CURVE_RGB = (255, 150, 30)
 #: length of the translate gizmo's arrows (pixels)
 GIZMO_PX = 70
 #: depth tolerance of the brush's visibility test, in pixel footprints
@@ -313,19 +330,42 @@ class Editor:
         self.motion()
 
     def handle_centre(self) -> np.ndarray:
-        """Centroid of the handle (cached per document version)."""
+        """Posed centroid of the active handle (cached per document version and pose)."""
         s = self.session
-        key = (s.version, id(s.cloud))
+        k = s.selection.active
+        key = (s.version, id(s.cloud), k, s.pose[k].tobytes() if k < len(s.pose) else b"")
         if self._centre_key != key:
             self._centre = s.handle_centroid() if s.selection.handle.any() else None
             self._centre_key = key
         return self._centre
 
+    def curve_dots(self, w: int, h: int) -> np.ndarray:
+        """(k + 1, 2) pixel positions of the (moved) picked curve points (NaN behind the eye)."""
+        s = self.session
+        pts = s.curve_point_positions()
+        if not len(pts):
+            return np.zeros((0, 2))
+        px, d = self.cam.project(pts, w, h)
+        px = np.array(px, float)
+        px[np.asarray(d) <= 0] = np.nan
+        return px
+
+    def curve_dot_hit(self, x: float, y: float) -> int | None:
+        w, h = self.size
+        px = self.curve_dots(w, h)
+        if not len(px):
+            return None
+        with np.errstate(invalid="ignore"):
+            d = np.hypot(px[:, 0] - x, px[:, 1] - y)
+        d = np.where(np.isfinite(d), d, np.inf)
+        j = int(np.argmin(d))
+        return j if d[j] <= CURVE_DOT_PICK_PX else None
+
     def gizmo_axes(self, w: int, h: int) -> list:
         """Screen segments ``(axis, p0, p1)`` of the translate gizmo's arrows
         (shown when the basis is ready and nothing is being manipulated)."""
         s = self.session
-        if s.basis is None or s.manip is not None:
+        if not s.active_fitted() or s.manip is not None or s.curve_mode:
             return []
         piv = self.handle_centre()
         if piv is None:
@@ -354,10 +394,10 @@ class Editor:
                 best, axis = dist, k
         return axis
 
-    def view_info(self) -> ViewInfo:
+    def view_info(self, pivot=None) -> ViewInfo:
         w, h = self.size
         r, u, b = self.cam.basis()
-        piv = self.session.handle_centroid()
+        piv = self.session.handle_centroid() if pivot is None else np.asarray(pivot, float)
         px, depth = self.cam.project(piv, w, h)
         return ViewInfo(r, u, b, (float(px[0, 0]), float(px[0, 1])),
                         self.cam.world_per_pixel(max(float(depth[0]), 1e-9), h))
@@ -365,7 +405,9 @@ class Editor:
     # -------------------------------------------------------------- picking
     def pick_key(self) -> tuple:
         w, h = self.size
-        return (self.cam.state(), w, h, id(self.session.cloud))
+        dc = self.viewport.dc
+        return (self.cam.state(), w, h, id(self.session.cloud), id(self.session.basis),
+                None if dc is None or not dc.any() else dc.tobytes())
 
     def get_picker(self) -> BrushPicker:
         w, h = self.size
@@ -481,7 +523,7 @@ class Editor:
                 s.end_stroke(self.stroke_changed)
                 self.stroke_changed = False
             if self.drag == "manip" and s is not None and s.manip is not None:
-                self.commit()
+                self.finish_manip()
             self.drag = None
             return
         if e.action != g.PRESS or s is None or self.prompt is not None or self.confirm_quit:
@@ -492,13 +534,16 @@ class Editor:
         ctrl = bool(e.mods & g.MOD_CONTROL)
         if s.manip is not None:
             if e.button == g.MOUSE_BUTTON_LEFT:
-                self.commit()
+                self.finish_manip()
             elif e.button == g.MOUSE_BUTTON_RIGHT:
                 s.cancel()
                 self.motion()
             return
         if e.button == g.MOUSE_BUTTON_MIDDLE or (e.button == g.MOUSE_BUTTON_LEFT and alt):
             self.drag = "pan" if shift else ("dolly" if ctrl and not alt else "orbit")
+            return
+        if e.button == g.MOUSE_BUTTON_LEFT and s.curve_mode:
+            self.curve_click(x, y)
             return
         if e.button == g.MOUSE_BUTTON_LEFT:
             axis = self.gizmo_hit(x, y) if s.basis is not None and not ctrl else None
@@ -509,9 +554,10 @@ class Editor:
                 return
             if s.basis is not None and not ctrl and not self.erase_toggle:
                 i = self.splat_under(x, y)
-                self.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle "
-                           f"{bool(i >= 0 and s.selection.handle[i])}")
-                if i >= 0 and s.selection.handle[i]:
+                k = s.selection.handle_of(i) if i >= 0 else -1
+                self.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle {k}")
+                if k >= 0:
+                    s.select_handle(k)
                     if s.begin(GRAB, self.view_info(), (x, y)):
                         self.drag = "manip"
                         self.motion()
@@ -557,7 +603,7 @@ class Editor:
             if k in (g.KEY_X, g.KEY_Y, g.KEY_Z):
                 m.set_axis({g.KEY_X: 0, g.KEY_Y: 1, g.KEY_Z: 2}[k])
             elif k in (g.KEY_ENTER, g.KEY_KP_ENTER):
-                self.commit()
+                self.finish_manip()
             elif k == g.KEY_ESCAPE:
                 s.cancel()
                 self.drag = None
@@ -590,14 +636,45 @@ class Editor:
             self.motion()
             return
         if k in (g.KEY_G, g.KEY_R, g.KEY_S):
-            if s.basis is None:
+            if not s.active_fitted():
                 self.say("paint a support region and a handle first" if not s.selection.handle.any()
-                         else "the deformation is still being fitted")
+                         else "the deformation is still being fitted" if s.fitting
+                         else f"cannot move the handle: {s.fit_error}" if s.fit_error
+                         else "the active handle is not fitted yet")
             else:
                 s.begin({g.KEY_G: GRAB, g.KEY_R: ROTATE, g.KEY_S: SCALE}[k], self.view_info(), self.mouse)
                 self.motion()
+        elif k in (g.KEY_ENTER, g.KEY_KP_ENTER):
+            if s.pose_pending:
+                self.commit()
+        elif k == g.KEY_ESCAPE and s.pose_pending:
+            s.reset_pose()
+            self.say("pending moves discarded")
+        elif k == g.KEY_ESCAPE and s.curve_mode:
+            s.curve_mode = False
+        elif k == g.KEY_K:
+            if shift:
+                s.clear_curve()
+            else:
+                s.curve_mode = not s.curve_mode
+                self.say("curve tool: click on the support to add points, drag a dot to bend"
+                         if s.curve_mode else "curve tool off")
+        elif k == g.KEY_BACKSPACE and s.curve_points:
+            s.remove_curve_point()
+        elif k == g.KEY_N:
+            if s.add_handle():
+                self.say(f"handle {len(s.selection.handles)}: paint it with the handle brush")
+            else:
+                self.say("the active handle is empty: paint it with the handle brush")
+        elif k == g.KEY_DELETE:
+            if s.remove_handle():
+                self.say(f"handle removed ({len(s.selection.handles)} left)")
         elif k == g.KEY_TAB:
-            s.brush_target = HANDLE if s.brush_target == SUPPORT else SUPPORT
+            if len(s.selection.handles) > 1:
+                s.cycle_handle(-1 if shift else 1)
+                s.brush_target = HANDLE
+            else:
+                s.brush_target = HANDLE if s.brush_target == SUPPORT else SUPPORT
         elif k in (g.KEY_1, g.KEY_2):
             s.brush_target = SUPPORT if k == g.KEY_1 else HANDLE
         elif k == g.KEY_E:
@@ -623,6 +700,37 @@ class Editor:
         self.motion()
 
     # -------------------------------------------------------------- actions
+    def curve_click(self, x: float, y: float) -> None:
+        """Curve tool: drag the dot under the cursor, else add a curve point."""
+        s = self.session
+        j = self.curve_dot_hit(x, y)
+        if j is not None:
+            if s.begin_curve_point(j, self.view_info(s.curve_point_positions()[j]), (x, y)):
+                self.drag = "manip"
+                self.motion()
+            else:
+                self.say("the curve is still being fitted" if s.fitting else
+                         f"cannot bend: {s.fit_error}" if s.fit_error else "add a second curve point")
+            return
+        i = self.splat_under(x, y)
+        if i < 0 or not s.selection.support[i]:
+            self.say("curve points go on the support (blue): paint it first (1)")
+            return
+        if s.add_curve_point(s.cloud.positions[i]):
+            self.motion()
+
+    def finish_manip(self) -> None:
+        """End the running move: applied at once for a single handle, else kept."""
+        s = self.session
+        self.drag = None
+        try:
+            if s.finish() == "commit":
+                self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
+        except SplatEditError as exc:
+            s.cancel()
+            self.say(f"edit not applied: {exc}")
+        self.motion()
+
     def commit(self) -> None:
         s = self.session
         self.drag = None
@@ -688,11 +796,11 @@ class Editor:
             vp.set_cloud(s.cloud)
             self.picker = None
         if self.sel_version_seen != s.version:
-            vp.set_selection(s.selection.support, s.selection.handle, s.version)
+            vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
             self.sel_version_seen = s.version
         if vp.basis is not s.basis:
             vp.set_basis(s.basis)
-        vp.set_dc(s.current_dc() if (s.basis is not None and s.manip is not None) else None)
+        vp.set_dc(s.current_dc() if s.basis is not None else None)
 
     def scene_state(self) -> tuple:
         s = self.session
@@ -770,6 +878,7 @@ class Editor:
                           self.cam.scene_radius)
         self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
                                        handle=s.selection.handle.copy(), sel_version=s.version,
+                                       inactive=s.selection.others(),
                                        basis=s.basis, dc=self.viewport.dc, camera=cam, w=w, h=h,
                                        pick_key=self.pick_key()))
 
@@ -778,6 +887,7 @@ class Editor:
         patches = []
         s = self.session
         if s is not None:
+            patches.extend(self.curve_patches(w, h))
             patches.extend(self.gizmo_patches(w, h))
             if (self.drag not in ("orbit", "pan", "dolly") and s.manip is None and self.prompt is None
                     and not self.confirm_quit and self.cursor_inside):
@@ -813,21 +923,47 @@ class Editor:
             patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))
         return patches
 
+    def curve_patches(self, w: int, h: int) -> list:
+        """The control curve c'(t) as a line strip and its picked points as dots."""
+        s = self.session
+        out = []
+        poly = s.curve_polyline()
+        if poly is not None:
+            px, d = self.cam.project(poly, w, h)
+            px = np.array(px, float)
+            px[np.asarray(d) <= 0] = np.nan
+            p = ov.polyline_patch(px, CURVE_RGB, 3)
+            if p:
+                out.append(p)
+        dots = self.curve_dots(w, h)
+        active = s.manip_target[1] if (s.manip_target and s.manip_target[0] == "curve") else None
+        for j, q in enumerate(dots):
+            if np.isfinite(q).all():
+                out.append(ov.dot_patch(q, (255, 255, 255) if j == active else CURVE_RGB,
+                                        7 if j == active else 5))
+        return out
+
     def gizmo_patches(self, w: int, h: int) -> list:
         s = self.session
-        if not s.selection.handle.any():
-            return []
+        out = []
+        if len(s.selection.handles) > 1:        # inactive handles: a dark green cross at their centre
+            for k, hm in enumerate(s.selection.handles):
+                if k != s.selection.active and hm.any():
+                    px, d = self.cam.project(s.handle_centroid(k), w, h)
+                    if d[0] > 0:
+                        out.append(ov.cross_patch(px[0], (20, 90, 25), 6))
+        if not s.selection.handle.any() or (s.manip_target and s.manip_target[0] == "curve"):
+            return out
         piv = self.handle_centre()
         m = s.current_matrix()
         cur = m[:3, :3] @ piv + m[:3, 3]
-        out = []
         for k, p0, p1 in self.gizmo_axes(w, h):
             p = ov.line_patch(p0, p1, ov.AXIS_RGB[k], 3, dot=True)
             if p:
                 out.append(p)
         px, depth = self.cam.project(np.vstack([piv, cur]), w, h)
         if depth.min() <= 0:
-            return []
+            return out
         if s.manip is not None and s.manip.axis is not None:
             a = np.zeros(3)
             a[s.manip.axis] = self.cam.scene_radius
@@ -840,7 +976,7 @@ class Editor:
             p = ov.line_patch(px[0], px[1], (255, 255, 255), 1)
             if p:
                 out.append(p)
-        out.append(ov.cross_patch(px[1], ov.HANDLE_RGB if s.basis is not None else (200, 200, 200)))
+        out.append(ov.cross_patch(px[1], ov.HANDLE_RGB if s.active_fitted() else (200, 200, 200)))
         return out
 
     def panel_lines(self) -> list:
@@ -854,6 +990,15 @@ class Editor:
         lines.append((f"brush: {tgt}{erase}  radius {self.brush_radius:.0f} px   (Tab, E, [ ])",
                       ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
         lines.append(f"support {st['support']:,}   handle {st['handle']:,}")
+        hs = s.selection.handles
+        if len(hs) > 1 or s.curve_points or s.curve_mode:
+            sizes = " ".join(f"[{n:,}]" if k == s.selection.active else f"{n:,}"
+                             for k, n in enumerate(st["handle_sizes"]))
+            tool = " K:ON" if s.curve_mode else ""
+            lines.append((f"handles {len(hs)}: {sizes}   curve {st['curve_points']} pts{tool}   "
+                          f"columns {st['columns']}/16", CURVE_RGB if s.curve_mode else (235, 235, 235)))
+        if s.pose_pending and s.manip is None:
+            lines.append(("pending moves: Enter applies them as one edit, Esc discards", (255, 230, 120)))
         state = st["state"]
         if state == "fitting":
             lines.append(f"solver: {st.get('stage', 'fitting')} {st.get('fraction', 0) * 100:.0f}% "
@@ -907,7 +1052,11 @@ class Editor:
             st.update(n=s.cloud.n, state=ss["state"], support=ss["support"], handle=ss["handle"],
                       edits=len(s.edits), dirty=s.dirty, undo_position=s.history.position,
                       history=len(s.history), manip=None if s.manip is None else s.manip.mode,
-                      brush=s.brush_target, fit_error=ss.get("error"))
+                      brush=s.brush_target, fit_error=ss.get("error"), handles=ss["handles"],
+                      active_handle=ss["active_handle"], handle_sizes=ss["handle_sizes"],
+                      curve_points=ss["curve_points"], curve_mode=s.curve_mode,
+                      pose_pending=ss["pose_pending"], columns=ss["columns"],
+                      basis_columns=None if s.basis is None else s.basis.n_columns)
             idle = (not self.jobs and s.fit_job is None and self.drag is None and s.manip is None
                     and not self.scene_interactive and self.scene_key == self.scene_state()
                     and not (self.refiner is not None and self.refiner.busy))
@@ -915,6 +1064,16 @@ class Editor:
             w, h = self.size
             st["gizmo"] = [[k, *(round(float(v), 1) for v in (*p0, *p1))]
                            for k, p0, p1 in self.gizmo_axes(w, h)] if w and h else []
+            st["curve_dots"] = [[round(float(v), 1) for v in q] for q in self.curve_dots(w, h)] \
+                if w and h else []
+            hc = []
+            for k, hm in enumerate(s.selection.handles):
+                if hm.any() and w and h:
+                    px, d = self.cam.project(s.handle_centroid(k), w, h)
+                    hc.append([round(float(px[0, 0]), 1), round(float(px[0, 1]), 1)])
+                else:
+                    hc.append(None)
+            st["handle_px"] = hc
         text = json.dumps(st, sort_keys=True)
         if text != self._status_last:
             tmp = self.status_file.with_suffix(".tmp")

@@ -2,7 +2,9 @@
 
 The editor's document state is small and immutable-by-convention: the base
 cloud (a :class:`SplatCloud` never modified in place), the support and handle
-masks and the list of committed edits.  :class:`History` keeps snapshots of
+masks (several handles, one active), the session's rig (control-curve points
+and the pending pose: per-handle matrices and curve-point moves) and the list
+of committed edits.  :class:`History` keeps snapshots of
 those: ``push`` after every user action (a brush stroke, a clear, a commit),
 ``undo``/``redo`` move along the list.  Clouds are shared between snapshots
 until an edit replaces them, so a selection step costs two bit-packed masks;
@@ -21,20 +23,32 @@ import numpy as np
 class Snapshot:
     cloud: object                 # SplatCloud
     support: bytes                # np.packbits of the (n,) bool mask
-    handle: bytes
+    handle: bytes                 # the active handle
     edits: tuple = ()             # committed script Edits, in order
     label: str = ""
     n: int = 0
+    handles: tuple = ()           # every handle (packbits), in order
+    active: int = 0               # index of the active handle
+    rig: tuple = ()               # session state beyond the masks (curve, pending pose)
 
     @staticmethod
-    def make(cloud, support: np.ndarray, handle: np.ndarray, edits=(), label: str = "") -> "Snapshot":
-        return Snapshot(cloud, np.packbits(support).tobytes(), np.packbits(handle).tobytes(),
-                        tuple(edits), label, len(support))
+    def make(cloud, support: np.ndarray, handle, edits=(), label: str = "", *, active: int = 0,
+             rig: tuple = ()) -> "Snapshot":
+        """``handle``: one mask or a list of masks (``active`` picks the active one)."""
+        hs = [handle] if isinstance(handle, np.ndarray) else list(handle)
+        packed = tuple(np.packbits(h).tobytes() for h in hs)
+        return Snapshot(cloud, np.packbits(support).tobytes(), packed[active], tuple(edits), label,
+                        len(support), packed, active, tuple(rig))
+
+    def _unpack(self, b: bytes) -> np.ndarray:
+        return np.unpackbits(np.frombuffer(b, np.uint8), count=self.n).astype(bool)
 
     def masks(self) -> tuple[np.ndarray, np.ndarray]:
-        s = np.unpackbits(np.frombuffer(self.support, np.uint8), count=self.n).astype(bool)
-        h = np.unpackbits(np.frombuffer(self.handle, np.uint8), count=self.n).astype(bool)
-        return s, h
+        """(support, active handle)."""
+        return self._unpack(self.support), self._unpack(self.handle)
+
+    def handle_masks(self) -> list[np.ndarray]:
+        return [self._unpack(b) for b in (self.handles or (self.handle,))]
 
 
 def _cloud_bytes(cloud) -> int:
@@ -78,7 +92,7 @@ class History:
             if id(s.cloud) not in seen:
                 seen.add(id(s.cloud))
                 total += _cloud_bytes(s.cloud)
-            total += len(s.support) + len(s.handle)
+            total += len(s.support) + sum(len(b) for b in s.handles)
         return total
 
     @property

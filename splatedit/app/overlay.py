@@ -146,3 +146,44 @@ def progress_bar(width: int, fraction: float, label: str, size: int = 14) -> np.
     fx = 8 + int((width - 16) * min(max(fraction, 0.0), 1.0))
     d.rectangle((8, y, fx, y + 8), fill=(90, 160, 255, 255))
     return np.asarray(img)
+
+
+def polyline_patch(points, rgb, width: int = 3) -> Patch | None:
+    """A line strip through pixel ``points`` (m, 2) with a dark halo; NaN
+    points break the strip."""
+    p = np.asarray(points, float)
+    ok = np.isfinite(p).all(axis=1) & (np.abs(p) < 1e5).all(axis=1) if len(p) else np.zeros(0, bool)
+    if ok.sum() < 2:
+        return None
+    q = p[ok]
+    m = width + 4
+    bx, by = int(math.floor(q[:, 0].min())) - m, int(math.floor(q[:, 1].min())) - m
+    w = int(math.ceil(q[:, 0].max())) - bx + m + 1
+    h = int(math.ceil(q[:, 1].max())) - by + m + 1
+    img = Image.new("RGBA", (w, h), (0, 0, 0, 0))
+    d = ImageDraw.Draw(img)
+    runs, cur = [], []
+    for good, pt in zip(ok, p):
+        if good:
+            cur.append((float(pt[0]) - bx, float(pt[1]) - by))
+        elif cur:
+            runs.append(cur)
+            cur = []
+    if cur:
+        runs.append(cur)
+    for col, wd in (((0, 0, 0, 140), width + 2), (tuple(rgb) + (255,), width)):
+        for r in runs:
+            if len(r) >= 2:
+                d.line(r, fill=col, width=wd, joint="curve")
+    return Patch(bx, by, np.asarray(img))
+
+
+def dot_patch(p, rgb, radius: int = 5) -> Patch:
+    """A filled dot with a dark outline at pixel ``p``."""
+    x, y = float(p[0]), float(p[1])
+    s = radius + 3
+    img = Image.new("RGBA", (2 * s + 1, 2 * s + 1), (0, 0, 0, 0))
+    d = ImageDraw.Draw(img)
+    d.ellipse((s - radius - 1, s - radius - 1, s + radius + 1, s + radius + 1), fill=(0, 0, 0, 200))
+    d.ellipse((s - radius, s - radius, s + radius, s + radius), fill=tuple(rgb) + (255,))
+    return Patch(int(round(x)) - s, int(round(y)) - s, np.asarray(img))

@@ -9,11 +9,27 @@ States::
         new base (the selection is kept, a new fit starts for the next edit)
     MANIPULATE --Esc / right click--> cancel (back to READY)
 
+The *rig* of an edit (paper Sect. 3 and 6 end): one support, one or more
+disjoint handles (one active, moved by the manipulator) and optionally one
+non-rigid control curve (2..16 picked points, an interpolating B-spline
+through them, :class:`~splatedit.deform.curves.ControlCurve`).  One basis is
+fitted for all of them at once: 4 columns per non-empty handle, k + 1 for
+the curve, at most ``RENDER_MAX_BASIS_COLUMNS`` (16) in total.  The *pose*
+is a pending matrix per handle plus a pending displacement per picked curve
+point; every frame ``dC = basis.displacement(pose)`` for all columns.
+
+When the rig is a single handle without curve, ending a manipulation
+commits the edit at once (as before).  Otherwise ending a manipulation only
+stores it in the pose (the other handles keep theirs) and :meth:`Session.
+commit` (Enter) applies the whole pose as one edit; :meth:`Session.
+reset_pose` (Esc) discards it.  A commit consumes the curve (its points are
+cleared; undo brings them back) and keeps support and handles.
+
 Every user action that changes the document (a stroke, a clear, a commit)
 pushes a :class:`~splatedit.app.history.Snapshot`; undo/redo restore them
 (and restart the fit for the restored selection).  Committed edits are
-recorded as script edits (``indices`` support + ``indices`` handle +
-``matrix`` transform) and :meth:`Session.edit_script` returns an
+recorded as script edits (``indices`` support + ``indices`` handles +
+``matrix`` transforms + ``curves`` with ``points`` and ``move``) and :meth:`Session.edit_script` returns an
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
 """
@@ -29,12 +45,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from splatedit.app.brush import SUPPORT, Selection
+from splatedit.app.brush import HANDLE, SUPPORT, Selection
 from splatedit.app.history import History, Snapshot
 from splatedit.errors import SplatEditError
-from splatedit.tolerances import IQR_DEFAULT_TOL
+from splatedit.tolerances import IQR_DEFAULT_TOL, RENDER_MAX_BASIS_COLUMNS
 
 GRAB, ROTATE, SCALE = "grab", "rotate", "scale"
+#: basis columns per rigid handle
+HANDLE_COLUMNS = 4
+#: at most this many picked points per control curve
+MAX_CURVE_POINTS = 16
 AXIS_NAMES = "XYZ"
 
 
@@ -207,8 +227,19 @@ class Job:
     cancel: threading.Event = field(default_factory=threading.Event)
 
 
+
+def columns_needed(n_handles: int, n_curve_points: int) -> int:
+    """Basis columns of a rig: 4 per handle, k + 1 for a curve of k + 1 >= 2 points."""
+    return HANDLE_COLUMNS * n_handles + (n_curve_points if n_curve_points >= 2 else 0)
+
+
+def _matrix_tuple(m) -> tuple:
+    return tuple(tuple(float(x) for x in row) for row in np.asarray(m, float))
+
+
 class Session:
-    """Document + selection + fitting + manipulation + history.
+    """Document + selection (support, handles, curve) + fitting + pose +
+    manipulation + history.
 
     Args:
         cloud: the loaded :class:`SplatCloud`.
@@ -224,35 +255,58 @@ class Session:
         self.on_change = on_change or (lambda: None)
         self.cloud = cloud
         self.selection = Selection(cloud.n)
+        self.pose: list[np.ndarray] = [np.eye(4)]      # pending matrix per handle
+        self.curve_points: list[np.ndarray] = []       # picked points (3,) of the control curve
+        self.curve_moves = np.zeros((0, 3))            # pending displacement per picked point
+        self.curve_mode = False                        # the editor's curve tool is on
         self.edits: tuple = ()
         self.history = History()
         self.history.reset(self._snapshot("open"))
         self.basis = None
         self.basis_key = None
+        self.basis_groups = None      # (fitted handle indices, ControlCurve or None) of the basis
         self.fit_job: Job | None = None
         self.fit_error: str | None = None
         self.manip: Manipulation | None = None
+        self.manip_target = None      # ("handle", i) or ("curve", j)
         self.brush_target = SUPPORT
         self.version = 0          # bumps whenever cloud or selection changes
         self.last_commit_seconds = 0.0
+        self._curve_cache = (None, None)
 
     # ---------------------------------------------------------- snapshots
+    def _rig(self) -> tuple:
+        return (tuple(tuple(float(x) for x in p) for p in self.curve_points),
+                tuple(tuple(float(x) for x in d) for d in self.curve_moves),
+                tuple(_matrix_tuple(m) for m in self.pose))
+
     def _snapshot(self, label: str) -> Snapshot:
-        return Snapshot.make(self.cloud, self.selection.support, self.selection.handle,
-                             self.edits, label)
+        return Snapshot.make(self.cloud, self.selection.support, self.selection.handles, self.edits,
+                             label, active=self.selection.active, rig=self._rig())
 
     def _restore(self, snap: Snapshot) -> None:
         self.cloud = snap.cloud
-        s, h = snap.masks()
-        self.selection = Selection(len(s), s, h)
+        s, _ = snap.masks()
+        self.selection = Selection(len(s), s, handles=snap.handle_masks(), active=snap.active)
+        pts, moves, pose = snap.rig if snap.rig else ((), (), ())
+        self.curve_points = [np.array(p, float) for p in pts]
+        self.curve_moves = np.array(moves, float).reshape(-1, 3)
+        self.pose = [np.array(m, float) for m in pose]
+        self._sync_pose()
         self.edits = snap.edits
         self.manip = None
+        self.manip_target = None
         self.version += 1
         self.request_fit()
         self.on_change()
 
+    def _sync_pose(self) -> None:
+        n = len(self.selection.handles)
+        self.pose = (self.pose + [np.eye(4) for _ in range(n)])[:n]
+
     def push(self, label: str) -> None:
-        """Record the current state (after a stroke, clear or commit)."""
+        """Record the current state (after a stroke, clear, pose change or commit)."""
+        self._sync_pose()
         self.history.push(self._snapshot(label))
         self.version += 1
         self.request_fit()
@@ -298,18 +352,134 @@ class Session:
 
     def clear(self, target: str | None = None) -> None:
         if self.manip is None and self.selection.clear(target):
+            self.pose = [np.eye(4)]
             self.push("clear")
 
     def set_selection(self, support, handle, label: str = "select") -> None:
-        self.selection = Selection(self.cloud.n, support, handle)
+        handles = handle if isinstance(handle, (list, tuple)) else [handle]
+        self.selection = Selection(self.cloud.n, support, handles=handles)
+        self.pose = [np.eye(4)]
         self.push(label)
+
+    # -------------------------------------------------------------- handles
+    def _check_columns(self, n_handles: int, n_points: int, what: str) -> None:
+        k = columns_needed(n_handles, n_points)
+        if k > RENDER_MAX_BASIS_COLUMNS:
+            raise SplatEditError(
+                f"cannot {what}: the basis would need {k} columns (4 per handle + 1 per curve point "
+                f"from 2 points on), at most {RENDER_MAX_BASIS_COLUMNS} are supported")
+
+    def _n_handles_planned(self) -> int:
+        """Handles that take basis columns (all but a lone empty one)."""
+        hs = self.selection.handles
+        return len(hs) if (len(hs) > 1 or hs[0].any()) else 0
+
+    def add_handle(self) -> bool:
+        """Start a new handle (active; the brush then paints it).  An empty
+        active handle is reused.  Raises SplatEditError over 16 columns."""
+        if self.manip is not None:
+            return False
+        self.brush_target = HANDLE
+        if not self.selection.handle.any():
+            return False
+        self._check_columns(len(self.selection.handles) + 1, len(self.curve_points), "add a handle")
+        self.selection.add_handle()
+        self.push("new handle")
+        return True
+
+    def remove_handle(self) -> bool:
+        """Remove the active handle (and its pending transform)."""
+        if self.manip is not None:
+            return False
+        i = self.selection.active
+        several = len(self.selection.handles) > 1
+        if not self.selection.remove_handle(i):
+            return False
+        if several:
+            del self.pose[i]
+        else:
+            self.pose = [np.eye(4)]
+        self.push("remove handle")
+        return True
+
+    def select_handle(self, i: int) -> bool:
+        """Make handle ``i`` (modulo the count) the active one (not an undo step)."""
+        if self.manip is not None or not self.selection.select_handle(i):
+            return False
+        self.version += 1
+        self.on_change()
+        return True
+
+    def cycle_handle(self, step: int = 1) -> bool:
+        return self.select_handle(self.selection.active + step)
+
+    # ---------------------------------------------------------------- curve
+    def curve(self):
+        """The :class:`ControlCurve` through the picked points (None below 2)."""
+        if len(self.curve_points) < 2:
+            return None
+        key = tuple(p.tobytes() for p in self.curve_points)
+        if self._curve_cache[0] != key:
+            from splatedit.deform.curves import ControlCurve
+            self._curve_cache = (key, ControlCurve.through(np.array(self.curve_points, dtype=np.float64)))
+        return self._curve_cache[1]
+
+    def add_curve_point(self, point) -> bool:
+        """Append a picked point (2..16 per curve; consecutive ones distinct)."""
+        if self.manip is not None:
+            return False
+        p = np.array(point, dtype=np.float64).reshape(3)
+        if len(self.curve_points) >= MAX_CURVE_POINTS:
+            raise SplatEditError(f"a curve has at most {MAX_CURVE_POINTS} points")
+        self._check_columns(self._n_handles_planned(), len(self.curve_points) + 1, "add a curve point")
+        if self.curve_points:
+            scale = max(float(np.abs(p).max()), 1.0)
+            if float(np.linalg.norm(p - self.curve_points[-1])) <= 1e-9 * scale:
+                raise SplatEditError("this point is the curve's last point: pick another one")
+        self.curve_points.append(p)
+        self.curve_moves = np.vstack([self.curve_moves, np.zeros((1, 3))])
+        self.push("curve point")
+        return True
+
+    def remove_curve_point(self) -> bool:
+        """Remove the last picked point."""
+        if self.manip is not None or not self.curve_points:
+            return False
+        self.curve_points.pop()
+        self.curve_moves = self.curve_moves[:-1].copy()
+        self.push("remove curve point")
+        return True
+
+    def clear_curve(self) -> bool:
+        if self.manip is not None or not self.curve_points:
+            return False
+        self.curve_points = []
+        self.curve_moves = np.zeros((0, 3))
+        self.push("clear curve")
+        return True
+
+    def curve_point_positions(self, live: bool = True) -> np.ndarray:
+        """(k + 1, 3) current (moved) picked points."""
+        if not self.curve_points:
+            return np.zeros((0, 3))
+        return np.array(self.curve_points) + self.live_curve_moves(live)
+
+    def curve_polyline(self, count: int = 160, live: bool = True) -> np.ndarray | None:
+        """Points of the moved curve c'(t) for drawing (None below 2 points)."""
+        c = self.curve()
+        if c is None:
+            return None
+        t = np.linspace(0.0, 1.0, count)
+        return c.evaluate(t, c.controls + c.control_displacement(self.live_curve_moves(live)))
 
     # --------------------------------------------------------------- fitting
     def selection_key(self):
-        return (id(self.cloud),) + self.selection.key()
+        curve = tuple(p.tobytes() for p in self.curve_points) if len(self.curve_points) >= 2 else ()
+        return (id(self.cloud),) + self.selection.key() + (curve,)
 
     def request_fit(self) -> None:
-        """Start (or restart) a background fit when the handle is not empty."""
+        """Start (or restart) a background fit of all non-empty handles and
+        the curve (when it has at least 2 points)."""
         key = self.selection_key()
         if self.basis is not None and self.basis_key == key:
             return
@@ -320,13 +490,26 @@ class Session:
             self.fit_job = None
         self.basis = None
         self.basis_key = None
+        self.basis_groups = None
         self.fit_error = None
-        if not self.selection.handle.any():
+        hidx = self.selection.nonempty()
+        curve = self.curve()
+        if not hidx and curve is None:
+            return
+        if not self.selection.support.any():
+            self.fit_error = "paint a support region first (1)"
+            return
+        k = columns_needed(len(hidx), len(self.curve_points))
+        if k > RENDER_MAX_BASIS_COLUMNS:
+            self.fit_error = (f"{k} basis columns needed (4 per handle + 1 per curve point), at most "
+                              f"{RENDER_MAX_BASIS_COLUMNS}: remove a handle or curve points")
             return
         cloud = self.cloud
         support = self.selection.support.copy()
-        handle = self.selection.handle.copy()
+        handles = [self.selection.handles[k].copy() for k in hidx]
+        curves = [curve] if curve is not None else []
         job = Job("fit", Future(), key=key, stage="fitting")
+        job.groups = (tuple(hidx), curve)
 
         def progress(stage, fraction):
             if job.cancel.is_set():
@@ -335,8 +518,8 @@ class Session:
 
         def work():
             from splatedit.deform.basis import DeformationBasis
-            return DeformationBasis.fit(cloud, support, [handle], method=self.method, tol=self.tol,
-                                        max_centers=self.max_centers, progress=progress)
+            return DeformationBasis.fit(cloud, support, handles, curves=curves, method=self.method,
+                                        tol=self.tol, max_centers=self.max_centers, progress=progress)
 
         if self.fit_sync:
             try:
@@ -354,12 +537,14 @@ class Session:
         if job is None or not job.future.done():
             return False
         self.fit_job = None
-        if job.key != self.selection_key():
+        key, groups = job.key, job.groups
+        if key != self.selection_key():
             self.request_fit()
             return True
         try:
             self.basis = job.future.result()
-            self.basis_key = job.key
+            self.basis_key = key
+            self.basis_groups = groups
         except Cancelled:
             return False
         except SplatEditError as exc:
@@ -396,57 +581,167 @@ class Session:
             return "error"
         return "select"
 
+    # ------------------------------------------------------------------ pose
+    @property
+    def single_rig(self) -> bool:
+        """One handle and no curve: ending a manipulation commits at once."""
+        return len(self.selection.handles) == 1 and not self.curve_points
+
+    @property
+    def pose_pending(self) -> bool:
+        """Some handle or curve point has a pending (uncommitted) move."""
+        return (any(not np.array_equal(m, np.eye(4)) for m in self.pose)
+                or bool(self.curve_moves.any()))
+
+    def handle_matrix(self, k: int, live: bool = True) -> np.ndarray:
+        """Pending matrix of handle ``k`` (with the running manipulation when ``live``)."""
+        m = self.pose[k] if k < len(self.pose) else np.eye(4)
+        if live and self.manip is not None and self.manip_target == ("handle", k):
+            m = self.manip.matrix() @ m
+        return m
+
+    def live_curve_moves(self, live: bool = True) -> np.ndarray:
+        mv = self.curve_moves.copy()
+        if live and self.manip is not None and self.manip_target and self.manip_target[0] == "curve":
+            j = self.manip_target[1]
+            p = self.curve_points[j] + mv[j]
+            m = self.manip.matrix()
+            mv[j] = m[:3, :3] @ p + m[:3, 3] - self.curve_points[j]
+        return mv
+
+    def inputs(self, live: bool = True) -> list:
+        """Per-group inputs of ``basis.displacement`` (fitted handles, then the curve)."""
+        hidx, curve = self.basis_groups
+        out = [self.handle_matrix(k, live) for k in hidx]
+        if curve is not None:
+            out.append(curve.control_displacement(self.live_curve_moves(live)))
+        return out
+
+    def reset_pose(self) -> bool:
+        """Discard the pending transforms and curve moves (an undo step)."""
+        if self.manip is not None:
+            self.cancel()
+        if not self.pose_pending:
+            return False
+        self.pose = [np.eye(4) for _ in self.selection.handles]
+        self.curve_moves = np.zeros_like(self.curve_moves)
+        self.push("reset pose")
+        return True
+
     # ---------------------------------------------------------- manipulation
-    def handle_centroid(self) -> np.ndarray:
-        return self.cloud.positions[self.selection.handle].mean(axis=0)
+    def handle_centroid(self, k: int | None = None) -> np.ndarray:
+        """Centroid of handle ``k`` (default: the active one) moved by its pending matrix."""
+        k = self.selection.active if k is None else k
+        c = self.cloud.positions[self.selection.handles[k]].mean(axis=0)
+        m = self.pose[k] if k < len(self.pose) else np.eye(4)
+        return m[:3, :3] @ c + m[:3, 3]
+
+    def active_fitted(self) -> bool:
+        """The active handle is part of the fitted basis."""
+        return self.basis is not None and self.selection.active in self.basis_groups[0]
 
     def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float]) -> bool:
-        """Start G/R/S (needs a fitted basis)."""
-        if self.basis is None or self.manip is not None:
+        """Start G/R/S of the active handle (needs a basis that includes it)."""
+        if self.manip is not None or not self.active_fitted():
             return False
         self.manip = Manipulation(mode, self.handle_centroid(), view, mouse)
+        self.manip_target = ("handle", self.selection.active)
+        return True
+
+    def begin_curve_point(self, j: int, view: ViewInfo, mouse: tuple[float, float]) -> bool:
+        """Start dragging picked curve point ``j`` (needs a basis with the curve)."""
+        if self.manip is not None or self.basis is None or self.basis_groups[1] is None:
+            return False
+        if not 0 <= j < len(self.curve_points):
+            return False
+        self.manip = Manipulation(GRAB, self.curve_points[j] + self.curve_moves[j], view, mouse)
+        self.manip_target = ("curve", int(j))
         return True
 
     def current_matrix(self) -> np.ndarray:
         return np.eye(4) if self.manip is None else self.manip.matrix()
 
     def current_dc(self) -> np.ndarray | None:
-        """dC of the current manipulation (None when there is no basis)."""
+        """dC of the whole pose, live manipulation included (None without basis)."""
         if self.basis is None:
             return None
-        return self.basis.displacement([self.current_matrix()])
+        return self.basis.displacement(self.inputs())
 
     def cancel(self) -> None:
         self.manip = None
+        self.manip_target = None
         self.on_change()
 
-    def commit(self) -> bool:
-        """Apply the current manipulation: the deformed cloud becomes the new
-        base, the edit is recorded, the selection is kept."""
-        from splatedit.script import Edit, Matrix
-        from splatedit.select.regions import Indices
-        if self.manip is None or self.basis is None:
-            return False
-        m = self.manip.matrix()
+    def _bake(self) -> None:
+        """Store the running manipulation in the pose."""
+        t = self.manip_target
+        if t[0] == "handle":
+            self.pose[t[1]] = self.handle_matrix(t[1])
+        else:
+            self.curve_moves = self.live_curve_moves()
         self.manip = None
-        if np.allclose(m, np.eye(4), atol=0, rtol=0):
+        self.manip_target = None
+
+    def finish(self) -> str:
+        """End the running manipulation: commit at once for a single-handle
+        rig ("commit", or "" when nothing moved); else keep it in the pose
+        ("pose") for a later :meth:`commit`."""
+        if self.manip is None:
+            return ""
+        if self.single_rig:
+            return "commit" if self.commit() else ""
+        moved = not np.array_equal(self.manip.matrix(), np.eye(4))
+        what = "move handle" if self.manip_target[0] == "handle" else "move curve point"
+        self._bake()
+        if moved:
+            self.push(what)
+        else:
+            self.on_change()
+        return "pose" if moved else ""
+
+    def commit(self) -> bool:
+        """Apply the pose (running manipulation included) as one edit: the
+        deformed cloud becomes the new base, the edit is recorded, support and
+        handles are kept, the curve is consumed.  Raises InputError (state
+        unchanged) when a splat degenerates."""
+        from splatedit.script import Curve, Edit, Matrix
+        from splatedit.select.regions import Indices
+        if self.basis is None:
+            return False
+        inputs = self.inputs(live=True)
+        moves = self.live_curve_moves(live=True)
+        hidx, curve = self.basis_groups
+        mats = inputs[:len(hidx)]
+        if all(np.array_equal(m, np.eye(4)) for m in mats) and not (curve is not None and moves.any()):
+            self.manip = None
+            self.manip_target = None
             self.on_change()
             return False
         t0 = time.perf_counter()
-        dc = self.basis.displacement([m])
+        dc = self.basis.displacement(inputs)
         # the same arrays as ``splatedit deform`` (basis.apply); only the moved
         # (support) splats are re-validated, the others are bitwise copies
         new = self.basis.apply(self.cloud, dc)
         new.subset(self.basis.indices)      # raises InputError on a degenerate splat
         self.last_commit_seconds = time.perf_counter() - t0
-        sup = self.selection.support
-        edit = Edit(Indices(tuple(int(i) for i in np.flatnonzero(sup))),
-                    (Indices(tuple(int(i) for i in np.flatnonzero(self.selection.handle))),),
-                    (Matrix(tuple(tuple(float(x) for x in row) for row in m)),))
+        sel = self.selection
+        idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+        curves = ()
+        if curve is not None:
+            curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.curve_points),
+                            tuple(tuple(float(x) for x in d) for d in moves), None),)
+        edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
+                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves)
+        self.manip = None
+        self.manip_target = None
         self.cloud = new
         self.edits = self.edits + (edit,)
         self.basis = None
         self.basis_key = None
+        self.basis_groups = None
+        self.pose = [np.eye(4) for _ in sel.handles]
+        self.curve_points = []
+        self.curve_moves = np.zeros((0, 3))
         self.push("edit")
         return True
 
@@ -456,13 +751,18 @@ class Session:
         return EditScript(tuple(self.edits), SolverSettings(self.method, self.tol, self.max_centers))
 
     def stats(self) -> dict:
-        s = {"state": self.state, "support": self.selection.counts[0],
-             "handle": self.selection.counts[1], "edits": len(self.edits)}
+        sel = self.selection
+        s = {"state": self.state, "support": sel.counts[0], "handle": sel.counts[1],
+             "edits": len(self.edits), "handles": len(sel.handles), "active_handle": sel.active,
+             "handle_sizes": [int(h.sum()) for h in sel.handles], "curve_points": len(self.curve_points),
+             "pose_pending": self.pose_pending,
+             "columns": columns_needed(len(sel.nonempty()), len(self.curve_points))}
         if self.basis is not None:
             st = self.basis.stats if isinstance(self.basis.stats, dict) else vars(self.basis.stats)
             s.update(centers=st.get("n_centers"), constraints=st.get("n_constraints"),
                      residual=st.get("residual"), method=st.get("method"),
-                     fit_seconds=st.get("fit_seconds"), basis_seconds=st.get("basis_seconds"))
+                     fit_seconds=st.get("fit_seconds"), basis_seconds=st.get("basis_seconds"),
+                     columns=self.basis.n_columns)
         if self.fit_job is not None:
             s.update(stage=self.fit_job.stage, fraction=self.fit_job.fraction,
                      elapsed=time.perf_counter() - self.fit_job.started)

@@ -12,7 +12,13 @@ renderer is only updated when it draws) and chooses what to draw:
 
 The LOD level is drawn by a second :class:`~splatedit.render.renderer.Renderer`
 sharing the first one's Vulkan device; its deformation-basis rows are the
-representatives' rows (:meth:`LodLevel.rows`), so the handle moves at LOD too.
+representatives' rows (:meth:`LodLevel.rows`), so the handles move at LOD too.
+
+The basis is uploaded with all its columns (4 per handle, k + 1 for a
+curve; at most 16): the paper uploads only the active handle's rows, but
+with several handles holding simultaneous pending transforms every group's
+displacement must be drawn, and switching the active handle must not
+re-upload anything.
 """
 
 from __future__ import annotations
@@ -52,6 +58,7 @@ class Viewport:
         self.cloud = None
         self.support = None
         self.handle = None
+        self.inactive = None
         self.sel_version = 0
         self.basis = None
         self.dc = None
@@ -77,8 +84,10 @@ class Viewport:
         self._measured = {k: v for k, v in self._measured.items() if k[0] is None}
         self._last_key = None
 
-    def set_selection(self, support, handle, version: int) -> None:
+    def set_selection(self, support, handle, version: int, inactive=None) -> None:
+        """Masks to tint: support, active handle, inactive handles (darker)."""
         self.support, self.handle, self.sel_version = support, handle, version
+        self.inactive = inactive
 
     def set_basis(self, basis) -> None:
         self.basis = basis
@@ -101,11 +110,13 @@ class Viewport:
             slot.cloud = cloud
             slot.sel = slot.basis = slot.dc = None
         if slot.sel != (self.sel_version, id(cloud)):
-            s, h = self.support, self.handle
+            s, h, i = self.support, self.handle, self.inactive
             if s is not None and len(s) == cloud.n:
+                if i is None:
+                    i = np.zeros(cloud.n, bool)
                 if level is not None:
-                    s, h = level.masks(s, h)
-                slot.r.set_selection(s, h)
+                    s, h, i = level.masks(s, h, i)
+                slot.r.set_selection(s, h, i)
             else:
                 slot.r.set_selection(None, None)
             slot.sel = (self.sel_version, id(cloud))
@@ -115,7 +126,10 @@ class Viewport:
                 slot.r.clear_basis()
                 slot.basis = None
             else:
-                rows = basis.rows_for_gpu(0)
+                # every column of every group (handles and curve), uploaded once per
+                # fit: each frame only dC (K x 3) changes, so all pending transforms
+                # are drawn together and switching the active handle costs nothing
+                rows = basis.rows_for_gpu()
                 if level is not None:
                     rows = level.rows(*rows)
                 slot.r.set_basis(*rows)
@@ -305,7 +319,7 @@ class BackgroundRefiner:
                     if vp is None:
                         vp = Viewport(budget_ms=self._budget)
                     vp.set_cloud(st["cloud"])
-                    vp.set_selection(st["support"], st["handle"], st["sel_version"])
+                    vp.set_selection(st["support"], st["handle"], st["sel_version"], st.get("inactive"))
                     vp.set_basis(st["basis"])
                     vp.set_dc(st["dc"])
                     img = vp.render(st["camera"], st["w"], st["h"])

@@ -34,6 +34,7 @@ from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDE
 FLAG_SUPPORT = 1
 FLAG_HANDLE = 2
 FLAG_DEFORMED = 4
+FLAG_INACTIVE = 8            # an inactive handle (the editor's several handles): darker
 
 _UBO_BYTES = 272
 _GEOM_STRIDE = 36           # centre, u, v as float32
@@ -354,16 +355,19 @@ class Renderer:
         out[idx] = True
         return out
 
-    def set_selection(self, support_mask=None, handle_mask=None) -> None:
+    def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
         """Tint the support region (blue) and handle (green); boolean masks of
-        shape (n,) or index arrays; None clears."""
+        shape (n,) or index arrays; None clears.  ``inactive_mask``: splats
+        of inactive handles, tinted green and drawn darker."""
         self._check_open()
         self._require_cloud()
         s = self._mask("support_mask", support_mask)
         h = self._mask("handle_mask", handle_mask)
+        i = self._mask("inactive_mask", inactive_mask)
         f = self._flags.view(np.uint32)
         f &= np.uint32(FLAG_DEFORMED)
-        f |= (s.astype(np.uint32) * FLAG_SUPPORT) | (h.astype(np.uint32) * FLAG_HANDLE)
+        f |= ((s.astype(np.uint32) * FLAG_SUPPORT) | ((h | i).astype(np.uint32) * FLAG_HANDLE)
+              | (i.astype(np.uint32) * FLAG_INACTIVE))
 
     def set_basis(self, indices, B, Bx, By, Bz) -> None:
         """Deformation basis rows for the splats ``indices`` (N,); B, Bx, By, Bz
