@@ -13,6 +13,7 @@ import sys
 import time
 from pathlib import Path
 
+from splatedit.app.options import parse_size
 from splatedit.errors import ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
@@ -54,16 +55,6 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
     if len(parts) != 3:
         raise argparse.ArgumentTypeError(f"{name} must be three comma-separated numbers like 0,0,1, got {text!r}")
     return tuple(parts)  # type: ignore[return-value]
-
-
-def _parse_size(text: str) -> tuple[int, int]:
-    try:
-        w, h = (int(x) for x in text.lower().split("x"))
-    except ValueError:
-        raise argparse.ArgumentTypeError(f"size must look like 1280x720, got {text!r}") from None
-    if not (1 <= w <= 16384 and 1 <= h <= 16384):
-        raise argparse.ArgumentTypeError(f"size must be between 1x1 and 16384x16384, got {text!r}")
-    return w, h
 
 
 # ------------------------------------------------------------------ commands
@@ -198,7 +189,8 @@ def cmd_demo(args) -> int:
 
 
 def cmd_edit(args) -> int:
-    from splatedit.app.editor import options_from_args, run_editor
+    from splatedit.app.editor import run_editor
+    from splatedit.app.options import options_from_args
     return run_editor(args.file, **options_from_args(args))
 
 
@@ -255,7 +247,7 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("render", help="render a model to PNG with the Vulkan EWA splat renderer")
     s.add_argument("input")
     s.add_argument("-o", "--output", required=True, help="output PNG")
-    s.add_argument("--size", type=_parse_size, default=(1280, 720), help="WxH (default 1280x720)")
+    s.add_argument("--size", type=parse_size, default=(1280, 720), help="WxH (default 1280x720)")
     s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"))
     s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"))
     s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"))
@@ -265,7 +257,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 
-    from splatedit.app.editor import CONTROLS, add_arguments
+    from splatedit.app.options import CONTROLS, add_arguments
     s = sub.add_parser("edit", help="interactive editor (a window; F1 in it lists the controls)",
                        epilog=CONTROLS, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(s)

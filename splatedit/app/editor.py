@@ -25,54 +25,11 @@ import numpy as np
 from splatedit.app import overlay as ov
 from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, picker_for_view, stroke_points
 from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
 from splatedit.app.session import GRAB, ROTATE, SCALE, Session, ViewInfo
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import IQR_DEFAULT_TOL
 
-CONTROLS = """\
-Camera
-  Middle drag            orbit around the pivot          (laptop: Alt + left drag)
-  Shift + middle drag    pan                             (laptop: Alt + Shift + left drag)
-  Ctrl + middle drag     dolly
-  Wheel                  zoom to the cursor
-  Home                   frame the whole model
-  F  or  numpad .        frame the selection (handle, else support)
-  Numpad 1 / 3 / 7       front / right / top view
-Selection (paper Sect. 3: support = blue, handles = green, the active one brighter)
-  Left drag              paint with the brush (only visible splats)
-  Ctrl + left drag       erase with the brush            (E toggles erase mode)
-  1 / 2                  brush paints the support / the active handle (inside the support)
-  Tab                    one handle: toggle support / handle brush; several: next handle (Shift: previous)
-  N                      new handle (becomes active; paint it with the handle brush)
-  Delete                 remove the active handle
-  [ / ]  or  Ctrl+wheel  brush radius
-  C / Shift+C            clear the selection / clear the handles
-Deformation (the basis of all handles and the curve is fitted in the background;
-             at most 16 columns: 4 per handle + 1 per curve point)
-  Left drag on a handle  make it active and move it in the view plane
-  Left drag on an arrow  move the active handle along that axis (gizmo: X red, Y green, Z blue)
-  G / R / S              grab / rotate / scale the active handle with the mouse
-    X / Y / Z            constrain to that world axis (again: free)
-    0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)
-    Enter or left click  done (one handle, no curve: the edit is applied at once)
-    Esc or right click   cancel this move
-  With several handles or a curve the moves are kept (the other handles keep theirs):
-    Enter                apply all of them as one edit (the result becomes the new base)
-    Esc                  discard the pending moves
-Control curve (paper Sect. 3 end, Fig. 3 and 7)
-  K                      curve tool on / off (Shift+K: clear the curve)
-  Left click on support  add a curve point (2..16); the spline through them is drawn
-  Left drag on a dot     move that point in the view plane (X / Y / Z: along an axis)
-  Backspace              remove the last curve point
-  Enter / Esc            apply the bent curve as an edit (the curve is consumed) / discard moves
-File and history
-  Ctrl+Z / Ctrl+Shift+Z  undo / redo (edits and selections; Ctrl+Y also redoes)
-  Ctrl+S                 save <name>-edited.ply (+ <name>-edited.edits.json edit script)
-  Ctrl+Shift+S           save as: type a path, Enter
-  Ctrl+E                 export only the edit script
-  F1  or  H              show / hide this help
-  Q  or  Esc             quit (asks first when there are unsaved changes: Y, Q or Esc again quits, N stays)
-"""
 
 #: a left press this close to a curve dot (pixels) drags it
 CURVE_DOT_PICK_PX = 10
@@ -1193,32 +1150,6 @@ def run_editor(path=None, **options) -> int:
         return editor.run()
     finally:
         editor.close()
-
-
-def add_arguments(p) -> None:
-    """Add the ``splatedit edit`` options to an argparse parser."""
-    p.add_argument("file", nargs="?", help="model to open (default: the bundled bunny)")
-    p.add_argument("--save-as", help="save path (default: <name>-edited.ply next to the input, "
-                   "or in the current directory for the bundled model)")
-    p.add_argument("--size", default="1280x720", help="window size WxH (default 1280x720)")
-    p.add_argument("--method", default="auto", choices=("auto", "lu", "iqr"),
-                   help="solver (also written to the exported edit script)")
-    p.add_argument("--tol", type=float, default=IQR_DEFAULT_TOL, help="IQR relative tolerance")
-    p.add_argument("--no-vsync", action="store_true", help="present without vsync (MAILBOX/IMMEDIATE)")
-    p.add_argument("--no-lod", action="store_true", help="never draw a level of detail while moving")
-    p.add_argument("--budget-ms", type=float, default=100.0,
-                   help="frame-time budget while moving (default 100 ms = 10 fps)")
-    p.add_argument("--status-file", help="test hook: a JSON file rewritten when the state changes")
-
-
-def options_from_args(a) -> dict:
-    """The :func:`run_editor` keyword options of parsed :func:`add_arguments` arguments."""
-    try:
-        w, h = (int(v) for v in str(a.size).lower().split("x"))
-    except ValueError:
-        raise SplatEditError(f"--size must look like 1280x720, got {a.size!r}") from None
-    return dict(size=(w, h), save_as=a.save_as, method=a.method, tol=a.tol, vsync=not a.no_vsync,
-                lod=not a.no_lod, budget_ms=a.budget_ms, status_file=a.status_file)
 
 
 def main(argv=None) -> int:
