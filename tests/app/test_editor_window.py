@@ -10,7 +10,7 @@ exported edit script and against ``splatedit deform`` replaying it.
 
 The editor reports its state in a JSON status file (``--status-file``), so
 the test waits for conditions ("fit done", "idle") instead of sleeping.
-Set ``SPLATEDIT_UPDATE_REFERENCE=1`` to rewrite the reference image.
+Set ``SPLATEDIT_UPDATE_REFERENCES=1`` to rewrite the reference image.
 """
 
 from __future__ import annotations
@@ -155,7 +155,7 @@ def test_full_edit_session(xvfb, tmp_path):
         x, y, pw, ph = s["panel_box"]
         mask = np.ones(shot.shape[:2], bool)
         mask[: y + ph + 40, : x + pw + 4] = False      # panel and progress bars (timings differ)
-        if os.environ.get("SPLATEDIT_UPDATE_REFERENCE") == "1":
+        if os.environ.get("SPLATEDIT_UPDATE_REFERENCES") == "1":
             from PIL import Image
             REFERENCE.parent.mkdir(exist_ok=True)
             Image.fromarray(np.where(mask[..., None], shot, 0).astype(np.uint8)).save(REFERENCE)
