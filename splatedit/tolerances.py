@@ -69,8 +69,10 @@ EVAL_THREADS = 2
 POLY_RANK_RTOL = 1e-9
 #: cap on the bytes of one (chunk rows x n_centers) float64 work matrix when
 #: evaluating a fitted RBF; the chunk is min(EVAL_CHUNK_ROWS, this / (8 n))
-#: rows, so evaluation memory stays bounded even for thousands of centers
-EVAL_CHUNK_MAX_BYTES = 32 * 2**20
+#: rows, so evaluation memory stays bounded even for thousands of centers.
+#: 4 MiB keeps the element-wise passes in cache: measured 3.6 ns per
+#: (point, centre) pair against 4.7-7.2 ns with 8-32 MiB, for 372 and 4228 centres
+EVAL_CHUNK_MAX_BYTES = 4 * 2**20
 #: constraint points closer than this (relative to the bounding-box diagonal)
 #: are duplicates: merged when their values agree, a SolverError otherwise
 DUPLICATE_POINT_REL = 1e-10

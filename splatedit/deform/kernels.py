@@ -144,6 +144,17 @@ def poly_matrix(x: np.ndarray) -> np.ndarray:
     return out
 
 
+def poly_gradient_coefficients(q: np.ndarray) -> np.ndarray:
+    """(3, 4, k) matrices G_d with ``grad_d p(x) = [1, x, y, z] @ G_d`` for the
+    quadratic ``p = sum_j q_j p_j`` (q: (10, k), monomials in :data:`MONOMIALS` order)."""
+    q = np.asarray(q, dtype=np.float64)
+    return np.stack([
+        np.stack([q[1], 2.0 * q[4], q[5], q[6]]),   # d/dx: x, x^2, xy, xz
+        np.stack([q[2], q[5], 2.0 * q[7], q[8]]),   # d/dy: y, xy, y^2, yz
+        np.stack([q[3], q[6], q[8], 2.0 * q[9]]),   # d/dz: z, xz, yz, z^2
+    ])
+
+
 def poly_gradient(x: np.ndarray) -> np.ndarray:
     """``G[i, j, d] = d p_j / d x_d at x_i`` (shape (N, 10, 3))."""
     x = np.asarray(x, dtype=np.float64)

@@ -33,6 +33,7 @@ from splatedit.deform.centers import FarthestPointSampler
 from splatedit.deform.kernels import (
     N_POLY,
     augmented_centers,
+    poly_gradient_coefficients,
     evaluation_squared_distances,
     kernel_matrix,
     poly_gradient,
@@ -368,6 +369,8 @@ class TriharmonicRBF:
         # [W, c_x W, c_y W, c_z W]: one GEMM with the distance matrix gives
         # sum_j w_j r_ij and sum_j w_j r_ij c_jd for the gradient
         self._centers_aug = augmented_centers(self._centers_n)
+        self._poly_grad_coeffs = (None if self.poly_coeffs is None
+                                  else poly_gradient_coefficients(self.poly_coeffs))
         self._grad_weights = np.ascontiguousarray(np.concatenate(
             [self.weights] + [c[:, d:d + 1] * self.weights for d in range(3)], axis=1))
         self._k = k
@@ -582,7 +585,12 @@ class TriharmonicRBF:
             else:
                 g[...] = 0.0
             if self.poly_coeffs is not None:
-                g += np.einsum("ijd,jk->ikd", poly_gradient(xc), self.poly_coeffs)
+                # the quadratic's gradient is affine in x: [1, x, y, z] @ G_d
+                x1 = np.empty((len(xc), 4))
+                x1[:, 0] = 1.0
+                x1[:, 1:] = xc
+                for d in range(3):
+                    g[:, :, d] += x1 @ self._poly_grad_coeffs[d]
             g /= self.scale  # chain rule: d/dx = (1/scale) d/dxn
 
     def __call__(self, x) -> np.ndarray:
