@@ -60,9 +60,48 @@ _BASIS_CHUNK = 65536
 #: one thread (its threads only add contention for so thin a product; measured
 #: 2-4x slower at 16384 rows on a loaded 2-core machine) and the chunk stays
 #: in L2; large enough that the Python loop is negligible
-_APPLY_CHUNK = 4096
+_APPLY_CHUNK = 65536
+#: a gap of non-support splats between two runs of support splats is computed
+#: through (with zero basis rows, then restored bitwise) when it is at most this
+#: fraction of the shorter neighbouring run: one long GEMM instead of one call
+#: per run (a 1M-splat support made of 1000 grid rows: 35 ms -> see PERFORMANCE.md)
+_GAP_FILL_REL = 0.25
 #: runs of consecutive splat indices at least this long are written by slice
 _RUN_MIN = 512
+
+
+def _fill_small_gaps(index: np.ndarray, rel: float = _GAP_FILL_REL, run_min: int | None = None):
+    """Sorted splat indices plus the rows of the small gaps between their runs.
+
+    Returns ``(span, member)``: ``span`` (M,) sorted indices (``index`` and
+    the filled gap rows), ``member`` (M,) bool, True where ``span`` is in
+    ``index``.  A gap is filled when it is at most ``rel`` times the shorter of
+    its two neighbouring runs and both runs have at least ``run_min`` splats,
+    so scattered indices (short runs) are left alone.
+    """
+    index = np.asarray(index)
+    run_min = _RUN_MIN if run_min is None else run_min
+    n = len(index)
+    if n < 2:
+        return index, np.ones(n, dtype=bool)
+    gaps = np.diff(index) - 1
+    breaks = np.flatnonzero(gaps > 0)
+    if len(breaks) == 0:
+        return index, np.ones(n, dtype=bool)
+    starts = np.concatenate([[0], breaks + 1])
+    ends = np.concatenate([breaks + 1, [n]])
+    run_len = ends - starts
+    shorter = np.minimum(run_len[:-1], run_len[1:])
+    fill = (gaps[breaks] <= rel * shorter) & (shorter >= run_min)
+    if not fill.any():
+        return index, np.ones(n, dtype=bool)
+    lo = index[breaks[fill]] + 1
+    hi = index[breaks[fill] + 1]
+    extra = np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)])
+    span = np.concatenate([index, extra])
+    member = np.concatenate([np.ones(n, dtype=bool), np.zeros(len(extra), dtype=bool)])
+    order = np.argsort(span, kind="stable")
+    return span[order], member[order]
 
 
 def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
@@ -337,29 +376,35 @@ class DeformationBasis:
                 and c["v"] is cloud.v):
             return c
         idx = self.indices
-        order, segments = _run_plan(idx)
-        rows = idx[order]
-        pk = self._pack[order]
+        # computing through small gaps of fixed splats (restored afterwards) turns
+        # many short runs into a few long GEMMs
+        span, member = _fill_small_gaps(idx)
+        order, segments = _run_plan(span)
+        rows = span[order]
+        sel = member[order]                               # plan rows that are support splats
+        pack_rows = (np.cumsum(member) - 1)[order][sel]   # their rows in self._pack
+        pk = self._pack[pack_rows]
         k = self.n_columns
         arrays = []
         for name in ("positions", "u", "v"):
             src = getattr(cloud, name)[rows]
-            a = np.empty((len(rows), k + 3))
+            a = np.zeros((len(rows), k + 3))
             if name == "positions":
-                a[:, :k] = pk[:, 0, :]
+                a[sel, :k] = pk[:, 0, :]
             else:
-                np.einsum("nj,njk->nk", src, pk[:, 1:, :], out=a[:, :k])
+                a[sel, :k] = np.einsum("nj,njk->nk", src[sel], pk[:, 1:, :])
             a[:, k:] = src
             arrays.append(a)
+        filler = span[~member]
         # when the support is most of the cloud, copy only its complement
         # (long runs by slice, the rest by index); otherwise one plain copy
         comp_segments = None
         n_all = len(cloud.positions)
-        if 2 * len(idx) > n_all:
-            comp = np.setdiff1d(np.arange(n_all), idx, assume_unique=True)
+        if 2 * len(span) > n_all:
+            comp = np.setdiff1d(np.arange(n_all), span, assume_unique=True)
             comp_segments = [d for _, _, d in _run_plan(comp, chunk=1 << 30)[1]]
         self._cpu = dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
-                         segments=segments, comp_segments=comp_segments)
+                         segments=segments, comp_segments=comp_segments, filler=filler)
         return self._cpu
 
     def release_cpu_cache(self) -> None:
@@ -391,6 +436,9 @@ class DeformationBasis:
                     np.matmul(a[lo:hi], mx, out=o[dest])
                 else:
                     o[dest] = a[lo:hi] @ mx
+        if len(c["filler"]):  # fixed splats computed through: restore them bitwise
+            for s, o in zip(srcs, outs):
+                o[c["filler"]] = s[c["filler"]]
         return outs
 
     def apply(self, cloud, dC, *, validate: bool = False):

@@ -374,3 +374,43 @@ def test_two_handle_edit_matches_exact_solve_and_scipy(two):
     oracle = RBFInterpolator(con.points, con.values @ dc, kernel="cubic", degree=2)
     theirs = oracle(cloud.positions[lu.indices[rows]])
     assert np.abs(lu.displacements(dc)[rows] - theirs).max() / np.abs(con.values @ dc).max() < 1e-8
+
+
+def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_zero(monkeypatch):
+    """The CPU apply computes through short gaps of fixed splats between long
+    runs of support splats (one long GEMM instead of a call per run) and then
+    restores them: they must come out bitwise identical, -0.0 included."""
+    import splatedit.deform.basis as basis_module
+    from splatedit.deform.basis import _fill_small_gaps
+    monkeypatch.setattr(basis_module, "_RUN_MIN", 64)   # runs of 112 count as long here
+    cloud = wavy_plane_cloud(120)
+    p = cloud.positions.copy()
+    n = len(p)
+    # support: every row of the grid except a short gap in each, so runs are long and gaps small
+    support = np.ones(n, dtype=bool)
+    gap_rows = np.arange(0, n, 120)[:, None] + np.arange(50, 58)[None, :]
+    gap_rows = gap_rows[gap_rows < n].ravel()
+    support[gap_rows] = False
+    support[: 3 * 120] = False          # a fixed border for the band
+    p[gap_rows, 0] = -0.0                # negative zeros must survive
+    cloud = SplatCloud(p, cloud.u, cloud.v)
+    handle = support & (np.linalg.norm(cloud.positions[:, :2], axis=1) < 0.2)
+    span, member = _fill_small_gaps(np.flatnonzero(support))
+    assert (~member).sum() > 0          # the plan really computes through gaps
+    b = DeformationBasis.fit(cloud, support, [handle], method="iqr")
+    out = b.apply(cloud, b.displacement([translate([0.0, 0.0, 0.1])]))
+    fixed = ~support
+    for name in ("positions", "u", "v"):
+        assert getattr(out, name)[fixed].tobytes() == getattr(cloud, name)[fixed].tobytes()
+    assert np.allclose(out.positions[handle] - cloud.positions[handle], [0, 0, 0.1])
+
+
+def test_gap_filling_leaves_scattered_indices_alone():
+    from splatedit.deform.basis import _fill_small_gaps
+    idx = np.sort(np.random.default_rng(0).choice(100_000, 30_000, replace=False))
+    span, member = _fill_small_gaps(idx)
+    assert member.all() and np.array_equal(span, idx)
+    runs = np.concatenate([np.arange(0, 1000), np.arange(1100, 2100), np.arange(5000, 5010)])
+    span, member = _fill_small_gaps(runs)
+    assert np.array_equal(span[member], runs)
+    assert np.array_equal(span[~member], np.arange(1000, 1100))   # 100 <= 0.25 * 1000; the 10-run is short
