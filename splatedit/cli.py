@@ -13,7 +13,7 @@ import sys
 import time
 from pathlib import Path
 
-from splatedit.app.options import parse_size
+from splatedit.app.options import parse_size, positive_float
 from splatedit.errors import ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
@@ -140,6 +140,8 @@ def cmd_render(args) -> int:
     from splatedit.io import read
     from splatedit.io.atomic import check_writable_target
     from splatedit.render.headless import render_to_png
+    if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
+        raise ParameterError("--buffers", "must differ from the PNG path (-o)")
     for target in (args.output, args.buffers):
         if target is not None:
             check_writable_target(target, overwrite=args.force, protect=args.input)
@@ -199,10 +201,20 @@ def cmd_main(args) -> int:
     if os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY"):
         from splatedit.app.editor import run_editor
         return run_editor(None)
-    args.output_dir = "."
+    args.output_dir = str(_fresh_directory(Path("splatedit-demo")))
     args.no_render = False
-    args.force = True
+    args.force = False
     return cmd_demo(args)
+
+
+def _fresh_directory(base: Path) -> Path:
+    """``base`` if it does not exist yet, else ``base-2``, ``base-3``, ... (never
+    writes into a folder that holds earlier results)."""
+    candidate, k = base, 1
+    while candidate.exists():
+        k += 1
+        candidate = base.with_name(f"{base.name}-{k}")
+    return candidate
 
 
 def cmd_bench(args) -> int:
@@ -240,7 +252,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--edit", required=True, type=Path, help="edit script (JSON)")
     s.add_argument("-o", "--output", required=True, help="output PLY")
     s.add_argument("--method", choices=("auto", "lu", "iqr"), help="override the script's solver method")
-    s.add_argument("--tol", type=float, help="override the script's IQR tolerance")
+    s.add_argument("--tol", type=positive_float, help="override the script's IQR tolerance")
     s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists (even the input)")
     s.set_defaults(func=cmd_deform)
 

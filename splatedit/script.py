@@ -51,9 +51,9 @@ from typing import Any, Callable
 
 import numpy as np
 
-from splatedit.errors import EditScriptError, SplatEditError
+from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.select.regions import Box, Indices, Region, Sphere
-from splatedit.tolerances import IQR_DEFAULT_TOL
+from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL
 
 SCRIPT_VERSION = 1
 METHODS = ("auto", "iqr", "lu")
@@ -288,10 +288,14 @@ def _transform(ctx: _Ctx, value, jp: str) -> Transform:
                 raise ctx.fail(f"{jp}.matrix[{r}]", f"must be a list of 4 numbers, got {_kind(row)}")
             vals.append(tuple(ctx.number(x, f"{jp}.matrix[{r}][{c}]") for c, x in enumerate(row)))
         m = np.array(vals)
-        if not np.allclose(m[3], [0, 0, 0, 1]):
+        if not np.array_equal(m[3], [0, 0, 0, 1]):
             raise ctx.fail(f"{jp}.matrix[3]", "the last row of an affine matrix must be [0, 0, 0, 1]")
-        if abs(np.linalg.det(m[:3, :3])) < 1e-12:
+        sv = np.linalg.svd(m[:3, :3], compute_uv=False)
+        if sv[-1] <= AFFINE_MIN_SINGULAR_REL * sv[0]:
             raise ctx.fail(f"{jp}.matrix", "is singular (it would flatten the handle)")
+        if np.linalg.det(m[:3, :3]) < 0:
+            raise ctx.fail(f"{jp}.matrix", "mirrors the handle (negative determinant), which would turn "
+                           "its splats inside out")
         return Matrix(tuple(vals))
     translate = ctx.vec3(obj["translate"], f"{jp}.translate") if "translate" in obj else (0.0, 0.0, 0.0)
     axis, degrees, rcenter = None, 0.0, None
@@ -570,7 +574,12 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         r, basis, d_c = fit_edit(cloud, edit, script.solver, method=method, tol=tol,
                                  source=source, progress=progress)
         t0 = time.perf_counter()
-        new = basis.apply(cloud, d_c)
+        try:   # commit validates: an extreme edit must not write an unreadable model
+            new = basis.commit(cloud, d_c)
+        except InputError as exc:
+            raise EditScriptError(f"the edit makes splats degenerate ({exc.reason}, splat "
+                                  f"{exc.row}); use a milder transform", json_path=edit.json_path,
+                                  path=source) from None
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
         rep = EditReport(i, int(r.support.sum()), [int(h.sum()) for h in r.handles], stats["n_constraints"],

@@ -89,6 +89,11 @@ IQR_R_DIAG_RTOL = 1e-13
 #: and its LU copy would need 2 * 8 * m^2 bytes (6.4 GB at 20000)
 LU_MAX_CONSTRAINTS = 20000
 
+# --- edit scripts -------------------------------------------------------
+#: an affine matrix whose smallest singular value is below this fraction of
+#: its largest is rejected as singular (it would flatten the handle)
+AFFINE_MIN_SINGULAR_REL = 1e-9
+
 # --- constraints --------------------------------------------------------
 #: thickness of the fixed and handle bands, in point spacings ("three rings")
 BAND_RINGS = 3.0
@@ -110,6 +115,14 @@ RENDER_MIN_WEIGHT = 1e-3
 RENDER_CLIP_MARGIN_REL = 0.05
 #: near plane is at least far * this (keeps float depth precision usable)
 RENDER_NEAR_FAR_RATIO = 1e-3
+#: Camera: |forward x up| <= this * |forward| |up| (sine of their angle) means
+#: the up hint is parallel to the view direction
+RENDER_CAMERA_MIN_UP_SINE = 1e-12
+#: Camera.clip_range: the bounding-sphere radius is at least this times
+#: max(1, eye distance), so that a single point still gets near < far
+RENDER_CLIP_MIN_RADIUS_REL = 1e-12
+#: Camera.frame: smallest bounding-sphere radius framed (model units; a single point)
+RENDER_FRAME_MIN_RADIUS = 1e-9
 #: Camera.frame: distance so that the bounding sphere fits the view, times this
 RENDER_FRAME_MARGIN = 1.05
 #: default vertical field of view, degrees
@@ -138,3 +151,62 @@ RENDER_MAX_BASIS_COLUMNS = 16
 #: Measured at 1280x720 (lavapipe): 1M-splat sphere 1.5x faster than all
 #: quads, 100k 1.3x faster with 3 px than with 1 px
 RENDER_POINT_SPLAT_MAX_PX = 3.0
+
+# --- interactive editor (splatedit.app) ----------------------------------
+#: orbit camera: pitch is kept within +-this many degrees of the horizon
+EDITOR_PITCH_LIMIT_DEG = 89.0
+#: orbit camera: radians of orbit per pixel of mouse motion
+EDITOR_ORBIT_RAD_PER_PX = 0.008
+#: orbit camera: distance factor per wheel step (zoom in for positive steps)
+EDITOR_DOLLY_STEP = 0.85
+#: orbit camera: closest and farthest distance, relative to the model radius
+EDITOR_MIN_DIST_REL = 1e-3
+EDITOR_MAX_DIST_REL = 1e3
+#: orbit camera clip planes: distance -+ this many model radii
+EDITOR_CLIP_RADII = 2.0
+#: orbit camera: the near plane is at least distance * this, and at least
+#: EDITOR_NEAR_MIN (model units); far is at least near * EDITOR_FAR_MIN_NEAR
+EDITOR_NEAR_MIN_REL = 1e-3
+EDITOR_NEAR_MIN = 1e-6
+EDITOR_FAR_MIN_NEAR = 10.0
+#: orbit camera: a framed sphere fills the view up to this margin
+EDITOR_FRAME_MARGIN = 1.1
+#: a left press this close to a curve dot (pixels) drags it
+EDITOR_CURVE_DOT_PICK_PX = 10
+#: length of the translate gizmo's arrows (pixels); arrows shorter on screen
+#: than EDITOR_GIZMO_MIN_PX (seen end-on) are hidden; a press within
+#: EDITOR_GIZMO_HIT_PX of an arrow's outer three quarters grabs it
+EDITOR_GIZMO_PX = 70
+EDITOR_GIZMO_MIN_PX = 12
+EDITOR_GIZMO_HIT_PX = 7.0
+#: depth tolerance of the brush's visibility test, in pixel footprints
+EDITOR_PICK_TOL_PX = 6.0
+#: the brush radius range (pixels)
+EDITOR_BRUSH_MIN_PX, EDITOR_BRUSH_MAX_PX = 2, 400
+#: brush radius factor per wheel step (Ctrl+wheel) and per [ / ] key press
+EDITOR_BRUSH_WHEEL_STEP = 1.15
+EDITOR_BRUSH_KEY_STEP = 1.2
+#: seconds without motion after which the full-quality frame is drawn
+EDITOR_REFINE_DELAY_S = 0.2
+#: full-quality frames predicted slower than this (ms) are drawn in the background
+EDITOR_ASYNC_REFINE_MS = 400.0
+#: seconds without motion before such a background frame is started
+EDITOR_ASYNC_REFINE_DELAY_S = 0.6
+#: assumed full-quality cost (ms per splat at the window size) before the first measurement
+EDITOR_GUESS_MS_PER_SPLAT = 6e-4
+#: models with more splats than this get a level-of-detail pyramid
+EDITOR_LOD_MIN_SPLATS = 150_000
+#: level-of-detail grid cell = this * sqrt(surface area / splat budget)
+#: (a square grid of cell c gives about area / c^2 clusters; the margin
+#: absorbs the clusters cut by cell borders)
+EDITOR_LOD_CELL_FACTOR = 1.08
+#: smallest level-of-detail grid cell, relative to the bounding-box diagonal
+EDITOR_LOD_MIN_CELL_REL = 1e-6
+#: an axis-constrained grab does nothing while the axis's screen direction
+#: (|(a . right, a . up)|, 1 when the axis lies in the view plane) is shorter
+#: than this (the axis points at the viewer)
+EDITOR_AXIS_MIN_SCREEN_LEN = 1e-6
+#: a mouse-driven scale factor is clamped to at least this; a typed factor
+#: must be > 0 (a negative one would mirror the handle and turn its normals
+#: inside out)
+EDITOR_MIN_SCALE_FACTOR = 1e-3

@@ -85,6 +85,10 @@ BAD_SCRIPTS = [
     (["edits", 1, "transforms", 0, "matrix", 3], [0, 0, 1, 1], "$.edits[1].transforms[0].matrix[3]", "last row"),
     (["edits", 1, "transforms", 0, "matrix"], [[0] * 4] * 3 + [[0, 0, 0, 1]], "$.edits[1].transforms[0].matrix", "singular"),
     (["edits", 1, "transforms", 0, "matrix", 0], [1, 0, 0], "$.edits[1].transforms[0].matrix[0]", "4 numbers"),
+    (["edits", 1, "transforms", 0, "matrix"], [[-1, 0, 0, 0], [0, 1, 0, 0], [0, 0, 1, 0], [0, 0, 0, 1]],
+     "$.edits[1].transforms[0].matrix", "mirrors the handle"),
+    (["edits", 1, "transforms", 0, "matrix", 3], [0, 0, 0, 1.0000000001], "$.edits[1].transforms[0].matrix[3]",
+     "last row"),
     # control curves
     (["edits", 2, "curves"], [], "$.edits[2].curves", "non-empty list of curves"),
     (["edits", 2, "curves"], _DELETE, "$.edits[2]", "at least one handle or curve"),
@@ -217,3 +221,20 @@ def test_invalid_json_names_file_and_line(tmp_path):
 def test_missing_script_file_is_a_clear_error(tmp_path):
     with pytest.raises(EditScriptError, match="cannot read"):
         load_script(tmp_path / "nope.json")
+
+
+def test_uniform_tiny_scale_is_not_called_singular():
+    doc = copy.deepcopy(GOOD)
+    doc["edits"][1]["transforms"][0] = {"matrix": [[1e-4, 0, 0, 0], [0, 1e-4, 0, 0], [0, 0, 1e-4, 0], [0, 0, 0, 1]]}
+    parse_script(doc)
+
+
+def test_edit_that_makes_splats_degenerate_is_refused_with_its_json_path():
+    from splatedit.bench.solve import sphere_cloud
+    from splatedit.script import run_script
+    cloud = sphere_cloud(3000)
+    doc = {"version": 1, "edits": [
+        {"support": {"sphere": {"center": [0, 0, 1], "radius": 0.8}},
+         "handle": {"sphere": {"center": [0, 0, 1], "radius": 0.3}}, "transform": {"scale": 1e-9}}]}
+    with pytest.raises(EditScriptError, match=r"\$\.edits\[0\]: the edit makes splats degenerate"):
+        run_script(cloud, parse_script(doc))

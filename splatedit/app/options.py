@@ -67,6 +67,17 @@ def parse_size(text: str) -> tuple[int, int]:
     return w, h
 
 
+def positive_float(text: str) -> float:
+    """argparse type: a finite number > 0 (tolerances, budgets)."""
+    try:
+        x = float(text)
+    except ValueError:
+        raise argparse.ArgumentTypeError(f"must be a number, got {text!r}") from None
+    if not (x > 0 and x != float("inf")):
+        raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
+    return x
+
+
 def add_arguments(p) -> None:
     """Add the ``splatedit edit`` options to an argparse parser."""
     p.add_argument("file", nargs="?", help="model to open (default: the bundled bunny)")
@@ -75,10 +86,10 @@ def add_arguments(p) -> None:
     p.add_argument("--size", type=parse_size, default=(1280, 720), help="window size WxH (default 1280x720)")
     p.add_argument("--method", default="auto", choices=("auto", "lu", "iqr"),
                    help="solver (also written to the exported edit script)")
-    p.add_argument("--tol", type=float, default=IQR_DEFAULT_TOL, help="IQR relative tolerance")
+    p.add_argument("--tol", type=positive_float, default=IQR_DEFAULT_TOL, help="IQR relative tolerance")
     p.add_argument("--no-vsync", action="store_true", help="present without vsync (MAILBOX/IMMEDIATE)")
     p.add_argument("--no-lod", action="store_true", help="never draw a level of detail while moving")
-    p.add_argument("--budget-ms", type=float, default=100.0,
+    p.add_argument("--budget-ms", type=positive_float, default=100.0,
                    help="frame-time budget while moving (default 100 ms = 10 fps)")
     p.add_argument("--status-file", help="test hook: a JSON file rewritten when the state changes")
 

@@ -15,19 +15,26 @@ from splatedit.errors import InputError
 
 
 def check_writable_target(path: str | Path, *, overwrite: bool, protect: str | Path | None = None) -> Path:
-    """Refuse to clobber an existing file (or the input ``protect``) unless asked.
+    """Check, before any long work, that ``path`` can be written.
+
+    Refuses to clobber an existing file (or the input ``protect``) unless
+    ``overwrite``; the parent must be an existing directory.
 
     Raises:
-        InputError: naming the path, when it exists and ``overwrite`` is False,
-            or when it is the protected input file and ``overwrite`` is False.
+        InputError: naming the path.
     """
     p = Path(path)
+    parent = p.parent if str(p.parent) else Path(".")
+    if not parent.exists():
+        raise InputError("directory does not exist", path=str(parent))
+    if not parent.is_dir():
+        raise InputError("is not a directory", path=str(parent))
+    if p.is_dir():
+        raise InputError("is a directory", path=str(p))
     if protect is not None and p.exists() and Path(protect).exists() and p.resolve() == Path(protect).resolve() and not overwrite:
         raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
     if p.exists() and not overwrite:
         raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
-    if p.exists() and p.is_dir():
-        raise InputError("is a directory", path=str(p))
     return p
 
 
@@ -48,19 +55,24 @@ def _current_umask() -> int:
 def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
     """Open a temp file beside ``path``; on success rename it onto ``path``.
 
-    On any exception the temporary file is removed and ``path`` is untouched.
+    On any exception the temporary file is removed and ``path`` is untouched;
+    an ``OSError`` becomes an :class:`InputError` naming ``path``.
     """
     p = Path(path)
     directory = p.parent if str(p.parent) else Path(".")
     if not directory.is_dir():
-        raise InputError("directory does not exist", path=str(directory))
+        raise InputError("directory does not exist" if not directory.exists() else "is not a directory",
+                         path=str(directory))
     # keep an existing file's permissions; new files get the usual 0666 & ~umask
     # (mkstemp itself creates 0600 files)
     if p.exists():
         perms = p.stat().st_mode & 0o777
     else:
         perms = 0o666 & ~_current_umask()
-    fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=directory)
+    try:
+        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=directory)
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror or exc}", path=str(p)) from None
     try:
         os.fchmod(fd, perms)
         with os.fdopen(fd, mode) as fh:
@@ -68,6 +80,10 @@ def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
             fh.flush()
             os.fsync(fh.fileno())
         os.replace(tmp, p)
+    except OSError as exc:   # disk full, permissions, target became a directory, ...
+        with contextlib.suppress(FileNotFoundError):
+            os.unlink(tmp)
+        raise InputError(f"cannot write: {exc.strerror or exc}", path=str(p)) from None
     except BaseException:
         with contextlib.suppress(FileNotFoundError):
             os.unlink(tmp)

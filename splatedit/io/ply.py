@@ -56,7 +56,7 @@ def _wrap(exc: Exception, path) -> InputError:
 def _load(path) -> plyfile.PlyData:
     known = {"face": {name: 3 for name in _FACE_LISTS}}
     errors = (plyfile.PlyParseError, ValueError, TypeError, UnicodeDecodeError, IndexError,
-              EOFError, OSError, MemoryError)
+              EOFError, OSError, MemoryError, OverflowError)
     try:
         try:
             # Triangle meshes: memory-map the faces as an (f, 3) array.
@@ -308,7 +308,9 @@ _PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "i4": "int"}
 def _header(vert: np.ndarray, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
     lines = ["ply", f"format {fmt} 1.0"]
     if comment:
-        lines += [f"comment {c}" for c in comment.splitlines()]
+        # PLY headers are ASCII: escape anything else (e.g. a file name like été.ply)
+        safe = comment.encode("ascii", "backslashreplace").decode("ascii")
+        lines += [f"comment {c}" for c in safe.splitlines()]
     lines.append(f"element vertex {len(vert)}")
     for name in vert.dtype.names:
         lines.append(f"property {_PLY_TYPE[vert.dtype[name].str[1:]]} {name}")
