@@ -319,7 +319,7 @@ def _transform(ctx: _Ctx, value, jp: str) -> Transform:
 
 
 def _curves(ctx: _Ctx, value, jp: str) -> tuple[Curve, ...]:
-    from splatedit.deform.curves import _MIN_CHORD_REL
+    from splatedit.deform.curves import first_coincident_point
     if not isinstance(value, list) or not value:
         raise ctx.fail(jp, f"must be a non-empty list of curves, got {_kind(value)}")
     out = []
@@ -331,12 +331,10 @@ def _curves(ctx: _Ctx, value, jp: str) -> tuple[Curve, ...]:
             raise ctx.fail(f"{cjp}.points", f"must be a list of at least 2 points [x, y, z], "
                            f"got {_kind(pts_in)}")
         pts = tuple(ctx.vec3(p, f"{cjp}.points[{k}]") for k, p in enumerate(pts_in))
-        arr = np.array(pts)
-        extent = max(float(np.ptp(arr, axis=0).max()), float(np.abs(arr).max()), 1e-300)
-        for k in range(1, len(pts)):
-            if np.linalg.norm(arr[k] - arr[k - 1]) <= _MIN_CHORD_REL * extent:
-                raise ctx.fail(f"{cjp}.points[{k}]", f"coincides with points[{k - 1}]; "
-                               "consecutive curve points must be distinct")
+        k = first_coincident_point(pts)
+        if k is not None:
+            raise ctx.fail(f"{cjp}.points[{k}]", f"coincides with points[{k - 1}]; "
+                           "consecutive curve points must be distinct")
         mv = c["move"]
         if not isinstance(mv, list) or len(mv) != len(pts):
             raise ctx.fail(f"{cjp}.move", f"must be a list with one [dx, dy, dz] per point "

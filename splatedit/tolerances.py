@@ -94,6 +94,11 @@ LU_MAX_CONSTRAINTS = 20000
 #: its largest is rejected as singular (it would flatten the handle)
 AFFINE_MIN_SINGULAR_REL = 1e-9
 
+# --- control curves -----------------------------------------------------
+#: consecutive picked curve points closer than this (relative to the points'
+#: extent) coincide
+CURVE_MIN_CHORD_REL = 1e-9
+
 # --- constraints --------------------------------------------------------
 #: thickness of the fixed and handle bands, in point spacings ("three rings")
 BAND_RINGS = 3.0

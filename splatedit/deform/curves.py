@@ -44,14 +44,26 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from splatedit.errors import ParameterError
+from splatedit.tolerances import CURVE_MIN_CHORD_REL
 
 #: highest spline degree (cubic)
 CURVE_DEGREE = 3
 #: polyline points per knot span used to measure arc length
 _ARC_POINTS_PER_SPAN = 64
-#: consecutive picked points closer than this (relative to the curve's
-#: extent) coincide
-_MIN_CHORD_REL = 1e-9
+
+
+def first_coincident_point(points) -> int | None:
+    """Index j >= 1 of the first picked point that coincides with point j - 1
+    (closer than CURVE_MIN_CHORD_REL of the points' extent), or None.
+
+    Args:
+        points: (k + 1, 3) picked curve points.
+    """
+    q = np.asarray(points, dtype=np.float64)
+    chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
+    extent = max(float(np.ptp(q, axis=0).max()), float(np.abs(q).max()), 1e-300)
+    small = np.flatnonzero(chords <= CURVE_MIN_CHORD_REL * extent)
+    return int(small[0]) + 1 if len(small) else None
 
 
 def bspline_basis(t, knots, degree: int) -> np.ndarray:
@@ -139,13 +151,11 @@ class ControlCurve:
                 raise ParameterError("samples", f"must be an integer >= 2 or None, got {samples!r}")
             samples = int(samples)
         k = len(q) - 1
-        chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
-        extent = max(float(np.ptp(q, axis=0).max()), float(np.abs(q).max()), 1e-300)
-        small = np.flatnonzero(chords <= _MIN_CHORD_REL * extent)
-        if len(small):
-            j = int(small[0])
-            raise ParameterError("points", f"points {j} and {j + 1} coincide; consecutive "
+        j = first_coincident_point(q)
+        if j is not None:
+            raise ParameterError("points", f"points {j - 1} and {j} coincide; consecutive "
                                  "curve points must be distinct")
+        chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
         params = np.concatenate([[0.0], np.cumsum(chords)]) / chords.sum()
         params[-1] = 1.0
         p = min(CURVE_DEGREE, k)
