@@ -102,6 +102,12 @@ CURVE_MIN_CHORD_REL = 1e-9
 # --- constraints --------------------------------------------------------
 #: thickness of the fixed and handle bands, in point spacings ("three rings")
 BAND_RINGS = 3.0
+#: relative slack on the band width so points at exactly ``rings * spacing``
+#: (regular samplings) are not lost to rounding
+BAND_SLACK_REL = 1e-9
+#: a handle's control frame whose edge vectors (scaled to unit size) span a
+#: volume below this is degenerate (its 4 points are nearly coplanar)
+FRAME_MIN_DET_REL = 1e-12
 
 # --- rendering (splatedit.render) -------------------------------------------
 #: EWA screen-space low-pass filter radius in pixels (sqrt(2)/2): every splat covers at

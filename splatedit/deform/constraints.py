@@ -73,11 +73,7 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError, SolverError
 from splatedit.model.spacing import point_spacing
-from splatedit.tolerances import BAND_RINGS
-
-#: relative slack on the band width so points at exactly ``rings * spacing``
-#: (regular samplings) are not lost to rounding
-_BAND_SLACK_REL = 1e-9
+from splatedit.tolerances import BAND_RINGS, BAND_SLACK_REL, FRAME_MIN_DET_REL
 
 
 # ----------------------------------------------------------------- frames
@@ -101,7 +97,7 @@ def _frame_inverse(frame: np.ndarray) -> np.ndarray:
         raise ParameterError("frame", f"must be 4 points (4, 3), got shape {c.shape}")
     e = (c[1:] - c[0]).T  # columns b - a, c - a, d - a
     scale = max(float(np.abs(e).max()), 1e-300)
-    if abs(np.linalg.det(e / scale)) < 1e-12:
+    if abs(np.linalg.det(e / scale)) < FRAME_MIN_DET_REL:
         raise ParameterError("frame", "its 4 points are (nearly) coplanar")
     return np.linalg.inv(e)
 
@@ -372,7 +368,7 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
         if not (np.isfinite(h) and h > 0):
             raise ParameterError("spacing", f"must be > 0, got {spacing}")
     width = rings * h
-    w_query = width * (1.0 + _BAND_SLACK_REL)
+    w_query = width * (1.0 + BAND_SLACK_REL)
 
     # fixed band: outside the support, within the width of a support splat
     out_index = np.flatnonzero(~sup)
@@ -398,7 +394,7 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
 
     # curves: keep the samples whose nearest splat is free and that have no
     # outside splat, handle splat or earlier curve sample within one spacing
-    drop_width = h * (1.0 + _BAND_SLACK_REL)
+    drop_width = h * (1.0 + BAND_SLACK_REL)
     held = np.flatnonzero(~free)  # outside the support, or in a handle
     held_pts = pos[held]
     previous: list[np.ndarray] = []
