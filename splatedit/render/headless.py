@@ -2,13 +2,14 @@
 
 from __future__ import annotations
 
+import os
 from pathlib import Path
 
 import numpy as np
 from PIL import Image
 
-from splatedit.errors import ParameterError
-from splatedit.io.atomic import atomic_open
+from splatedit.errors import InputError, ParameterError
+from splatedit.io.atomic import atomic_open, check_writable_target
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
@@ -31,6 +32,12 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         buffers_path: also save the float buffers (depth, normal, weight,
             colour; see :meth:`Renderer.render_buffers`) to this ``.npz``.
     Returns the PNG path.
+
+    Raises:
+        InputError: naming the path, when an output cannot be written (its
+            directory cannot be created or written, it is a directory, the
+            disk is full, ...); the directories are checked (and created)
+            before rendering.
     """
     try:
         w, h = (int(s) for s in size)
@@ -39,6 +46,9 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
     if dC is not None and basis is None:
         raise ParameterError("dC", "given without a basis")
     out_png = Path(out_png)
+    outputs = [out_png] + ([Path(buffers_path)] if buffers_path is not None else [])
+    for out in outputs:
+        _prepare_output(out)
     if camera is None:
         camera = Camera.frame(*cloud.bounds(), aspect=w / h)
     with Renderer(device_name=device_name) as r:
@@ -51,11 +61,29 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
         img = r.render(camera, w, h)
         bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None
-    out_png.parent.mkdir(parents=True, exist_ok=True)
-    with atomic_open(out_png, "wb") as fh:
-        Image.fromarray(img, "RGBA").save(fh, format="PNG")
+    _write(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
     if bufs is not None:
-        Path(buffers_path).parent.mkdir(parents=True, exist_ok=True)
-        with atomic_open(Path(buffers_path), "wb") as fh:
-            np.savez_compressed(fh, **bufs)
+        _write(Path(buffers_path), lambda fh: np.savez_compressed(fh, **bufs))
     return out_png
+
+
+def _prepare_output(path: Path) -> None:
+    """Before rendering: create ``path``'s directory and check that a file can
+    be written there (the CLI has already refused existing files unless
+    --force, so an existing file is fine here)."""
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"cannot create its directory {str(parent)!r}: {e.strerror or e}", path=str(path)) from None
+    check_writable_target(path, overwrite=True)
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(f"directory {str(parent)!r} is not writable", path=str(path))
+
+
+def _write(path: Path, save) -> None:
+    try:
+        with atomic_open(path, "wb") as fh:
+            save(fh)
+    except OSError as e:
+        raise InputError(f"cannot write: {e.strerror or e}", path=str(path)) from None

@@ -93,12 +93,22 @@ class RenderTarget:
 
 
 class _Targets:
-    """Per-size images and framebuffers."""
+    """Per-size images and framebuffers.  A failure part-way (an image too
+    large for the device) destroys what was already created."""
 
     def __init__(self, r: "Renderer", width: int, height: int):
-        dev = r.dev
         self.width, self.height = width, height
         self.objects = []
+        self.target_fbs = {}      # id(target) -> (target, framebuffer)
+        try:
+            self._create(r)
+        except BaseException:
+            self.destroy()
+            raise
+
+    def _create(self, r: "Renderer"):
+        dev = r.dev
+        width, height = self.width, self.height
 
         def img(fmt, usage):
             im = V.Image(dev, width, height, fmt, usage)
@@ -117,7 +127,6 @@ class _Targets:
         self.resolve_set = V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET))
         self.objects.append(self.resolve_set)
         self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
-        self.target_fbs = {}      # id(target) -> (target, framebuffer)
         self.pick_index = self.pick_depth = self.fb_pick = None
         self._r = r
 
@@ -137,11 +146,20 @@ class _Targets:
     def ensure_pick(self):
         if self.fb_pick is None:
             dev = self._r.dev
-            self.pick_index = V.Image(dev, self.width, self.height, "r32ui", ("color", "transfer_src"))
-            self.objects.append(self.pick_index)
-            self.pick_depth = V.Image(dev, self.width, self.height, "d32f", ("depth", "transfer_src"))
-            self.objects.append(self.pick_depth)
-            self.fb_pick = self._fb(dev, self._r.cache.render_pass(_RP_PICK), [self.pick_index, self.pick_depth])
+            first = len(self.objects)
+            try:
+                self.pick_index = V.Image(dev, self.width, self.height, "r32ui", ("color", "transfer_src"))
+                self.objects.append(self.pick_index)
+                self.pick_depth = V.Image(dev, self.width, self.height, "d32f", ("depth", "transfer_src"))
+                self.objects.append(self.pick_depth)
+                self.fb_pick = self._fb(dev, self._r.cache.render_pass(_RP_PICK),
+                                        [self.pick_index, self.pick_depth])
+            except BaseException:
+                for o in reversed(self.objects[first:]):
+                    o.destroy()
+                del self.objects[first:]
+                self.pick_index = self.pick_depth = self.fb_pick = None
+                raise
 
     def destroy(self):
         for o in reversed(self.objects):
@@ -161,10 +179,6 @@ class _Prep:
 
 def _rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
     return V.RenderPassDesc(colors=(V.Attachment(target.format, "dont_care", final=target.final),))
-
-
-def _srgb_to_linear(c):
-    return np.asarray(c, dtype=np.float64) ** 2.2
 
 
 class Renderer:
@@ -227,6 +241,7 @@ class Renderer:
         self.n = 0
         self._basis_cols = 4
         self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_reach = 0.0       # see _clip_bounds
         self._dC = np.zeros((4, 3))
         self._dC_dirty = True
         self.dC_ubo = None
@@ -243,34 +258,55 @@ class Renderer:
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 8)
         except BaseException:
-            self.close()
+            try:
+                self.close()
+            except Exception:    # noqa: BLE001 - the construction error is the one to report
+                pass
             raise
 
     # ------------------------------------------------------------ lifecycle
     def close(self) -> None:
-        """Destroy every Vulkan object (reverse creation order); idempotent."""
+        """Destroy every Vulkan object (reverse creation order); idempotent.
+
+        Teardown runs to the end even when a step fails (``wait_idle`` after a
+        device loss: destroying objects of a lost device is still valid); the
+        first error is raised afterwards."""
         if self._closed:
             return
         self._closed = True
+        errors = []
+
+        def step(fn):
+            try:
+                fn()
+            except Exception as e:   # noqa: BLE001 - re-raised below, after the whole teardown
+                errors.append(e)
+
         if self.dev.device is not None:
-            self.dev.wait_idle()
-        self._free_cloud()
+            step(self.dev.wait_idle)
+        step(self._free_cloud)
         if self._targets is not None:
-            self._targets.destroy()
+            step(self._targets.destroy)
             self._targets = None
         for obj in (self._query, self.splat_set, self.dC_ubo, self.ubo, self.sampler):
             if obj is not None:
-                obj.destroy()
+                step(obj.destroy)
         if self.cache is not None:
-            self.cache.destroy()
+            step(self.cache.destroy)
         if self._own_device:
-            self.dev.close()
+            step(self.dev.close)
+        if errors:
+            raise errors[0]
 
     def __enter__(self):
         return self
 
-    def __exit__(self, *exc):
-        self.close()
+    def __exit__(self, exc_type, exc, tb):
+        try:
+            self.close()
+        except Exception:
+            if exc_type is None:
+                raise            # else: let the exception of the with-block propagate
 
     def _check_open(self):
         if self._closed:
@@ -308,6 +344,9 @@ class Renderer:
         lo, hi = cloud.bounds()
         self.origin = 0.5 * (lo + hi)
         r = cloud.radii
+        self._radii = r
+        #: undeformed bounds padded by the largest splat radius; near/far come
+        #: from these grown by the deformation's reach (:meth:`_clip_bounds`)
         self.bounds = (lo - r.max(), hi + r.max())
         geom = np.empty((n, 9), dtype=np.float32)
         geom[:, 0:3] = cloud.positions - self.origin
@@ -327,6 +366,7 @@ class Renderer:
         self.cloud = cloud
         self.n = n
         self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_reach = 0.0
         self._basis_cols = 4
         self._dC = np.zeros((4, 3))
         self._dC_dirty = True
@@ -427,6 +467,34 @@ class Renderer:
         view[idx] = rows.reshape(len(idx), 16 * g)
         flags[idx] |= np.uint32(FLAG_DEFORMED)
         self._basis_rows = idx
+        self._basis_reach = self._reach(idx, *mats)
+
+    def _reach(self, idx, B, Bx, By, Bz) -> float:
+        """max over the rows i of sum_k |B_ik| + (1 + RENDER_VISIBILITY_EPS_RADII)
+        r_i sum_k |grad B_ik|: times max_k |dC_k| it bounds how far any part of
+        a deformed splat (or its visibility-pass copy) can move.
+
+        Splat i's centre moves by |sum_k B_ik dC_k| <= sum_k |B_ik| |dC_k|.  Its
+        axes become J u, J v with J = I + sum_k dC_k (grad B_ik)^T, so its
+        radius grows by at most r_i ||J - I|| <= r_i sum_k |dC_k| |grad B_ik|;
+        the visibility pass pushes the splat back by RENDER_VISIBILITY_EPS_RADII
+        of its new radius, which grows by the same factor."""
+        if not len(idx):
+            return 0.0
+        grad = np.sqrt(Bx * Bx + By * By + Bz * Bz).sum(axis=1)
+        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._radii[idx] * grad
+        return float(per_row.max())
+
+    def _clip_bounds(self):
+        """The box that near/far are chosen from: the undeformed bounds grown
+        by a bound on any splat's displacement (see :meth:`_reach`), so that
+        geometry moved outside the model (a handle dragged towards the eye)
+        is not clipped."""
+        lo, hi = self.bounds
+        if not len(self._basis_rows):
+            return lo, hi
+        grow = self._basis_reach * float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+        return lo - grow, hi + grow
 
     def clear_basis(self) -> None:
         """Drop the deformation basis (every splat undeformed)."""
@@ -437,11 +505,15 @@ class Renderer:
         flags[self._basis_rows] &= np.uint32(~FLAG_DEFORMED & 0xFFFFFFFF)
         self._basis_buf.view(np.float32).reshape(self.n, -1)[self._basis_rows] = 0.0
         self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_reach = 0.0
 
     def set_displacement(self, dC) -> None:
         """Control-frame displacement dC (K, 3), K = the basis' column count
         (K = 4 before any :meth:`set_basis`).  Only dC (192 bytes) is uploaded
-        to the GPU, when the next frame is recorded."""
+        to the GPU, when the next frame is recorded; that frame's near/far
+        planes are chosen from the model bounds grown by the largest possible
+        splat displacement (:meth:`_clip_bounds`), so geometry moved outside
+        the undeformed model is not clipped."""
         self._check_open()
         a = np.asarray(dC, dtype=np.float64)
         if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols:
@@ -521,7 +593,7 @@ class Renderer:
     def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         if not isinstance(camera, Camera):
             raise ParameterError("camera", f"must be a Camera, got {type(camera).__name__}")
-        near, far = camera.clip_range(*self.bounds)
+        near, far = camera.clip_range(*self._clip_bounds())
         view = camera.view_matrix()
         view = view @ _translate(self.origin)       # model stored relative to origin
         proj = camera.projection_matrix(width / height, near, far)

@@ -29,3 +29,12 @@ def cpu_deform(cloud: SplatCloud, idx, B, Bx, By, Bz, dC) -> SplatCloud:
     u[idx] = np.einsum("nij,nj->ni", J, u[idx])
     v[idx] = np.einsum("nij,nj->ni", J, v[idx])
     return cloud.replace(positions=p, u=u, v=v)
+
+
+def bump_basis(points: np.ndarray, centre, sigma: float):
+    """One column B(p) = exp(-|p - c|^2 / sigma^2) and its gradient: a smooth
+    bump that moves the splats near ``centre`` by up to the whole dC."""
+    diff = points - np.asarray(centre, dtype=np.float64)
+    B = np.exp(-np.einsum("ni,ni->n", diff, diff) / sigma ** 2)[:, None]
+    grad = -2.0 / sigma ** 2 * diff * B
+    return B, grad[:, 0:1], grad[:, 1:2], grad[:, 2:3]

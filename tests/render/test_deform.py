@@ -7,7 +7,7 @@ import pytest
 
 from splatedit.errors import ParameterError
 from splatedit.render.camera import Camera
-from tests.render.deform_util import cpu_deform, gaussian_basis
+from tests.render.deform_util import bump_basis, cpu_deform, gaussian_basis
 from tests.render.scenes import sphere, torus
 
 W = H = 192
@@ -90,6 +90,39 @@ def test_prepass_basis_windows(renderer, monkeypatch):
     finally:
         monkeypatch.undo()
         renderer.set_cloud(base)
+
+
+@pytest.mark.parametrize("centre, dC, direction", [
+    ((0.0, 0.0, 1.0), (0.0, 0.0, 1.6), (0.3, 0.2, 1.0)),      # pulled 1.6 units towards the eye
+    ((0.7, 0.0, 0.7), (0.8, 0.0, -3.0), (0.0, 0.0, 1.0)),     # pushed 3 units away, beside the sphere
+])
+def test_deformation_beyond_the_undeformed_bounds_is_not_clipped(renderer, centre, dC, direction):
+    """near/far come from the undeformed cloud; a displacement that leaves its
+    bounding sphere must grow them (the editor: a handle dragged outside the
+    model), so the GPU image equals the CPU-deformed cloud's with the same
+    camera (framed on the undeformed cloud, as in the editor)."""
+    base = sphere(5000)
+    idx = np.arange(base.n)
+    B = bump_basis(base.positions, centre, sigma=0.8)
+    dC = np.array([dC])
+    deformed = cpu_deform(base, idx, *B, dC)
+    cam = Camera.frame(*base.bounds(), 1.0, direction=direction)
+    near, far = cam.clip_range(*base.bounds())
+    depth = (deformed.positions - cam.eye) @ ((cam.target - cam.eye) / np.linalg.norm(cam.target - cam.eye))
+    assert depth.min() < near or depth.max() > far        # the undeformed clip range would cut it
+
+    def setup():
+        renderer.set_basis(idx, *B)
+        renderer.set_displacement(dC)
+    img = _compare(renderer, base, deformed, cam, setup)
+    assert (img[..., :3] < 250).any()
+    # and the plain vertex path
+    saved = renderer.prepass
+    renderer.prepass = False
+    try:
+        _compare(renderer, base, deformed, cam, setup)
+    finally:
+        renderer.prepass = saved
 
 
 def test_basis_replacement_clears_old_rows(renderer):

@@ -2,9 +2,13 @@
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
+import pytest
 from PIL import Image
 
+from splatedit.errors import InputError
 from splatedit.render.camera import Camera
 from splatedit.render.headless import render_to_png
 from tests.render.deform_util import gaussian_basis
@@ -49,3 +53,55 @@ def test_render_to_png(tmp_path):
     assert set(bufs.files) == {"depth", "normal", "weight", "color"}
     assert bufs["normal"].shape == (64, 96, 3)
     assert not list(tmp_path.glob("**/*.tmp"))
+
+
+def _no_renderer(monkeypatch):
+    import splatedit.render.headless as headless
+
+    def refuse(*a, **k):
+        raise AssertionError("rendered before checking the output")
+    monkeypatch.setattr(headless, "Renderer", refuse)
+
+
+def test_render_to_png_output_under_a_regular_file(tmp_path, monkeypatch):
+    """Checked before rendering: an InputError naming the path."""
+    (tmp_path / "file").write_text("x")
+    _no_renderer(monkeypatch)
+    out = tmp_path / "file" / "img.png"
+    with pytest.raises(InputError) as e:
+        render_to_png(sphere(50), out, size=(8, 8))
+    assert str(out) in str(e.value) and "\n" not in str(e.value)
+    with pytest.raises(InputError, match=str(tmp_path / "file" / "b.npz")):
+        render_to_png(sphere(50), tmp_path / "ok.png", size=(8, 8), buffers_path=tmp_path / "file" / "b.npz")
+    with pytest.raises(InputError, match="is a directory"):
+        render_to_png(sphere(50), tmp_path, size=(8, 8))
+    assert not (tmp_path / "ok.png").exists()
+
+
+def test_render_to_png_write_error_is_an_input_error(tmp_path, monkeypatch):
+    import errno
+    import contextlib
+    import splatedit.render.headless as headless
+
+    @contextlib.contextmanager
+    def full_disk(path, mode="wb"):
+        raise OSError(errno.ENOSPC, os.strerror(errno.ENOSPC), str(path))
+        yield
+    monkeypatch.setattr(headless, "atomic_open", full_disk)
+    out = tmp_path / "img.png"
+    with pytest.raises(InputError, match="No space left") as e:
+        render_to_png(sphere(200), out, size=(16, 16))
+    assert e.value.path == str(out)
+
+
+def test_cli_render_output_under_a_regular_file_is_one_line(tmp_path, capsys):
+    from splatedit.cli import main
+    from splatedit.io import write
+    ply = tmp_path / "s.ply"
+    write(ply, sphere(200))
+    (tmp_path / "file").write_text("x")
+    out = tmp_path / "file" / "img.png"
+    assert main(["-q", "render", str(ply), "-o", str(out), "--size", "16x16"]) == 2
+    err = capsys.readouterr().err.strip()
+    # (the CLI's own check may already refuse the parent directory: then it names that)
+    assert err.count("\n") == 0 and str(out.parent) in err and err.startswith("splatedit: error:"), err

@@ -310,7 +310,12 @@ class DescriptorSet:
         layouts = [layout.handle]
         ainfo = vk.VkDescriptorSetAllocateInfo(descriptorPool=self.pool, descriptorSetCount=1,
                                                pSetLayouts=layouts)
-        self.handle = call(vk.vkAllocateDescriptorSets, device.device, ainfo)[0]
+        self.handle = None
+        try:
+            self.handle = call(vk.vkAllocateDescriptorSets, device.device, ainfo)[0]
+        except BaseException:
+            self.destroy()
+            raise
 
     def write(self, entries: dict):
         """``entries``: binding -> Buffer or (Buffer, offset, range) (uniform/storage;
