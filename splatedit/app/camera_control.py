@@ -18,15 +18,14 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from splatedit.render.camera import perspective
+from splatedit.tolerances import (EDITOR_CLIP_RADII, EDITOR_DOLLY_STEP, EDITOR_FAR_MIN_NEAR,
+                                  EDITOR_FRAME_MARGIN, EDITOR_MAX_DIST_REL, EDITOR_MIN_DIST_REL,
+                                  EDITOR_NEAR_MIN, EDITOR_NEAR_MIN_REL, EDITOR_ORBIT_RAD_PER_PX,
+                                  EDITOR_PITCH_LIMIT_DEG, RENDER_FOV_DEG)
+
 #: pitch is kept within +-this (radians) of the horizon
-PITCH_LIMIT = math.radians(89.0)
-#: radians of orbit per pixel of mouse motion
-ORBIT_RAD_PER_PX = 0.008
-#: distance factor per wheel step (zoom in for positive steps)
-DOLLY_STEP = 0.85
-#: closest and farthest camera distance relative to the model radius
-MIN_DIST_REL = 1e-3
-MAX_DIST_REL = 1e3
+PITCH_LIMIT = math.radians(EDITOR_PITCH_LIMIT_DEG)
 
 
 def _normalize(v: np.ndarray) -> np.ndarray:
@@ -40,7 +39,7 @@ class OrbitCamera:
     distance: float = 3.0
     yaw: float = 0.0
     pitch: float = 0.0
-    fov_deg: float = 40.0
+    fov_deg: float = RENDER_FOV_DEG
     up_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
     scene_radius: float = 1.0
 
@@ -75,21 +74,15 @@ class OrbitCamera:
         return m
 
     def near_far(self) -> tuple[float, float]:
-        near = max(self.distance - 2.0 * self.scene_radius, self.distance * 1e-3, 1e-6)
-        far = self.distance + 2.0 * self.scene_radius
-        return near, max(far, near * 10)
+        near = max(self.distance - EDITOR_CLIP_RADII * self.scene_radius,
+                   self.distance * EDITOR_NEAR_MIN_REL, EDITOR_NEAR_MIN)
+        far = self.distance + EDITOR_CLIP_RADII * self.scene_radius
+        return near, max(far, near * EDITOR_FAR_MIN_NEAR)
 
     def projection(self, aspect: float) -> np.ndarray:
         """(4, 4) Vulkan perspective (y down in NDC, depth 0..1)."""
         n, f = self.near_far()
-        t = 1.0 / math.tan(math.radians(self.fov_deg) / 2)
-        p = np.zeros((4, 4))
-        p[0, 0] = t / aspect
-        p[1, 1] = -t
-        p[2, 2] = f / (n - f)
-        p[2, 3] = n * f / (n - f)
-        p[3, 2] = -1.0
-        return p
+        return perspective(self.fov_deg, aspect, n, f)
 
     def view_projection(self, w: int, h: int) -> np.ndarray:
         return self.projection(w / max(h, 1)) @ self.view()
@@ -133,8 +126,8 @@ class OrbitCamera:
     # --------------------------------------------------------------- motion
     def orbit(self, dx_px: float, dy_px: float) -> None:
         """Turntable orbit about ``target`` by a mouse motion in pixels."""
-        self.yaw -= dx_px * ORBIT_RAD_PER_PX
-        self.pitch = float(np.clip(self.pitch + dy_px * ORBIT_RAD_PER_PX, -PITCH_LIMIT, PITCH_LIMIT))
+        self.yaw -= dx_px * EDITOR_ORBIT_RAD_PER_PX
+        self.pitch = float(np.clip(self.pitch + dy_px * EDITOR_ORBIT_RAD_PER_PX, -PITCH_LIMIT, PITCH_LIMIT))
 
     def pan(self, dx_px: float, dy_px: float, h: int) -> None:
         """Move the pivot in the view plane so the pivot plane follows the mouse."""
@@ -144,12 +137,12 @@ class OrbitCamera:
 
     def dolly(self, steps: float, x: float | None = None, y: float | None = None,
               w: int = 1, h: int = 1, depth: float | None = None) -> None:
-        """Zoom by ``DOLLY_STEP ** steps`` (positive = closer).  With a cursor
+        """Zoom by ``EDITOR_DOLLY_STEP ** steps`` (positive = closer).  With a cursor
         position, the world point under the cursor (at ``depth``, default the
         pivot's depth) stays under the cursor (dolly to cursor)."""
-        f = DOLLY_STEP ** steps
-        new_dist = float(np.clip(self.distance * f, MIN_DIST_REL * self.scene_radius,
-                                 MAX_DIST_REL * self.scene_radius))
+        f = EDITOR_DOLLY_STEP ** steps
+        new_dist = float(np.clip(self.distance * f, EDITOR_MIN_DIST_REL * self.scene_radius,
+                                 EDITOR_MAX_DIST_REL * self.scene_radius))
         f = new_dist / self.distance
         if x is None or y is None:
             self.distance = new_dist
@@ -159,7 +152,7 @@ class OrbitCamera:
         self.target = p + (np.asarray(self.target, float) - p) * f
         self.distance = new_dist
 
-    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = 1.1) -> None:
+    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN) -> None:
         """Look at a sphere (``center``, ``radius``) so it fills the view."""
         self.target = np.asarray(center, float).copy()
         half_v = math.radians(self.fov_deg) / 2

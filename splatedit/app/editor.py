@@ -15,9 +15,7 @@ import json
 import math
 import os
 import sys
-import threading
 import time
-import traceback
 from pathlib import Path
 
 import numpy as np
@@ -25,64 +23,20 @@ import numpy as np
 from splatedit.app import overlay as ov
 from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, picker_for_view, stroke_points
 from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.jobs import Job
 from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
 from splatedit.app.session import GRAB, ROTATE, SCALE, Session, ViewInfo
-from splatedit.errors import SplatEditError
-from splatedit.tolerances import IQR_DEFAULT_TOL
+from splatedit.errors import InputError, ParameterError, SplatEditError
+from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_BRUSH_KEY_STEP,
+                                  EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX, EDITOR_BRUSH_WHEEL_STEP,
+                                  EDITOR_CURVE_DOT_PICK_PX, EDITOR_GIZMO_HIT_PX,
+                                  EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX, EDITOR_GUESS_MS_PER_SPLAT,
+                                  EDITOR_LOD_MIN_SPLATS, EDITOR_PICK_TOL_PX, EDITOR_REFINE_DELAY_S,
+                                  IQR_DEFAULT_TOL)
 
 
-#: a left press this close to a curve dot (pixels) drags it
-CURVE_DOT_PICK_PX = 10
 #: colour of the control curve and its dots
 CURVE_RGB = (255, 150, 30)
-#: length of the translate gizmo's arrows (pixels)
-GIZMO_PX = 70
-#: depth tolerance of the brush's visibility test, in pixel footprints
-PICK_TOL_PX = 6.0
-#: the brush radius range (pixels)
-BRUSH_MIN, BRUSH_MAX = 2, 400
-#: seconds without motion after which the full-quality frame is drawn
-REFINE_DELAY = 0.2
-#: full-quality frames predicted slower than this (ms) are drawn in the background
-ASYNC_REFINE_MS = 400.0
-#: seconds without motion before such a background frame is started
-ASYNC_REFINE_DELAY = 0.6
-#: assumed full-quality cost (ms per splat at the window size) before the first measurement
-GUESS_MS_PER_SPLAT = 6e-4
-#: models with more splats than this get a level-of-detail pyramid
-LOD_MIN_SPLATS = 150_000
-
-
-# ------------------------------------------------------------ worker jobs
-class Job:
-    """A function run in a daemon thread with progress and a result."""
-
-    def __init__(self, name: str, fn, wake=None):
-        self.name = name
-        self.stage = name
-        self.fraction = 0.0
-        self.result = None
-        self.error: BaseException | None = None
-        self.done = False
-        self.started = time.perf_counter()
-        self._wake = wake
-
-        def run():
-            try:
-                self.result = fn(self.progress)
-            except BaseException as exc:  # noqa: BLE001 - reported in the overlay
-                self.error = exc
-                if not isinstance(exc, SplatEditError):
-                    traceback.print_exc()
-            self.done = True
-            if self._wake:
-                self._wake()
-
-        self.thread = threading.Thread(target=run, name=f"splatedit-{name}", daemon=True)
-        self.thread.start()
-
-    def progress(self, stage: str, fraction: float) -> None:
-        self.stage, self.fraction = stage, fraction
 
 
 def _default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
@@ -100,6 +54,47 @@ def _default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
 
 def script_path_for(ply: Path) -> Path:
     return ply.with_suffix("").with_name(ply.with_suffix("").name + ".edits.json")
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return Path(a).expanduser().resolve() == Path(b).expanduser().resolve()
+    except (OSError, RuntimeError):     # e.g. a symlink loop: compare the spellings
+        return Path(a) == Path(b)
+
+
+def save_refusal(target, model) -> str | None:
+    """Why the editor refuses to save to ``target`` (None when it may): saves
+    never replace the opened model (a user's file or the bundled one), nor
+    does the edit script written beside the save."""
+    if model is None:
+        return None
+    for path in (target, script_path_for(Path(target))):
+        if _same_file(path, model):
+            return (f"not saved: {path} is the opened model, which saves never replace "
+                    "(Ctrl+Shift+S: save under another name)")
+    return None
+
+
+def check_model_file(path) -> None:
+    """Refuse a model the editor could not open, before any window exists:
+    missing, a directory, an extension :func:`splatedit.io.read` does not
+    know, or unreadable.  Raises :class:`InputError` (one line, exit 2)."""
+    from splatedit.io import READ_EXTENSIONS
+    p = Path(path)
+    if not p.exists():
+        raise InputError("no such file", path=str(path))
+    if p.is_dir():
+        raise InputError("is a directory, not a file", path=str(path))
+    ext = p.suffix.lower()
+    if ext not in READ_EXTENSIONS:
+        raise InputError(f"unsupported file extension {ext or '(none)'!r} for reading; "
+                         f"supported: {', '.join(READ_EXTENSIONS)}", path=str(path))
+    try:
+        with open(p, "rb") as f:
+            f.read(1)
+    except OSError as exc:
+        raise InputError(f"cannot read the file ({exc.strerror or exc})", path=str(path)) from None
 
 
 # ------------------------------------------------------------------ editor
@@ -169,6 +164,7 @@ class Editor:
         self.saved_path: Path | None = None
         self.saved_script: Path | None = None
         self.validation_count = 0
+        self.load_error: SplatEditError | None = None
         self._status_last = None
         self.panel_box = (0, 0, 0, 0)
         self.sel_version_seen = -1
@@ -216,16 +212,16 @@ class Editor:
         self.session = Session(cloud, method=self.method, tol=self.tol, max_centers=self.max_centers,
                                on_change=self.wake)
         self.viewport.set_cloud(cloud)
-        if cloud.n >= LOD_MIN_SPLATS and self.viewport.ms_per_splat is None:
+        if cloud.n >= EDITOR_LOD_MIN_SPLATS and self.viewport.ms_per_splat is None:
             # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
             # that a huge model's first full-quality frame is already drawn in the background
             w, h = self.size
-            self.viewport.assume_cost(GUESS_MS_PER_SPLAT, max(w * h, 1))
+            self.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
         r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
         self.cam.scene_radius = max(r, 1e-9)
         self.frame_all()
         self.window.set_title(f"splatedit - {self.cloud_name}")
-        if self.use_lod and cloud.n >= LOD_MIN_SPLATS:
+        if self.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
             def work(progress):
                 from splatedit.model.lod import LodPyramid
                 return LodPyramid(cloud, progress=progress)
@@ -239,7 +235,10 @@ class Editor:
             del self.jobs[name]
             if job.error is not None:
                 if name == "load":
-                    self.say(f"cannot open {self.path}: {job.error}")
+                    # reported by run_editor's caller as any bad input: "splatedit: error: ..."
+                    err = job.error
+                    self.load_error = err if isinstance(err, SplatEditError) else SplatEditError(
+                        f"{self.path}: cannot read the model: {err}")
                     self.exit_code = 2
                     self.running = False
                 else:
@@ -316,7 +315,7 @@ class Editor:
             d = np.hypot(px[:, 0] - x, px[:, 1] - y)
         d = np.where(np.isfinite(d), d, np.inf)
         j = int(np.argmin(d))
-        return j if d[j] <= CURVE_DOT_PICK_PX else None
+        return j if d[j] <= EDITOR_CURVE_DOT_PICK_PX else None
 
     def gizmo_axes(self, w: int, h: int) -> list:
         """Screen segments ``(axis, p0, p1)`` of the translate gizmo's arrows
@@ -330,18 +329,18 @@ class Editor:
         px, d = self.cam.project(piv, w, h)
         if d[0] <= 0:
             return []
-        length = self.cam.world_per_pixel(float(d[0]), h) * GIZMO_PX
+        length = self.cam.world_per_pixel(float(d[0]), h) * EDITOR_GIZMO_PX
         ends, de = self.cam.project(piv + np.eye(3) * length, w, h)
         out = []
         for k in range(3):
-            if de[k] > 0 and float(np.hypot(*(ends[k] - px[0]))) > 12:
+            if de[k] > 0 and float(np.hypot(*(ends[k] - px[0]))) > EDITOR_GIZMO_MIN_PX:
                 out.append((k, px[0], ends[k]))
         return out
 
     def gizmo_hit(self, x: float, y: float) -> int | None:
         """The gizmo arrow under pixel (x, y) (outer three quarters, 7 px wide)."""
         w, h = self.size
-        best, axis = 7.0, None
+        best, axis = EDITOR_GIZMO_HIT_PX, None
         q = np.array([x, y])
         for k, p0, p1 in self.gizmo_axes(w, h):
             d = p1 - p0
@@ -374,7 +373,7 @@ class Editor:
             ready = self.refiner.take_pick(key) if self.refiner is not None else None
             idx, front = ready if ready is not None else self.viewport.pick(self.cam, w, h)
             self.picker = picker_for_view(idx, front, self.cam, s.cloud.positions, s.cloud.radii,
-                                          PICK_TOL_PX)
+                                          EDITOR_PICK_TOL_PX)
             self.picker_key = key
         return self.picker
 
@@ -426,7 +425,8 @@ class Editor:
         if self.session is None:
             return
         if e.mods & self.g.MOD_CONTROL:
-            self.brush_radius = float(np.clip(self.brush_radius * (1.15 ** e.dy), BRUSH_MIN, BRUSH_MAX))
+            self.brush_radius = float(np.clip(self.brush_radius * (EDITOR_BRUSH_WHEEL_STEP ** e.dy),
+                                              EDITOR_BRUSH_MIN_PX, EDITOR_BRUSH_MAX_PX))
             return
         w, h = self.size
         # zoom to the surface point under the cursor: picked once (when the pick map of
@@ -639,9 +639,9 @@ class Editor:
         elif k == g.KEY_C:
             s.clear(HANDLE if shift else None)
         elif k == g.KEY_LEFT_BRACKET:
-            self.brush_radius = max(BRUSH_MIN, self.brush_radius / 1.2)
+            self.brush_radius = max(EDITOR_BRUSH_MIN_PX, self.brush_radius / EDITOR_BRUSH_KEY_STEP)
         elif k == g.KEY_RIGHT_BRACKET:
-            self.brush_radius = min(BRUSH_MAX, self.brush_radius * 1.2)
+            self.brush_radius = min(EDITOR_BRUSH_MAX_PX, self.brush_radius * EDITOR_BRUSH_KEY_STEP)
         elif k == g.KEY_HOME:
             self.frame_all()
         elif k in (g.KEY_F, g.KEY_KP_DECIMAL):
@@ -677,9 +677,16 @@ class Editor:
             self.motion()
 
     def finish_manip(self) -> None:
-        """End the running move: applied at once for a single handle, else kept."""
+        """End the running move: applied at once for a single handle, else kept.
+        A typed value that cannot be applied (a scale factor <= 0) is refused:
+        the manipulation goes on."""
         s = self.session
         self.drag = None
+        bad = s.manip.problem() if s.manip is not None else None
+        if bad:
+            self.say(f"{bad}: type another value (Backspace), or Esc to cancel")
+            self.motion()
+            return
         try:
             if s.finish() == "commit":
                 self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
@@ -691,6 +698,11 @@ class Editor:
     def commit(self) -> None:
         s = self.session
         self.drag = None
+        bad = s.manip.problem() if s.manip is not None else None
+        if bad:
+            self.say(f"{bad}: type another value (Backspace), or Esc to cancel")
+            self.motion()
+            return
         try:
             if s.commit():
                 self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
@@ -711,6 +723,10 @@ class Editor:
         s = self.session
         if "save" in self.jobs:
             self.say("a save is already running")
+            return
+        refusal = save_refusal(path, self.path)
+        if refusal:
+            self.say(refusal)
             return
         cloud, script, pos = s.cloud, s.edit_script(), s.history.position
         self.save_as = path
@@ -774,7 +790,7 @@ class Editor:
         else:
             self.sync_document()
             key = self.scene_state()
-            moving = time.perf_counter() - self.last_motion < REFINE_DELAY or self.drag is not None
+            moving = time.perf_counter() - self.last_motion < EDITOR_REFINE_DELAY_S or self.drag is not None
             stale = self.scene is None or key != self.scene_key
             if stale or (self.scene_interactive and not moving):
                 if not moving and self.async_refine():
@@ -782,7 +798,7 @@ class Editor:
                     # view has been still for a while (a started frame cannot be aborted)
                     if stale:
                         self.render_scene(key, interactive=True)
-                    if self.scene_interactive and time.perf_counter() - self.last_motion >= ASYNC_REFINE_DELAY:
+                    if self.scene_interactive and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S:
                         self.request_refine(key)
                 else:
                     self.render_scene(key, interactive=moving)
@@ -814,7 +830,7 @@ class Editor:
     def async_refine(self) -> bool:
         """True when full-quality frames are slow enough to be drawn in the background."""
         vp = self.viewport
-        return vp.ms_per_splat is not None and vp.ms_per_splat * self.session.cloud.n > ASYNC_REFINE_MS
+        return vp.ms_per_splat is not None and vp.ms_per_splat * self.session.cloud.n > EDITOR_ASYNC_REFINE_MS
 
     def render_scene(self, key, interactive: bool) -> None:
         w, h = self.size
@@ -987,7 +1003,7 @@ class Editor:
         if self.status_file is None:
             return
         s = self.session
-        msgs = self.validation_count + len(self.presenter.validation_messages)
+        msgs = self.validation_count
         st = {"loaded": s is not None, "frames_presented": self.presenter.frames_presented,
               "running": self.running, "jobs": sorted(self.jobs), "validation_messages": msgs,
               "confirm_quit": self.confirm_quit, "prompt": self.prompt, "help": self.show_help,
@@ -1089,6 +1105,8 @@ class Editor:
         finally:
             self.running = False
             self.write_status()
+        if self.load_error is not None:
+            raise self.load_error
         return self.exit_code
 
     def close(self) -> None:
@@ -1096,7 +1114,7 @@ class Editor:
             self.session.close()
         for j in list(self.jobs.values()):
             if j.name == "saving":
-                j.thread.join()     # never leave a half-written file behind
+                j.wait()     # never leave a half-written file behind
         if self.refiner is not None:
             self.refiner.close()
             self.refiner = None
@@ -1143,8 +1161,10 @@ def run_editor(path=None, **options) -> int:
         bundled = True
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
-    if not Path(path).exists():
-        raise SplatEditError(f"{path}: no such file")
+    check_model_file(path)      # before any window: a bad path is one error line, exit 2
+    if options.get("save_as") and save_refusal(options["save_as"], path):
+        raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
+                             "saves never replace it: choose another path")
     editor = Editor(path, bundled=bundled, **options)
     try:
         return editor.run()

@@ -37,18 +37,19 @@ recorded as script edits (``indices`` support + ``indices`` handles +
 from __future__ import annotations
 
 import math
-import threading
 import time
-import traceback
-from concurrent.futures import Future, ThreadPoolExecutor
-from dataclasses import dataclass, field
+from concurrent.futures import ThreadPoolExecutor
+from dataclasses import dataclass
 
 import numpy as np
 
 from splatedit.app.brush import HANDLE, SUPPORT, Selection
 from splatedit.app.history import History, Snapshot
+from splatedit.app.jobs import Cancelled, Job
+from splatedit.deform.transform import compose, rotate, scale, translate
 from splatedit.errors import SplatEditError
-from splatedit.tolerances import IQR_DEFAULT_TOL, RENDER_MAX_BASIS_COLUMNS
+from splatedit.tolerances import (EDITOR_AXIS_MIN_SCREEN_LEN, EDITOR_MIN_SCALE_FACTOR, IQR_DEFAULT_TOL,
+                                  RENDER_MAX_BASIS_COLUMNS)
 
 GRAB, ROTATE, SCALE = "grab", "rotate", "scale"
 #: basis columns per rigid handle
@@ -58,37 +59,12 @@ MAX_CURVE_POINTS = 16
 AXIS_NAMES = "XYZ"
 
 
-class Cancelled(Exception):
-    """Raised inside a worker's progress callback to abandon a stale job."""
-
-
-# ------------------------------------------------------------ affine helpers
-def translation(d) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = d
-    return m
-
-
-def rotation(axis, radians: float, center) -> np.ndarray:
-    a = np.asarray(axis, float)
-    a = a / np.linalg.norm(a)
-    k = np.array([[0, -a[2], a[1]], [a[2], 0, -a[0]], [-a[1], a[0], 0]])
-    r = np.eye(3) + math.sin(radians) * k + (1 - math.cos(radians)) * (k @ k)
-    m = np.eye(4)
-    m[:3, :3] = r
+def _axis_scaling(axis: int, factor: float, center) -> np.ndarray:
+    """Scale by ``factor`` (> 0) along world axis ``axis`` about ``center``."""
+    s = np.eye(4)
+    s[axis, axis] = factor
     c = np.asarray(center, float)
-    m[:3, 3] = c - r @ c
-    return m
-
-
-def scaling(factors, center) -> np.ndarray:
-    """Scale by ``factors`` (3,) along the world axes about ``center``."""
-    s = np.diag(np.asarray(factors, float))
-    m = np.eye(4)
-    m[:3, :3] = s
-    c = np.asarray(center, float)
-    m[:3, 3] = c - s @ c
-    return m
+    return compose(translate(-c), s, translate(c))
 
 
 # ------------------------------------------------------------ manipulation
@@ -151,31 +127,45 @@ class Manipulation:
         except ValueError:
             return None
 
+    def problem(self) -> str | None:
+        """Why the typed value cannot be applied (None when it can): a scale
+        factor must be > 0 (a negative one mirrors the handle and turns its
+        normals inside out, 0 flattens it)."""
+        v = self.typed_value()
+        if v is not None and not math.isfinite(v):
+            return "the typed value is too large"
+        if self.mode == SCALE and v is not None and not v > 0:
+            return f"the scale factor must be > 0, got {self.typed}"
+        return None
+
     def _axis_vec(self) -> np.ndarray:
         a = np.zeros(3)
         a[self.axis] = 1.0
         return a
 
     def matrix(self) -> np.ndarray:
+        """The manipulation's (4, 4) matrix; a typed value that cannot be
+        applied (:meth:`problem`, shown by :meth:`describe`) is ignored: the
+        mouse's value is used meanwhile."""
         v = self.view
-        typed = self.typed_value()
+        typed = self.typed_value() if self.problem() is None else None
         dx = self.mouse[0] - self.start[0]
         dy = self.mouse[1] - self.start[1]
         if self.mode == GRAB:
             if typed is not None:
                 a = self._axis_vec() if self.axis is not None else np.array([1.0, 0.0, 0.0])
-                return translation(a * typed)
+                return translate(a * typed)
             d = (v.right * dx - v.up * dy) * v.world_per_px
             if self.axis is not None:
                 a = self._axis_vec()
                 # the mouse motion along the axis's screen direction
                 sa = np.array([a @ v.right, -(a @ v.up)])
                 L = float(np.hypot(*sa))
-                if L < 1e-6:
+                if L < EDITOR_AXIS_MIN_SCREEN_LEN:
                     return np.eye(4)
                 t = (dx * sa[0] + dy * sa[1]) / (L * L) * v.world_per_px
                 d = a * t
-            return translation(d)
+            return translate(d)
         if self.mode == ROTATE:
             axis = self._axis_vec() if self.axis is not None else v.back
             if typed is not None:
@@ -189,7 +179,7 @@ class Manipulation:
                 ang = -(a1 - a0)
                 if float(axis @ v.back) < 0:
                     ang = -ang
-            return rotation(axis, ang, self.pivot)
+            return rotate(axis, math.degrees(ang), self.pivot)
         if self.mode == SCALE:
             if typed is not None:
                 f = typed
@@ -198,13 +188,10 @@ class Manipulation:
                 r0 = math.hypot(self.start[0] - cx, self.start[1] - cy)
                 r1 = math.hypot(self.mouse[0] - cx, self.mouse[1] - cy)
                 f = r1 / max(r0, 1.0)
-            f = max(f, 1e-3) if f >= 0 else min(f, -1e-3)
-            fac = np.ones(3)
+            f = max(f, EDITOR_MIN_SCALE_FACTOR)
             if self.axis is None:
-                fac[:] = f
-            else:
-                fac[self.axis] = f
-            return scaling(fac, self.pivot)
+                return scale(f, self.pivot)
+            return _axis_scaling(self.axis, f, self.pivot)
         raise ValueError(self.mode)
 
     def describe(self) -> str:
@@ -212,20 +199,10 @@ class Manipulation:
         prep = "about" if self.mode == ROTATE else "along"
         ax = f" {prep} {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
         val = f"  value: {self.typed}" if self.typed else ""
+        bad = self.problem()
+        if bad:
+            val += f"  ({bad})"
         return f"{name}{ax}{val}   (Enter/click: apply, Esc/right click: cancel)"
-
-
-# ----------------------------------------------------------------- jobs
-@dataclass
-class Job:
-    kind: str
-    future: Future
-    key: object = None
-    stage: str = ""
-    fraction: float = 0.0
-    started: float = field(default_factory=time.perf_counter)
-    cancel: threading.Event = field(default_factory=threading.Event)
-
 
 
 def columns_needed(n_handles: int, n_curve_points: int) -> int:
@@ -433,8 +410,9 @@ class Session:
             raise SplatEditError(f"a curve has at most {MAX_CURVE_POINTS} points")
         self._check_columns(self._n_handles_planned(), len(self.curve_points) + 1, "add a curve point")
         if self.curve_points:
-            scale = max(float(np.abs(p).max()), 1.0)
-            if float(np.linalg.norm(p - self.curve_points[-1])) <= 1e-9 * scale:
+            from splatedit.deform.curves import first_coincident_point
+            # the same check (consecutive points distinct) as building the curve
+            if first_coincident_point(np.array(self.curve_points + [p])) is not None:
                 raise SplatEditError("this point is the curve's last point: pick another one")
         self.curve_points.append(p)
         self.curve_moves = np.vstack([self.curve_moves, np.zeros((1, 3))])
@@ -508,60 +486,46 @@ class Session:
         support = self.selection.support.copy()
         handles = [self.selection.handles[k].copy() for k in hidx]
         curves = [curve] if curve is not None else []
-        job = Job("fit", Future(), key=key, stage="fitting")
-        job.groups = (tuple(hidx), curve)
-
-        def progress(stage, fraction):
-            if job.cancel.is_set():
-                raise Cancelled()
-            job.stage, job.fraction = stage, fraction
-
-        def work():
+        def work(progress):
             from splatedit.deform.basis import DeformationBasis
             return DeformationBasis.fit(cloud, support, handles, curves=curves, method=self.method,
                                         tol=self.tol, max_centers=self.max_centers, progress=progress)
 
-        if self.fit_sync:
-            try:
-                job.future.set_result(work())
-            except BaseException as exc:  # noqa: BLE001 - reported via poll
-                job.future.set_exception(exc)
-        else:
-            job.future = self._pool.submit(work)
-            job.future.add_done_callback(lambda f: self.on_change())
+        # fits run one at a time on the session's pool (a cancelled one ends at its
+        # next progress report); fit_sync runs it here
+        job = Job("fitting", work, None if self.fit_sync else self.on_change, key=key,
+                  executor=self._pool, sync=self.fit_sync)
+        job.groups = (tuple(hidx), curve)
         self.fit_job = job
 
     def poll(self) -> bool:
         """Collect a finished fit; True when the state changed."""
         job = self.fit_job
-        if job is None or not job.future.done():
+        if job is None or not job.done:
             return False
         self.fit_job = None
         key, groups = job.key, job.groups
         if key != self.selection_key():
             self.request_fit()
             return True
-        try:
-            self.basis = job.future.result()
+        exc = job.error
+        if exc is None:
+            self.basis = job.result
             self.basis_key = key
             self.basis_groups = groups
-        except Cancelled:
+        elif isinstance(exc, Cancelled):
             return False
-        except SplatEditError as exc:
+        elif isinstance(exc, SplatEditError):
             self.fit_error = str(exc)
-        except Exception as exc:  # noqa: BLE001 - a bug, but keep the editor alive
+        else:   # a bug (its traceback is printed by the job), but keep the editor alive
             self.fit_error = f"internal error while fitting: {exc!r}"
-            traceback.print_exc()
         return True
 
     def wait_fit(self, timeout: float = 120.0) -> bool:
         """Block until the fit finishes (tests and scripted use)."""
         t0 = time.perf_counter()
         while self.fit_job is not None and time.perf_counter() - t0 < timeout:
-            try:
-                self.fit_job.future.result(timeout=0.05)
-            except Exception:  # noqa: BLE001
-                pass
+            self.fit_job.wait(0.05)
             self.poll()
         return self.basis is not None
 
@@ -672,6 +636,13 @@ class Session:
         self.manip_target = None
         self.on_change()
 
+    def _check_manip(self) -> None:
+        """Raise SplatEditError (state unchanged) when the running manipulation's
+        typed value cannot be applied (e.g. a scale factor <= 0)."""
+        bad = self.manip.problem() if self.manip is not None else None
+        if bad:
+            raise SplatEditError(bad)
+
     def _bake(self) -> None:
         """Store the running manipulation in the pose."""
         t = self.manip_target
@@ -688,6 +659,7 @@ class Session:
         ("pose") for a later :meth:`commit`."""
         if self.manip is None:
             return ""
+        self._check_manip()
         if self.single_rig:
             return "commit" if self.commit() else ""
         moved = not np.array_equal(self.manip.matrix(), np.eye(4))
@@ -708,6 +680,7 @@ class Session:
         from splatedit.select.regions import Indices
         if self.basis is None:
             return False
+        self._check_manip()
         inputs = self.inputs(live=True)
         moves = self.live_curve_moves(live=True)
         hidx, curve = self.basis_groups
@@ -719,10 +692,10 @@ class Session:
             return False
         t0 = time.perf_counter()
         dc = self.basis.displacement(inputs)
-        # the same arrays as ``splatedit deform`` (basis.apply); only the moved
-        # (support) splats are re-validated, the others are bitwise copies
-        new = self.basis.apply(self.cloud, dc)
-        new.subset(self.basis.indices)      # raises InputError on a degenerate splat
+        # the same arrays and the same checks as ``splatedit deform`` and as reading the
+        # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
+        # length is relative to the *whole* cloud's diagonal, which the edit may change)
+        new = self.basis.commit(self.cloud, dc)     # raises InputError on a degenerate splat
         self.last_commit_seconds = time.perf_counter() - t0
         sel = self.selection
         idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731

@@ -27,6 +27,7 @@ import numpy as np
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
+from splatedit.tolerances import EDITOR_LOD_CELL_FACTOR, EDITOR_LOD_MIN_CELL_REL
 
 PROGRESS_STAGE = "building levels of detail"
 #: default splat budgets of the coarser levels (levels with more than half of
@@ -143,8 +144,8 @@ def level_for_budget(cloud: SplatCloud, budget: int, max_iter: int = 12,
         sample = np.linspace(0, cloud.n - 1, k).astype(np.int64)
         disc = np.pi * np.linalg.norm(cloud.u[sample], axis=1) * np.linalg.norm(cloud.v[sample], axis=1)
         area = float(np.median(disc)) * cloud.n / 2.0
-        cell = 1.08 * math.sqrt(max(area, 1e-30) / max(budget, 1))
-    cell = max(cell, float(np.linalg.norm(ext)) * 1e-6)
+        cell = EDITOR_LOD_CELL_FACTOR * math.sqrt(max(area, 1e-30) / max(budget, 1))
+    cell = max(cell, float(np.linalg.norm(ext)) * EDITOR_LOD_MIN_CELL_REL)
     level = build_level(cloud, cell)
     it = 0
     while level.n > budget and it < max_iter:

@@ -11,7 +11,8 @@ import math
 import numpy as np
 
 from splatedit.errors import ParameterError
-from splatedit.tolerances import (RENDER_CLIP_MARGIN_REL, RENDER_FOV_DEG, RENDER_FRAME_MARGIN,
+from splatedit.tolerances import (RENDER_CAMERA_MIN_UP_SINE, RENDER_CLIP_MARGIN_REL, RENDER_CLIP_MIN_RADIUS_REL,
+                                  RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS,
                                   RENDER_NEAR_FAR_RATIO)
 
 
@@ -21,6 +22,18 @@ def _vec3(name, value) -> np.ndarray:
         raise ParameterError(name, f"must be 3 finite numbers, got {value!r}")
     return arr
 
+
+def perspective(fov_deg: float, aspect: float, near: float, far: float) -> np.ndarray:
+    """4x4 eye -> clip perspective for Vulkan (x right, y down in NDC, depth 0
+    at ``near``, 1 at ``far``) for a vertical field of view ``fov_deg``."""
+    f = 1.0 / math.tan(math.radians(fov_deg) / 2.0)
+    p = np.zeros((4, 4))
+    p[0, 0] = f / aspect
+    p[1, 1] = -f
+    p[2, 2] = far / (near - far)
+    p[2, 3] = near * far / (near - far)
+    p[3, 2] = -1.0
+    return p
 
 class Camera:
     """A perspective camera.
@@ -43,7 +56,8 @@ class Camera:
         fwd = self.target - self.eye
         if np.linalg.norm(fwd) == 0.0:
             raise ParameterError("target", "must differ from eye")
-        if np.linalg.norm(np.cross(fwd, self.up)) <= 1e-12 * np.linalg.norm(fwd) * np.linalg.norm(self.up):
+        sine_bound = RENDER_CAMERA_MIN_UP_SINE * np.linalg.norm(fwd) * np.linalg.norm(self.up)
+        if np.linalg.norm(np.cross(fwd, self.up)) <= sine_bound:
             raise ParameterError("up", "must not be parallel to the view direction")
         if near is not None and far is not None and not 0.0 < near < far:
             raise ParameterError("near", f"need 0 < near < far, got near={near}, far={far}")
@@ -78,7 +92,7 @@ class Camera:
         c, r = 0.5 * (lo + hi), 0.5 * float(np.linalg.norm(hi - lo))
         f = (self.target - self.eye) / np.linalg.norm(self.target - self.eye)
         d = float(np.dot(c - self.eye, f))
-        r = max(r, 1e-12 * max(1.0, abs(d)))
+        r = max(r, RENDER_CLIP_MIN_RADIUS_REL * max(1.0, abs(d)))
         far = self.far if self.far is not None else max(d + r * (1 + RENDER_CLIP_MARGIN_REL), r)
         near = self.near if self.near is not None else max(d - r * (1 + RENDER_CLIP_MARGIN_REL),
                                                            far * RENDER_NEAR_FAR_RATIO)
@@ -88,14 +102,7 @@ class Camera:
 
     def projection_matrix(self, aspect: float, near: float, far: float) -> np.ndarray:
         """4x4 eye -> clip for Vulkan: x right, y down in NDC, depth 0 at near, 1 at far."""
-        f = 1.0 / math.tan(math.radians(self.fov_deg) / 2.0)
-        p = np.zeros((4, 4))
-        p[0, 0] = f / aspect
-        p[1, 1] = -f
-        p[2, 2] = far / (near - far)
-        p[2, 3] = near * far / (near - far)
-        p[3, 2] = -1.0
-        return p
+        return perspective(self.fov_deg, aspect, near, far)
 
     # ----------------------------------------------------------------- framing
     @classmethod
@@ -108,7 +115,7 @@ class Camera:
         if aspect <= 0:
             raise ParameterError("aspect", f"must be positive, got {aspect}")
         c = 0.5 * (lo + hi)
-        r = max(0.5 * float(np.linalg.norm(hi - lo)), 1e-9)
+        r = max(0.5 * float(np.linalg.norm(hi - lo)), RENDER_FRAME_MIN_RADIUS)
         half_v = math.radians(fov_deg) / 2.0
         half_h = math.atan(math.tan(half_v) * aspect)
         dist = r / math.sin(min(half_v, half_h)) * RENDER_FRAME_MARGIN

@@ -7,9 +7,42 @@ events; no application logic runs inside glfw callbacks.
 
 from __future__ import annotations
 
+import os
 from dataclasses import dataclass
 
 from splatedit.render.vk.swapchain import PresentError
+
+
+#: the message of a failed glfw initialisation without any display
+NO_DISPLAY_MESSAGE = ("cannot open a window: no display (set DISPLAY, or use the headless "
+                      "commands: splatedit demo/render/deform)")
+
+
+def _init_glfw(glfw) -> None:
+    """``glfwInit`` without glfw's own error reporting (pyGLFW turns every GLFW
+    error into a python warning on stderr); a failure becomes one
+    :class:`PresentError` (a SplatEditError: ``splatedit: error: ...``)."""
+    saved = glfw.ERROR_REPORTING
+    glfw.ERROR_REPORTING = "ignore"
+    try:
+        ok = glfw.init()
+        detail = ""
+        if not ok:
+            try:
+                code, desc = glfw.get_error()
+                if desc:
+                    detail = desc.decode("utf-8", "replace") if isinstance(desc, bytes) else str(desc)
+            except Exception:  # noqa: BLE001 - the message is only a detail
+                detail = ""
+    finally:
+        glfw.ERROR_REPORTING = saved
+    if ok:
+        return
+    if not os.environ.get("DISPLAY") and not os.environ.get("WAYLAND_DISPLAY"):
+        raise PresentError(NO_DISPLAY_MESSAGE)
+    display = os.environ.get("DISPLAY") or os.environ.get("WAYLAND_DISPLAY")
+    raise PresentError(f"cannot open a window: cannot connect to the display {display!r}"
+                       + (f" ({detail})" if detail else ""))
 
 
 @dataclass
@@ -42,8 +75,7 @@ class Window:
     def __init__(self, title: str, width: int = 1280, height: int = 720):
         import glfw
         self.glfw = glfw
-        if not glfw.init():
-            raise PresentError("cannot initialise glfw (is DISPLAY set and an X server running?)")
+        _init_glfw(glfw)
         if not glfw.vulkan_supported():
             glfw.terminate()
             raise PresentError("glfw finds no Vulkan loader")
