@@ -680,22 +680,15 @@ class Editor:
         """End the running move: applied at once for a single handle, else kept.
         A typed value that cannot be applied (a scale factor <= 0) is refused:
         the manipulation goes on."""
-        s = self.session
-        self.drag = None
-        bad = s.manip.problem() if s.manip is not None else None
-        if bad:
-            self.say(f"{bad}: type another value (Backspace), or Esc to cancel")
-            self.motion()
-            return
-        try:
-            if s.finish() == "commit":
-                self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
-        except SplatEditError as exc:
-            s.cancel()
-            self.say(f"edit not applied: {exc}")
-        self.motion()
+        self._apply(lambda s: s.finish() == "commit")
 
     def commit(self) -> None:
+        """Enter: apply the running move and every pending one as one edit."""
+        self._apply(lambda s: s.commit())
+
+    def _apply(self, action) -> None:
+        """Run ``action(session)`` (True when an edit was applied) unless the
+        running manipulation has a value that cannot be applied."""
         s = self.session
         self.drag = None
         bad = s.manip.problem() if s.manip is not None else None
@@ -704,7 +697,7 @@ class Editor:
             self.motion()
             return
         try:
-            if s.commit():
+            if action(s):
                 self.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
         except SplatEditError as exc:
             s.cancel()

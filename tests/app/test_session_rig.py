@@ -11,19 +11,9 @@ from splatedit.app.session import Session, ViewInfo, GRAB
 from splatedit.errors import SplatEditError
 from splatedit.model import SplatCloud
 from splatedit.script import load_script, run_script
+from tests.app.sessions import plane_cloud, view
 
 
-def plane_cloud(k=30):
-    xs, ys = np.meshgrid(np.linspace(-1, 1, k), np.linspace(-1, 1, k))
-    p = np.c_[xs.ravel(), ys.ravel(), np.zeros(k * k)]
-    r = 2.0 / (k - 1)
-    n = len(p)
-    return SplatCloud(p, np.tile([r, 0, 0], (n, 1)), np.tile([0, r, 0], (n, 1)), name="plane")
-
-
-def view():
-    return ViewInfo(right=np.array([1.0, 0, 0]), up=np.array([0, 1.0, 0]), back=np.array([0, 0, 1.0]),
-                    pivot_px=(100.0, 100.0), world_per_px=0.01)
 
 
 @pytest.fixture
