@@ -28,3 +28,10 @@ def test_readme_documents_every_cli_command():
     sub = next(a for a in build_parser()._actions if a.dest == "command")
     for name in sub.choices:
         assert f"splatedit {name}" in README, name
+
+
+def test_readme_python_example_runs(tmp_path, monkeypatch):
+    block = re.search(r"```python\n(.*?)```", README, flags=re.S).group(1)
+    monkeypatch.chdir(tmp_path)
+    exec(compile(block, "README.md", "exec"), {})
+    assert (tmp_path / "bunny-ear.ply").is_file()
