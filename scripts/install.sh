@@ -2,13 +2,14 @@
 # Install everything splatedit needs on Debian 12 (run as root), into ./.venv.
 #   System: Python 3 + venv, Mesa lavapipe (CPU Vulkan), the Vulkan loader,
 #   glslang (shader compiler, for the SPIR-V staleness test), the Khronos
-#   validation layer (the test suite runs with it on) and Xvfb (window tests).
+#   validation layer (the test suite runs with it on), Xvfb + xdotool (window
+#   tests) and the DejaVu fonts (editor overlay).
 #   Python: this package and its test extras from PyPI.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
 apt_packages=(python3 python3-venv python3-pip mesa-vulkan-drivers libvulkan1 glslang-tools
-              vulkan-validationlayers xvfb xauth x11-utils xdotool)
+              vulkan-validationlayers xvfb xauth x11-utils xdotool fonts-dejavu-core)
 if command -v apt-get >/dev/null 2>&1; then
     missing=()
     for p in "${apt_packages[@]}"; do
