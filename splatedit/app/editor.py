@@ -154,6 +154,7 @@ class Editor:
         self.scene_key = None
         self.scene_interactive = False
         self.refiner = None
+        self._refine_failed_key = None   # view whose background frame failed (not retried)
         self.last_motion = 0.0
         self.frame_ms = 0.0
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
@@ -791,10 +792,16 @@ class Editor:
                     # view has been still for a while (a started frame cannot be aborted)
                     if stale:
                         self.render_scene(key, interactive=True)
-                    if self.scene_interactive and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S:
+                    if (self.scene_interactive and key != self._refine_failed_key
+                            and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S):
                         self.request_refine(key)
                 else:
                     self.render_scene(key, interactive=moving)
+            if self.refiner is not None and self.refiner.error is not None:
+                # a failed full-quality frame is reported once and not retried for this view
+                self.say(f"full-quality frame failed: {self.refiner.error}")
+                self.refiner.error = None
+                self._refine_failed_key = key
             if self.refiner is not None and self.scene_interactive:
                 img = self.refiner.take(key)
                 if img is not None and img.shape[:2] == (h, w):
