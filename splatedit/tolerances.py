@@ -190,6 +190,16 @@ EDITOR_CURVE_DOT_PICK_PX = 10
 EDITOR_GIZMO_PX = 70
 EDITOR_GIZMO_MIN_PX = 12
 EDITOR_GIZMO_HIT_PX = 7.0
+#: rotate rings of the gizmo: a circle of this radius (pixels at the handle's
+#: depth) around the handle centroid per world axis, drawn with this many
+#: segments; a ring whose axis makes |axis . view direction| below
+#: EDITOR_GIZMO_RING_MIN_COS is seen almost edge-on and hidden.  The uniform
+#: scale grip is a screen circle of radius EDITOR_GIZMO_SCALE_PX (outside the
+#: arrows); both are grabbed within EDITOR_GIZMO_HIT_PX
+EDITOR_GIZMO_RING_PX = 52
+EDITOR_GIZMO_RING_SEGMENTS = 64
+EDITOR_GIZMO_RING_MIN_COS = 0.2
+EDITOR_GIZMO_SCALE_PX = 92
 #: depth tolerance of the brush's visibility test, in pixel footprints
 EDITOR_PICK_TOL_PX = 6.0
 #: the brush radius range (pixels)

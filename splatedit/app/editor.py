@@ -30,7 +30,9 @@ from splatedit.errors import InputError, ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_BRUSH_KEY_STEP,
                                   EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX, EDITOR_BRUSH_WHEEL_STEP,
                                   EDITOR_CURVE_DOT_PICK_PX, EDITOR_GIZMO_HIT_PX,
-                                  EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX, EDITOR_GUESS_MS_PER_SPLAT,
+                                  EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX, EDITOR_GIZMO_RING_MIN_COS,
+                                  EDITOR_GIZMO_RING_PX, EDITOR_GIZMO_RING_SEGMENTS, EDITOR_GIZMO_SCALE_PX,
+                                  EDITOR_GUESS_MS_PER_SPLAT,
                                   EDITOR_LOD_MIN_SPLATS, EDITOR_PICK_TOL_PX, EDITOR_REFINE_DELAY_S,
                                   IQR_DEFAULT_TOL)
 
@@ -318,25 +320,64 @@ class Editor:
         j = int(np.argmin(d))
         return j if d[j] <= EDITOR_CURVE_DOT_PICK_PX else None
 
+    def _gizmo_base(self, w: int, h: int):
+        """``(pivot, pivot_px, world_per_px)`` of the gizmo, or None when it is
+        hidden (no fitted active handle, a manipulation running, the curve
+        tool on, or the handle behind the eye)."""
+        s = self.session
+        if not s.active_fitted() or s.manip is not None or s.curve_mode:
+            return None
+        piv = self.handle_centre()
+        if piv is None:
+            return None
+        px, d = self.cam.project(piv, w, h)
+        if d[0] <= 0:
+            return None
+        return piv, px[0], self.cam.world_per_pixel(float(d[0]), h)
+
     def gizmo_axes(self, w: int, h: int) -> list:
         """Screen segments ``(axis, p0, p1)`` of the translate gizmo's arrows
         (shown when the basis is ready and nothing is being manipulated)."""
-        s = self.session
-        if not s.active_fitted() or s.manip is not None or s.curve_mode:
+        base = self._gizmo_base(w, h)
+        if base is None:
             return []
-        piv = self.handle_centre()
-        if piv is None:
-            return []
-        px, d = self.cam.project(piv, w, h)
-        if d[0] <= 0:
-            return []
-        length = self.cam.world_per_pixel(float(d[0]), h) * EDITOR_GIZMO_PX
-        ends, de = self.cam.project(piv + np.eye(3) * length, w, h)
+        piv, p0, wpp = base
+        ends, de = self.cam.project(piv + np.eye(3) * (wpp * EDITOR_GIZMO_PX), w, h)
         out = []
         for k in range(3):
-            if de[k] > 0 and float(np.hypot(*(ends[k] - px[0]))) > EDITOR_GIZMO_MIN_PX:
-                out.append((k, px[0], ends[k]))
+            if de[k] > 0 and float(np.hypot(*(ends[k] - p0))) > EDITOR_GIZMO_MIN_PX:
+                out.append((k, p0, ends[k]))
         return out
+
+    def gizmo_rings(self, w: int, h: int) -> list:
+        """Screen polylines ``(axis, pixels (m, 2))`` of the rotate rings: a
+        circle around the handle centroid in the plane normal to each world
+        axis (closed: the last point repeats the first; NaN behind the eye);
+        rings seen almost edge-on are left out."""
+        base = self._gizmo_base(w, h)
+        if base is None:
+            return []
+        piv, _, wpp = base
+        back = self.cam.basis()[2]
+        t = np.linspace(0.0, 2.0 * math.pi, EDITOR_GIZMO_RING_SEGMENTS + 1)
+        t[-1] = 0.0
+        out = []
+        for k in range(3):
+            if abs(float(back[k])) < EDITOR_GIZMO_RING_MIN_COS:
+                continue
+            e = np.eye(3)
+            u, v = e[(k + 1) % 3], e[(k + 2) % 3]
+            pts = piv + wpp * EDITOR_GIZMO_RING_PX * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
+            px, d = self.cam.project(pts, w, h)
+            px = np.array(px, float)
+            px[np.asarray(d) <= 0] = np.nan
+            out.append((k, px))
+        return out
+
+    def gizmo_scale_circle(self, w: int, h: int):
+        """``(centre_px, radius_px)`` of the uniform scale grip, or None."""
+        base = self._gizmo_base(w, h)
+        return None if base is None else (base[1], float(EDITOR_GIZMO_SCALE_PX))
 
     def gizmo_hit(self, x: float, y: float) -> int | None:
         """The gizmo arrow under pixel (x, y) (outer three quarters, 7 px wide)."""
@@ -350,6 +391,73 @@ class Editor:
             if t >= 0.25 and dist <= best:
                 best, axis = dist, k
         return axis
+
+    def ring_hit(self, x: float, y: float) -> int | None:
+        """The rotate ring under pixel (x, y) (within EDITOR_GIZMO_HIT_PX), the nearest one."""
+        w, h = self.size
+        best, axis = EDITOR_GIZMO_HIT_PX, None
+        q = np.array([x, y], float)
+        for k, px in self.gizmo_rings(w, h):
+            a, b = px[:-1], px[1:]
+            ok = np.isfinite(a).all(axis=1) & np.isfinite(b).all(axis=1)
+            if not ok.any():
+                continue
+            a, b = a[ok], b[ok]
+            d = b - a
+            dd = np.maximum((d * d).sum(axis=1), 1e-12)
+            t = np.clip(((q - a) * d).sum(axis=1) / dd, 0.0, 1.0)
+            dist = float(np.hypot(*(q - (a + t[:, None] * d)).T).min())
+            if dist <= best:
+                best, axis = dist, k
+        return axis
+
+    def scale_hit(self, x: float, y: float) -> bool:
+        """Pixel (x, y) is on the scale grip (within EDITOR_GIZMO_HIT_PX of its circle)."""
+        w, h = self.size
+        c = self.gizmo_scale_circle(w, h)
+        if c is None:
+            return False
+        return abs(math.hypot(x - c[0][0], y - c[0][1]) - c[1]) <= EDITOR_GIZMO_HIT_PX
+
+    def gizmo_pick(self, x: float, y: float) -> tuple | None:
+        """What a left press at (x, y) grabs on the gizmo: ``(GRAB, axis)`` on an
+        arrow, else ``(ROTATE, axis)`` on a ring, else ``(SCALE, None)`` on the
+        scale grip, else None (priority in that order)."""
+        k = self.gizmo_hit(x, y)
+        if k is not None:
+            return GRAB, k
+        k = self.ring_hit(x, y)
+        if k is not None:
+            return ROTATE, k
+        if self.scale_hit(x, y):
+            return SCALE, None
+        return None
+
+    def ring_grab_point(self, k: int, w: int, h: int):
+        """A pixel on ring ``k`` that :meth:`gizmo_pick` maps to that ring: the
+        ring point farthest from the arrows and the other rings (for the status
+        file), or None when every point of it is covered by them."""
+        rings = dict(self.gizmo_rings(w, h))
+        if k not in rings:
+            return None
+        q = rings[k][:-1]
+        q = q[np.isfinite(q).all(axis=1)]
+        if not len(q):
+            return None
+        ring_d = np.full(len(q), np.inf)         # to the other rings (the nearest ring is picked)
+        for j, p in rings.items():
+            p = p[np.isfinite(p).all(axis=1)]
+            if j != k and len(p):
+                ring_d = np.minimum(ring_d, np.hypot(q[:, None, 0] - p[None, :, 0],
+                                                     q[:, None, 1] - p[None, :, 1]).min(axis=1))
+        arrow_d = np.full(len(q), np.inf)        # to the arrows (picked first)
+        for _, p0, p1 in self.gizmo_axes(w, h):
+            d = p1 - p0
+            t = np.clip((q - p0) @ d / max(float(d @ d), 1e-12), 0.0, 1.0)
+            arrow_d = np.minimum(arrow_d, np.hypot(*(q - (p0 + t[:, None] * d)).T))
+        score = np.where(arrow_d > EDITOR_GIZMO_HIT_PX + 2, np.minimum(ring_d, arrow_d), -1.0)
+        i = int(np.argmax(score))
+        return q[i] if score[i] > 4.0 else None
 
     def view_info(self, pivot=None) -> ViewInfo:
         w, h = self.size
@@ -504,9 +612,10 @@ class Editor:
             self.curve_click(x, y)
             return
         if e.button == g.MOUSE_BUTTON_LEFT:
-            axis = self.gizmo_hit(x, y) if s.basis is not None and not ctrl else None
-            if axis is not None and s.begin(GRAB, self.view_info(), (x, y)):
-                s.manip.set_axis(axis)
+            hit = self.gizmo_pick(x, y) if s.basis is not None and not ctrl else None
+            if hit is not None and s.begin(hit[0], self.view_info(), (x, y)):
+                if hit[1] is not None:
+                    s.manip.set_axis(hit[1])
                 self.drag = "manip"
                 self.motion()
                 return
@@ -930,6 +1039,15 @@ class Editor:
         piv = self.handle_centre()
         m = s.current_matrix()
         cur = m[:3, :3] @ piv + m[:3, 3]
+        grip = self.gizmo_scale_circle(w, h)
+        if grip is not None and np.isfinite(grip[0]).all() and np.abs(grip[0]).max() < 1e5:
+            img = ov.ring(int(round(grip[1])), (225, 225, 225), 1)
+            out.append(ov.Patch(int(round(grip[0][0])) - img.shape[1] // 2,
+                                int(round(grip[0][1])) - img.shape[0] // 2, img))
+        for k, px in self.gizmo_rings(w, h):
+            p = ov.polyline_patch(px, ov.AXIS_RGB[k], 2)
+            if p:
+                out.append(p)
         for k, p0, p1 in self.gizmo_axes(w, h):
             p = ov.line_patch(p0, p1, ov.AXIS_RGB[k], 3, dot=True)
             if p:
@@ -1037,6 +1155,14 @@ class Editor:
             w, h = self.size
             st["gizmo"] = [[k, *(round(float(v), 1) for v in (*p0, *p1))]
                            for k, p0, p1 in self.gizmo_axes(w, h)] if w and h else []
+            back = self.cam.basis()[2]
+            st["gizmo_rings"] = [[k, *(round(float(v), 1) for v in q), round(abs(float(back[k])), 3)]
+                                 for k, _ in self.gizmo_rings(w, h)
+                                 for q in [self.ring_grab_point(k, w, h)] if q is not None] \
+                if w and h else []
+            grip = self.gizmo_scale_circle(w, h) if w and h else None
+            st["gizmo_scale"] = None if grip is None else [round(float(grip[0][0]), 1),
+                                                           round(float(grip[0][1]), 1), grip[1]]
             st["curve_dots"] = [[round(float(v), 1) for v in q] for q in self.curve_dots(w, h)] \
                 if w and h else []
             hc = []

@@ -32,6 +32,8 @@ Deformation (the basis of all handles and the curve is fitted in the background;
              at most 16 columns: 4 per handle + 1 per curve point)
   Left drag on a handle  make it active and move it in the view plane
   Left drag on an arrow  move the active handle along that axis (gizmo: X red, Y green, Z blue)
+  Left drag on a ring    rotate the active handle about that axis, through its centre
+  Left drag outer circle scale the active handle about its centre (outward: larger)
   G / R / S              grab / rotate / scale the active handle with the mouse
     X / Y / Z            constrain to that world axis (again: free)
     0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)

@@ -5,13 +5,11 @@ replaying the exported edit script with ``splatedit deform``."""
 from __future__ import annotations
 
 import json
-import subprocess
-import sys
 
 import numpy as np
 import pytest
 
-from tests.app.test_editor_window import EditorProcess, _foreground_centre
+from tests.app.window_harness import EditorProcess, _foreground_centre, assert_replay_reproduces
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 
@@ -86,12 +84,4 @@ def test_two_handles_and_a_curve(xvfb, tmp_path):
     assert np.abs(np.asarray(e2["curves"][0]["move"][1])).max() > 0
     src, saved = read(default_model_path()), read(out)
     assert np.abs(saved.positions - src.positions).max() > 1e-3
-    replay = tmp_path / "replay.ply"
-    r = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "deform", str(default_model_path()),
-                        "--edit", str(script_path), "-o", str(replay)], capture_output=True, text=True,
-                       timeout=120)
-    assert r.returncode == 0, r.stderr
-    again = read(replay)
-    assert np.allclose(again.positions, saved.positions, rtol=0, atol=1e-6)
-    assert np.allclose(again.u, saved.u, rtol=1e-5, atol=1e-9)
-    assert np.allclose(again.v, saved.v, rtol=1e-5, atol=1e-9)
+    assert_replay_reproduces(script_path, out, tmp_path)

@@ -4,8 +4,9 @@ One editor process runs a whole session on the bundled model: paint the
 support, paint the handle, drag the handle (commit on release), undo, redo,
 a second edit typed on the keyboard (G Z 0.05 Enter) with a resize and an
 unmap/map ("minimize" at the X level: there is no window manager) in the
-middle, a screenshot compared with a committed reference, Ctrl+S, then quit
-with unsaved changes (asks first).  The saved PLY is checked against the
+middle, a screenshot compared with a committed reference, Ctrl+S, gizmo
+drags (an arrow, a rotate ring -- saved as and replayed --, the scale grip),
+then quit with unsaved changes (asks first).  The saved PLY is checked against the
 exported edit script and against ``splatedit deform`` replaying it.
 
 The editor reports its state in a JSON status file (``--status-file``), so
@@ -16,83 +17,20 @@ Set ``SPLATEDIT_UPDATE_REFERENCES=1`` to rewrite the reference image.
 from __future__ import annotations
 
 import json
+import math
 import os
-import shutil
 import subprocess
-import sys
 import time
 from pathlib import Path
 
 import numpy as np
 import pytest
 
-from tests.app.xwd import read_xwd
+from tests.app.window_harness import EditorProcess, _foreground_centre, assert_replay_reproduces
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 
 REFERENCE = Path(__file__).parent / "data" / "editor_after_edits.png"
-WINDOW = (960, 600)
-
-
-class EditorProcess:
-    def __init__(self, xvfb, tmp: Path, *args):
-        self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1")
-        self.screen = xvfb["screen"]
-        self.status_path = tmp / "status.json"
-        self.stderr_path = tmp / "editor.stderr"
-        self.stderr = open(self.stderr_path, "w")
-        cmd = [sys.executable, "-m", "splatedit.app.editor", "--status-file", str(self.status_path),
-               "--size", f"{WINDOW[0]}x{WINDOW[1]}", *args]
-        self.proc = subprocess.Popen(cmd, env=self.env, stdout=self.stderr, stderr=subprocess.STDOUT,
-                                     cwd=tmp)
-
-    def status(self) -> dict:
-        try:
-            return json.loads(self.status_path.read_text())
-        except (FileNotFoundError, json.JSONDecodeError):
-            return {}
-
-    def wait(self, cond, what: str, timeout: float = 60.0) -> dict:
-        t0 = time.time()
-        while time.time() - t0 < timeout:
-            s = self.status()
-            if s:
-                try:
-                    if cond(s):
-                        return s
-                except KeyError:
-                    pass
-            if self.proc.poll() is not None and not (s and cond(s)):
-                break
-            time.sleep(0.05)
-        raise AssertionError(f"timed out waiting for: {what}; last status {self.status()}; "
-                             f"stderr:\n{self.stderr_path.read_text()[-3000:]}")
-
-    def idle(self, cond=lambda s: True, what="idle", timeout=60.0) -> dict:
-        return self.wait(lambda s: s.get("idle") and cond(s), what, timeout)
-
-    def xdo(self, *args) -> None:
-        subprocess.run(["xdotool", *map(str, args)], env=self.env, check=True, timeout=30)
-
-    def screenshot(self) -> np.ndarray:
-        return read_xwd(self.screen)
-
-    def close(self) -> None:
-        if self.proc.poll() is None:
-            self.proc.kill()
-            self.proc.wait(10)
-        self.stderr.close()
-
-
-def _foreground_centre(img: np.ndarray, panel) -> tuple[int, int]:
-    w, h = WINDOW
-    a = img[:h, :w].astype(int)
-    fg = a.min(axis=2) < 230
-    x, y, pw, ph = panel
-    fg[: y + ph + 4, : x + pw + 4] = False
-    ys, xs = np.nonzero(fg)
-    assert len(xs) > 1000, "the model is not visible in the window"
-    return int(np.median(xs)), int(np.median(ys))
 
 
 def _small(img: np.ndarray) -> np.ndarray:
@@ -214,6 +152,33 @@ def test_full_edit_session(xvfb, tmp_path):
         ed.wait(lambda s: gizmo_script.exists() and not s["jobs"], "script exported")
         m = np.asarray(json.loads(gizmo_script.read_text())["edits"][2]["transform"]["matrix"])
         assert np.allclose(m[:3, :3], np.eye(3)) and m[0, 3] > 0 and m[1, 3] == 0 and m[2, 3] == 0
+        # --- a rotate ring: the mouse turns 30 degrees around the centre (a fourth edit), saved as
+        s = ed.idle(lambda s: s["state"] == "ready" and s["gizmo_rings"] and s["gizmo_scale"], "rings shown")
+        k, gx, gy, _ = max(s["gizmo_rings"], key=lambda r: r[3])       # the most open ring
+        pcx, pcy, grip_r = s["gizmo_scale"]
+        a0, rad = math.atan2(gy - pcy, gx - pcx), math.hypot(gx - pcx, gy - pcy)
+        path = [(int(round(pcx + rad * math.cos(a0 + math.radians(t)))),
+                 int(round(pcy + rad * math.sin(a0 + math.radians(t))))) for t in (0, 10, 20, 30)]
+        moves = [v for x, y in path[1:] for v in ("mousemove", x, y)]
+        ed.xdo("mousemove", *path[0], "mousedown", "1", *moves, "sleep", "0.2", "mouseup", "1")
+        s = ed.idle(lambda s: s["edits"] == 4 and s["state"] == "ready", "ring edit")
+        (x0, y0), (x1, y1) = path[0], path[-1]
+        swept = math.degrees(math.atan2(y1 - pcy, x1 - pcx) - math.atan2(y0 - pcy, x0 - pcx))
+        ring_out = tmp_path / "ring.ply"
+        ed.xdo("key", "ctrl+shift+s")
+        ed.wait(lambda s: s["prompt"] is not None, "save-as prompt for the ring edit")
+        ed.xdo("type", "--delay", "5", str(ring_out))
+        ed.wait(lambda s: s["prompt"] == str(ring_out), "ring path typed")
+        ed.xdo("key", "Return")
+        s = ed.idle(lambda s: s["saved"] == str(ring_out) and not s["dirty"], "ring edit saved")
+        ring_script = Path(s["script"])
+        # --- the scale grip: dragged outward 1.25 times its radius (a fifth edit, not saved)
+        s = ed.idle(lambda s: s["state"] == "ready" and s["gizmo_scale"], "scale grip shown")
+        pcx, pcy, grip_r = s["gizmo_scale"]
+        gx, gy = int(round(pcx)), int(round(pcy + grip_r))
+        ed.xdo("mousemove", gx, gy, "mousedown", "1", "mousemove", gx, int(round(pcy + 1.1 * grip_r)),
+               "mousemove", gx, int(round(pcy + 1.25 * grip_r)), "sleep", "0.2", "mouseup", "1")
+        s = ed.idle(lambda s: s["edits"] == 5 and s["dirty"], "scale grip edit")
         # --- unsaved changes: quitting asks first
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation")
@@ -259,15 +224,23 @@ def test_full_edit_session(xvfb, tmp_path):
     assert disp[free].max() <= hdisp * 1.05 + 1e-6 and disp[free].max() > 0
 
     # --- replaying the exported script with `splatedit deform` reproduces the saved file
-    replay = tmp_path / "replay.ply"
-    r = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "deform", str(default_model_path()),
-                        "--edit", str(script_path), "-o", str(replay)], capture_output=True, text=True,
-                       timeout=120)
-    assert r.returncode == 0, r.stderr
-    again = read(replay)
-    assert np.allclose(again.positions, saved.positions, rtol=0, atol=1e-6)
-    assert np.allclose(again.u, saved.u, rtol=1e-5, atol=1e-9)
-    assert np.allclose(again.v, saved.v, rtol=1e-5, atol=1e-9)
+    assert_replay_reproduces(script_path, out, tmp_path)
+
+    # --- the ring edit: a rotation about world axis k by the swept angle, through the
+    # handle centroid (kept in place), reproduced by replaying its saved script
+    doc = json.loads(ring_script.read_text())
+    assert len(doc["edits"]) == 4
+    e4 = doc["edits"][3]
+    m = np.asarray(e4["transform"]["matrix"])
+    r = m[:3, :3]
+    assert np.allclose(r @ r.T, np.eye(3), atol=1e-9) and np.allclose(r[:, k], np.eye(3)[k], atol=1e-9)
+    angle = math.degrees(math.acos(np.clip((np.trace(r) - 1) / 2, -1, 1)))
+    assert abs(angle - abs(swept)) < 1.0, (angle, swept)
+    ring_saved = read(ring_out)
+    centre = ring_saved.positions[np.asarray(e4["handle"]["indices"])].astype(float).mean(axis=0)
+    assert np.allclose(r @ centre + m[:3, 3], centre, rtol=0, atol=1e-5)
+    assert np.abs(ring_saved.positions - read(other).positions).max() > 1e-3
+    assert_replay_reproduces(ring_script, ring_out, tmp_path)
 
 
 def test_unreadable_model_exits_with_an_error(xvfb, tmp_path):

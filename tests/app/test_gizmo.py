@@ -1,0 +1,184 @@
+"""The gizmo without a window: arrows, rotate rings and the scale grip are
+picked in that order, and a drag on a ring / on the grip gives a rotation
+about that world axis / a uniform scale, both about the handle centroid,
+applied on release like the arrow drag (single handle: an edit at once)."""
+
+from __future__ import annotations
+
+import math
+import types
+
+import numpy as np
+import pytest
+
+from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.editor import Editor
+from splatedit.app.session import GRAB, ROTATE, SCALE, Session
+from splatedit.tolerances import EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_SCALE_PX
+from tests.app.sessions import plane_cloud
+
+W, H = 640, 480
+G = types.SimpleNamespace(RELEASE=0, PRESS=1, MOUSE_BUTTON_LEFT=0, MOUSE_BUTTON_RIGHT=1,
+                          MOUSE_BUTTON_MIDDLE=2, MOD_SHIFT=1, MOD_CONTROL=2, MOD_ALT=4)
+
+
+class StubEditor(Editor):
+    size = (W, H)
+
+    def __init__(self, session, cam):            # no window, no GPU
+        self.session, self.cam, self.g = session, cam, G
+        self.mouse = self.drag_last = (0.0, 0.0)
+        self.drag = self.prompt = None
+        self.confirm_quit = self.erase_toggle = False
+        self.cursor_inside = True
+        self._centre = self._centre_key = None
+        self.messages = []
+
+    def motion(self):
+        pass
+
+    def say(self, text):
+        self.messages.append(text)
+
+
+def button(ed, x, y, action):
+    ed.on_button(types.SimpleNamespace(x=x, y=y, action=action, button=G.MOUSE_BUTTON_LEFT, mods=0))
+
+
+def drag(ed, points):
+    """Left press at points[0], moves through the rest, release at the last."""
+    button(ed, *points[0], G.PRESS)
+    for x, y in points[1:]:
+        ed.on_move(types.SimpleNamespace(x=x, y=y))
+    m = None if ed.session.manip is None else ed.session.manip.matrix()
+    button(ed, *points[-1], G.RELEASE)
+    return m
+
+
+@pytest.fixture
+def editor():
+    s = Session(plane_cloud(), fit_sync=True)
+    r = np.linalg.norm(s.cloud.positions[:, :2] - [0.2, 0.1], axis=1)
+    s.brush_target = SUPPORT
+    s.end_stroke(s.paint(np.flatnonzero(r < 0.8)))
+    s.brush_target = HANDLE
+    s.end_stroke(s.paint(np.flatnonzero(r < 0.2)))
+    assert s.wait_fit() and s.active_fitted()
+    # an oblique view: all three rings are visible
+    cam = OrbitCamera(np.zeros(3), 4.0, yaw=0.6, pitch=0.5, scene_radius=1.5)
+    yield StubEditor(s, cam)
+    s.close()
+
+
+def around(c, p, degrees, steps=6):
+    """Points from ``p`` turning by ``degrees`` about pixel ``c`` (same radius)."""
+    v = np.subtract(p, c)
+    out = []
+    for t in np.linspace(0.0, math.radians(degrees), steps + 1):
+        cs, sn = math.cos(t), math.sin(t)
+        out.append((c[0] + cs * v[0] - sn * v[1], c[1] + sn * v[0] + cs * v[1]))
+    return out
+
+
+def rotation_axis_angle(m):
+    r = m[:3, :3]
+    ang = math.degrees(math.acos(np.clip((np.trace(r) - 1) / 2, -1, 1)))
+    w, v = np.linalg.eig(r)
+    axis = np.real(v[:, np.argmin(np.abs(w - 1))])
+    return axis / np.linalg.norm(axis), ang
+
+
+def test_all_parts_are_shown_and_picked_in_priority_order(editor):
+    ed = editor
+    rings = dict(ed.gizmo_rings(W, H))
+    assert sorted(rings) == [0, 1, 2] and len(ed.gizmo_axes(W, H)) == 3
+    c, rad = ed.gizmo_scale_circle(W, H)
+    centre_px = ed.cam.project(ed.handle_centre(), W, H)[0][0]
+    assert np.allclose(c, centre_px) and rad == EDITOR_GIZMO_SCALE_PX
+    # every ring point lies on the projected world circle around the centroid
+    for k, px in rings.items():
+        assert np.isfinite(px).all() and np.allclose(px[0], px[-1])
+        assert ed.gizmo_pick(*ed.ring_grab_point(k, W, H)) == (ROTATE, k)
+    # an arrow wins over a ring where they cross
+    n_crossings = 0
+    for k, p0, p1 in ed.gizmo_axes(W, H):
+        tip = p0 + 0.95 * (p1 - p0)
+        assert ed.gizmo_pick(*tip) == (GRAB, k)
+        crossing = [q for q in rings[(k + 1) % 3]
+                    if abs(float(np.linalg.det(np.c_[p1 - p0, q - p0]))) / np.linalg.norm(p1 - p0) < 1.0
+                    and 0.3 < (q - p0) @ (p1 - p0) / ((p1 - p0) @ (p1 - p0)) < 1.0]
+        for q in crossing:
+            assert ed.gizmo_pick(*q) == (GRAB, k)
+        n_crossings += len(crossing)
+    # the scale grip: on its circle (away from the rest), not inside nor outside it
+    for ang in np.linspace(0, 2 * math.pi, 12, endpoint=False):
+        d = np.array([math.cos(ang), math.sin(ang)])
+        assert ed.gizmo_pick(*(c + d * rad)) == (SCALE, None)
+        assert ed.gizmo_pick(*(c + d * (rad + EDITOR_GIZMO_HIT_PX + 2))) is None
+    assert n_crossings > 0
+    assert ed.gizmo_pick(5, 5) is None
+    # the overlay draws grip, rings and arrows
+    assert len(ed.gizmo_patches(W, H)) >= 1 + 3 + 3
+
+
+def test_edge_on_rings_are_hidden_and_nothing_shows_while_moving(editor):
+    ed = editor
+    ed.cam.yaw, ed.cam.pitch = 0.0, 0.0          # looking down -z: X and Y rings seen edge-on
+    assert [k for k, _ in ed.gizmo_rings(W, H)] == [2]
+    c, rad = ed.gizmo_scale_circle(W, H)
+    ed.session.curve_mode = True
+    assert ed.gizmo_rings(W, H) == [] and ed.gizmo_scale_circle(W, H) is None
+    assert ed.gizmo_pick(c[0] + rad, c[1]) is None
+
+
+@pytest.mark.parametrize("k", [0, 1, 2])
+def test_ring_drag_rotates_about_that_axis_through_the_centroid(editor, k):
+    ed, s = editor, editor.session
+    piv = ed.handle_centre().copy()
+    hnd = s.selection.handle.copy()
+    before = s.cloud.positions[hnd].copy()
+    c = ed.gizmo_scale_circle(W, H)[0]
+    g = ed.ring_grab_point(k, W, H)
+    m = drag(ed, around(c, g, 25.0))
+    axis, ang = rotation_axis_angle(m)
+    assert abs(abs(axis[k]) - 1) < 1e-9 and ang == pytest.approx(25.0, abs=1e-6)
+    assert np.allclose(m[:3, :3] @ piv + m[:3, 3], piv)          # the centroid stays put
+    # the mouse sweeps counter-clockwise on screen: a positive turn about the axis
+    # when it points at the viewer (right-handed), negative when it points away
+    back = ed.cam.basis()[2]
+    signed = math.degrees(math.atan2(m[:3, :3][(k + 2) % 3, (k + 1) % 3], m[:3, :3][(k + 1) % 3, (k + 1) % 3]))
+    assert np.sign(signed) == -np.sign(back[k])      # y down: the listed sweep is clockwise on screen
+    # released: one handle, no curve -> applied at once, the handle moved rigidly
+    assert ed.drag is None and s.manip is None and len(s.edits) == 1 and not s.pose_pending
+    assert np.allclose(s.cloud.positions[hnd], before @ m[:3, :3].T + m[:3, 3], atol=1e-9)
+
+
+def test_grip_drag_scales_uniformly_about_the_centroid(editor):
+    ed, s = editor, editor.session
+    piv = ed.handle_centre().copy()
+    c, rad = ed.gizmo_scale_circle(W, H)
+    d = np.array([-0.6, 0.8])
+    m = drag(ed, [tuple(c + d * rad), tuple(c + d * rad * 1.2), tuple(c + d * rad * 1.5)])
+    assert np.allclose(m[:3, :3], 1.5 * np.eye(3))
+    assert np.allclose(m[:3, :3] @ piv + m[:3, 3], piv)
+    assert len(s.edits) == 1
+    # inward, even through the centre: the factor stays > 0
+    assert s.wait_fit() and s.active_fitted()
+    c, rad = ed.gizmo_scale_circle(W, H)
+    m = drag(ed, [tuple(c + d * rad), tuple(c + d * 0.5 * rad), tuple(c)])
+    assert m[0, 0] > 0 and np.allclose(m[:3, :3], m[0, 0] * np.eye(3)) and m[0, 0] < 0.02
+
+
+def test_ring_drag_with_several_handles_is_kept_as_a_pending_move(editor):
+    ed, s = editor, editor.session
+    assert s.add_handle()
+    r = np.linalg.norm(s.cloud.positions[:, :2] - [-0.3, -0.3], axis=1)
+    s.end_stroke(s.paint(np.flatnonzero(r < 0.15)))
+    assert s.wait_fit() and s.active_fitted()
+    ed._centre_key = None
+    c = ed.gizmo_scale_circle(W, H)[0]
+    m = drag(ed, around(c, ed.ring_grab_point(2, W, H), 20.0))
+    assert abs(rotation_axis_angle(m)[0][2]) == pytest.approx(1.0)
+    assert s.pose_pending and len(s.edits) == 0
+    assert np.allclose(s.pose[s.selection.active], m)
