@@ -553,9 +553,10 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
                                      method=method or solver.method,
                                      tol=solver.tol if tol is None else tol,
                                      max_centers=solver.max_centers, progress=progress)
+        d_c = basis.displacement(r.inputs)
     except SplatEditError as exc:
         raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
-    return r, basis, basis.displacement(r.inputs)
+    return r, basis, d_c
 
 
 def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,

@@ -333,6 +333,10 @@ class Editor:
         px, d = self.cam.project(piv, w, h)
         if d[0] <= 0:
             return None
+        margin = EDITOR_GIZMO_SCALE_PX
+        x, y = float(px[0][0]), float(px[0][1])
+        if not (-margin <= x <= w + margin and -margin <= y <= h + margin):
+            return None   # far off-screen: its rings would be huge patches for nothing
         return piv, px[0], self.cam.world_per_pixel(float(d[0]), h)
 
     def gizmo_axes(self, w: int, h: int) -> list:
@@ -908,9 +912,10 @@ class Editor:
                     self.render_scene(key, interactive=moving)
             if self.refiner is not None and self.refiner.error is not None:
                 # a failed full-quality frame is reported once and not retried for this view
-                self.say(f"full-quality frame failed: {self.refiner.error}")
+                failed_key, exc = self.refiner.error
+                self.say(f"full-quality frame failed: {exc}")
                 self.refiner.error = None
-                self._refine_failed_key = key
+                self._refine_failed_key = failed_key
             if self.refiner is not None and self.scene_interactive:
                 img = self.refiner.take(key)
                 if img is not None and img.shape[:2] == (h, w):

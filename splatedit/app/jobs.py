@@ -60,6 +60,8 @@ class Job:
 
     def _run(self, fn) -> None:
         try:
+            if self.cancel.is_set():   # cancelled while still queued: do not start
+                raise Cancelled()
             self.result = fn(self.progress)
         except BaseException as exc:  # noqa: BLE001 - reported by whoever polls the job
             self.error = exc

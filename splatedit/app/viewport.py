@@ -330,7 +330,7 @@ class BackgroundRefiner:
                         with self._cv:
                             self.pick = (st["pick_key"], idx, depth)
                 except Exception as exc:  # noqa: BLE001 - shown by the editor
-                    self.error = exc
+                    self.error = (key, exc)   # the view that failed, and why
                     img = None
                 with self._cv:
                     if self.pending_key == key:

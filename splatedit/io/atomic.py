@@ -74,8 +74,10 @@ def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
     except OSError as exc:
         raise InputError(f"cannot write: {exc.strerror or exc}", path=str(p)) from None
     try:
-        os.fchmod(fd, perms)
         with os.fdopen(fd, mode) as fh:
+            # best effort: some file systems (vfat) refuse chmod, the data matter more
+            with contextlib.suppress(OSError):
+                os.fchmod(fh.fileno(), perms)
             yield fh
             fh.flush()
             os.fsync(fh.fileno())

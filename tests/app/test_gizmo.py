@@ -182,3 +182,11 @@ def test_ring_drag_with_several_handles_is_kept_as_a_pending_move(editor):
     assert abs(rotation_axis_angle(m)[0][2]) == pytest.approx(1.0)
     assert s.pose_pending and len(s.edits) == 0
     assert np.allclose(s.pose[s.selection.active], m)
+
+
+def test_gizmo_is_hidden_when_the_handle_is_far_off_screen(editor):
+    assert editor.gizmo_rings(W, H) and editor.gizmo_axes(W, H)
+    # look far to the side: the handle projects thousands of pixels outside the window
+    editor.cam.target = np.array([40.0, 0.0, 0.0])
+    assert not editor.gizmo_rings(W, H) and not editor.gizmo_axes(W, H)
+    assert editor.gizmo_scale_circle(W, H) is None
