@@ -94,7 +94,7 @@ def cmd_convert(args) -> int:
     return 0
 
 
-def _run_edits(args, cloud, script_path, on_gpu=None):
+def _run_edits(args, cloud, script_path):
     from splatedit.script import load_script, run_script
     script = load_script(script_path)
     return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
