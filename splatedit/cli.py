@@ -99,7 +99,15 @@ def _run_edits(args, cloud, script_path):
     script = load_script(script_path)
     return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
                       source=str(script_path), progress=args.progress,
-                      on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+                      on_edit=lambda rep: _print_report(args, rep))
+
+
+def _print_report(args, rep) -> None:
+    """One edit's report line on stdout, its warnings on stderr."""
+    args.progress.close()
+    print(rep.line())
+    for w in rep.warnings:
+        print(f"splatedit: warning: {w}", file=sys.stderr)
 
 
 def cmd_deform(args) -> int:
@@ -172,14 +180,17 @@ def _gpu_edit(args, cloud):
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
-                              on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+                              on_edit=lambda rep: _print_report(args, rep))
     resolved, basis, d_c = fit_edit(cloud, script.edits[-1], script.solver, source=source,
                                     progress=args.progress)
     args.progress.close()
     st = basis.stats
-    print(f"edit {len(script.edits) - 1}: support {int(resolved.support.sum())} splats, {st['method']} with "
+    print(f"edit {len(script.edits) - 1}: support {len(basis.indices)} splats, {st['method']} with "
           f"{st['n_centers']} centers (residual {st['residual']:.2e}), {d_c.shape[0]} basis columns "
           f"uploaded to the GPU")
+    for c in basis.constraints.conflicts:
+        print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
+              file=sys.stderr)
     return cloud, basis.rows_for_gpu(), d_c
 
 

@@ -10,7 +10,8 @@ Format (version 1)::
         "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
         "curves": [CURVE, ...]}]}            # optional; see below
 
-    REGION    = {"sphere": {"center": [x,y,z], "radius": r}}
+    REGION    = {"sphere": {"center": [x,y,z], "radius": r}}      (a support region may add
+                                                                "fill_holes": false)
               | {"box": {"min": [x,y,z], "max": [x,y,z]}}
               | {"indices": [i, ...]}
     TRANSFORM = {"matrix": [[4 numbers] x 4]}                      (row-major, acts on column vectors)
@@ -121,6 +122,9 @@ class Edit:
     transforms: tuple[Transform, ...]
     json_path: str = "$"
     curves: tuple[Curve, ...] = ()
+    #: close the selection before fitting (``"fill_holes": false`` on the
+    #: support region turns it off; see splatedit.select.closure)
+    fill_holes: bool = True
 
 
 @dataclass(frozen=True)
@@ -172,6 +176,8 @@ class EditScript:
         edits = []
         for e in self.edits:
             item: dict[str, Any] = {"support": region(e.support)}
+            if not e.fill_holes:
+                item["support"]["fill_holes"] = False
             if len(e.handles) == 1:
                 item["handle"] = region(e.handles[0])
                 item["transform"] = transform(e.transforms[0])
@@ -382,7 +388,13 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
         jp = f"$.edits[{i}]"
         e = ctx.obj(e, jp, required=("support",),
                     allowed=("support", "handle", "handles", "transform", "transforms", "curves"))
-        support = _region(ctx, e["support"], f"{jp}.support")
+        sup_in, fill_holes = e["support"], True
+        if isinstance(sup_in, dict) and "fill_holes" in sup_in:
+            fill_holes = sup_in["fill_holes"]
+            if not isinstance(fill_holes, bool):
+                raise ctx.fail(f"{jp}.support.fill_holes", f"must be true or false, got {_kind(fill_holes)}")
+            sup_in = {k: v for k, v in sup_in.items() if k != "fill_holes"}
+        support = _region(ctx, sup_in, f"{jp}.support")
         curves = _curves(ctx, e["curves"], f"{jp}.curves") if "curves" in e else ()
         if "handle" in e and "handles" in e:
             raise ctx.fail(jp, "needs exactly one of 'handle' or 'handles'")
@@ -410,7 +422,7 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             if not isinstance(ts, list) or len(ts) != len(hs):
                 raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
             transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
-        edits.append(Edit(support, handles, transforms, jp, curves))
+        edits.append(Edit(support, handles, transforms, jp, curves, fill_holes))
     return EditScript(tuple(edits), solver)
 
 
@@ -446,13 +458,18 @@ class EditReport:
     notes: list[str] = field(default_factory=list)
     #: per curve: (picked points, kept samples)
     curves: list[tuple[int, int]] = field(default_factory=list)
+    #: splats the selection closure added (support and handles)
+    closure_added: int = 0
+    #: warnings for the user (conflicting constraints), one sentence each
+    warnings: list[str] = field(default_factory=list)
 
     def line(self) -> str:
         hs = "+".join(map(str, self.handles))
         notes = f" ({'; '.join(self.notes)})" if self.notes else ""
+        closed = f" (closure added {self.closure_added})" if self.closure_added else ""
         groups = [f"handle {hs}"] if self.handles else []
         groups += [f"curve {k} points/{n} samples" for k, n in self.curves]
-        return (f"edit {self.index}: support {self.support} splats, {', '.join(groups)}, "
+        return (f"edit {self.index}: support {self.support} splats{closed}, {', '.join(groups)}, "
                 f"{self.constraints} constraints, {self.method} with {self.centers} centers "
                 f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
                 f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
@@ -508,6 +525,7 @@ class ResolvedEdit:
     matrices: list
     curves: list
     curve_moves: list
+    fill_holes: bool = True
 
     @property
     def inputs(self) -> list:
@@ -532,7 +550,7 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
             raise EditScriptError(str(exc), json_path=f"{edit.json_path}.curves[{j}]",
                                   path=source) from None
         curves.append(cc)
-    return ResolvedEdit(support, handles, matrices, curves, moves)
+    return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes)
 
 
 def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
@@ -552,7 +570,8 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
         basis = DeformationBasis.fit(cloud, r.support, r.handles, curves=r.curves,
                                      method=method or solver.method,
                                      tol=solver.tol if tol is None else tol,
-                                     max_centers=solver.max_centers, progress=progress)
+                                     max_centers=solver.max_centers, fill_holes=r.fill_holes,
+                                     progress=progress)
         d_c = basis.displacement(r.inputs)
     except SplatEditError as exc:
         raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
@@ -581,11 +600,14 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                                   path=source) from None
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
-        rep = EditReport(i, int(r.support.sum()), [int(h.sum()) for h in r.handles], stats["n_constraints"],
+        con = basis.constraints
+        rep = EditReport(i, len(con.support_index), [len(h) for h in con.handle_index], stats["n_constraints"],
                          stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
                          stats["basis_seconds"] + (time.perf_counter() - t0), disp,
                          [stats["message"]] if stats.get("message") else [],
-                         [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))])
+                         [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
+                         stats.get("closure_added", 0),
+                         [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts])
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)

@@ -44,16 +44,20 @@ from splatedit.deform.constraints import (
     Constraints,
     affine_coordinate_gradients,
     affine_coordinates,
+    as_mask,
     build_constraints,
 )
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
+from splatedit.select.closure import close_selection
 from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
+#: progress stage name of the selection closure
+CLOSURE_STAGE = "closing the selection"
 #: support splats per chunk when evaluating the RBF for the basis
 _BASIS_CHUNK = 65536
 #: rows per GEMM in the CPU apply: small enough that OpenBLAS runs it on
@@ -152,7 +156,9 @@ class DeformationBasis:
             K = 4 h + sum over curves of (k + 1).
         control_frames: (h, 4, 3) control frames C of the handles.
         stats: dict of fit statistics: ``n_constraints`` (m), ``n_centers``,
-            ``residual``, ``method``, ``polynomial``, ``constraints_seconds``
+            ``residual``, ``method``, ``polynomial``, ``closure_seconds``,
+            ``closure_added`` (splats the closure added), ``n_conflicts``
+            (fixed splats dropped next to handle bands), ``constraints_seconds``
             (bands and control frames), ``fit_seconds`` (the RBF solve),
             ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
             ``n_handle_band``, ``n_curve_samples``, ``n_curve_dropped``,
@@ -166,13 +172,14 @@ class DeformationBasis:
         self._pack = pack  # (N, 4, K): B, Bx, By, Bz
         self.stats = stats
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
+        self.closure = None  # the ClosureResult when fit() closed the selection
 
     # ------------------------------------------------------------ building
     @classmethod
     def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
             tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
             rings: float = BAND_RINGS, spacing: float | None = None,
-            progress=None) -> "DeformationBasis":
+            fill_holes: bool = True, graph=None, progress=None) -> "DeformationBasis":
         """Build constraints, fit one RBF to all group columns, evaluate bases.
 
         Args:
@@ -183,11 +190,31 @@ class DeformationBasis:
             method, tol, max_centers: passed to :meth:`TriharmonicRBF.fit`
                 ("auto" = exact LU up to AUTO_EXACT_MAX_CONSTRAINTS, else IQR).
             rings, spacing: band thickness (see :func:`build_constraints`).
+            fill_holes: close the selection first (default; see
+                :mod:`splatedit.select.closure`: back sides of thin parts,
+                gaps, enclosed islands, a margin around handles); the closed
+                masks are ``closure.support`` / ``closure.handles``.
+            graph: the cloud's :class:`~splatedit.select.graph.NeighbourGraph`
+                for the closure (built when None).
             progress: optional ``progress(stage, fraction)``.
         Raises:
             ParameterError / SolverError from the constraints and the fit.
         """
         t0 = time.perf_counter()
+        closure = None
+        if fill_holes:
+            n = len(cloud.positions)
+            if isinstance(handles, np.ndarray) and handles.ndim == 1:
+                handles = [handles]
+            sup_mask = as_mask("support", support, n)
+            h_masks = [as_mask(f"handles[{i}]", h, n) for i, h in enumerate(handles)]
+            report(progress, CLOSURE_STAGE, 0.0)
+            closure = close_selection(cloud, sup_mask, [h & sup_mask for h in h_masks], graph=graph)
+            # handle splats outside the painted support stay an error of build_constraints
+            support = closure.support
+            handles = [c | (h & ~sup_mask) for c, h in zip(closure.handles, h_masks)]
+            report(progress, CLOSURE_STAGE, 1.0)
+        t_closure = time.perf_counter()
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
         t_con = time.perf_counter()
@@ -223,14 +250,19 @@ class DeformationBasis:
         stats = dict(
             n_constraints=con.n_constraints, n_centers=int(rbf.n_centers),
             residual=float(rbf.residual), method=rbf.method, polynomial=bool(rbf.polynomial),
-            constraints_seconds=t_con - t0, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
+            closure_seconds=t_closure - t0,
+            closure_added=0 if closure is None else closure.n_added,
+            n_conflicts=sum(c.count for c in con.conflicts),
+            constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
             n_fixed_band=int(len(con.fixed_index)),
             n_handle_band=[int(len(b)) for b in con.handle_band_index],
             n_curve_samples=[int(len(c.points)) for c in con.curves],
             n_curve_dropped=[int(c.n_dropped) for c in con.curves],
             spacing=float(con.spacing), message=getattr(rbf, "message", ""),
         )
-        return cls(con, rbf, pack, stats)
+        out = cls(con, rbf, pack, stats)
+        out.closure = closure
+        return out
 
     # ------------------------------------------------------------ accessors
     @property

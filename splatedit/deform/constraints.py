@@ -73,7 +73,7 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError, SolverError
 from splatedit.model.spacing import point_spacing
-from splatedit.tolerances import BAND_RINGS, BAND_SLACK_REL, FRAME_MIN_DET_REL
+from splatedit.tolerances import BAND_RINGS, BAND_SLACK_REL, CONFLICT_RINGS, FRAME_MIN_DET_REL
 
 
 # ----------------------------------------------------------------- frames
@@ -156,6 +156,34 @@ class ConstraintGroup:
         return self.weights.shape[1]
 
 
+@dataclass(frozen=True)
+class Conflict:
+    """Fixed splats that lay too close to a handle's band and were left out of
+    the fit (two different displacements almost at one place make an
+    ill-conditioned, tearing fit).
+
+    Attributes:
+        handle: index of the handle (group) whose band they touch.
+        fixed_index: (c,) cloud indices of the dropped fixed-band splats.
+        center: (3,) centroid of those splats (model units), to say where.
+        min_distance: smallest fixed-to-handle-band distance (model units).
+    """
+    handle: int
+    fixed_index: np.ndarray
+    center: np.ndarray
+    min_distance: float
+
+    @property
+    def count(self) -> int:
+        return len(self.fixed_index)
+
+    def describe(self, spacing: float) -> str:
+        c = ", ".join(f"{x:.4g}" for x in self.center)
+        return (f"{self.count} fixed splats lie within {CONFLICT_RINGS:g} point spacings of handle "
+                f"{self.handle} (closest {self.min_distance / spacing:.2g} spacings, around ({c})); "
+                "they were left out of the fit and do not move: add them to the support")
+
+
 @dataclass
 class Constraints:
     """Everything the RBF fit and the basis precomputation need.
@@ -174,6 +202,8 @@ class Constraints:
         support_index: (N,) sorted cloud indices of the support.
         free_index: (N_free,) sorted cloud indices of support minus handles.
         n_points: number of splats of the cloud the masks refer to.
+        conflicts: fixed-band splats dropped next to handle bands (see
+            :class:`Conflict`), one entry per handle that had any.
     """
 
     points: np.ndarray
@@ -185,6 +215,7 @@ class Constraints:
     support_index: np.ndarray
     free_index: np.ndarray
     n_points: int
+    conflicts: list[Conflict] = field(default_factory=list)
 
     @property
     def n_constraints(self) -> int:
@@ -247,7 +278,8 @@ class Constraints:
 
 
 # --------------------------------------------------------------- building
-def _as_mask(name: str, sel, n: int) -> np.ndarray:
+def as_mask(name: str, sel, n: int) -> np.ndarray:
+    """(n,) bool mask from a mask or an index array (ParameterError naming ``name``)."""
     arr = np.asarray(sel)
     if arr.dtype == bool:
         if arr.shape != (n,):
@@ -320,7 +352,7 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
     n = len(pos)
     if not (np.isfinite(rings) and rings > 0):
         raise ParameterError("rings", f"must be > 0, got {rings}")
-    sup = _as_mask("support", support, n)
+    sup = as_mask("support", support, n)
     if not sup.any():
         raise ParameterError("support", "selects no splats (empty support region)")
     if isinstance(handles, np.ndarray) and handles.ndim == 1:
@@ -333,7 +365,7 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
     hmasks = []
     covered = np.zeros(n, dtype=bool)
     for i, h in enumerate(handles):
-        m = _as_mask(f"handles[{i}]", h, n)
+        m = as_mask(f"handles[{i}]", h, n)
         if not m.any():
             raise ParameterError(f"handles[{i}]", "selects no splats (empty handle)")
         outside = m & ~sup
@@ -392,6 +424,22 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
                                       weights=affine_coordinates(pos[band], frame),
                                       controls=frame, band_index=band, member_index=hidx))
 
+    # conflicts: fixed-band splats within CONFLICT_RINGS spacings of a handle
+    # band get a different displacement almost at the same place: drop them
+    conflicts = []
+    conflict_width = CONFLICT_RINGS * h * (1.0 + BAND_SLACK_REL)
+    for i, g in enumerate(groups):
+        if len(fixed_index) == 0:
+            break
+        d, _ = cKDTree(g.points).query(pos[fixed_index], k=1, distance_upper_bound=conflict_width,
+                                       workers=-1)
+        bad = np.isfinite(d)
+        if bad.any():
+            idx = fixed_index[bad]
+            conflicts.append(Conflict(handle=i, fixed_index=idx, center=pos[idx].mean(axis=0),
+                                      min_distance=float(d[bad].min())))
+            fixed_index = fixed_index[~bad]
+
     # curves: keep the samples whose nearest splat is free and that have no
     # outside splat, handle splat or earlier curve sample within one spacing
     drop_width = h * (1.0 + BAND_SLACK_REL)
@@ -436,4 +484,4 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
         col += g.n_columns
     return Constraints(points=pts, values=values, fixed_index=fixed_index, groups=groups,
                        spacing=h, band_width=width, support_index=support_index,
-                       free_index=free_index, n_points=n)
+                       free_index=free_index, n_points=n, conflicts=conflicts)

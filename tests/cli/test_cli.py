@@ -93,7 +93,7 @@ def test_deform_refuses_to_overwrite_its_input_unless_forced(small_ply, tmp_path
 def test_deform_moves_handle_by_the_transform_and_keeps_fixed_splats_bitwise(small_ply, tmp_path):
     script = tmp_path / "edit.json"
     script.write_text(json.dumps({"version": 1, "edits": [
-        {"support": {"sphere": {"center": [0, 0, 1], "radius": 0.8}},
+        {"support": {"sphere": {"center": [0, 0, 1], "radius": 0.8}, "fill_holes": False},
          "handle": {"sphere": {"center": [0, 0, 1], "radius": 0.25}}, "transform": {"translate": [0, 0, 0.3]}}]}))
     out = tmp_path / "out.ply"
     res = run_cli("deform", small_ply, "--edit", script, "-o", out)

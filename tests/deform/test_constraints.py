@@ -195,7 +195,7 @@ def test_error_bad_mask_shape_and_indices(plane):
         build_constraints(plane, disc(plane, 0.7), [disc(plane, 0.2)], rings=0)
 
 
-def test_error_conflicting_duplicates_across_groups():
+def test_fixed_duplicate_of_a_handle_splat_is_dropped_and_reported_as_a_conflict():
     c = sphere_cloud(2000)
     from splatedit.model.cloud import SplatCloud
     # splat 0 duplicated: one copy in the handle, the other outside the support
@@ -206,5 +206,11 @@ def test_error_conflicting_duplicates_across_groups():
     sup = dist <= 0.9
     hnd = dist <= 0.3
     sup[-1] = hnd[-1] = False
-    with pytest.raises(SolverError, match="same position"):
-        build_constraints(d, sup, [hnd], rings=40)
+    con = build_constraints(d, sup, [hnd], rings=40)
+    assert len(con.conflicts) == 1 and con.conflicts[0].handle == 0
+    dup = len(d.positions) - 1
+    assert dup in con.conflicts[0].fixed_index and dup not in con.fixed_index
+    assert con.conflicts[0].min_distance == 0.0
+    assert "fixed splats lie within" in con.conflicts[0].describe(con.spacing)
+    # the kept constraints have distinct positions, so the fit is well posed
+    assert len(np.unique(con.points, axis=0)) == len(con.points)
