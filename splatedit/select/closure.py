@@ -33,8 +33,10 @@ Python API alike), by four rules, each on the neighbour graph of
 
 Handles are closed by rules 1-3 too, inside the closed support and outside
 the other handles: a handle painted on the front of an ear's tip takes the
-back of the tip (the user grabbed the tip).  Closure only adds splats; the
-result is closed (closing it again adds nothing).
+back of the tip (the user grabbed the tip).  Closure only adds splats.  It
+is not idempotent in general (T and the handle margin grow with the
+selection), so the editor closes after each stroke and fits the closed
+selection as it is, and exported scripts say ``"fill_holes": false``.
 """
 
 from __future__ import annotations
@@ -105,14 +107,15 @@ def _rms_radius(points: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
 
 
-def _back_sides(pos: np.ndarray, nrm: np.ndarray, sel: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+def _back_sides(pos: np.ndarray, nrm: np.ndarray, sel: np.ndarray, allowed: np.ndarray,
+                t: float) -> np.ndarray:
     """Indices of ``allowed`` unselected splats that are the back side of a
-    thin part whose front ``sel`` (n,) bool was painted (rule 1)."""
+    thin part whose front ``sel`` (n,) bool was painted, at most ``t`` (model
+    units) behind it (rule 1)."""
     sel_idx = np.flatnonzero(sel)
     if len(sel_idx) < 2:
         return np.zeros(0, np.int64)
     sp = pos[sel_idx]
-    t = CLOSURE_THIN_MAX_REL * _rms_radius(sp)
     if not t > 0:
         return np.zeros(0, np.int64)
     lo, hi = sp.min(axis=0) - t, sp.max(axis=0) + t
@@ -162,10 +165,10 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> np
 
 
 def _close(graph: NeighbourGraph, pos: np.ndarray, nrm: np.ndarray, sel: np.ndarray,
-           allowed: np.ndarray) -> tuple[np.ndarray, ClosureCounts]:
+           allowed: np.ndarray, thickness: float) -> tuple[np.ndarray, ClosureCounts]:
     """Rules 1-3 for one mask inside ``allowed``; returns the closed mask and counts."""
     out = sel.copy()
-    back = _back_sides(pos, nrm, out, allowed)
+    back = _back_sides(pos, nrm, out, allowed, thickness)
     out[back] = True
     closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=allowed | out), CLOSURE_GAP_RINGS)
     gaps = int((closed & ~out).sum())
@@ -175,8 +178,8 @@ def _close(graph: NeighbourGraph, pos: np.ndarray, nrm: np.ndarray, sel: np.ndar
     return out, ClosureCounts(back_sides=len(back), gaps=gaps, islands=len(islands))
 
 
-def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourGraph | None = None
-                    ) -> ClosureResult:
+def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourGraph | None = None,
+                    changed: np.ndarray | None = None) -> ClosureResult:
     """Close a painted selection (see the module docstring).
 
     Args:
@@ -185,6 +188,12 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         handles: (n,) bool masks, disjoint, inside the support.
         graph: the cloud's :class:`NeighbourGraph` (built when None; the
             editor keeps one per base cloud).
+        changed: (n,) bool, the splats painted or erased since the selection
+            was last closed (the editor's stroke), or None.  The rest of the
+            selection is taken as closed already and only a neighbourhood of
+            the change is closed (the thickness bound T and the handle margin
+            still come from the whole selection): the cost follows the
+            stroke, not the model (see ``splatedit bench closure``).
     Returns:
         A :class:`ClosureResult`; the input masks are not modified.
     """
@@ -198,44 +207,81 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     graph = NeighbourGraph.build(pos) if graph is None else graph
     if graph.n != n:
         raise ValueError(f"the neighbour graph has {graph.n} splats, the cloud {n}")
-    nrm = cloud.normals
-    everything = np.ones(n, bool)
-
-    sup, c_sup = _close(graph, pos, nrm, sup_in, everything)
-    hs = [h & sup for h in hs_in]
+    thickness = [CLOSURE_THIN_MAX_REL * _rms_radius(pos[m]) if m.any() else 0.0
+                 for m in [sup_in] + hs_in]
+    margins = [max(BAND_RINGS * graph.spacing, CLOSURE_HANDLE_MARGIN_REL * t / CLOSURE_THIN_MAX_REL)
+               for t in thickness[1:]]
+    if changed is None:
+        region = np.arange(n)
+        sub_graph = graph
+    else:
+        region = _neighbourhood(pos, np.asarray(changed, bool), sup_in, hs_in,
+                                max(thickness + margins) + CLOSURE_ISLAND_RINGS * 2 * graph.spacing)
+        if len(region) == 0:
+            empty = np.zeros(n, bool)
+            return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], empty, empty.copy())
+        sub_graph = graph.subgraph(region)
+    sub_pos = pos[region]
+    u, v = cloud.u[region], cloud.v[region]
+    nrm = np.cross(u, v)
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+    sup_r, c_sup = _close(sub_graph, sub_pos, nrm, sup_in[region], np.ones(len(region), bool),
+                          thickness[0])
+    hs_r = [h[region] & sup_r for h in hs_in]
     c_h = ClosureCounts()
-    for i, h in enumerate(hs):
+    for i, h in enumerate(hs_r):
         if not h.any():
             continue
-        others = np.zeros(n, bool)
-        for k, o in enumerate(hs):
+        others = np.zeros(len(region), bool)
+        for k, o in enumerate(hs_r):
             if k != i:
                 others |= o
-        closed, c = _close(graph, pos, nrm, h, sup & ~others)
-        hs[i] = closed
+        closed, c = _close(sub_graph, sub_pos, nrm, h, sup_r & ~others, thickness[1 + i])
+        hs_r[i] = closed
         c_h = ClosureCounts(c_h.back_sides + c.back_sides, c_h.gaps + c.gaps, c_h.islands + c.islands)
 
     margin = 0
-    for h in hs:
-        if not h.any():
+    for h, width in zip(hs_r, margins):
+        if not h.any() or not width > 0:
             continue
-        hp = pos[h]
-        width = max(BAND_RINGS * graph.spacing, CLOSURE_HANDLE_MARGIN_REL * _rms_radius(hp))
-        cand = np.flatnonzero(~sup)
+        hp = sub_pos[h]
+        cand = np.flatnonzero(~sup_r)
         lo, hi = hp.min(axis=0) - width, hp.max(axis=0) + width
-        cand = cand[np.all((pos[cand] >= lo) & (pos[cand] <= hi), axis=1)]
-        if len(cand) == 0 or not width > 0:
+        cand = cand[np.all((sub_pos[cand] >= lo) & (sub_pos[cand] <= hi), axis=1)]
+        if len(cand) == 0:
             continue
-        d, _ = cKDTree(hp).query(pos[cand], k=1, distance_upper_bound=width, workers=-1)
+        d, _ = cKDTree(hp).query(sub_pos[cand], k=1, distance_upper_bound=width, workers=-1)
         near = cand[np.isfinite(d)]
-        sup[near] = True
+        sup_r[near] = True
         margin += len(near)
+
+    counts = ClosureCounts(c_sup.back_sides + c_h.back_sides, c_sup.gaps + c_h.gaps,
+                           c_sup.islands + c_h.islands, margin)
+    sup = sup_in.copy()
+    sup[region] |= sup_r
+    hs = []
+    for h, hr in zip(hs_in, hs_r):
+        out = h.copy()
+        out[region] |= hr
+        hs.append(out)
     any_h = np.zeros(n, bool)
     for h in hs:
         any_h |= h
-    counts = ClosureCounts(c_sup.back_sides + c_h.back_sides, c_sup.gaps + c_h.gaps,
-                           c_sup.islands + c_h.islands, margin)
     added_h = any_h.copy()
     for h in hs_in:
         added_h &= ~h
     return ClosureResult(sup, hs, sup & ~sup_in, added_h, counts)
+
+
+def _neighbourhood(pos: np.ndarray, changed: np.ndarray, support: np.ndarray, handles: list,
+                   reach: float) -> np.ndarray:
+    """Sorted indices of the splats within the box of the changed splats (and
+    of the handles, whose margin depends on their whole extent) grown by
+    ``reach`` (model units)."""
+    parts = [changed] + [h for h in handles if (h & changed).any()]
+    boxes = [(pos[m].min(axis=0), pos[m].max(axis=0)) for m in parts if m.any()]
+    if not boxes:
+        return np.zeros(0, np.int64)
+    lo = np.min([b[0] for b in boxes], axis=0) - reach
+    hi = np.max([b[1] for b in boxes], axis=0) + reach
+    return np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1))

@@ -34,13 +34,14 @@ class NeighbourGraph:
         indptr: (n + 1,) int64 CSR row pointers.
         indices: (E,) int32 neighbour indices (each undirected edge twice).
         spacing: median nearest-neighbour distance of distinct splats (model units).
-        tree: cKDTree of the positions (reused by closure and the brush).
+        tree: cKDTree of the positions (reused by the brush), or None for a
+            :meth:`subgraph`.
     """
 
     indptr: np.ndarray
     indices: np.ndarray
     spacing: float
-    tree: cKDTree
+    tree: cKDTree | None = None
 
     @classmethod
     def build(cls, positions: np.ndarray, k: int = GRAPH_NEIGHBOURS,
@@ -72,6 +73,20 @@ class NeighbourGraph:
         indptr.setflags(write=False)
         indices.setflags(write=False)
         return cls(indptr, indices, float(spacing), tree)
+
+    def subgraph(self, index: np.ndarray) -> "NeighbourGraph":
+        """The graph induced by the splats ``index`` (sorted unique int array),
+        renumbered 0..len(index)-1 in that order (same spacing, no tree)."""
+        index = np.asarray(index, np.int64)
+        lookup = np.full(self.n, -1, np.int32)
+        lookup[index] = np.arange(len(index), dtype=np.int32)
+        counts = self.indptr[index + 1] - self.indptr[index]
+        nb = lookup[self.neighbours_of(index)]
+        keep = nb >= 0
+        row = np.repeat(np.arange(len(index)), counts)[keep]
+        indptr = np.zeros(len(index) + 1, np.int64)
+        np.cumsum(np.bincount(row, minlength=len(index)), out=indptr[1:])
+        return self._frozen(indptr, nb[keep].astype(np.int32), self.spacing, None)
 
     @property
     def n(self) -> int:
