@@ -124,7 +124,8 @@ def splats_in_sphere(tree, sphere: BrushSphere) -> np.ndarray:
 
 
 # ------------------------------------------------------------------ masks
-def _target_mask(sel: Selection, target: str) -> np.ndarray:
+def target_mask(sel: Selection, target: str) -> np.ndarray:
+    """The support or the active handle's mask (not a copy)."""
     return sel.support if target == SUPPORT else sel.handle
 
 
@@ -139,7 +140,7 @@ def grown(sel: Selection, graph, target: str, rings: int = 1) -> np.ndarray:
 
 def shrunk(sel: Selection, graph, target: str, rings: int = 1) -> np.ndarray:
     """The target's mask shrunk by ``rings`` rings (its boundary removed)."""
-    return graph.shrink(_target_mask(sel, target), rings)
+    return graph.shrink(target_mask(sel, target), rings)
 
 
 def connected_region(graph, seed: int, reach: np.ndarray | None = None) -> np.ndarray:
@@ -161,7 +162,7 @@ def set_target(sel: Selection, target: str, mask: np.ndarray) -> bool:
     """Make the target's mask ``mask`` with the brush rules (a handle stays
     inside the support and disjoint from the others; removing support splats
     removes them from every handle).  Returns True when something changed."""
-    old = _target_mask(sel, target)
+    old = target_mask(sel, target)
     mask = np.asarray(mask, bool)
     add = np.flatnonzero(mask & ~old)
     rem = np.flatnonzero(old & ~mask)
