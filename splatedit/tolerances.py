@@ -109,6 +109,41 @@ BAND_SLACK_REL = 1e-9
 #: volume below this is degenerate (its 4 points are nearly coplanar)
 FRAME_MIN_DET_REL = 1e-12
 
+# --- selection closure (splatedit.select) ---------------------------------
+#: neighbour graph: k nearest neighbours per splat (symmetrised).  10 keeps a
+#: surface sampled by a scan or a mesh connected (every splat has neighbours
+#: all around) without linking the two sides of thin parts much more often
+#: than their sampling does anyway
+GRAPH_NEIGHBOURS = 10
+#: an edge is cut when it is longer than this times the smaller local scale of
+#: its two splats (median distance to their k neighbours): outliers and
+#: bridges across gaps between parts do not connect
+GRAPH_EDGE_MAX_REL = 3.0
+#: closure rule 1: normals of a thin part's two sides face opposite ways
+#: within acos(-0.5) = 120 degrees
+CLOSURE_OPPOSITE_COS = 0.0
+#: closure rule 1: the thickness bound T of a thin part, times the RMS radius
+#: of the painted selection
+CLOSURE_THIN_MAX_REL = 1.0
+#: closure rule 1: the k nearest selected splats (within T) tried as the
+#: painted side across the part (the nearest one is often a rim splat seen
+#: edge-on, whose normal is not opposite)
+CLOSURE_BACK_NEIGHBOURS = 16
+#: closure rule 1: the painted splat lies within acos(this) of straight
+#: behind the candidate along both normals (a part's two sides face each
+#: other through its thickness; other surfaces within T lie off to the side)
+CLOSURE_BACK_CONE_COS = 0.7
+#: closure rule 2: morphological closing radius in rings (fills slits and
+#: rims up to twice this wide)
+CLOSURE_GAP_RINGS = 2
+#: closure rule 3: unselected components within this many rings of the
+#: selection that reach no farther are enclosed islands
+CLOSURE_ISLAND_RINGS = 8
+#: closure rule 4: unselected splats closer to a handle than max(band width,
+#: this times the handle's RMS radius) join the support, so the deformation
+#: has room to fall off (a fixed splat next to a moving handle tears)
+CLOSURE_HANDLE_MARGIN_REL = 1.0
+
 # --- rendering (splatedit.render) -------------------------------------------
 #: EWA screen-space low-pass filter radius in pixels (sqrt(2)/2): every splat covers at
 #: least the disc of this radius around its projected centre (Botsch, Hornung,
