@@ -255,6 +255,8 @@ class Editor:
                     self.running = False
                 else:
                     self.say(f"{job.name} failed: {job.error}")
+                    if name == "graph":
+                        self.tools.poll()
                 continue
             if name == "load":
                 self.on_loaded(job.result)

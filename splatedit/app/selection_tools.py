@@ -244,6 +244,7 @@ class SelectionTools:
         self.highlight_until = 0.0
         self.last_added = 0
         self.closure_pending = False                 # a selection changed while no graph was ready
+        self._failed = None                          # the cloud whose graph failed (not retried)
 
     # ------------------------------------------------------------ graph
     def toggle_mode(self) -> str:
@@ -253,7 +254,7 @@ class SelectionTools:
     def prepare(self, cloud) -> None:
         """Start building the neighbour graph of ``cloud`` unless it is cached
         or being built."""
-        if id(cloud) in self._graphs or self._job_cloud is cloud:
+        if id(cloud) in self._graphs or self._job_cloud is cloud or self._failed is cloud:
             return
         if self._job is not None:
             self._job.cancel.set()
@@ -286,6 +287,8 @@ class SelectionTools:
         if job.error is None:
             self._store(cloud, job.result)
             return True
+        if not job.cancel.is_set():
+            self._failed = cloud
         return False
 
     def graph(self, cloud, wait: bool = True):

@@ -86,6 +86,21 @@ def test_3d_brush_paints_the_ear_through_and_the_grab_does_not_tear(xvfb, tmp_pa
         shot = ed.screenshot()[:h, :w]
         from PIL import Image
         Image.fromarray(shot[..., :3]).save(tmp_path / "painted.png")
+        painted = s["support"]
+        # --- the tools: V toggles the mode, grow / shrink by a ring and undo are one step each
+        ed.xdo("key", "v")
+        ed.wait(lambda s: s["brush_mode"] == "visible", "visible-only brush")
+        ed.xdo("key", "v")
+        ed.wait(lambda s: s["brush_mode"] == "3d", "3D brush again")
+        ed.xdo("key", "ctrl+equal")
+        s = ed.idle(lambda s: s["history"] == 3, "grown")
+        grown = s["support"]
+        ed.xdo("key", "ctrl+minus")
+        s = ed.idle(lambda s: s["history"] == 4, "shrunk")
+        assert grown > painted and s["support"] < grown
+        ed.xdo("key", "ctrl+z", "ctrl+z")
+        s = ed.idle(lambda s: s["undo_position"] == 1, "tools undone")
+        assert s["support"] == painted
         # --- the handle: the ear's tip (handle brush, a small radius)
         ed.xdo("key", "2", *["bracketleft"] * (presses + 3 if key == "bracketright" else 3))
         tip_px = tip + (base - tip) * 0.04
