@@ -25,6 +25,7 @@ from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, picker_for_view, s
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.jobs import Job
 from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
+from splatedit.app import selection_tools as seltools
 from splatedit.app.session import GRAB, ROTATE, SCALE, Session, ViewInfo
 from splatedit.errors import InputError, ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_BRUSH_KEY_STEP,
@@ -173,6 +174,8 @@ class Editor:
         self.sel_version_seen = -1
         self.start_time = time.perf_counter()
         self.debug_enabled = os.environ.get("SPLATEDIT_EDITOR_DEBUG", "") not in ("", "0")
+        self.tools = seltools.SelectionTools(self._start_graph_job)
+        self._warned_no_graph = False
 
     # ---------------------------------------------------------------- utils
     def wake(self) -> None:
@@ -196,6 +199,11 @@ class Editor:
 
     def motion(self) -> None:
         self.last_motion = time.perf_counter()
+
+    def _start_graph_job(self, name: str, fn) -> Job:
+        job = Job(name, fn, self.wake)
+        self.jobs["graph"] = job
+        return job
 
     # -------------------------------------------------------------- loading
     def start_load(self) -> None:
@@ -229,6 +237,7 @@ class Editor:
                 from splatedit.model.lod import LodPyramid
                 return LodPyramid(cloud, progress=progress)
             self.jobs["lod"] = Job("levels of detail", work, self.wake)
+        self.tools.prepare(cloud)
         self.say(f"loaded {self.cloud_name}: {cloud.n:,} splats")
 
     def poll_jobs(self) -> None:
@@ -246,6 +255,8 @@ class Editor:
                     self.running = False
                 else:
                     self.say(f"{job.name} failed: {job.error}")
+                    if name == "graph":
+                        self.tools.poll()
                 continue
             if name == "load":
                 self.on_loaded(job.result)
@@ -261,6 +272,9 @@ class Editor:
             elif name == "export":
                 self.saved_script = job.result
                 self.say(f"edit script written to {job.result}")
+            elif name == "graph":
+                if self.tools.poll() and self.tools.closure_pending and self.session is not None:
+                    self.close_pending_selection()
 
     # --------------------------------------------------------------- camera
     def frame_all(self) -> None:
@@ -501,12 +515,76 @@ class Editor:
         s = self.session
         erase = self.erase_toggle or bool(self.window.mods() & self.g.MOD_CONTROL)
         picker = self.get_picker()
+        graph = self.tools.graph(s.cloud) if self.tools.mode == seltools.BRUSH_3D else None
+        if self.tools.mode == seltools.BRUSH_3D and graph is None and not self._warned_no_graph:
+            self._warned_no_graph = True
+            self.say("3D brush: the neighbour graph is being built, painting visible splats meanwhile")
+        displaced = self.viewport.dc is not None and bool(self.viewport.dc.any())
         changed = False
         for x, y in points:
-            changed |= s.paint(picker.query(x, y, self.brush_radius), erase=erase)
+            if graph is not None:
+                sph = seltools.brush_sphere(picker, self.cam, s.cloud.positions, x, y, self.brush_radius,
+                                       self.size, displaced)
+                idx = seltools.splats_in_sphere(graph.tree, sph) if sph is not None else np.zeros(0, np.int64)
+            else:
+                idx = picker.query(x, y, self.brush_radius)
+            changed |= s.paint(idx, erase=erase)
         if changed:
             self.stroke_changed = True
             self.motion()
+
+    # ------------------------------------------------------ selection tools
+    def close_pending_selection(self) -> None:
+        """The neighbour graph arrived after a selection change: close it now (an undo step)."""
+        s = self.session
+        if s.manip is not None:
+            return
+        n = self.tools.close(s)
+        if n:
+            s.push("fill holes")
+            self.say(f"closure added {n:,} splats")
+
+    def selection_tool(self, tool: str, x: float | None = None, y: float | None = None,
+                       whole: bool = False) -> None:
+        """Run ``tool`` ("grow", "shrink", "connected", "invert") on the brush
+        target (support or active handle), close the selection: one undo step."""
+        s = self.session
+        if s.manip is not None:
+            return
+        target = s.brush_target
+        what = "support" if target == SUPPORT else "handle"
+        graph = self.tools.graph(s.cloud)
+        if graph is None and tool != "invert":
+            self.say("the neighbour graph is still being built: try again in a moment")
+            return
+        sel = s.selection
+        if tool == "grow":
+            mask = seltools.grown(sel, graph, target)
+        elif tool == "shrink":
+            mask = seltools.shrunk(sel, graph, target)
+        elif tool == "invert":
+            mask = seltools.inverted(sel, target)
+        elif tool == "connected":
+            picker = self.get_picker()
+            sph = seltools.brush_sphere(picker, self.cam, s.cloud.positions, x, y, self.brush_radius, self.size,
+                                   self.viewport.dc is not None and bool(self.viewport.dc.any()))
+            if sph is None:
+                self.say("select connected: put the cursor on the model")
+                return
+            reach = None
+            if not whole:
+                reach = np.zeros(s.cloud.n, bool)
+                reach[seltools.splats_in_sphere(graph.tree, sph)] = True
+            mask = seltools.target_mask(sel, target) | seltools.connected_region(graph, sph.seed, reach)
+        else:
+            raise ValueError(tool)
+        before = s.selection.counts
+        if not self.tools.apply(s, target, mask, f"{tool} {what}"):
+            self.say(f"{tool}: the {what} did not change")
+            return
+        n = s.selection.counts[0 if target == SUPPORT else 1] - before[0 if target == SUPPORT else 1]
+        added = self.tools.last_added
+        self.say(f"{tool} {what}: {n:+,} splats" + (f", closure added {added:,}" if added else ""))
 
     # ---------------------------------------------------------------- input
     def handle_events(self, events) -> None:
@@ -590,6 +668,10 @@ class Editor:
         self.mouse = (x, y)
         if e.action == g.RELEASE:
             if self.drag == "paint" and s is not None:
+                if self.stroke_changed:
+                    added = self.tools.close(s)
+                    if added:
+                        self.say(f"closure added {added:,} splats")
                 s.end_stroke(self.stroke_changed)
                 self.stroke_changed = False
             if self.drag == "manip" and s is not None and s.manip is not None:
@@ -704,6 +786,12 @@ class Editor:
                     self.save(self.save_target())
             elif k == g.KEY_E:
                 self.export_script()
+            elif k in (g.KEY_EQUAL, g.KEY_KP_ADD):
+                self.selection_tool("grow")
+            elif k in (g.KEY_MINUS, g.KEY_KP_SUBTRACT):
+                self.selection_tool("shrink")
+            elif k == g.KEY_I:
+                self.selection_tool("invert")
             self.motion()
             return
         if k in (g.KEY_G, g.KEY_R, g.KEY_S):
@@ -750,6 +838,12 @@ class Editor:
             s.brush_target = SUPPORT if k == g.KEY_1 else HANDLE
         elif k == g.KEY_E:
             self.erase_toggle = not self.erase_toggle
+        elif k == g.KEY_V:
+            mode = self.tools.toggle_mode()
+            self.say("brush: 3D (everything inside the sphere, front and back)" if mode == seltools.BRUSH_3D
+                     else "brush: visible splats only")
+        elif k == g.KEY_L:
+            self.selection_tool("connected", *self.mouse, whole=shift)
         elif k == g.KEY_C:
             s.clear(HANDLE if shift else None)
         elif k == g.KEY_LEFT_BRACKET:
@@ -875,6 +969,7 @@ class Editor:
         if vp.cloud is not s.cloud:
             vp.set_cloud(s.cloud)
             self.picker = None
+        self.tools.prepare(s.cloud)
         if self.sel_version_seen != s.version:
             vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
             self.sel_version_seen = s.version
@@ -983,6 +1078,16 @@ class Editor:
                 img = ov.ring(int(round(self.brush_radius)), col)
                 patches.append(ov.Patch(int(self.mouse[0]) - img.shape[1] // 2,
                                         int(self.mouse[1]) - img.shape[0] // 2, img))
+                tag = ov.text_panel(("3D" if self.tools.mode == seltools.BRUSH_3D else "VIS",), size=11,
+                                    fg=tuple(col) + (255,), pad=2, bg=(20, 22, 28, 150))
+                r = int(round(self.brush_radius * 0.7071))
+                patches.append(ov.Patch(int(self.mouse[0]) + r + 2, int(self.mouse[1]) + r + 2, tag))
+            hl = self.tools.highlighted(s.cloud)
+            if hl is not None:
+                px, d = self.cam.project(s.cloud.positions[hl], w, h)
+                p = seltools.points_patch(np.where((d > 0)[:, None], px, np.nan), (w, h))
+                if p is not None:
+                    patches.insert(0, p)
         panel = ov.text_panel(tuple(self.panel_lines()))
         self.panel_box = (8, 8, panel.shape[1], panel.shape[0])
         patches.append(ov.Patch(8, 8, panel))
@@ -1083,7 +1188,8 @@ class Editor:
         lines = [f"{self.cloud_name}   {s.cloud.n:,} splats"]
         tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
         erase = "  ERASE" if self.erase_toggle else ""
-        lines.append((f"brush: {tgt}{erase}  radius {self.brush_radius:.0f} px   (Tab, E, [ ])",
+        mode = "3D" if self.tools.mode == seltools.BRUSH_3D else "VISIBLE"
+        lines.append((f"brush: {tgt} {mode}{erase}  radius {self.brush_radius:.0f} px   (Tab, V, E, [ ])",
                       ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
         lines.append(f"support {st['support']:,}   handle {st['handle']:,}")
         hs = s.selection.handles
@@ -1152,7 +1258,9 @@ class Editor:
                       active_handle=ss["active_handle"], handle_sizes=ss["handle_sizes"],
                       curve_points=ss["curve_points"], curve_mode=s.curve_mode,
                       pose_pending=ss["pose_pending"], columns=ss["columns"],
-                      basis_columns=None if s.basis is None else s.basis.n_columns)
+                      basis_columns=None if s.basis is None else s.basis.n_columns,
+                      brush_mode=self.tools.mode, closure_added=self.tools.last_added,
+                      closure_highlight=self.tools.highlighted(s.cloud) is not None)
             idle = (not self.jobs and s.fit_job is None and self.drag is None and s.manip is None
                     and not self.scene_interactive and self.scene_key == self.scene_state()
                     and not (self.refiner is not None and self.refiner.busy))

@@ -20,7 +20,8 @@ Camera
   F  or  numpad .        frame the selection (handle, else support)
   Numpad 1 / 3 / 7       front / right / top view
 Selection (paper Sect. 3: support = blue, handles = green, the active one brighter)
-  Left drag              paint with the brush (only visible splats)
+  Left drag              paint with the brush: 3D, every splat in the sphere under the circle
+  V                      brush mode: 3D (front and back) / visible splats only
   Ctrl + left drag       erase with the brush            (E toggles erase mode)
   1 / 2                  brush paints the support / the active handle (inside the support)
   Tab                    one handle: toggle support / handle brush; several: next handle (Shift: previous)
@@ -28,6 +29,10 @@ Selection (paper Sect. 3: support = blue, handles = green, the active one bright
   Delete                 remove the active handle
   [ / ]  or  Ctrl+wheel  brush radius
   C / Shift+C            clear the selection / clear the handles
+  Ctrl + =  /  Ctrl + -  grow / shrink the brush target by one ring (numpad + / - too)
+  L / Shift+L            add the connected part under the cursor within the brush / all of it
+  Ctrl + I               invert the brush target (support: handles cleared; handle: within the support)
+  After each stroke or tool the selection is closed (holes, back sides); additions flash yellow
 Deformation (the basis of all handles and the curve is fitted in the background;
              at most 16 columns: 4 per handle + 1 per curve point)
   Left drag on a handle  make it active and move it in the view plane

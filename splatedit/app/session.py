@@ -210,6 +210,18 @@ def columns_needed(n_handles: int, n_curve_points: int) -> int:
     return HANDLE_COLUMNS * n_handles + (n_curve_points if n_curve_points >= 2 else 0)
 
 
+def _no_fill_holes(fn) -> dict:
+    """``{"fill_holes": False}`` when ``fn`` (DeformationBasis.fit, script.Edit)
+    takes it, else ``{}``.  The editor closes the selection itself, visibly,
+    after each stroke (:mod:`splatedit.app.selection_tools`); the fit and the
+    exported script use exactly that selection, so ``splatedit deform``
+    replays the edit bit for bit.  (Transitional: the ``fill_holes`` options
+    of the fit and of edit scripts land on ``main`` separately; once merged
+    this can pass ``fill_holes=False`` directly.)"""
+    import inspect
+    return {"fill_holes": False} if "fill_holes" in inspect.signature(fn).parameters else {}
+
+
 def _matrix_tuple(m) -> tuple:
     return tuple(tuple(float(x) for x in row) for row in np.asarray(m, float))
 
@@ -489,7 +501,8 @@ class Session:
         def work(progress):
             from splatedit.deform.basis import DeformationBasis
             return DeformationBasis.fit(cloud, support, handles, curves=curves, method=self.method,
-                                        tol=self.tol, max_centers=self.max_centers, progress=progress)
+                                        tol=self.tol, max_centers=self.max_centers, progress=progress,
+                                        **_no_fill_holes(DeformationBasis.fit))
 
         # fits run one at a time on the session's pool (a cancelled one ends at its
         # next progress report); fit_sync runs it here
@@ -704,7 +717,8 @@ class Session:
             curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.curve_points),
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
         edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
-                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves)
+                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
+                    **_no_fill_holes(Edit))
         self.manip = None
         self.manip_target = None
         self.cloud = new
