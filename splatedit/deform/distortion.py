@@ -3,7 +3,8 @@
 For a splat with orthogonal tangent semi-axes u, v and the deformation's
 Jacobian J at its centre, the *principal stretches* s1 >= s2 are the singular
 values of the 3x2 matrix ``[J u / |u|, J v / |v|]`` (the map of the splat's
-unit tangent axes).  Then
+unit tangent axes; for axes that are not orthogonal, the singular values of
+J restricted to the tangent plane, see :func:`principal_stretches`).  Then
 
 * ``stretch = max(s1, 1 / s2)`` (>= 1; 1 = undistorted, 2 = some direction
   doubled or halved in length),
@@ -68,23 +69,38 @@ class DistortionStats:
                 f"{self.min_area_change:.3g}..{self.max_area_change:.3g}")
 
 
-def principal_stretches(a: np.ndarray, b: np.ndarray):
-    """Singular values of the (n, 3, 2) matrices ``[a, b]``.
+def principal_stretches(u0: np.ndarray, v0: np.ndarray, u1: np.ndarray, v1: np.ndarray):
+    """Principal stretches of the linear maps taking (u0, v0) to (u1, v1).
 
     Args:
-        a, b: (n, 3) float images of the unit tangent axes (``J u/|u|``, ``J v/|v|``).
+        u0, v0: (n, 3) float original tangent axes (independent, any lengths).
+        u1, v1: (n, 3) float their images ``J u0``, ``J v0``.
     Returns:
-        ``(s1, s2)`` (n,) float64 with s1 >= s2 >= 0, from the 2x2 Gram matrix
-        [[a.a, a.b], [a.b, b.b]]: s1^2 = its larger eigenvalue and
-        s2 = |a x b| / s1 (stable when the splat is nearly flattened).
+        ``(s1, s2)`` (n,) float64 with s1 >= s2 >= 0: the singular values of
+        the map of the tangent plane, i.e. the square roots of the eigenvalues
+        of G0^-1 G1 with the Gram matrices G0 = [u0 v0]^T [u0 v0] and G1 =
+        [u1 v1]^T [u1 v1].  For orthogonal axes these are the singular values
+        of ``[u1/|u0|, v1/|v0|]``; s1 s2 = |u1 x v1| / |u0 x v0| (the area
+        change), and s2 = s1 s2 / s1 stays accurate for flattened splats.
     """
-    e = np.einsum("ij,ij->i", a, a)
-    g = np.einsum("ij,ij->i", b, b)
-    f = np.einsum("ij,ij->i", a, b)
-    half = 0.5 * (e - g)
-    s1 = np.sqrt(0.5 * (e + g) + np.sqrt(half * half + f * f))
-    area = np.linalg.norm(np.cross(a, b), axis=1)
+    def gram(a, b):
+        return (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", a, b), np.einsum("ij,ij->i", b, b))
+
+    e0, f0, g0 = gram(u0, v0)
+    e1, f1, g1 = gram(u1, v1)
+    det0 = e0 * g0 - f0 * f0
     with np.errstate(divide="ignore", invalid="ignore"):
+        # M = G0^-1 G1; its eigenvalues are half +- disc (disc from the entries,
+        # not from half^2 - det: no cancellation when s1 ~ s2)
+        m00 = (g0 * e1 - f0 * f1) / det0
+        m01 = (g0 * f1 - f0 * g1) / det0
+        m10 = (e0 * f1 - f0 * e1) / det0
+        m11 = (e0 * g1 - f0 * f1) / det0
+        half = 0.5 * (m00 + m11)
+        dd = 0.5 * (m00 - m11)
+        disc = np.sqrt(np.maximum(dd * dd + m01 * m10, 0.0))
+        area = np.linalg.norm(np.cross(u1, v1), axis=1) / np.linalg.norm(np.cross(u0, v0), axis=1)
+        s1 = np.sqrt(half + disc)
         s2 = np.where(s1 > 0.0, area / s1, 0.0)
     return s1, np.minimum(s2, s1)
 
@@ -101,8 +117,8 @@ def _finish(stretch: np.ndarray, area: np.ndarray, warn: float, broken: float) -
         warn=float(warn), broken=float(broken), stretch=stretch, area_change=area)
 
 
-def _stretch_area(a, b, stretch_out, area_out):
-    s1, s2 = principal_stretches(a, b)
+def _stretch_area(u0, v0, u1, v1, stretch_out, area_out):
+    s1, s2 = principal_stretches(u0, v0, u1, v1)
     with np.errstate(divide="ignore"):
         np.maximum(s1, 1.0 / s2, out=stretch_out)
     np.multiply(s1, s2, out=area_out)
@@ -134,9 +150,7 @@ def distortion_from_axes(u0, v0, u1, v1, *, warn: float = DISTORTION_WARN_STRETC
     stretch, area = np.empty(n), np.empty(n)
     for s in range(0, n, chunk):
         e = min(n, s + chunk)
-        a = u1[s:e] / np.linalg.norm(u0[s:e], axis=1)[:, None]
-        b = v1[s:e] / np.linalg.norm(v0[s:e], axis=1)[:, None]
-        _stretch_area(a, b, stretch[s:e], area[s:e])
+        _stretch_area(u0[s:e], v0[s:e], u1[s:e], v1[s:e], stretch[s:e], area[s:e])
     return _finish(stretch, area, warn, broken)
 
 
@@ -186,7 +200,7 @@ class DistortionProbe:
             e = min(n, s + self.chunk)
             a = (self.uhat[s:e] + self.au[s:e] @ d).astype(np.float64)
             b = (self.vhat[s:e] + self.av[s:e] @ d).astype(np.float64)
-            _stretch_area(a, b, stretch[s:e], area[s:e])
+            _stretch_area(self.uhat[s:e], self.vhat[s:e], a, b, stretch[s:e], area[s:e])
         return _finish(stretch, area, warn, broken)
 
 
