@@ -94,12 +94,24 @@ def cmd_convert(args) -> int:
     return 0
 
 
+def _print_edit(args, rep) -> None:
+    """One edit's report line, its distortion figures and (stderr) a warning
+    when splats are stretched beyond DISTORTION_WARN_STRETCH."""
+    args.progress.close()
+    print(rep.line())
+    if rep.distortion is not None:
+        print(rep.distortion_line())
+    warning = rep.distortion_warning()
+    if warning:
+        print(f"splatedit: warning: {warning}", file=sys.stderr, flush=True)
+
+
 def _run_edits(args, cloud, script_path):
     from splatedit.script import load_script, run_script
     script = load_script(script_path)
     return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
                       source=str(script_path), progress=args.progress,
-                      on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+                      on_edit=lambda rep: _print_edit(args, rep))
 
 
 def cmd_deform(args) -> int:
@@ -172,7 +184,7 @@ def _gpu_edit(args, cloud):
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
-                              on_edit=lambda rep: (args.progress.close(), print(rep.line())))
+                              on_edit=lambda rep: _print_edit(args, rep))
     resolved, basis, d_c = fit_edit(cloud, script.edits[-1], script.solver, source=source,
                                     progress=args.progress)
     args.progress.close()
@@ -180,6 +192,12 @@ def _gpu_edit(args, cloud):
     print(f"edit {len(script.edits) - 1}: support {int(resolved.support.sum())} splats, {st['method']} with "
           f"{st['n_centers']} centers (residual {st['residual']:.2e}), {d_c.shape[0]} basis columns "
           f"uploaded to the GPU")
+    from splatedit.deform.distortion import basis_distortion
+    dist = basis_distortion(basis, cloud, d_c)
+    print(f"  distortion: {dist.summary()}")
+    if dist.exceeds_warn:
+        print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
+              f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
     return cloud, basis.rows_for_gpu(), d_c
 
 
