@@ -246,6 +246,11 @@ DISTORTION_BROKEN_STRETCH = 4.0
 #: 3) temporaries small; 1M random splats (loaded 2-core machine): 115 ms at
 #: 8192 rows, 125 ms at 65536, 209 ms in one block
 DISTORTION_CHUNK = 65536
+#: support splats per block of the editor's DistortionProbe: its (3, K) x (K,
+#: chunk) float32 GEMM stays single-threaded in OpenBLAS; at 65536 rows K = 16
+#: took 18 ms per 1M splats alone and 250-450 ms for the whole probe on the
+#: loaded 2-core machine (threads waiting on each other), 4.8 ms at 16384
+DISTORTION_PROBE_CHUNK = 16384
 #: heat map (resolve pass): stretch is encoded as log(stretch) / log(this) in
 #: 0..1 in the splat colour (8 bits: steps of 0.55 % in stretch) so the ramp
 #: can continue past the 3x red to a dark red at this saturation

@@ -26,7 +26,8 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.errors import ParameterError
-from splatedit.tolerances import DISTORTION_BROKEN_STRETCH, DISTORTION_CHUNK, DISTORTION_WARN_STRETCH
+from splatedit.tolerances import (DISTORTION_BROKEN_STRETCH, DISTORTION_CHUNK, DISTORTION_PROBE_CHUNK,
+                                  DISTORTION_WARN_STRETCH)
 
 
 @dataclass(frozen=True)
@@ -69,6 +70,37 @@ class DistortionStats:
                 f"{self.min_area_change:.3g}..{self.max_area_change:.3g}")
 
 
+def _gram(a, b):
+    """Gram entries (a.a, a.b, b.b) and |a x b| of (3, n) coordinate rows."""
+    ax, ay, az = a
+    bx, by, bz = b
+    e = ax * ax + ay * ay + az * az
+    f = ax * bx + ay * by + az * bz
+    g = bx * bx + by * by + bz * bz
+    cx, cy, cz = ay * bz - az * by, az * bx - ax * bz, ax * by - ay * bx
+    return e, f, g, np.sqrt(cx * cx + cy * cy + cz * cz)
+
+
+def _stretches_from_gram(e0, f0, g0, c0, e1, f1, g1, c1):
+    """(s1, s2) from the Gram entries and cross-product lengths of the
+    original (0) and deformed (1) axis pairs, see :func:`principal_stretches`."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        inv = 1.0 / (e0 * g0 - f0 * f0)
+        # M = G0^-1 G1; its eigenvalues are half +- disc (disc from the entries,
+        # not from half^2 - det: no cancellation when s1 ~ s2)
+        m00 = (g0 * e1 - f0 * f1) * inv
+        m01 = (g0 * f1 - f0 * g1) * inv
+        m10 = (e0 * f1 - f0 * e1) * inv
+        m11 = (e0 * g1 - f0 * f1) * inv
+        half = 0.5 * (m00 + m11)
+        dd = 0.5 * (m00 - m11)
+        disc = np.sqrt(np.maximum(dd * dd + m01 * m10, 0.0))
+        area = c1 / c0
+        s1 = np.sqrt(half + disc)
+        s2 = np.where(s1 > 0.0, area / s1, 0.0)
+    return s1, np.minimum(s2, s1)
+
+
 def principal_stretches(u0: np.ndarray, v0: np.ndarray, u1: np.ndarray, v1: np.ndarray):
     """Principal stretches of the linear maps taking (u0, v0) to (u1, v1).
 
@@ -83,26 +115,8 @@ def principal_stretches(u0: np.ndarray, v0: np.ndarray, u1: np.ndarray, v1: np.n
         of ``[u1/|u0|, v1/|v0|]``; s1 s2 = |u1 x v1| / |u0 x v0| (the area
         change), and s2 = s1 s2 / s1 stays accurate for flattened splats.
     """
-    def gram(a, b):
-        return (np.einsum("ij,ij->i", a, a), np.einsum("ij,ij->i", a, b), np.einsum("ij,ij->i", b, b))
-
-    e0, f0, g0 = gram(u0, v0)
-    e1, f1, g1 = gram(u1, v1)
-    det0 = e0 * g0 - f0 * f0
-    with np.errstate(divide="ignore", invalid="ignore"):
-        # M = G0^-1 G1; its eigenvalues are half +- disc (disc from the entries,
-        # not from half^2 - det: no cancellation when s1 ~ s2)
-        m00 = (g0 * e1 - f0 * f1) / det0
-        m01 = (g0 * f1 - f0 * g1) / det0
-        m10 = (e0 * f1 - f0 * e1) / det0
-        m11 = (e0 * g1 - f0 * f1) / det0
-        half = 0.5 * (m00 + m11)
-        dd = 0.5 * (m00 - m11)
-        disc = np.sqrt(np.maximum(dd * dd + m01 * m10, 0.0))
-        area = np.linalg.norm(np.cross(u1, v1), axis=1) / np.linalg.norm(np.cross(u0, v0), axis=1)
-        s1 = np.sqrt(half + disc)
-        s2 = np.where(s1 > 0.0, area / s1, 0.0)
-    return s1, np.minimum(s2, s1)
+    t = [np.ascontiguousarray(np.asarray(x, dtype=np.float64).T) for x in (u0, v0, u1, v1)]
+    return _stretches_from_gram(*_gram(t[0], t[1]), *_gram(t[2], t[3]))
 
 
 def _finish(stretch: np.ndarray, area: np.ndarray, warn: float, broken: float) -> DistortionStats:
@@ -117,8 +131,7 @@ def _finish(stretch: np.ndarray, area: np.ndarray, warn: float, broken: float) -
         warn=float(warn), broken=float(broken), stretch=stretch, area_change=area)
 
 
-def _stretch_area(u0, v0, u1, v1, stretch_out, area_out):
-    s1, s2 = principal_stretches(u0, v0, u1, v1)
+def _stretch_area(s1, s2, stretch_out, area_out):
     with np.errstate(divide="ignore"):
         np.maximum(s1, 1.0 / s2, out=stretch_out)
     np.multiply(s1, s2, out=area_out)
@@ -150,43 +163,46 @@ def distortion_from_axes(u0, v0, u1, v1, *, warn: float = DISTORTION_WARN_STRETC
     stretch, area = np.empty(n), np.empty(n)
     for s in range(0, n, chunk):
         e = min(n, s + chunk)
-        _stretch_area(u0[s:e], v0[s:e], u1[s:e], v1[s:e], stretch[s:e], area[s:e])
+        _stretch_area(*principal_stretches(u0[s:e], v0[s:e], u1[s:e], v1[s:e]), stretch[s:e], area[s:e])
     return _finish(stretch, area, warn, broken)
 
 
 class DistortionProbe:
     """Distortion of one basis' support for any displacement ``dC``, without
-    deforming the cloud.
+    deforming the cloud (the editor's per-frame figures).
 
     Built once per (basis, base cloud): ``Au = sum_j (u_j/|u|) Bj`` and ``Av``
-    likewise ((N, K) float32, Bj in Bx, By, Bz; 8 K bytes per splat each), so
-    that the deformed unit axes are ``u/|u| + Au dC`` and ``v/|v| + Av dC``.
-    Each :meth:`stats` call is then two (N, K) x (K, 3) products and the 2x2
-    singular values, in chunks.  float32 suffices for display figures
-    (relative error ~1e-6 on the stretch); the CLI measures the committed
-    float64 axes with :func:`distortion_from_axes`.
+    likewise (stored transposed, (K, N) float32: 4 K bytes per splat each; Bj
+    in Bx, By, Bz), so that the deformed unit axes are ``u/|u| + dC^T Au`` and
+    ``v/|v| + dC^T Av``, plus the undeformed Gram entries.  Each
+    :meth:`stats` call is then two (3, K) x (K, N) products and elementwise
+    float32 arithmetic on contiguous rows, in chunks.  float32 suffices for
+    display figures (relative error ~1e-5 on the stretch); the CLI measures the
+    committed float64 axes with :func:`distortion_from_axes`.
     """
 
-    def __init__(self, basis, cloud, *, chunk: int = DISTORTION_CHUNK):
+    def __init__(self, basis, cloud, *, chunk: int = DISTORTION_PROBE_CHUNK):
         idx = basis.indices
-        u = cloud.u[idx]
-        v = cloud.v[idx]
-        self.uhat = (u / np.linalg.norm(u, axis=1)[:, None]).astype(np.float32)
-        self.vhat = (v / np.linalg.norm(v, axis=1)[:, None]).astype(np.float32)
-        k = basis.n_columns
-        n = len(idx)
-        self.au = np.empty((n, k), np.float32)
-        self.av = np.empty((n, k), np.float32)
+        n, k = len(idx), basis.n_columns
         grads = (basis.Bx, basis.By, basis.Bz)
+        #: per chunk of ``chunk`` support splats: (uhat, vhat) (3, m) and (Au, Av) (K, m),
+        #: each contiguous (a column slice of one (K, N) array made BLAS 5-10x slower)
+        self.chunks = []
         for s in range(0, n, chunk):
             e = min(n, s + chunk)
-            self.au[s:e] = sum(self.uhat[s:e, j:j + 1] * grads[j][s:e] for j in range(3))
-            self.av[s:e] = sum(self.vhat[s:e, j:j + 1] * grads[j][s:e] for j in range(3))
+            part = []
+            for ax in (cloud.u, cloud.v):
+                x = ax[idx[s:e]]
+                x = x / np.linalg.norm(x, axis=1, keepdims=True)
+                w = x[:, 0:1] * grads[0][s:e] + x[:, 1:2] * grads[1][s:e] + x[:, 2:3] * grads[2][s:e]
+                part += [np.ascontiguousarray(x.T, np.float32), np.ascontiguousarray(w.T, np.float32)]
+            uh, au, vh, av = part
+            self.chunks.append((uh, vh, au, av, _gram(uh, vh)))
+        self.n = n
         self.n_columns = k
-        self.chunk = chunk
 
     def __len__(self) -> int:
-        return len(self.uhat)
+        return self.n
 
     def stats(self, dC, *, warn: float = DISTORTION_WARN_STRETCH,
               broken: float = DISTORTION_BROKEN_STRETCH) -> DistortionStats:
@@ -194,13 +210,16 @@ class DistortionProbe:
         d = np.asarray(dC, dtype=np.float32)
         if d.shape != (self.n_columns, 3):
             raise ParameterError("dC", f"expected shape ({self.n_columns}, 3), got {d.shape}")
-        n = len(self.uhat)
+        dt = np.ascontiguousarray(d.T)
+        n = len(self)
         stretch, area = np.empty(n), np.empty(n)
-        for s in range(0, n, self.chunk):
-            e = min(n, s + self.chunk)
-            a = (self.uhat[s:e] + self.au[s:e] @ d).astype(np.float64)
-            b = (self.vhat[s:e] + self.av[s:e] @ d).astype(np.float64)
-            _stretch_area(self.uhat[s:e], self.vhat[s:e], a, b, stretch[s:e], area[s:e])
+        s = 0
+        for uh, vh, au, av, g0 in self.chunks:
+            e = s + uh.shape[1]
+            a = uh + dt @ au
+            b = vh + dt @ av
+            _stretch_area(*_stretches_from_gram(*g0, *_gram(a, b)), stretch[s:e], area[s:e])
+            s = e
         return _finish(stretch, area, warn, broken)
 
 
