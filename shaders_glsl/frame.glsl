@@ -12,7 +12,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 background;    // rgb (sRGB, written as is), alpha
     vec4 light;         // ambient, diffuse, specular, shininess
     vec4 misc;          // gaussian sharpness, 1/gamma, min weight, point-size threshold (pixels)
-    uvec4 options;      // backface culling, apply gamma, -, -
+    uvec4 options;      // backface culling, apply gamma, display (0 shaded, 1 stretch heat map), -
 } F;
 
 // Per-splat flag bits (renderer.py FLAG_*).

@@ -32,6 +32,7 @@ layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };   
 layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };             // 2 VkDrawIndirectCommand
 
 #include "splat_math.glsl"
+#include "distortion.glsl"
 
 // bound corner in pixels, 16.16 -> 12.4 fixed point (1/16 pixel), rounded outwards
 uint pack_px(vec2 ndc, float dir) {
@@ -59,6 +60,7 @@ void main() {
         vec3 u = vec3(geom[9 * i + 3], geom[9 * i + 4], geom[9 * i + 5]);
         vec3 v = vec3(geom[9 * i + 6], geom[9 * i + 7], geom[9 * i + 8]);
         uint fl = flags[i];
+        vec3 u0 = u, v0 = v;
         if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
@@ -70,7 +72,10 @@ void main() {
             u += Jm * u;
             v += Jm * v;
         }
-        kind = prepare_splat(p, u, v, unpackUnorm4x8(colors[i]).rgb, fl, S);
+        vec3 srgb = unpackUnorm4x8(colors[i]).rgb;
+        kind = prepare_splat(p, u, v, srgb, fl, S);
+        if (F.options.z == 1u)                // heat map: the stretch of the same J (distortion.glsl)
+            S.color = heat_encode((fl & FLAG_DEFORMED) != 0u ? splat_stretch(u0, v0, u, v) : 1.0, srgb, fl);
     }
     // workgroup-aggregated slot allocation (one global atomic per workgroup and list)
     if (gl_LocalInvocationIndex == 0u) { s_count[0] = 0u; s_count[1] = 0u; }

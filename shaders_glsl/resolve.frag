@@ -1,8 +1,10 @@
 #version 450
 #extension GL_GOOGLE_include_directive : require
 // Pass 3: normalise the accumulated attributes and shade (deferred Phong with
-// a headlight), background colour, gamma.
+// a headlight), background colour, gamma.  Heat-map mode (F.options.z == 1):
+// the accumulated colour is the encoded stretch of distortion.glsl.
 #include "frame.glsl"
+#include "distortion.glsl"
 
 layout(set = 0, binding = 1) uniform sampler2D accum_color;   // w*rgb, w
 layout(set = 0, binding = 2) uniform sampler2D accum_normal;  // w*n, w*depth
@@ -14,6 +16,7 @@ void main() {
     vec4 b = texelFetch(accum_normal, ip, 0);
     if (!(a.a >= F.misc.z)) { o_color = F.background; return; }
     vec3 col = a.rgb / a.a;
+    if (F.options.z == 1u) col = heat_resolve(col);
     vec3 n = normalize(b.xyz);
     float depth = b.w / a.a;
     vec3 ray = vec3(F.pix_to_ray.x * gl_FragCoord.x + F.pix_to_ray.y,

@@ -39,9 +39,11 @@ void cull() {
 }
 
 #include "splat_math.glsl"
+#include "distortion.glsl"
 
 void main() {
     vec3 p = in_center, u = in_u, v = in_v;
+    vec3 u0 = u, v0 = v;
     uint flags = in_flags;
     if ((flags & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
         vec3 dp = vec3(0.0);
@@ -58,6 +60,9 @@ void main() {
         || (PRIM_MODE == 2 && kind != SPLAT_POINT)) { cull(); return; }
     v_ms_cn = S.ms_cn; v_mt_tc = S.mt_tc; v_mw_r = S.mw_r; v_center = S.center;
     v_color = vec4(S.color, 1.0);
+    if (F.options.z == 1u)                    // heat map: the stretch of the same J (distortion.glsl)
+        v_color.rgb = heat_encode((flags & FLAG_DEFORMED) != 0u ? splat_stretch(u0, v0, u, v) : 1.0,
+                                  in_color.rgb, flags);
     v_normal = vec4(S.normal, 0.0);
     v_index = uint(gl_InstanceIndex) + 1u;
     if (PRIM_MODE == 2) {                     // small splat: square point at its centre

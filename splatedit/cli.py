@@ -94,20 +94,26 @@ def cmd_convert(args) -> int:
     return 0
 
 
+def _print_edit(args, rep) -> None:
+    """One edit's report line, its distortion figures and (stderr) warnings:
+    conflicting constraints, splats stretched beyond DISTORTION_WARN_STRETCH."""
+    args.progress.close()
+    print(rep.line())
+    if rep.distortion is not None:
+        print(rep.distortion_line())
+    warnings = list(rep.warnings)
+    if rep.distortion_warning():
+        warnings.append(rep.distortion_warning())
+    for w in warnings:
+        print(f"splatedit: warning: {w}", file=sys.stderr, flush=True)
+
+
 def _run_edits(args, cloud, script_path):
     from splatedit.script import load_script, run_script
     script = load_script(script_path)
     return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
                       source=str(script_path), progress=args.progress,
-                      on_edit=lambda rep: _print_report(args, rep))
-
-
-def _print_report(args, rep) -> None:
-    """One edit's report line on stdout, its warnings on stderr."""
-    args.progress.close()
-    print(rep.line())
-    for w in rep.warnings:
-        print(f"splatedit: warning: {w}", file=sys.stderr)
+                      on_edit=lambda rep: _print_edit(args, rep))
 
 
 def cmd_deform(args) -> int:
@@ -180,7 +186,7 @@ def _gpu_edit(args, cloud):
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
-                              on_edit=lambda rep: _print_report(args, rep))
+                              on_edit=lambda rep: _print_edit(args, rep))
     resolved, basis, d_c = fit_edit(cloud, script.edits[-1], script.solver, source=source,
                                     progress=args.progress)
     args.progress.close()
@@ -191,6 +197,12 @@ def _gpu_edit(args, cloud):
     for c in basis.constraints.conflicts:
         print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
               file=sys.stderr)
+    from splatedit.deform.distortion import basis_distortion
+    dist = basis_distortion(basis, cloud, d_c)
+    print(f"  distortion: {dist.summary()}")
+    if dist.exceeds_warn:
+        print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
+              f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
     return cloud, basis.rows_for_gpu(), d_c
 
 

@@ -52,6 +52,7 @@ from typing import Any, Callable
 
 import numpy as np
 
+from splatedit.deform.distortion import DistortionStats, distortion_from_axes
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL
@@ -462,6 +463,25 @@ class EditReport:
     closure_added: int = 0
     #: warnings for the user (conflicting constraints), one sentence each
     warnings: list[str] = field(default_factory=list)
+    #: distortion of the support splats (splatedit.deform.distortion): per-splat
+    #: stretch max(s1, 1/s2) and area change s1 s2 of the committed axes
+    distortion: DistortionStats | None = None
+
+    def distortion_line(self) -> str:
+        """``  distortion: stretch max 1.84x, 0 > 3x, 0 > 4x, area change 0.71..2.30``."""
+        if self.distortion is None:
+            return ""
+        return f"  distortion: {self.distortion.summary()}"
+
+    def distortion_warning(self) -> str | None:
+        """The warning text when splats are stretched beyond the warn threshold, else None."""
+        d = self.distortion
+        if d is None or not d.exceeds_warn:
+            return None
+        return (f"edit {self.index} stretches {d.n_above_warn} of {d.n} support splats "
+                f"({100.0 * d.fraction_above_warn:.1f} %) more than {d.warn:g}x "
+                f"({d.n_above_broken} more than {d.broken:g}x, max {d.max_stretch:.2f}x): "
+                f"expect blurred detail and holes there; use a larger support or a milder transform")
 
     def line(self) -> str:
         hs = "+".join(map(str, self.handles))
@@ -599,6 +619,8 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                                   f"{exc.row}); use a milder transform", json_path=edit.json_path,
                                   path=source) from None
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
+        i_sup = basis.indices
+        dist = distortion_from_axes(cloud.u[i_sup], cloud.v[i_sup], new.u[i_sup], new.v[i_sup])
         stats = basis.stats
         con = basis.constraints
         rep = EditReport(i, len(con.support_index), [len(h) for h in con.handle_index], stats["n_constraints"],
@@ -607,7 +629,8 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                          [stats["message"]] if stats.get("message") else [],
                          [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
                          stats.get("closure_added", 0),
-                         [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts])
+                         [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts],
+                         dist)
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)

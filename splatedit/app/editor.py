@@ -762,6 +762,8 @@ class Editor:
                 self.drag = None
             elif k == g.KEY_BACKSPACE:
                 m.backspace()
+            elif k == g.KEY_D:
+                self.toggle_distortion_map()
             elif k in (g.KEY_G, g.KEY_R, g.KEY_S):
                 m.mode = {g.KEY_G: GRAB, g.KEY_R: ROTATE, g.KEY_S: SCALE}[k]
                 m.typed = ""
@@ -844,6 +846,8 @@ class Editor:
                      else "brush: visible splats only")
         elif k == g.KEY_L:
             self.selection_tool("connected", *self.mouse, whole=shift)
+        elif k == g.KEY_D and not shift:
+            self.toggle_distortion_map()
         elif k == g.KEY_C:
             s.clear(HANDLE if shift else None)
         elif k == g.KEY_LEFT_BRACKET:
@@ -865,6 +869,13 @@ class Editor:
         self.motion()
 
     # -------------------------------------------------------------- actions
+    def toggle_distortion_map(self) -> None:
+        """D: colour the support by stretch (renderer heat map) / back to shading."""
+        vp = self.viewport
+        vp.distortion_map = not vp.distortion_map
+        self.say("distortion heat map " + ("on: 1x grey, 1.5x yellow, 2x orange, 3x red, 4x+ dark red"
+                                           if vp.distortion_map else "off"))
+
     def curve_click(self, x: float, y: float) -> None:
         """Curve tool: drag the dot under the cursor, else add a curve point."""
         s = self.session
@@ -980,7 +991,8 @@ class Editor:
     def scene_state(self) -> tuple:
         s = self.session
         dc = None if self.viewport.dc is None else self.viewport.dc.tobytes()
-        return (self.cam.state(), self.size, id(s.cloud), s.version, id(s.basis), dc)
+        return (self.cam.state(), self.size, id(s.cloud), s.version, id(s.basis), dc,
+                self.viewport.distortion_map)
 
     def draw(self) -> None:
         w, h = self.size
@@ -1062,6 +1074,7 @@ class Editor:
                                        handle=s.selection.handle.copy(), sel_version=s.version,
                                        inactive=s.selection.others(),
                                        basis=s.basis, dc=self.viewport.dc, camera=cam, w=w, h=h,
+                                       distortion_map=self.viewport.distortion_map,
                                        pick_key=self.pick_key()))
 
     # -------------------------------------------------------------- overlay
@@ -1215,6 +1228,7 @@ class Editor:
             lines.append("solver: paint a support (1) then a handle (2)")
         if s.manip is not None:
             lines.append((s.manip.describe(), (255, 230, 120)))
+        lines += ov.distortion_lines(s.distortion(), self.viewport.distortion_map)
         info = self.viewport.last_info
         if info:
             what = f"{info['splats']:,} splats" + (" LOD" if info.get("lod") else "") + \

@@ -53,6 +53,9 @@ Control curve (paper Sect. 3 end, Fig. 3 and 7)
   Left drag on a dot     move that point in the view plane (X / Y / Z: along an axis)
   Backspace              remove the last curve point
   Enter / Esc            apply the bent curve as an edit (the curve is consumed) / discard moves
+Distortion
+  D                      heat map on / off: the support coloured by stretch (1x grey .. 3x red)
+                         (the panel shows "stretch max N.Nx, K > 3x" while a pose is moved)
 File and history
   Ctrl+Z / Ctrl+Shift+Z  undo / redo (edits and selections; Ctrl+Y also redoes)
   Ctrl+S                 save <name>-edited.ply (+ <name>-edited.edits.json edit script)

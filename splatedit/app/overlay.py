@@ -187,3 +187,23 @@ def dot_patch(p, rgb, radius: int = 5) -> Patch:
     d.ellipse((s - radius - 1, s - radius - 1, s + radius + 1, s + radius + 1), fill=(0, 0, 0, 200))
     d.ellipse((s - radius, s - radius, s + radius, s + radius), fill=tuple(rgb) + (255,))
     return Patch(int(round(x)) - s, int(round(y)) - s, np.asarray(img))
+
+
+#: panel colours of the distortion line: within the warn threshold / above it
+DISTORTION_OK_RGB = (235, 235, 235)
+DISTORTION_WARN_RGB = (255, 110, 90)
+
+
+def distortion_lines(stats, heat_map: bool) -> list:
+    """Panel lines of the distortion feedback: ``stretch max N.Nx, K > 3x``
+    for the current pose (``stats``: a DistortionStats or None when nothing
+    is moved), red when splats exceed the warn threshold; plus the heat-map
+    legend while it is shown."""
+    out = []
+    if stats is not None:
+        text = (f"stretch max {stats.max_stretch:.1f}x, {stats.n_above_warn:,} > {stats.warn:g}x"
+                f"   area x{stats.min_area_change:.2f}..{stats.max_area_change:.2f}")
+        out.append((text, DISTORTION_WARN_RGB if stats.exceeds_warn else DISTORTION_OK_RGB))
+    if heat_map:
+        out.append(("heat map (D): 1x grey  1.5x yellow  2x orange  3x red  4x+ dark red", (255, 200, 120)))
+    return out

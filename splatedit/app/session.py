@@ -210,18 +210,6 @@ def columns_needed(n_handles: int, n_curve_points: int) -> int:
     return HANDLE_COLUMNS * n_handles + (n_curve_points if n_curve_points >= 2 else 0)
 
 
-def _no_fill_holes(fn) -> dict:
-    """``{"fill_holes": False}`` when ``fn`` (DeformationBasis.fit, script.Edit)
-    takes it, else ``{}``.  The editor closes the selection itself, visibly,
-    after each stroke (:mod:`splatedit.app.selection_tools`); the fit and the
-    exported script use exactly that selection, so ``splatedit deform``
-    replays the edit bit for bit.  (Transitional: the ``fill_holes`` options
-    of the fit and of edit scripts land on ``main`` separately; once merged
-    this can pass ``fill_holes=False`` directly.)"""
-    import inspect
-    return {"fill_holes": False} if "fill_holes" in inspect.signature(fn).parameters else {}
-
-
 def _matrix_tuple(m) -> tuple:
     return tuple(tuple(float(x) for x in row) for row in np.asarray(m, float))
 
@@ -502,7 +490,7 @@ class Session:
             from splatedit.deform.basis import DeformationBasis
             return DeformationBasis.fit(cloud, support, handles, curves=curves, method=self.method,
                                         tol=self.tol, max_centers=self.max_centers, progress=progress,
-                                        **_no_fill_holes(DeformationBasis.fit))
+                                        fill_holes=False)  # closed visibly after each stroke
 
         # fits run one at a time on the session's pool (a cancelled one ends at its
         # next progress report); fit_sync runs it here
@@ -644,6 +632,43 @@ class Session:
             return None
         return self.basis.displacement(self.inputs())
 
+    def distortion(self):
+        """:class:`~splatedit.deform.distortion.DistortionStats` of the support
+        for the current pose (live manipulation included), or None without a
+        basis, when nothing is moved, or before the first figures are ready.
+
+        Computed off the UI thread (a background job per pose, one at a time;
+        ``on_change`` is called when it is done), so a drag never waits for it:
+        the figures shown may be those of the pose one job earlier (a
+        DistortionProbe is built once per (basis, cloud); then about 5 ms per
+        100k support splats, see docs/PERFORMANCE.md).  ``fit_sync`` sessions
+        compute synchronously (tests)."""
+        dc = self.current_dc()
+        if dc is None or not dc.any():
+            return None
+        from splatedit.deform.distortion import DistortionProbe
+        src = (self.basis, self.cloud)
+        d = getattr(self, "_dist", None)
+        if d is None or d["src"][0] is not src[0] or d["src"][1] is not src[1]:
+            d = self._dist = {"src": src, "probe": None, "job": None, "result": None}
+        job = d["job"]
+        if job is not None and job.done:
+            d["job"] = None
+            if job.error is None:
+                d["result"] = job.result
+        key = dc.tobytes()
+        if d["job"] is None and (d["result"] is None or d["result"][0] != key):
+            basis, cloud = src
+
+            def work(progress):
+                if d["probe"] is None:
+                    d["probe"] = DistortionProbe(basis, cloud)
+                return key, d["probe"].stats(dc)
+            d["job"] = Job("distortion", work, self.on_change, sync=self.fit_sync)
+            if d["job"].done:
+                return self.distortion()
+        return None if d["result"] is None else d["result"][1]
+
     def cancel(self) -> None:
         self.manip = None
         self.manip_target = None
@@ -718,7 +743,7 @@ class Session:
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
         edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
                     tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
-                    **_no_fill_holes(Edit))
+                    fill_holes=False)  # the editor's closed selection, replayed as is
         self.manip = None
         self.manip_target = None
         self.cloud = new

@@ -63,6 +63,8 @@ class Viewport:
         self.basis = None
         self.dc = None
         self.pyramid = None
+        #: draw the distortion heat map instead of the shaded colours (Renderer.distortion_map)
+        self.distortion_map = False
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -98,6 +100,7 @@ class Viewport:
     # ------------------------------------------------------------- syncing
     def _sync(self, slot: _Slot, level=None) -> None:
         cloud = self.cloud
+        slot.r.distortion_map = self.distortion_map
         if level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
@@ -322,6 +325,7 @@ class BackgroundRefiner:
                     vp.set_selection(st["support"], st["handle"], st["sel_version"], st.get("inactive"))
                     vp.set_basis(st["basis"])
                     vp.set_dc(st["dc"])
+                    vp.distortion_map = bool(st.get("distortion_map", False))
                     img = vp.render(st["camera"], st["w"], st["h"])
                     self.last_ms = vp.last_info["ms"]
                     if st.get("pick_key") is not None and st.get("dc") is None:

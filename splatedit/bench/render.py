@@ -82,6 +82,11 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
     r.set_basis(np.arange(n), *B)
     r.set_displacement(dC)
     full, full_best = _frames(r, cam, w, h, repeats)
+    r.distortion_map = True
+    try:
+        heat, heat_best = _frames(r, cam, w, h, repeats)
+    finally:
+        r.distortion_map = False
     # a contiguous support region: the 10% of the splats nearest to one point
     d2 = np.sum((cloud.positions - cloud.positions[0]) ** 2, axis=1)
     idx = np.sort(np.argpartition(d2, max(n // 10 - 1, 0))[:max(n // 10, 1)])
@@ -104,6 +109,11 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
         "ms_frame_deformed_10pct": round(tenth["total"], 2),
         "deformed_10pct_over_plain": round(tenth["total"] / plain["total"], 3),
         "deformed_all_over_plain_best": round(full_best["total"] / plain_best["total"], 3),
+        "ms_prepass_deformed_all": round(full["prepass"], 2),
+        "ms_prepass_heat_map": round(heat["prepass"], 2),
+        "ms_frame_heat_map": round(heat["total"], 2),
+        "heat_map_over_deformed_prepass": round(heat["prepass"] / full["prepass"], 3),
+        "heat_map_over_deformed_prepass_best": round(heat_best["prepass"] / full_best["prepass"], 3),
         "deformed_10pct_over_plain_best": round(tenth_best["total"] / plain_best["total"], 3),
         "loadavg_1min": _loadavg(),
         "wall_s": round(time.perf_counter() - t0, 1),
@@ -145,6 +155,11 @@ def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repea
       with a contiguous support of 10% of the splats (the nearest to one splat);
     * ``deformed_all_over_plain_best``, ``deformed_10pct_over_plain_best``:
       the ratios of the fastest frames;
+    * ``ms_prepass_deformed_all`` / ``ms_prepass_heat_map`` / ``ms_frame_heat_map``:
+      median pre-pass (and frame) with every splat deformed, without and with
+      the distortion heat map (``Renderer.distortion_map``: the per-splat
+      stretch in the pre-pass); ``heat_map_over_deformed_prepass`` (and
+      ``_best``) their ratio;
     * ``loadavg_1min``: /proc/loadavg at the end of the case (NaN elsewhere);
     * ``wall_s``: wall-clock seconds of the case.
     """

@@ -227,6 +227,11 @@ class Renderer:
         #: point path threshold (pixels), see ``point_splats``
         self.point_max_px = float(RENDER_POINT_SPLAT_MAX_PX)
         self.prepass = bool(prepass)
+        #: display mode: False shaded colours; True the distortion heat map
+        #: (stretch of every deformed splat from the same Jacobian the pass
+        #: applies, shaders_glsl/distortion.glsl; 1x neutral grey, 1.5x yellow,
+        #: 2x orange, 3x red, 4x+ dark red; splats outside the support grey)
+        self.distortion_map = False
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         self._own_device = device is None
@@ -611,7 +616,7 @@ class Renderer:
         f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
                     min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
         opts = f[64:68].view(np.uint32)
-        opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 0, 0)
+        opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 1 if self.distortion_map else 0, 0)
         self.ubo.write(f)
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
@@ -803,7 +808,11 @@ class Renderer:
         * ``depth``: eye-space distance along the view axis, NaN for background;
         * ``normal``: unit eye-space normal (x right, y up, z towards the eye), NaN background;
         * ``weight``: accumulated splat weight (0 for background);
-        * ``color``: normalised linear RGB (selection tint included), NaN background.
+        * ``color``: normalised linear RGB (selection tint included), NaN background;
+          with :attr:`distortion_map` on, the encoded heat map instead
+          (shaders_glsl/distortion.glsl): r = support-weighted
+          log(stretch) / log(DISTORTION_HEAT_MAX_STRETCH), g = support share,
+          b = luminance.
         """
         self._check_open()
         self._require_cloud()

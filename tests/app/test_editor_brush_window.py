@@ -128,11 +128,7 @@ def test_3d_brush_paints_the_ear_through_and_the_grab_does_not_tear(xvfb, tmp_pa
     # --- the selection: the ear's whole thickness, front- and back-facing splats alike
     doc = json.loads(script_path.read_text())
     e = doc["edits"][0]
-    import inspect
-
-    from splatedit.script import Edit
-    if "fill_holes" in inspect.signature(Edit).parameters:   # edit scripts with the closure option
-        assert e["support"].get("fill_holes") is False       # the closed selection is recorded as is
+    assert e["support"].get("fill_holes") is False       # the closed selection is recorded as is
     support = np.zeros(src.n, bool)
     support[np.asarray(e["support"]["indices"])] = True
     assert support.sum() == support_n
