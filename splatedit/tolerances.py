@@ -152,6 +152,11 @@ CLOSURE_ISLAND_RINGS = 8
 #: by 8% of the diagonal): 1.0 left up to 23 splats stretched > 4x (max 4.6x),
 #: 1.5 up to 3 (6.5x), 2.0 none (max 3.4x)
 CLOSURE_HANDLE_MARGIN_REL = 2.0
+#: ... but at most this fraction of the model's bounding-box diagonal: a big
+#: handle (the bunny's head, RMS radius 0.2 of a 1.7 diagonal) would otherwise
+#: pull half the body into the support although the painted support already
+#: gives it room; ear-tip handles (2 x RMS radius up to 0.12) are not capped
+CLOSURE_HANDLE_MARGIN_MAX_REL = 0.08
 
 # --- rendering (splatedit.render) -------------------------------------------
 #: EWA screen-space low-pass filter radius in pixels (sqrt(2)/2): every splat covers at

@@ -26,10 +26,12 @@ Python API alike), by four rules, each on the neighbour graph of
 3. **Enclosed islands.**  Unselected connected components that lie within
    ``CLOSURE_ISLAND_RINGS`` rings of the selection and do not reach beyond
    that (they are surrounded by it): unpainted specks, crevices.
-4. **Handle margin.**  Unselected splats closer to a handle splat than the
-   constraint band width (``BAND_RINGS`` h) join the support, so no fixed
-   constraint sits right next to a handle (two different displacements
-   almost at one place).
+4. **Handle margin.**  Unselected splats closer to a handle than
+   max(``BAND_RINGS`` h, ``CLOSURE_HANDLE_MARGIN_REL`` times the handle's RMS
+   radius, at most ``CLOSURE_HANDLE_MARGIN_MAX_REL`` of the model's diagonal)
+   join the support: no fixed constraint sits right next to a moving handle
+   (the displacement would jump from the handle's to zero within a few
+   spacings: tears and needles).
 
 Handles are closed by rules 1-3 too, inside the closed support and outside
 the other handles: a handle painted on the front of an ear's tip takes the
@@ -52,6 +54,7 @@ from splatedit.tolerances import (
     CLOSURE_BACK_CONE_COS,
     CLOSURE_BACK_NEIGHBOURS,
     CLOSURE_GAP_RINGS,
+    CLOSURE_HANDLE_MARGIN_MAX_REL,
     CLOSURE_HANDLE_MARGIN_REL,
     CLOSURE_ISLAND_RINGS,
     CLOSURE_OPPOSITE_COS,
@@ -209,7 +212,9 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         raise ValueError(f"the neighbour graph has {graph.n} splats, the cloud {n}")
     thickness = [CLOSURE_THIN_MAX_REL * _rms_radius(pos[m]) if m.any() else 0.0
                  for m in [sup_in] + hs_in]
-    margins = [max(BAND_RINGS * graph.spacing, CLOSURE_HANDLE_MARGIN_REL * t / CLOSURE_THIN_MAX_REL)
+    diag = float(np.linalg.norm(pos.max(axis=0) - pos.min(axis=0)))
+    margins = [max(BAND_RINGS * graph.spacing,
+                   min(CLOSURE_HANDLE_MARGIN_REL * t / CLOSURE_THIN_MAX_REL, CLOSURE_HANDLE_MARGIN_MAX_REL * diag))
                for t in thickness[1:]]
     if changed is None:
         region = np.arange(n)

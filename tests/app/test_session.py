@@ -102,8 +102,9 @@ def test_full_session_commit_undo_redo_and_script(tmp_path, session):
     from splatedit.script import load_script, resolve_edit
     script = load_script(path)
     sup, hands, mats = resolve_edit(base, script.edits[0])
+    assert script.edits[0].fill_holes is False   # the editor's selection, replayed as is
     b = DeformationBasis.fit(base, sup, hands, method=script.solver.method, tol=script.solver.tol,
-                             max_centers=script.solver.max_centers)
+                             max_centers=script.solver.max_centers, fill_holes=False)
     out = b.apply(base, b.displacement(mats))
     assert np.array_equal(out.positions, new.positions)
     assert np.array_equal(out.u, new.u)
