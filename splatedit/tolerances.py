@@ -131,9 +131,29 @@ CLOSURE_OPPOSITE_COS = 0.0
 #: closure rule 1: the thickness bound T of a thin part, times the RMS radius
 #: of the painted selection
 CLOSURE_THIN_MAX_REL = 1.0
-#: closure rule 1: the k nearest selected splats (within T) tried as the
-#: painted side across the part (the nearest one is often a rim splat seen
-#: edge-on, whose normal is not opposite)
+#: closure rule 1 casts a ray into the material from every painted splat:
+#: samples at depths CLOSURE_RAY_START spacings * CLOSURE_RAY_STEP^j (up to
+#: T), each looking for the nearest splat within CLOSURE_RAY_RADIUS_REL times
+#: its depth (at least one spacing).  With step 1.5 and radius 0.35 the
+#: searched depth intervals [0.65, 1.35] d overlap, so no thickness is
+#: skipped; 1.5 spacings keeps the first sample off the painted surface
+CLOSURE_RAY_START = 1.5
+CLOSURE_RAY_STEP = 1.5
+CLOSURE_RAY_RADIUS_REL = 0.35
+#: splats tested where a ray meets the first surface (one per ray left about
+#: a third of the bunny ear's back unreached: rays bunch up behind curved fronts)
+CLOSURE_RAY_HITS = 4
+#: at most this many rays per closure (an even subsample of the painted
+#: splats): the hits only seed the growth over the graph, which reaches the
+#: rest of the back side
+CLOSURE_RAY_MAX = 500
+#: k-d tree queries of closure run on all cores only for batches at least this
+#: large (starting the threads took about 2 ms per call, more than a few
+#: thousand queries gain)
+CLOSURE_PARALLEL_QUERIES = 20000
+#: closure rule 1, growing the rays' hits over the graph: a neighbour joins the
+#: back side when one of its this many nearest painted splats (within T) lies
+#: across the part (the nearest one is often a rim splat seen edge-on)
 CLOSURE_BACK_NEIGHBOURS = 16
 #: closure rule 1: the painted splat lies within acos(this) of straight
 #: behind the candidate along both normals (a part's two sides face each
@@ -145,6 +165,11 @@ CLOSURE_GAP_RINGS = 2
 #: closure rule 3: unselected components within this many rings of the
 #: selection that reach no farther are enclosed islands
 CLOSURE_ISLAND_RINGS = 8
+#: a stroke's closure (``changed``) works on the splats within this many point
+#: spacings of the box of the changed splats: the graph rules reach
+#: CLOSURE_ISLAND_RINGS + 2 CLOSURE_GAP_RINGS rings, and a ring of the
+#: 10-neighbour graph spans up to about 2 spacings
+CLOSURE_REGION_RINGS = 2 * (CLOSURE_ISLAND_RINGS + 2 * CLOSURE_GAP_RINGS) + 2
 #: closure rule 4: unselected splats closer to a handle than max(band width,
 #: this times the handle's RMS radius, about its diameter) join the support,
 #: so the deformation has room to fall off: a fixed splat next to a moving
@@ -304,6 +329,12 @@ DISTORTION_WARN_STRETCH = 3.0
 #: above 4x a splat counts as broken (the issue's "broken" level); counted
 #: separately in the figures
 DISTORTION_BROKEN_STRETCH = 4.0
+#: a tear: two splats closer than TEAR_NEIGHBOUR_SPACINGS point spacings
+#: before an edit (surface neighbours) and farther apart than
+#: TEAR_APART_SPACINGS spacings after it (the measure of issue 8 and of the
+#: team's one-view stroke tool)
+TEAR_NEIGHBOUR_SPACINGS = 2.0
+TEAR_APART_SPACINGS = 8.0
 #: rows per vectorised block of the distortion computation: keeps the (chunk,
 #: 3) temporaries small; 1M random splats (loaded 2-core machine): 115 ms at
 #: 8192 rows, 125 ms at 65536, 209 ms in one block

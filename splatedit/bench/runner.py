@@ -53,7 +53,13 @@ def _editor(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "editor", **line}
 
 
-BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "render": _render, "editor": _editor}
+def _closure(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.closure import bench_closure
+    yield from bench_closure(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
+                             repeats=2 if quick else 3)
+
+
+BENCHES = {"solve": _solve, "closure": _closure, "groups": _groups, "qr": _qr, "render": _render, "editor": _editor}
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:

@@ -27,6 +27,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.tolerances import (DISTORTION_BROKEN_STRETCH, DISTORTION_CHUNK, DISTORTION_PROBE_CHUNK,
+                                  TEAR_APART_SPACINGS, TEAR_NEIGHBOUR_SPACINGS,
                                   DISTORTION_WARN_STRETCH)
 
 
@@ -239,3 +240,22 @@ def basis_distortion(basis, cloud, dC, **kw) -> DistortionStats:
             w = sum(src[:, j:j + 1] * g[s:e] for j, g in enumerate((basis.Bx, basis.By, basis.Bz)))
             dst[s:e] = src + w @ d
     return distortion_from_axes(cloud.u[idx], cloud.v[idx], u1, v1, chunk=chunk, **kw)
+
+
+def count_tears(positions0: np.ndarray, positions1: np.ndarray, spacing: float,
+                pairs: np.ndarray | None = None) -> int:
+    """Tears of a deformation: pairs of splats closer than
+    ``TEAR_NEIGHBOUR_SPACINGS`` point spacings before it (neighbours on the
+    surface) that end up more than ``TEAR_APART_SPACINGS`` spacings apart.
+
+    Args:
+        positions0, positions1: (n, 3) float64 before / after (model units).
+        spacing: the point spacing (model units), e.g. the median
+            nearest-neighbour distance.
+        pairs: optional precomputed (p, 2) neighbour pairs of ``positions0``.
+    """
+    from scipy.spatial import cKDTree
+    if pairs is None:
+        pairs = cKDTree(positions0).query_pairs(TEAR_NEIGHBOUR_SPACINGS * spacing, output_type="ndarray")
+    gap = np.linalg.norm(positions1[pairs[:, 0]] - positions1[pairs[:, 1]], axis=1)
+    return int((gap > TEAR_APART_SPACINGS * spacing).sum())

@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from splatedit.select.graph import NeighbourGraph
+from splatedit.select.graph import NeighbourGraph, unique_indices
 from splatedit.tolerances import (
     BAND_RINGS,
     CLOSURE_BACK_CONE_COS,
@@ -57,7 +57,14 @@ from splatedit.tolerances import (
     CLOSURE_HANDLE_MARGIN_MAX_REL,
     CLOSURE_HANDLE_MARGIN_REL,
     CLOSURE_ISLAND_RINGS,
+    CLOSURE_REGION_RINGS,
     CLOSURE_OPPOSITE_COS,
+    CLOSURE_PARALLEL_QUERIES,
+    CLOSURE_RAY_HITS,
+    CLOSURE_RAY_MAX,
+    CLOSURE_RAY_RADIUS_REL,
+    CLOSURE_RAY_START,
+    CLOSURE_RAY_STEP,
     CLOSURE_THIN_MAX_REL,
 )
 
@@ -106,44 +113,134 @@ class ClosureResult:
                 f"handle margin {c.handle_margin})")
 
 
+def _workers(n_queries: int) -> int:
+    """k-d tree query threads: starting threads costs more than small batches gain."""
+    return -1 if n_queries >= CLOSURE_PARALLEL_QUERIES else 1
+
+
 def _rms_radius(points: np.ndarray) -> float:
     return float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
 
 
-def _back_sides(pos: np.ndarray, nrm: np.ndarray, sel: np.ndarray, allowed: np.ndarray,
-                t: float) -> np.ndarray:
-    """Indices of ``allowed`` unselected splats that are the back side of a
-    thin part whose front ``sel`` (n,) bool was painted, at most ``t`` (model
-    units) behind it (rule 1)."""
-    sel_idx = np.flatnonzero(sel)
-    if len(sel_idx) < 2:
+def _unit_normals(cloud, index: np.ndarray) -> np.ndarray:
+    """(len(index), 3) unit normals u x v of the splats ``index``."""
+    nrm = np.cross(cloud.u[index], cloud.v[index])
+    nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
+    return nrm
+
+
+def _back_sides(cloud, graph: NeighbourGraph, tree: cKDTree, fronts: np.ndarray,
+                allowed: np.ndarray, t: float) -> np.ndarray:
+    """Indices of ``allowed`` (n,) bool splats that are the back side of a thin
+    part whose front splats ``fronts`` (indices) were painted, at most ``t``
+    (model units) behind them (rule 1).
+
+    From every front splat a ray goes into the material (along -n); the first
+    surface it meets (the nearest splat to points at depths growing by
+    ``CLOSURE_RAY_STEP`` from ``CLOSURE_RAY_START`` spacings, within
+    ``CLOSURE_RAY_RADIUS_REL`` of the depth; its ``CLOSURE_RAY_HITS`` nearest
+    splats there) is the back side where they pass
+    the facing tests; the ray stops there either way, so a part further
+    behind (the other ear) is never reached.  The hits are then grown over
+    the graph (:func:`_grow_back_sides`).  Cost: a few nearest-neighbour
+    queries per front splat in the cloud's k-d tree, plus a facing test per
+    splat of the back side and its one-ring.
+    """
+    pos = cloud.positions
+    spacing = graph.spacing
+    if len(fronts) == 0 or not t > 0 or not spacing > 0:
         return np.zeros(0, np.int64)
-    sp = pos[sel_idx]
-    if not t > 0:
+    depths = []
+    d = CLOSURE_RAY_START * spacing
+    while d <= t:
+        depths.append(d)
+        d *= CLOSURE_RAY_STEP
+    if not depths:
         return np.zeros(0, np.int64)
-    lo, hi = sp.min(axis=0) - t, sp.max(axis=0) + t
-    cand = np.flatnonzero(allowed & ~sel)
-    if len(cand) == 0:
-        return cand
-    cand = cand[np.all((pos[cand] >= lo) & (pos[cand] <= hi), axis=1)]
-    if len(cand) == 0:
-        return cand
-    kk = min(CLOSURE_BACK_NEIGHBOURS, len(sel_idx))
-    d, j = cKDTree(sp).query(pos[cand], k=kk, distance_upper_bound=t, workers=-1)
+    depths = np.array(depths)
+    n_front = _unit_normals(cloud, fronts)
+    rays = np.arange(0, len(fronts), max(1, len(fronts) // CLOSURE_RAY_MAX)) if len(fronts) > CLOSURE_RAY_MAX \
+        else np.arange(len(fronts))
+    p_ray, n_ray = pos[fronts[rays]], n_front[rays]
+    kk = CLOSURE_RAY_HITS
+    rows_out, u_out = [], []
+    live = np.arange(len(rays))
+    for d in depths:   # march all live rays one step; a ray stops at the first surface it meets
+        if len(live) == 0:
+            break
+        r = max(CLOSURE_RAY_RADIUS_REL * d, spacing)
+        dist, hit = tree.query(p_ray[live] - d * n_ray[live], k=kk, distance_upper_bound=r,
+                               workers=_workers(len(live)))
+        dist, hit = dist.reshape(len(live), kk), hit.reshape(len(live), kk)
+        met = np.isfinite(dist[:, 0])
+        within = np.isfinite(dist[met])
+        rows_out.append(np.repeat(live[met], kk)[within.ravel()])
+        u_out.append(hit[met].ravel()[within.ravel()])
+        live = live[~met]
+    rows = np.concatenate(rows_out) if rows_out else np.zeros(0, np.int64)
+    u = np.concatenate(u_out) if u_out else np.zeros(0, np.int64)
+    ok = allowed[u]
+    rows, u = rows[ok], u[ok]
+    if len(u) == 0:
+        return u.astype(np.int64)
+    n_u = _unit_normals(cloud, u)
+    off = pos[u] - p_ray[rows]
+    cone = CLOSURE_BACK_CONE_COS * np.linalg.norm(off, axis=1)
+    keep = ((np.einsum("ij,ij->i", n_u, n_ray[rows]) < -CLOSURE_OPPOSITE_COS)
+            & (np.einsum("ij,ij->i", off, n_ray[rows]) < -cone)
+            & (np.einsum("ij,ij->i", off, n_u) > cone))
+    seeds = np.unique(u[keep]).astype(np.int64)
+    return _grow_back_sides(cloud, graph, fronts, n_front, allowed, seeds, t)
+
+
+def _facing_back(cloud, front_tree: cKDTree, p_front: np.ndarray, n_front: np.ndarray,
+                 cand: np.ndarray, t: float) -> np.ndarray:
+    """(len(cand),) bool: candidate splats with one of their
+    ``CLOSURE_BACK_NEIGHBOURS`` nearest front splats (within ``t``) across the
+    part: normals opposite, each behind the other's surface within the cone."""
+    pos = cloud.positions
+    kk = min(CLOSURE_BACK_NEIGHBOURS, len(p_front))
+    d, j = front_tree.query(pos[cand], k=kk, distance_upper_bound=t, workers=_workers(len(cand)))
     d, j = d.reshape(len(cand), kk), j.reshape(len(cand), kk)
+    n_cand = _unit_normals(cloud, cand)
     keep = np.zeros(len(cand), bool)
-    for col in range(kk):  # any of the k nearest selected splats across the part
+    for col in range(kk):
         hit = np.flatnonzero(np.isfinite(d[:, col]) & ~keep)
         if len(hit) == 0:
             break
-        u, s = cand[hit], sel_idx[j[hit, col]]
-        off = pos[u] - pos[s]
+        s = j[hit, col]
+        off = pos[cand[hit]] - p_front[s]
         cone = CLOSURE_BACK_CONE_COS * np.linalg.norm(off, axis=1)
-        keep[hit] = ((np.einsum("ij,ij->i", nrm[u], nrm[s]) < -CLOSURE_OPPOSITE_COS)
-                     & (np.einsum("ij,ij->i", off, nrm[s]) < -cone)
-                     & (np.einsum("ij,ij->i", off, nrm[u]) > cone))
-    u = cand[keep]
-    return u
+        keep[hit] = ((np.einsum("ij,ij->i", n_cand[hit], n_front[s]) < -CLOSURE_OPPOSITE_COS)
+                     & (np.einsum("ij,ij->i", off, n_front[s]) < -cone)
+                     & (np.einsum("ij,ij->i", off, n_cand[hit]) > cone))
+    return keep
+
+
+def _grow_back_sides(cloud, graph: NeighbourGraph, fronts: np.ndarray, n_front: np.ndarray,
+                     allowed: np.ndarray, seeds: np.ndarray, t: float) -> np.ndarray:
+    """Grow the rays' hits over the neighbour graph: every allowed neighbour
+    of the back side found so far that passes the facing test against its
+    nearest front splats joins it (rays bunch up behind curved fronts and
+    leave parts of the back unreached).  Returns sorted indices."""
+    if len(seeds) == 0:
+        return seeds
+    p_front = cloud.positions[fronts]
+    front_tree = cKDTree(p_front)
+    back = np.zeros(graph.n, bool)
+    back[seeds] = True
+    tested = back.copy()
+    frontier = seeds
+    scratch = np.empty(graph.n, np.int64)
+    while len(frontier):
+        ring = graph.neighbours_of(frontier)
+        ring = unique_indices(ring[~tested[ring] & allowed[ring]], scratch)
+        tested[ring] = True
+        if len(ring) == 0:
+            break
+        frontier = ring[_facing_back(cloud, front_tree, p_front, n_front, ring, t)]
+        back[frontier] = True
+    return np.flatnonzero(back)
 
 
 def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> np.ndarray:
@@ -167,18 +264,15 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> np
     return shell[~open_[labels]]
 
 
-def _close(graph: NeighbourGraph, pos: np.ndarray, nrm: np.ndarray, sel: np.ndarray,
-           allowed: np.ndarray, thickness: float) -> tuple[np.ndarray, ClosureCounts]:
-    """Rules 1-3 for one mask inside ``allowed``; returns the closed mask and counts."""
+def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, int, int]:
+    """Rules 2 and 3 for one mask inside ``allowed``: (closed mask, gaps, islands)."""
     out = sel.copy()
-    back = _back_sides(pos, nrm, out, allowed, thickness)
-    out[back] = True
     closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=allowed | out), CLOSURE_GAP_RINGS)
     gaps = int((closed & ~out).sum())
     out |= closed
     islands = _enclosed(graph, out, allowed)
     out[islands] = True
-    return out, ClosureCounts(back_sides=len(back), gaps=gaps, islands=len(islands))
+    return out, gaps, len(islands)
 
 
 def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourGraph | None = None,
@@ -204,89 +298,87 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     n = len(pos)
     sup_in = np.asarray(support, bool)
     hs_in = [np.asarray(h, bool) for h in handles]
+    nothing = np.zeros(n, bool)
     if not sup_in.any():
-        empty = np.zeros(n, bool)
-        return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], empty, empty.copy())
+        return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], nothing, nothing.copy())
     graph = NeighbourGraph.build(pos) if graph is None else graph
     if graph.n != n:
         raise ValueError(f"the neighbour graph has {graph.n} splats, the cloud {n}")
+    changed = None if changed is None else np.asarray(changed, bool)
+    if changed is not None and not changed.any():
+        return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], nothing, nothing.copy())
+    tree = graph.tree if graph.tree is not None else cKDTree(pos)
+    diag = graph.diagonal
     thickness = [CLOSURE_THIN_MAX_REL * _rms_radius(pos[m]) if m.any() else 0.0
                  for m in [sup_in] + hs_in]
-    diag = float(np.linalg.norm(pos.max(axis=0) - pos.min(axis=0)))
-    margins = [max(BAND_RINGS * graph.spacing,
-                   min(CLOSURE_HANDLE_MARGIN_REL * t / CLOSURE_THIN_MAX_REL, CLOSURE_HANDLE_MARGIN_MAX_REL * diag))
-               for t in thickness[1:]]
+
+    def fronts(mask):
+        return np.flatnonzero(mask if changed is None else mask & changed)
+
+    # rule 1 for the support, then rules 2-3 on the graph around the change
+    sup = sup_in.copy()
+    back = _back_sides(cloud, graph, tree, fronts(sup), ~sup, thickness[0])
+    sup[back] = True
+    n_back = len(back)
     if changed is None:
-        region = np.arange(n)
-        sub_graph = graph
+        region, sub = np.arange(n), graph
     else:
-        region = _neighbourhood(pos, np.asarray(changed, bool), sup_in, hs_in,
-                                max(thickness + margins) + CLOSURE_ISLAND_RINGS * 2 * graph.spacing)
-        if len(region) == 0:
-            empty = np.zeros(n, bool)
-            return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], empty, empty.copy())
-        sub_graph = graph.subgraph(region)
-    sub_pos = pos[region]
-    u, v = cloud.u[region], cloud.v[region]
-    nrm = np.cross(u, v)
-    nrm /= np.maximum(np.linalg.norm(nrm, axis=1, keepdims=True), 1e-300)
-    sup_r, c_sup = _close(sub_graph, sub_pos, nrm, sup_in[region], np.ones(len(region), bool),
-                          thickness[0])
-    hs_r = [h[region] & sup_r for h in hs_in]
-    c_h = ClosureCounts()
-    for i, h in enumerate(hs_r):
-        if not h.any():
+        touched = changed.copy()
+        touched[back] = True
+        region = _box_region(tree, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
+        sub = graph.subgraph(region)
+    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], np.ones(len(region), bool))
+    sup[region] = sup_r
+
+    # the handles: rules 1-3 inside the closed support, outside the other handles
+    hs = [h & sup for h in hs_in]
+    for i, h in enumerate(hs):
+        if not fronts(h).size:
             continue
-        others = np.zeros(len(region), bool)
-        for k, o in enumerate(hs_r):
+        others = np.zeros(n, bool)
+        for k, o in enumerate(hs):
             if k != i:
                 others |= o
-        closed, c = _close(sub_graph, sub_pos, nrm, h, sup_r & ~others, thickness[1 + i])
-        hs_r[i] = closed
-        c_h = ClosureCounts(c_h.back_sides + c.back_sides, c_h.gaps + c.gaps, c_h.islands + c.islands)
+        allowed = sup & ~others
+        back = _back_sides(cloud, graph, tree, fronts(h), allowed & ~h, thickness[1 + i])
+        h[back] = True
+        n_back += len(back)
+        h_r, g, isl = _close_graph(sub, h[region], allowed[region])
+        h[region] = h_r
+        n_gaps, n_islands = n_gaps + g, n_islands + isl
 
-    margin = 0
-    for h, width in zip(hs_r, margins):
-        if not h.any() or not width > 0:
+    # rule 4: a margin of support around every handle (where a handle changed)
+    n_margin = 0
+    for i, h in enumerate(hs):
+        if not h.any() or (changed is not None and not (hs_in[i] & changed).any()):
             continue
-        hp = sub_pos[h]
-        cand = np.flatnonzero(~sup_r)
+        hp = pos[h]    # the closed handle: its back side counts for its size
+        width = max(BAND_RINGS * graph.spacing,
+                    min(CLOSURE_HANDLE_MARGIN_REL * _rms_radius(hp), CLOSURE_HANDLE_MARGIN_MAX_REL * diag))
         lo, hi = hp.min(axis=0) - width, hp.max(axis=0) + width
-        cand = cand[np.all((sub_pos[cand] >= lo) & (sub_pos[cand] <= hi), axis=1)]
+        cand = np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1) & ~sup)
         if len(cand) == 0:
             continue
-        d, _ = cKDTree(hp).query(sub_pos[cand], k=1, distance_upper_bound=width, workers=-1)
+        d, _ = cKDTree(hp).query(pos[cand], k=1, distance_upper_bound=width, workers=_workers(len(cand)))
         near = cand[np.isfinite(d)]
-        sup_r[near] = True
-        margin += len(near)
+        sup[near] = True
+        n_margin += len(near)
 
-    counts = ClosureCounts(c_sup.back_sides + c_h.back_sides, c_sup.gaps + c_h.gaps,
-                           c_sup.islands + c_h.islands, margin)
-    sup = sup_in.copy()
-    sup[region] |= sup_r
-    hs = []
-    for h, hr in zip(hs_in, hs_r):
-        out = h.copy()
-        out[region] |= hr
-        hs.append(out)
     any_h = np.zeros(n, bool)
     for h in hs:
         any_h |= h
     added_h = any_h.copy()
     for h in hs_in:
         added_h &= ~h
+    counts = ClosureCounts(n_back, n_gaps, n_islands, n_margin)
     return ClosureResult(sup, hs, sup & ~sup_in, added_h, counts)
 
 
-def _neighbourhood(pos: np.ndarray, changed: np.ndarray, support: np.ndarray, handles: list,
-                   reach: float) -> np.ndarray:
-    """Sorted indices of the splats within the box of the changed splats (and
-    of the handles, whose margin depends on their whole extent) grown by
-    ``reach`` (model units)."""
-    parts = [changed] + [h for h in handles if (h & changed).any()]
-    boxes = [(pos[m].min(axis=0), pos[m].max(axis=0)) for m in parts if m.any()]
-    if not boxes:
-        return np.zeros(0, np.int64)
-    lo = np.min([b[0] for b in boxes], axis=0) - reach
-    hi = np.max([b[1] for b in boxes], axis=0) + reach
-    return np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1))
+def _box_region(tree: cKDTree, pos: np.ndarray, touched: np.ndarray, reach: float) -> np.ndarray:
+    """Sorted indices of (at least) the splats within the box of ``touched``
+    grown by ``reach`` (model units): the ball around the box (a k-d tree
+    query, so the cost follows the region, not the cloud)."""
+    tp = pos[touched]
+    lo, hi = tp.min(axis=0) - reach, tp.max(axis=0) + reach
+    out = tree.query_ball_point((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2)
+    return np.sort(np.asarray(out, dtype=np.int64))

@@ -26,6 +26,15 @@ from scipy.spatial import cKDTree
 from splatedit.tolerances import GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
 
 
+def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
+    """``values`` (int array) without repeats, in no particular order, in
+    O(len(values)) with ``scratch`` (int64 array at least as long as the
+    largest value + 1, contents ignored) instead of a sort."""
+    order = np.arange(len(values))
+    scratch[values] = order
+    return values[scratch[values] == order]
+
+
 @dataclass(frozen=True)
 class NeighbourGraph:
     """Symmetric neighbour graph of ``n`` splats (CSR, read-only arrays).
@@ -36,12 +45,14 @@ class NeighbourGraph:
         spacing: median nearest-neighbour distance of distinct splats (model units).
         tree: cKDTree of the positions (reused by the brush), or None for a
             :meth:`subgraph`.
+        diagonal: bounding-box diagonal of the positions (model units).
     """
 
     indptr: np.ndarray
     indices: np.ndarray
     spacing: float
     tree: cKDTree | None = None
+    diagonal: float = 0.0
 
     @classmethod
     def build(cls, positions: np.ndarray, k: int = GRAPH_NEIGHBOURS,
@@ -50,9 +61,10 @@ class NeighbourGraph:
         pts = np.asarray(positions, dtype=np.float64)
         n = len(pts)
         tree = cKDTree(pts) if tree is None else tree
+        diagonal = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if n else 0.0
         if n < 2:
             ptr = np.zeros(n + 1, np.int64)
-            return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, tree)
+            return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, tree, diagonal)
         kk = min(k, n - 1)
         d, j = tree.query(pts, k=kk + 1, workers=-1)
         d, j = d[:, 1:], j[:, 1:].astype(np.int32)
@@ -66,17 +78,18 @@ class NeighbourGraph:
         a = sparse.coo_matrix((np.ones(len(i), np.int8), (i, j)), shape=(n, n)).tocsr()
         a = (a + a.T).tocsr()
         a.sort_indices()
-        return cls._frozen(a.indptr.astype(np.int64), a.indices.astype(np.int32), spacing, tree)
+        return cls._frozen(a.indptr.astype(np.int64), a.indices.astype(np.int32), spacing, tree, diagonal)
 
     @classmethod
-    def _frozen(cls, indptr, indices, spacing, tree) -> "NeighbourGraph":
+    def _frozen(cls, indptr, indices, spacing, tree, diagonal) -> "NeighbourGraph":
         indptr.setflags(write=False)
         indices.setflags(write=False)
-        return cls(indptr, indices, float(spacing), tree)
+        return cls(indptr, indices, float(spacing), tree, float(diagonal))
 
     def subgraph(self, index: np.ndarray) -> "NeighbourGraph":
         """The graph induced by the splats ``index`` (sorted unique int array),
-        renumbered 0..len(index)-1 in that order (same spacing, no tree)."""
+        renumbered 0..len(index)-1 in that order (same spacing and
+        diagonal, no tree)."""
         index = np.asarray(index, np.int64)
         lookup = np.full(self.n, -1, np.int32)
         lookup[index] = np.arange(len(index), dtype=np.int32)
@@ -86,7 +99,7 @@ class NeighbourGraph:
         row = np.repeat(np.arange(len(index)), counts)[keep]
         indptr = np.zeros(len(index) + 1, np.int64)
         np.cumsum(np.bincount(row, minlength=len(index)), out=indptr[1:])
-        return self._frozen(indptr, nb[keep].astype(np.int32), self.spacing, None)
+        return self._frozen(indptr, nb[keep].astype(np.int32), self.spacing, None, self.diagonal)
 
     @property
     def n(self) -> int:
@@ -112,10 +125,10 @@ class NeighbourGraph:
         return self.indices[np.arange(total) + offsets]
 
     def ring(self, mask: np.ndarray) -> np.ndarray:
-        """Indices of the splats not in ``mask`` with a neighbour in it (the one-ring)."""
+        """Sorted indices of the splats not in ``mask`` with a neighbour in it (the one-ring)."""
         nb = self.neighbours_of(self._boundary(mask))
-        nb = np.unique(nb)
-        return nb[~mask[nb]]
+        nb = nb[~mask[nb]]
+        return np.sort(unique_indices(nb, np.empty(self.n, np.int64)))
 
     def _boundary(self, mask: np.ndarray) -> np.ndarray:
         """Indices of ``mask`` splats with at least one neighbour outside it."""
@@ -136,11 +149,12 @@ class NeighbourGraph:
         (restricted to ``within`` when given); returns a new mask."""
         out = np.asarray(mask, bool).copy()
         frontier = np.flatnonzero(out)
+        scratch = np.empty(self.n, np.int64)
         for _ in range(int(rings)):
             if len(frontier) == 0:
                 break
-            nb = np.unique(self.neighbours_of(frontier))
-            nb = nb[~out[nb]]
+            nb = self.neighbours_of(frontier)
+            nb = unique_indices(nb[~out[nb]], scratch)
             if within is not None:
                 nb = nb[within[nb]]
             out[nb] = True
