@@ -1,0 +1,159 @@
+"""Robust splat sizes: a cap relative to the neighbours' sizes, boundary-aware.
+
+The spacing rules of :mod:`splatedit.model.estimate` (k-th neighbour distance)
+and :mod:`splatedit.model.mesh` (longest incident edge) give a splat the size
+of the largest gap next to it.  That closes the surface, but two kinds of
+points get far too large a disc:
+
+* stray points (scanner outliers, unreferenced mesh vertices): their nearest
+  neighbours are far away, so their disc is many times the size of any
+  surface splat;
+* boundary points (open mesh borders, the edge of a scan): all their
+  neighbours lie on one side, and long sliver triangles along a border give
+  their corners huge discs that overhang the border as flaps.
+
+:func:`limit_radii` caps every radius at ``SIZE_CAP_REL_NEIGHBOURS`` times
+the median radius of the point's neighbours (a robust local spacing: one
+stray neighbour does not move a median) and a boundary splat at
+``BOUNDARY_CAP_REL_NEIGHBOURS`` times it.  Boundary points of a point cloud
+are found by :func:`boundary_points` (angular gap of the neighbours projected
+into the tangent plane, as PCL's BoundaryEstimation does), those of a mesh by
+:func:`mesh_boundary_vertices` (vertices on an edge used by a single face).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, BOUNDARY_GAP_DEG,
+                                  ESTIMATE_CHUNK_POINTS, SIZE_CAP_REL_NEIGHBOURS, SIZE_NEIGHBOURS)
+
+
+def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None = None,
+                      neighbours=None) -> np.ndarray:
+    """The k - 1 nearest other points of every point.
+
+    Args:
+        points: (n, 3) float64 positions (model units).
+        k: neighbourhood size including the point itself, clamped to n.
+        neighbours: optional (n, >= k) int64 indices of a k-NN query that
+            includes the point itself (:func:`splatedit.model.estimate.knn`).
+    Returns:
+        (n, k - 1) int64 indices; the point itself is left out even when
+        duplicates of it came first.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    n = len(pts)
+    k = int(min(max(k, 2), n))
+    if neighbours is None or neighbours.shape[1] < k:
+        tree = cKDTree(pts) if tree is None else tree
+        neighbours = np.empty((n, k), dtype=np.int64)
+        step = 8 * ESTIMATE_CHUNK_POINTS
+        for lo in range(0, n, step):
+            neighbours[lo:lo + step] = tree.query(pts[lo:lo + step], k=k, workers=-1)[1]
+    idx = np.asarray(neighbours[:, :k], dtype=np.int64)
+    is_self = idx == np.arange(n)[:, None]
+    col = np.where(is_self.any(axis=1), is_self.argmax(axis=1), k - 1)
+    keep = np.arange(k)[None, :] != col[:, None]
+    return idx[keep].reshape(n, k - 1)
+
+
+def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
+    """Widest angle between consecutive neighbours around each point.
+
+    The neighbour offsets are projected into the point's tangent plane and
+    sorted by angle; an interior point of a well-sampled surface is surrounded
+    (gaps well below 180 degrees), a point on a border has an empty half-plane.
+
+    Args:
+        points: (n, 3) float64; normals: (n, 3) float64 unit normals.
+        neighbours: (n, m) int64 indices of other points (m >= 2).
+    Returns:
+        (n,) float64 radians in (0, 2 pi]; 2 pi where all neighbours project
+        onto the point or onto one ray.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    nrm = np.asarray(normals, dtype=np.float64)
+    n = len(pts)
+    out = np.full(n, 2.0 * np.pi)
+    step = ESTIMATE_CHUNK_POINTS
+    for lo in range(0, n, step):
+        p, nn = pts[lo:lo + step], nrm[lo:lo + step]
+        d = pts[neighbours[lo:lo + step]] - p[:, None, :]                  # (c, m, 3)
+        d -= np.einsum("cmj,cj->cm", d, nn)[..., None] * nn[:, None, :]
+        ln = np.linalg.norm(d, axis=2)
+        first = np.argmax(ln > 0, axis=1)                                   # nearest non-degenerate offset
+        ref = d[np.arange(len(p)), first]
+        ref /= np.maximum(np.linalg.norm(ref, axis=1, keepdims=True), 1e-300)
+        ort = np.cross(nn, ref)
+        ang = np.arctan2(np.einsum("cmj,cj->cm", d, ort), np.einsum("cmj,cj->cm", d, ref))
+        ang = np.where(ln > 0, ang, np.nan)
+        ang.sort(axis=1)                                                    # NaN (coincident) last
+        valid = (ln > 0).sum(axis=1)
+        wrap = np.concatenate([ang, ang[:, :1] + 2.0 * np.pi], axis=1)
+        gaps = np.diff(wrap, axis=1)
+        # the wrap-around gap sits after the last valid angle
+        last = np.maximum(valid - 1, 0)
+        rows = np.arange(len(p))
+        gaps[rows, last] = ang[rows, 0] + 2.0 * np.pi - ang[rows, last]
+        gaps = np.where(np.arange(gaps.shape[1])[None, :] < valid[:, None], gaps, -np.inf)
+        g = gaps.max(axis=1)
+        out[lo:lo + step] = np.where(valid >= 2, g, 2.0 * np.pi)
+    return out
+
+
+def boundary_points(points, normals, neighbours,
+                    gap_deg: float = BOUNDARY_GAP_DEG) -> np.ndarray:
+    """(n,) bool: points whose neighbours leave an angular gap wider than
+    ``gap_deg`` degrees in the tangent plane (see :func:`largest_angular_gap`;
+    arguments as there)."""
+    return largest_angular_gap(points, normals, neighbours) > np.radians(gap_deg)
+
+
+def mesh_boundary_vertices(n_vertices: int, faces) -> np.ndarray:
+    """(n,) bool: vertices on a border edge (an edge used by exactly one face).
+
+    Args:
+        n_vertices: number of vertices n.
+        faces: (f, 3) int64 triangles.
+    """
+    F = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    out = np.zeros(n_vertices, dtype=bool)
+    if len(F) == 0:
+        return out
+    e = np.concatenate([F[:, [0, 1]], F[:, [1, 2]], F[:, [2, 0]]])
+    e.sort(axis=1)
+    key = e[:, 0] * np.int64(n_vertices) + e[:, 1]
+    uniq, count = np.unique(key, return_counts=True)
+    border = uniq[count == 1]
+    out[border // n_vertices] = True
+    out[border % n_vertices] = True
+    return out
+
+
+def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_NEIGHBOURS,
+                boundary_cap: float = BOUNDARY_CAP_REL_NEIGHBOURS) -> np.ndarray:
+    """Cap radii relative to the median radius of each point's neighbours.
+
+    Args:
+        radii: (n,) float64 radii from a spacing rule (model units).
+        neighbours: (n, m) int64 indices of other points (m >= 1), e.g. from
+            :func:`neighbour_indices`.
+        boundary: optional (n,) bool, points that get ``boundary_cap``.
+        cap, boundary_cap: multiples of the neighbours' median radius.
+    Returns:
+        (n,) float64, ``min(radii, cap * median(radii[neighbours]))``
+        (``boundary_cap`` for boundary points); never larger than ``radii``.
+    """
+    r = np.asarray(radii, dtype=np.float64)
+    if len(r) < 2 or neighbours.shape[1] == 0:
+        return r.copy()
+    local = np.empty(len(r))
+    step = 8 * ESTIMATE_CHUNK_POINTS
+    for lo in range(0, len(r), step):
+        local[lo:lo + step] = np.median(r[neighbours[lo:lo + step]], axis=1)
+    limit = cap * local
+    if boundary is not None:
+        limit = np.where(boundary, np.minimum(limit, boundary_cap * local), limit)
+    return np.minimum(r, limit)
