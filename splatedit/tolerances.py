@@ -275,3 +275,10 @@ OUTLIER_STD_RATIO = 4.0
 #: clean value: 6.4 on hippo1.ply, 7.7 on bunny00.off (mesh vertices next to
 #: long edges); poste_france.xyz has stray points at 11-1052
 ISOLATED_SPACINGS = 10.0
+#: an outlier's splat (OUTLIER_* / ISOLATED_SPACINGS) that is kept is at most
+#: this times the median radius of its neighbours that are not outliers (of
+#: all such splats when every neighbour is an outlier): a stray is drawn no
+#: larger than the surface splats next to it instead of up to 21x the median
+#: (poste_france.xyz as read); clusters of strays escape the neighbour cap
+#: above because their neighbours are strays too
+OUTLIER_RADIUS_REL_MEDIAN = 1.0

@@ -29,7 +29,9 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
-from splatedit.model.sizing import boundary_points, limit_radii, neighbour_indices
+from splatedit.model.outliers import detect_outliers
+from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
+                                    neighbour_indices)
 from splatedit.model.spacing import nearest_neighbour_distances
 from splatedit.progress import report
 from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, FALLBACK_SPLAT_RADIUS,
@@ -289,7 +291,11 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     Every radius is capped at ``SIZE_CAP_REL_NEIGHBOURS`` times the median
     radius of its ``SIZE_NEIGHBOURS - 1`` nearest neighbours, and the radius
     of a boundary point (:func:`splatedit.model.sizing.boundary_points`) at
-    ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it (see :mod:`splatedit.model.sizing`).
+    ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it, and the radius of an outlier
+    (:func:`splatedit.model.outliers.detect_outliers`) at
+    ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of its neighbours
+    that are not outliers
+    (see :mod:`splatedit.model.sizing`).
 
     Args:
         points: (n, 3) float64 positions; normals: (n, 3) float64 unit normals.
@@ -308,7 +314,8 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
         distances, neighbours = knn(pts, k, tree=tree)
     r = splat_radii(pts, tree=tree, distances=distances)
     nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=neighbours)
-    return limit_radii(r, nb, boundary_points(pts, normals, nb))
+    r = limit_radii(r, nb, boundary_points(pts, normals, nb))
+    return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
 
 
 def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,

@@ -26,7 +26,9 @@ at most ``SIZE_CAP_REL_NEIGHBOURS`` times it, and at most
 ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex on a border edge (an
 edge of a single face).  A long sliver triangle at an open border would
 otherwise give its corners discs that overhang the border as flaps, and an
-unreferenced stray vertex a disc the size of its distance to the surface.
+unreferenced stray vertex a disc the size of its distance to the surface
+(outlier vertices, :mod:`splatedit.model.outliers`, are kept at most
+``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of their neighbours).
 On a closed mesh of regular triangles the cap changes nothing, so the
 covering argument above holds; where it does cut (slivers), the cut part of
 the sliver's area is no longer covered, which is the price of no flaps.
@@ -40,7 +42,9 @@ from scipy.spatial import cKDTree
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import fill_missing_normals, knn, splat_radii, tangent_frame
-from splatedit.model.sizing import limit_radii, mesh_boundary_vertices, neighbour_indices
+from splatedit.model.outliers import detect_outliers
+from splatedit.model.sizing import (limit_outlier_radii, limit_radii, mesh_boundary_vertices,
+                                    neighbour_indices)
 from splatedit.progress import report
 from splatedit.tolerances import MESH_NORMAL_MIN_REL, MESH_SPLAT_RADIUS_FACTOR, SIZE_NEIGHBOURS
 
@@ -128,9 +132,10 @@ def cloud_from_mesh(vertices, faces, *, normals=None, colors=None, name: str = "
         radius[lonely] = splat_radii(V, tree=tree, query=lonely)
     if n > 2:
         report(progress, "building mesh splats", 0.5)
-        _, nb = knn(V, SIZE_NEIGHBOURS, tree=tree)
+        dist, nb = knn(V, SIZE_NEIGHBOURS, tree=tree)
         nb = neighbour_indices(V, SIZE_NEIGHBOURS, neighbours=nb)
         radius = limit_radii(radius, nb, mesh_boundary_vertices(n, F))
+        radius = limit_outlier_radii(radius, detect_outliers(V, tree=tree, distances=dist).mask, nb)
     t1, t2 = tangent_frame(nrm)
     report(progress, "building mesh splats", 1.0)
     return SplatCloud(V, t1 * radius[:, None], t2 * radius[:, None], colors, F,

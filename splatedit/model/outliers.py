@@ -58,7 +58,7 @@ class OutlierFlags:
 
 def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_STD_RATIO,
                     isolated_spacings: float = ISOLATED_SPACINGS, *,
-                    tree: cKDTree | None = None) -> OutlierFlags:
+                    tree: cKDTree | None = None, distances=None) -> OutlierFlags:
     """Flag statistical and isolated outliers.
 
     Args:
@@ -70,6 +70,9 @@ def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_
             distances (the median over points whose nearest neighbour is
             not a duplicate).
         tree: optional prebuilt ``cKDTree(points)``.
+        distances: optional (n, >= k + 1) sorted distances of a k-NN query
+            that includes the point itself (column 0), e.g. from
+            :func:`splatedit.model.estimate.knn`; saves the query.
     Returns:
         :class:`OutlierFlags`; nothing is flagged for fewer than 3 points.
     """
@@ -79,14 +82,18 @@ def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_
     if n < 3:
         return OutlierFlags(none, none.copy(), float("inf"), float("inf"))
     k = int(min(max(k, 1), n - 1))
-    tree = cKDTree(pts) if tree is None else tree
-    mean_d = np.empty(n)
-    nearest = np.empty(n)
-    step = 8 * ESTIMATE_CHUNK_POINTS
-    for lo in range(0, n, step):
-        d, _ = tree.query(pts[lo:lo + step], k=k + 1, workers=-1)
-        mean_d[lo:lo + step] = d[:, 1:].mean(axis=1)
-        nearest[lo:lo + step] = d[:, 1]
+    if distances is not None and distances.shape[1] >= k + 1:
+        mean_d = distances[:, 1:k + 1].mean(axis=1)
+        nearest = np.array(distances[:, 1])
+    else:
+        tree = cKDTree(pts) if tree is None else tree
+        mean_d = np.empty(n)
+        nearest = np.empty(n)
+        step = 8 * ESTIMATE_CHUNK_POINTS
+        for lo in range(0, n, step):
+            d, _ = tree.query(pts[lo:lo + step], k=k + 1, workers=-1)
+            mean_d[lo:lo + step] = d[:, 1:].mean(axis=1)
+            nearest[lo:lo + step] = d[:, 1]
     pos = mean_d > 0
     statistical = none.copy()
     threshold = float("inf")

@@ -15,7 +15,10 @@ points get far too large a disc:
 :func:`limit_radii` caps every radius at ``SIZE_CAP_REL_NEIGHBOURS`` times
 the median radius of the point's neighbours (a robust local spacing: one
 stray neighbour does not move a median) and a boundary splat at
-``BOUNDARY_CAP_REL_NEIGHBOURS`` times it.  Boundary points of a point cloud
+``BOUNDARY_CAP_REL_NEIGHBOURS`` times it; :func:`limit_outlier_radii` keeps
+outliers (:mod:`splatedit.model.outliers`), which may sit in clusters whose
+neighbours are strays too, at most ``OUTLIER_RADIUS_REL_MEDIAN`` times the
+median radius of their neighbours that are not outliers.  Boundary points of a point cloud
 are found by :func:`boundary_points` (angular gap of the neighbours projected
 into the tangent plane, as PCL's BoundaryEstimation does), those of a mesh by
 :func:`mesh_boundary_vertices` (vertices on an edge used by a single face).
@@ -27,7 +30,8 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, BOUNDARY_GAP_DEG,
-                                  ESTIMATE_CHUNK_POINTS, SIZE_CAP_REL_NEIGHBOURS, SIZE_NEIGHBOURS)
+                                  ESTIMATE_CHUNK_POINTS, OUTLIER_RADIUS_REL_MEDIAN,
+                                  SIZE_CAP_REL_NEIGHBOURS, SIZE_NEIGHBOURS)
 
 
 def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None = None,
@@ -157,3 +161,34 @@ def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_N
     if boundary is not None:
         limit = np.where(boundary, np.minimum(limit, boundary_cap * local), limit)
     return np.minimum(r, limit)
+
+
+def limit_outlier_radii(radii, outliers, neighbours,
+                        rel: float = OUTLIER_RADIUS_REL_MEDIAN) -> np.ndarray:
+    """Cap the radii of outliers relative to the surface splats next to them.
+
+    An outlier's radius is at most ``rel`` times the median radius of its
+    neighbours that are not outliers themselves, or, when all its neighbours
+    are outliers (a cluster of strays), of all the points that are not.
+
+    Args:
+        radii: (n,) float64 radii (model units).
+        outliers: (n,) bool, e.g. :attr:`splatedit.model.outliers.OutlierFlags.mask`.
+        neighbours: (n, m) int64 indices of other points.
+    Returns:
+        (n,) float64, unchanged where ``outliers`` is False or when every
+        point is an outlier.
+    """
+    r = np.array(radii, dtype=np.float64)
+    mask = np.asarray(outliers, dtype=bool)
+    if not mask.any() or mask.all():
+        return r
+    idx = np.flatnonzero(mask)
+    nb = neighbours[idx]
+    vals = np.where(mask[nb], np.nan, r[nb])
+    some = ~np.isnan(vals).all(axis=1)
+    local = np.full(len(idx), float(np.median(r[~mask])))
+    if some.any():
+        local[some] = np.nanmedian(vals[some], axis=1)
+    r[idx] = np.minimum(r[idx], rel * local)
+    return r
