@@ -23,8 +23,8 @@ of :mod:`splatedit.model.estimate`.
 The radii are then capped relative to the median radius of the
 ``SIZE_NEIGHBOURS - 1`` nearest vertices (:func:`splatedit.model.sizing.limit_radii`):
 at most ``SIZE_CAP_REL_NEIGHBOURS`` times it, and at most
-``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex on a border edge (an
-edge of a single face).  A long sliver triangle at an open border would
+``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex of a face that touches
+a border edge (an edge of a single face).  A long sliver triangle at an open border would
 otherwise give its corners discs that overhang the border as flaps, and an
 unreferenced stray vertex a disc the size of its distance to the surface
 (outlier vertices, :mod:`splatedit.model.outliers`, are kept at most
@@ -43,7 +43,7 @@ from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import fill_missing_normals, knn, splat_radii, tangent_frame
 from splatedit.model.outliers import detect_outliers
-from splatedit.model.sizing import (limit_outlier_radii, limit_radii, mesh_boundary_vertices,
+from splatedit.model.sizing import (limit_outlier_radii, limit_radii, mesh_border_ring,
                                     neighbour_indices)
 from splatedit.progress import report
 from splatedit.tolerances import MESH_NORMAL_MIN_REL, MESH_SPLAT_RADIUS_FACTOR, SIZE_NEIGHBOURS
@@ -134,7 +134,7 @@ def cloud_from_mesh(vertices, faces, *, normals=None, colors=None, name: str = "
         report(progress, "building mesh splats", 0.5)
         dist, nb = knn(V, SIZE_NEIGHBOURS, tree=tree)
         nb = neighbour_indices(V, SIZE_NEIGHBOURS, neighbours=nb)
-        radius = limit_radii(radius, nb, mesh_boundary_vertices(n, F))
+        radius = limit_radii(radius, nb, mesh_border_ring(n, F))
         radius = limit_outlier_radii(radius, detect_outliers(V, tree=tree, distances=dist).mask, nb)
     t1, t2 = tangent_frame(nrm)
     report(progress, "building mesh splats", 1.0)

@@ -21,7 +21,8 @@ neighbours are strays too, at most ``OUTLIER_RADIUS_REL_MEDIAN`` times the
 median radius of their neighbours that are not outliers.  Boundary points of a point cloud
 are found by :func:`boundary_points` (angular gap of the neighbours projected
 into the tangent plane, as PCL's BoundaryEstimation does), those of a mesh by
-:func:`mesh_boundary_vertices` (vertices on an edge used by a single face).
+:func:`mesh_border_ring` (vertices of the faces that touch an edge used by a
+single face).
 """
 
 from __future__ import annotations
@@ -133,6 +134,20 @@ def mesh_boundary_vertices(n_vertices: int, faces) -> np.ndarray:
     border = uniq[count == 1]
     out[border // n_vertices] = True
     out[border % n_vertices] = True
+    return out
+
+
+def mesh_border_ring(n_vertices: int, faces) -> np.ndarray:
+    """(n,) bool: the vertices of every face that has a vertex on a border edge
+    (:func:`mesh_boundary_vertices` and the ring of vertices inside it).  A
+    strip of sliver triangles along a border gives the vertices of that inner
+    ring long edges too, so they are sized as boundary splats.
+    """
+    F = np.asarray(faces, dtype=np.int64).reshape(-1, 3)
+    border = mesh_boundary_vertices(n_vertices, F)
+    out = border.copy()
+    if border.any():
+        out[F[border[F].any(axis=1)].ravel()] = True
     return out
 
 
