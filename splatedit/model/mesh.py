@@ -23,15 +23,16 @@ of :mod:`splatedit.model.estimate`.
 The radii are then capped relative to the median radius of the
 ``SIZE_NEIGHBOURS - 1`` nearest vertices (:func:`splatedit.model.sizing.limit_radii`):
 at most ``SIZE_CAP_REL_NEIGHBOURS`` times it, and at most
-``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex of a face that touches
-a border edge (an edge of a single face).  A long sliver triangle at an open border would
-otherwise give its corners discs that overhang the border as flaps, and an
-unreferenced stray vertex a disc the size of its distance to the surface
-(outlier vertices, :mod:`splatedit.model.outliers`, are kept at most
-``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of their neighbours).
-On a closed mesh of regular triangles the cap changes nothing, so the
-covering argument above holds; where it does cut (slivers), the cut part of
-the sliver's area is no longer covered, which is the price of no flaps.
+``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex of a face that touches a
+border edge (an edge of a single face).  A strip of long sliver triangles at
+an open border would otherwise give its corners discs that overhang the border
+as flaps, and an unreferenced stray vertex a disc the size of its distance to
+the surface (outlier vertices, :mod:`splatedit.model.outliers`, are kept at
+most ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of their
+neighbours).  On a mesh of regular triangles the caps change nothing, so the
+covering argument above holds; where they cut, the covering is no longer
+proved but measured (see the constants in :mod:`splatedit.tolerances`): a
+sliver is thin, so the discs of its neighbours still cover it.
 """
 
 from __future__ import annotations
