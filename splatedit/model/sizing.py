@@ -58,10 +58,25 @@ def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None 
         for lo in range(0, n, step):
             neighbours[lo:lo + step] = tree.query(pts[lo:lo + step], k=k, workers=-1)[1]
     idx = np.asarray(neighbours[:, :k], dtype=np.int64)
-    is_self = idx == np.arange(n)[:, None]
-    col = np.where(is_self.any(axis=1), is_self.argmax(axis=1), k - 1)
-    keep = np.arange(k)[None, :] != col[:, None]
-    return idx[keep].reshape(n, k - 1)
+    out = idx[:, 1:].copy()                      # the usual case: the point itself comes first
+    odd = np.flatnonzero(idx[:, 0] != np.arange(n))
+    if len(odd):                                 # a duplicate came first: drop the point's own entry
+        sub = idx[odd]
+        is_self = sub == odd[:, None]
+        col = np.where(is_self.any(axis=1), is_self.argmax(axis=1), k - 1)
+        keep = np.arange(k)[None, :] != col[:, None]
+        out[odd] = sub[keep].reshape(len(odd), k - 1)
+    return out
+
+
+def _row_median(values: np.ndarray) -> np.ndarray:
+    """Median of every row of a (c, m) array (``np.partition``, faster than
+    ``np.median`` for short rows)."""
+    m = values.shape[1]
+    if m % 2:
+        return np.partition(values, m // 2, axis=1)[:, m // 2]
+    part = np.partition(values, [m // 2 - 1, m // 2], axis=1)
+    return 0.5 * (part[:, m // 2 - 1] + part[:, m // 2])
 
 
 def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
@@ -82,28 +97,26 @@ def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
     nrm = np.asarray(normals, dtype=np.float64)
     n = len(pts)
     out = np.full(n, 2.0 * np.pi)
+    # any tangent frame will do: the gaps do not depend on where angles start
+    axis = np.eye(3)[np.argmin(np.abs(nrm), axis=1)]
+    t1 = np.cross(nrm, axis)
+    t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+    t2 = np.cross(nrm, t1)
     step = ESTIMATE_CHUNK_POINTS
     for lo in range(0, n, step):
-        p, nn = pts[lo:lo + step], nrm[lo:lo + step]
-        d = pts[neighbours[lo:lo + step]] - p[:, None, :]                  # (c, m, 3)
-        d -= np.einsum("cmj,cj->cm", d, nn)[..., None] * nn[:, None, :]
-        ln = np.linalg.norm(d, axis=2)
-        first = np.argmax(ln > 0, axis=1)                                   # nearest non-degenerate offset
-        ref = d[np.arange(len(p)), first]
-        ref /= np.maximum(np.linalg.norm(ref, axis=1, keepdims=True), 1e-300)
-        ort = np.cross(nn, ref)
-        ang = np.arctan2(np.einsum("cmj,cj->cm", d, ort), np.einsum("cmj,cj->cm", d, ref))
-        ang = np.where(ln > 0, ang, np.nan)
-        ang.sort(axis=1)                                                    # NaN (coincident) last
-        valid = (ln > 0).sum(axis=1)
-        wrap = np.concatenate([ang, ang[:, :1] + 2.0 * np.pi], axis=1)
-        gaps = np.diff(wrap, axis=1)
-        # the wrap-around gap sits after the last valid angle
+        d = pts[neighbours[lo:lo + step]] - pts[lo:lo + step, None, :]       # (c, m, 3)
+        x = np.einsum("cmj,cj->cm", d, t1[lo:lo + step])
+        y = np.einsum("cmj,cj->cm", d, t2[lo:lo + step])
+        ok = (x != 0) | (y != 0)                  # not coincident in the tangent plane
+        ang = np.where(ok, np.arctan2(y, x), np.inf)
+        ang.sort(axis=1)                          # coincident ones last
+        valid = ok.sum(axis=1)
+        gaps = np.diff(ang, axis=1)               # consecutive gaps; inf - x past the valid ones
+        gaps[np.arange(gaps.shape[1])[None, :] >= valid[:, None] - 1] = -np.inf
+        rows = np.arange(len(d))
         last = np.maximum(valid - 1, 0)
-        rows = np.arange(len(p))
-        gaps[rows, last] = ang[rows, 0] + 2.0 * np.pi - ang[rows, last]
-        gaps = np.where(np.arange(gaps.shape[1])[None, :] < valid[:, None], gaps, -np.inf)
-        g = gaps.max(axis=1)
+        wrap = ang[:, 0] + 2.0 * np.pi - ang[rows, last]
+        g = np.maximum(gaps.max(axis=1, initial=-np.inf), wrap)
         out[lo:lo + step] = np.where(valid >= 2, g, 2.0 * np.pi)
     return out
 
@@ -171,7 +184,7 @@ def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_N
     local = np.empty(len(r))
     step = 8 * ESTIMATE_CHUNK_POINTS
     for lo in range(0, len(r), step):
-        local[lo:lo + step] = np.median(r[neighbours[lo:lo + step]], axis=1)
+        local[lo:lo + step] = _row_median(r[neighbours[lo:lo + step]])
     limit = cap * local
     if boundary is not None:
         limit = np.where(boundary, np.minimum(limit, boundary_cap * local), limit)
