@@ -31,11 +31,11 @@ from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.outliers import detect_outliers
 from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
-                                    neighbour_indices)
+                                    neighbour_indices, neighbour_median)
 from splatedit.model.spacing import nearest_neighbour_distances
 from splatedit.progress import report
-from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, FALLBACK_SPLAT_RADIUS,
-                                  MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
+from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
+                                  FALLBACK_SPLAT_RADIUS, MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
                                   ORIENT_NEIGHBOURS, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
                                   SIZE_NEIGHBOURS, SPACING_NEIGHBOUR, SPLAT_RADIUS_FACTOR)
 
@@ -314,7 +314,12 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
         distances, neighbours = knn(pts, k, tree=tree)
     r = splat_radii(pts, tree=tree, distances=distances)
     nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=neighbours)
-    r = limit_radii(r, nb, boundary_points(pts, normals, nb))
+    local = neighbour_median(r, nb)
+    # only a splat above the boundary cap can be changed by it: test just those
+    test = np.flatnonzero(r > BOUNDARY_CAP_REL_NEIGHBOURS * local)
+    boundary = np.zeros(n, dtype=bool)
+    boundary[test] = boundary_points(pts, normals, nb, query=test)
+    r = limit_radii(r, nb, boundary, local=local)
     return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
 
 

@@ -79,7 +79,7 @@ def _row_median(values: np.ndarray) -> np.ndarray:
     return 0.5 * (part[:, m // 2 - 1] + part[:, m // 2])
 
 
-def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
+def largest_angular_gap(points, normals, neighbours, *, query=None) -> np.ndarray:
     """Widest angle between consecutive neighbours around each point.
 
     The neighbour offsets are projected into the point's tangent plane and
@@ -89,12 +89,18 @@ def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
     Args:
         points: (n, 3) float64; normals: (n, 3) float64 unit normals.
         neighbours: (n, m) int64 indices of other points (m >= 2).
+        query: optional (q,) indices of the points to test (default all).
     Returns:
-        (n,) float64 radians in (0, 2 pi]; 2 pi where all neighbours project
-        onto the point or onto one ray.
+        (n,) (or (q,)) float64 radians in (0, 2 pi]; 2 pi where all
+        neighbours project onto the point or onto one ray.
     """
-    pts = np.asarray(points, dtype=np.float64)
-    nrm = np.asarray(normals, dtype=np.float64)
+    allp = np.asarray(points, dtype=np.float64)
+    if query is None:
+        pts, nrm = allp, np.asarray(normals, dtype=np.float64)
+    else:
+        query = np.asarray(query, dtype=np.int64)
+        pts, nrm = allp[query], np.asarray(normals, dtype=np.float64)[query]
+        neighbours = neighbours[query]
     n = len(pts)
     out = np.full(n, 2.0 * np.pi)
     # any tangent frame will do: the gaps do not depend on where angles start
@@ -104,7 +110,7 @@ def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
     t2 = np.cross(nrm, t1)
     step = ESTIMATE_CHUNK_POINTS
     for lo in range(0, n, step):
-        d = pts[neighbours[lo:lo + step]] - pts[lo:lo + step, None, :]       # (c, m, 3)
+        d = allp[neighbours[lo:lo + step]] - pts[lo:lo + step, None, :]      # (c, m, 3)
         x = np.einsum("cmj,cj->cm", d, t1[lo:lo + step])
         y = np.einsum("cmj,cj->cm", d, t2[lo:lo + step])
         ok = (x != 0) | (y != 0)                  # not coincident in the tangent plane
@@ -121,12 +127,12 @@ def largest_angular_gap(points, normals, neighbours) -> np.ndarray:
     return out
 
 
-def boundary_points(points, normals, neighbours,
-                    gap_deg: float = BOUNDARY_GAP_DEG) -> np.ndarray:
-    """(n,) bool: points whose neighbours leave an angular gap wider than
-    ``gap_deg`` degrees in the tangent plane (see :func:`largest_angular_gap`;
-    arguments as there)."""
-    return largest_angular_gap(points, normals, neighbours) > np.radians(gap_deg)
+def boundary_points(points, normals, neighbours, gap_deg: float = BOUNDARY_GAP_DEG, *,
+                    query=None) -> np.ndarray:
+    """(n,) (or (q,)) bool: points whose neighbours leave an angular gap wider
+    than ``gap_deg`` degrees in the tangent plane (see
+    :func:`largest_angular_gap`; arguments as there)."""
+    return largest_angular_gap(points, normals, neighbours, query=query) > np.radians(gap_deg)
 
 
 def mesh_boundary_vertices(n_vertices: int, faces) -> np.ndarray:
@@ -164,8 +170,19 @@ def mesh_border_ring(n_vertices: int, faces) -> np.ndarray:
     return out
 
 
+def neighbour_median(radii, neighbours) -> np.ndarray:
+    """(n,) float64: the median of ``radii`` over every point's neighbours
+    ((n, m) int64 indices, m >= 1)."""
+    r = np.asarray(radii, dtype=np.float64)
+    local = np.empty(len(r))
+    step = 8 * ESTIMATE_CHUNK_POINTS
+    for lo in range(0, len(r), step):
+        local[lo:lo + step] = _row_median(r[neighbours[lo:lo + step]])
+    return local
+
+
 def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_NEIGHBOURS,
-                boundary_cap: float = BOUNDARY_CAP_REL_NEIGHBOURS) -> np.ndarray:
+                boundary_cap: float = BOUNDARY_CAP_REL_NEIGHBOURS, local=None) -> np.ndarray:
     """Cap radii relative to the median radius of each point's neighbours.
 
     Args:
@@ -174,6 +191,7 @@ def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_N
             :func:`neighbour_indices`.
         boundary: optional (n,) bool, points that get ``boundary_cap``.
         cap, boundary_cap: multiples of the neighbours' median radius.
+        local: optional (n,) :func:`neighbour_median` of ``radii``.
     Returns:
         (n,) float64, ``min(radii, cap * median(radii[neighbours]))``
         (``boundary_cap`` for boundary points); never larger than ``radii``.
@@ -181,10 +199,7 @@ def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_N
     r = np.asarray(radii, dtype=np.float64)
     if len(r) < 2 or neighbours.shape[1] == 0:
         return r.copy()
-    local = np.empty(len(r))
-    step = 8 * ESTIMATE_CHUNK_POINTS
-    for lo in range(0, len(r), step):
-        local[lo:lo + step] = _row_median(r[neighbours[lo:lo + step]])
+    local = neighbour_median(r, neighbours) if local is None else local
     limit = cap * local
     if boundary is not None:
         limit = np.where(boundary, np.minimum(limit, boundary_cap * local), limit)
