@@ -240,8 +240,9 @@ SIZE_NEIGHBOURS = 16
 #: SIZE_NEIGHBOURS - 1 neighbours.  Measured on uniformly random sphere
 #: samples (the hard case for holes): the largest ratio was 1.70-1.92 at 4k
 #: points and 1.99-2.41 at 50k (3 seeds each), 1.45 on kitten.xyz; 3.0 never
-#: shrinks such a splat, while stray points (13x and 400x the median on
-#: poste_france.xyz before) end at most 3x their neighbours
+#: shrinks such a splat, while stray points (the largest splat was 397x the
+#: median on poste_france.xyz, 45x / 89x on kitten / hippo1 with 1 % injected
+#: outliers) end at most 3x their neighbours
 SIZE_CAP_REL_NEIGHBOURS = 3.0
 #: a point is on a boundary (open border, scan edge) when its neighbours,
 #: projected into its tangent plane, leave an angular gap wider than this
@@ -270,9 +271,10 @@ BOUNDARY_CAP_REL_NEIGHBOURS = 1.2
 #: on clean files (points flagged): linear space k=8, ratio 4: kitten 0, hippo1
 #: 30, bunny00 63; log space: 0, 9, 2.  With 1 % uniform outliers in the
 #: bounding box plus 5 far strays, recall of the injected points more than 5
-#: spacings off the surface is 0.83-1.00 (hippo1 0.87, bunny00 0.83) at a
-#: precision of 0.98-1.00; k = 16 or 24 flagged more clean points (16-22
-#: on hippo1) for no better recall
+#: spacings off the surface is 0.83-1.00 (kitten and poste_france 1.00,
+#: hippo1 0.87, bunny00 0.83) at a precision of 0.98-1.00 (poste_france's
+#: own strays not counted as false); k = 16 or 24 flagged more clean points
+#: (16-22 on hippo1) for no better recall
 OUTLIER_NEIGHBOURS = 8
 OUTLIER_STD_RATIO = 4.0
 #: a point with no other point within this many median nearest-neighbour
