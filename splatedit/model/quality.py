@@ -6,12 +6,11 @@ from __future__ import annotations
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.spatial import cKDTree
-
 from splatedit.model.cloud import SplatCloud
+from splatedit.model.estimate import knn
 from splatedit.model.outliers import OutlierFlags, detect_outliers
 from splatedit.model.sizing import boundary_points, mesh_boundary_vertices, neighbour_indices
-from splatedit.tolerances import SIZE_NEIGHBOURS
+from splatedit.tolerances import OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
 
 
 @dataclass(frozen=True)
@@ -38,14 +37,17 @@ class CloudQuality:
 def assess(cloud: SplatCloud) -> CloudQuality:
     """Outliers, boundary splats and the radius spread of ``cloud``."""
     pts = cloud.positions
-    tree = cKDTree(pts) if cloud.n > 1 else None
-    flags = detect_outliers(pts, tree=tree)
-    if cloud.faces is not None and len(cloud.faces):
-        boundary = mesh_boundary_vertices(cloud.n, cloud.faces)
-    elif cloud.n >= 3:
-        nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, cloud.n), tree=tree)
-        boundary = boundary_points(pts, cloud.normals, nb)
-    else:
-        boundary = np.zeros(cloud.n, dtype=bool)
+    n = cloud.n
     radii = cloud.radii
-    return CloudQuality(flags, boundary, float(radii.max() / np.median(radii)))
+    spread = float(radii.max() / np.median(radii))
+    if n < 3:
+        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread)
+    # one k-NN query serves the outlier test and the boundary test
+    dist, idx = knn(pts, max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1))
+    flags = detect_outliers(pts, distances=dist)
+    if cloud.faces is not None and len(cloud.faces):
+        boundary = mesh_boundary_vertices(n, cloud.faces)
+    else:
+        nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=idx)
+        boundary = boundary_points(pts, cloud.normals, nb)
+    return CloudQuality(flags, boundary, spread)
