@@ -60,3 +60,17 @@ def test_remove_outliers_refuses_a_mesh_in_one_line(shared_data, tmp_path, capsy
     assert len(err) == 1 and err[0].startswith("splatedit: error: ")
     assert "bunny00.off" in err[0] and "point clouds only" in err[0]
     assert not out.exists()
+
+
+def test_info_counts_the_border_vertices_of_a_cut_mesh(shared_data, tmp_path, capsys):
+    from splatedit.io import write
+    from splatedit.model.mesh import cloud_from_mesh
+    from splatedit.model.sizing import mesh_boundary_vertices
+    from tests.model.scan_helpers import cut_mesh
+    whole = read(shared_data / "bunny00.off")
+    assert _info(shared_data / "bunny00.off", capsys)["boundary_splats"] == 0     # closed
+    v, f = cut_mesh(whole.positions, whole.faces)
+    path = tmp_path / "half.off"
+    write(path, cloud_from_mesh(v, f))
+    info = _info(path, capsys)
+    assert info["boundary_splats"] == int(mesh_boundary_vertices(len(v), f).sum()) > 100
