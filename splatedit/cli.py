@@ -61,10 +61,12 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
 def cmd_info(args) -> int:
     import numpy as np
     from splatedit.io import read
+    from splatedit.model.quality import assess
     from splatedit.model.spacing import point_spacing
     cloud = read(args.file, progress=args.progress)
     lo, hi = cloud.bounds()
     radii = cloud.radii
+    quality = assess(cloud)
     info = {
         "file": str(args.file),
         "splats": cloud.n,
@@ -76,6 +78,11 @@ def cmd_info(args) -> int:
         "spacing": round(point_spacing(cloud.positions), 6),
         "splat_radius_median": round(float(np.median(radii)), 6),
         "splat_radius_max": round(float(radii.max()), 6),
+        "splat_radius_max_rel_median": round(quality.radius_max_rel_median, 3),
+        "boundary_splats": quality.boundary_count,
+        "outliers": quality.outliers.count,
+        "outliers_statistical": int(quality.outliers.statistical.sum()),
+        "outliers_isolated": int(quality.outliers.isolated.sum()),
     }
     if args.json:
         print(json.dumps(info))
@@ -88,7 +95,11 @@ def cmd_info(args) -> int:
 
 def cmd_convert(args) -> int:
     from splatedit.io import read, write
+    from splatedit.io.atomic import check_writable_target
+    check_writable_target(args.output, overwrite=args.force, protect=args.input)
     cloud = read(args.input, progress=args.progress)
+    if args.remove_outliers:
+        cloud = _remove_outliers(args, cloud)
     write(args.output, cloud, overwrite=args.force)
     print(f"wrote {args.output}: {cloud.n} splats" + ("" if cloud.faces is None else f", {len(cloud.faces)} faces"))
     return 0
@@ -106,6 +117,21 @@ def _print_edit(args, rep) -> None:
         warnings.append(rep.distortion_warning())
     for w in warnings:
         print(f"splatedit: warning: {w}", file=sys.stderr, flush=True)
+
+
+def _remove_outliers(args, cloud):
+    """``convert --remove-outliers``: drop statistical and isolated outliers
+    of a point cloud (a mesh is refused: its faces would need re-indexing and
+    a vertex used by faces is part of the surface)."""
+    from splatedit.model.outliers import detect_outliers
+    if cloud.faces is not None:
+        raise ParameterError("--remove-outliers", f"{args.input} is a triangle mesh "
+                             f"({len(cloud.faces)} faces); outlier removal works on point clouds only")
+    flags = detect_outliers(cloud.positions)
+    args.progress.close()
+    print(f"removed {flags.count} outlier(s) of {cloud.n} points "
+          f"({int(flags.statistical.sum())} statistical, {int(flags.isolated.sum())} isolated)")
+    return cloud.subset(~flags.mask) if flags.count else cloud
 
 
 def _run_edits(args, cloud, script_path):
@@ -259,7 +285,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-f", "--force", action="store_true", help="overwrite existing outputs")
     s.set_defaults(func=cmd_demo)
 
-    s = sub.add_parser("info", help="counts, bounds, attributes and spacing of a model")
+    s = sub.add_parser("info", help="counts, bounds, attributes, spacing, splat sizes, boundary splats and outliers of a model")
     s.add_argument("file")
     s.add_argument("--json", action="store_true", help="print one JSON object")
     s.set_defaults(func=cmd_info)
@@ -267,6 +293,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("convert", help="convert PLY/XYZ/OFF to a splat PLY (estimates normals and sizes when missing)")
     s.add_argument("input")
     s.add_argument("output")
+    s.add_argument("--remove-outliers", action="store_true",
+                   help="drop statistical and isolated outlier points (point clouds only)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists")
     s.set_defaults(func=cmd_convert)
 

@@ -16,7 +16,8 @@
   XOR of the edge flips on its tree path to the seed, computed by pointer
   jumping in O(n log depth).
 * :func:`splat_axes` builds an orthonormal tangent frame scaled to a radius
-  that closes the surface (see its docstring).
+  that closes the surface (see :func:`splat_radii`), capped relative to the
+  neighbours' radii and at boundaries (:mod:`splatedit.model.sizing`).
 """
 
 from __future__ import annotations
@@ -28,12 +29,15 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
+from splatedit.model.outliers import detect_outliers
+from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
+                                    neighbour_indices, neighbour_median)
 from splatedit.model.spacing import nearest_neighbour_distances
 from splatedit.progress import report
-from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, FALLBACK_SPLAT_RADIUS,
-                                  MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
+from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
+                                  FALLBACK_SPLAT_RADIUS, MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
                                   ORIENT_NEIGHBOURS, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
-                                  SPACING_NEIGHBOUR, SPLAT_RADIUS_FACTOR)
+                                  SIZE_NEIGHBOURS, SPACING_NEIGHBOUR, SPLAT_RADIUS_FACTOR)
 
 
 def _points(points) -> np.ndarray:
@@ -280,16 +284,56 @@ def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS
     return r
 
 
+def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distances=None,
+                       neighbours=None) -> np.ndarray:
+    """Hole-free splat radii (:func:`splat_radii`) with strays and borders tamed.
+
+    Every radius is capped at ``SIZE_CAP_REL_NEIGHBOURS`` times the median
+    radius of its ``SIZE_NEIGHBOURS - 1`` nearest neighbours, and the radius
+    of a boundary point (:func:`splatedit.model.sizing.boundary_points`) at
+    ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it, and the radius of an outlier
+    (:func:`splatedit.model.outliers.detect_outliers`) at
+    ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of its neighbours
+    that are not outliers
+    (see :mod:`splatedit.model.sizing`).
+
+    Args:
+        points: (n, 3) float64 positions; normals: (n, 3) float64 unit normals.
+        distances, neighbours: optional (n, >= SIZE_NEIGHBOURS) sorted
+            distances and indices from :func:`knn` (the point itself included).
+    Returns:
+        (n,) float64 radii (model units), all > 0.
+    """
+    pts = _points(points)
+    n = len(pts)
+    if n < 3:
+        return splat_radii(pts, tree=tree, distances=distances)
+    k = min(max(SIZE_NEIGHBOURS, SPACING_NEIGHBOUR + 1), n)
+    if distances is None or neighbours is None or neighbours.shape[1] < k \
+            or distances.shape[1] < SPACING_NEIGHBOUR + 1:
+        distances, neighbours = knn(pts, k, tree=tree)
+    r = splat_radii(pts, tree=tree, distances=distances)
+    nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=neighbours)
+    local = neighbour_median(r, nb)
+    # only a splat above the boundary cap can be changed by it: test just those
+    test = np.flatnonzero(r > BOUNDARY_CAP_REL_NEIGHBOURS * local)
+    boundary = np.zeros(n, dtype=bool)
+    boundary[test] = boundary_points(pts, normals, nb, query=test)
+    r = limit_radii(r, nb, boundary, local=local)
+    return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
+
+
 def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
-               distances=None, progress=None) -> tuple[np.ndarray, np.ndarray]:
+               distances=None, neighbours=None, progress=None) -> tuple[np.ndarray, np.ndarray]:
     """Circular splats: tangent axes ``(u, v)`` of length ``radius``.
 
     Args:
         points: (n, 3) float64 positions (model units).
         normals: (n, 3) float64 normals (normalised here; u x v points along them).
-        radius: None (estimate with :func:`splat_radii`), a scalar, or (n,)
-            float64 radii in model units.
-        distances: optional (n, >= SPACING_NEIGHBOUR + 1) distances from :func:`knn`.
+        radius: None (estimate with :func:`robust_splat_radii`), a scalar, or
+            (n,) float64 radii in model units.
+        distances, neighbours: optional (n, >= SIZE_NEIGHBOURS) distances and
+            indices from :func:`knn`.
     Returns:
         u, v: (n, 3) float64, orthogonal, ``|u| = |v| = radius``,
         ``normalize(u x v) = normal``.
@@ -301,7 +345,7 @@ def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
     report(progress, "sizing splats", 0.0)
     nrm = nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
     if radius is None:
-        r = splat_radii(pts, tree=tree, distances=distances)
+        r = robust_splat_radii(pts, nrm, tree=tree, distances=distances, neighbours=neighbours)
     else:
         r = np.broadcast_to(np.asarray(radius, dtype=np.float64), (len(pts),))
     t1, t2 = tangent_frame(nrm)
@@ -351,7 +395,7 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
             Zero-length rows are filled with PCA normals.
         colors: optional (n, 4) uint8 RGBA.
         radius: optional scalar or (n,) splat radii (model units); default
-            from neighbour spacing (:func:`splat_radii`).
+            from neighbour spacing (:func:`robust_splat_radii`).
         faces: optional (f, 3) int64 triangles, kept as they are.
     Returns:
         SplatCloud with circular splats.
@@ -360,7 +404,7 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
     tree = cKDTree(pts) if len(pts) > 1 else None
     dist = nb = None
     if len(pts) > 1:
-        kmax = SPACING_NEIGHBOUR + 1
+        kmax = max(SPACING_NEIGHBOUR + 1, SIZE_NEIGHBOURS)
         if normals is None:
             kmax = max(NORMAL_NEIGHBOURS, ORIENT_NEIGHBOURS + 1, kmax)
         if radius is None or normals is None:
@@ -373,5 +417,6 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
         if nrm.shape != pts.shape:
             raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
         nrm = fill_missing_normals(pts, nrm, tree=tree)
-    u, v = splat_axes(pts, nrm, radius=radius, tree=tree, distances=dist, progress=progress)
+    u, v = splat_axes(pts, nrm, radius=radius, tree=tree, distances=dist, neighbours=nb,
+                      progress=progress)
     return SplatCloud(pts, u, v, colors, faces, name=name, source=source)

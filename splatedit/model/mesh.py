@@ -19,6 +19,20 @@ Every vertex becomes a circular splat:
 Vertices without usable faces (isolated, only degenerate faces, or opposite
 faces cancelling) fall back to a PCA normal and the neighbour-spacing radius
 of :mod:`splatedit.model.estimate`.
+
+The radii are then capped relative to the median radius of the
+``SIZE_NEIGHBOURS - 1`` nearest vertices (:func:`splatedit.model.sizing.limit_radii`):
+at most ``SIZE_CAP_REL_NEIGHBOURS`` times it, and at most
+``BOUNDARY_CAP_REL_NEIGHBOURS`` times it for a vertex of a face that touches a
+border edge (an edge of a single face).  A strip of long sliver triangles at
+an open border would otherwise give its corners discs that overhang the border
+as flaps, and an unreferenced stray vertex a disc the size of its distance to
+the surface (outlier vertices, :mod:`splatedit.model.outliers`, are kept at
+most ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of their
+neighbours).  On a mesh of regular triangles the caps change nothing, so the
+covering argument above holds; where they cut, the covering is no longer
+proved but measured (see the constants in :mod:`splatedit.tolerances`): a
+sliver is thin, so the discs of its neighbours still cover it.
 """
 
 from __future__ import annotations
@@ -28,9 +42,12 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud
-from splatedit.model.estimate import fill_missing_normals, splat_radii, tangent_frame
+from splatedit.model.estimate import fill_missing_normals, knn, splat_radii, tangent_frame
+from splatedit.model.outliers import detect_outliers
+from splatedit.model.sizing import (limit_outlier_radii, limit_radii, mesh_border_ring,
+                                    neighbour_indices)
 from splatedit.progress import report
-from splatedit.tolerances import MESH_NORMAL_MIN_REL, MESH_SPLAT_RADIUS_FACTOR
+from splatedit.tolerances import MESH_NORMAL_MIN_REL, MESH_SPLAT_RADIUS_FACTOR, SIZE_NEIGHBOURS
 
 
 def mesh_vertex_normals(vertices, faces) -> np.ndarray:
@@ -79,7 +96,8 @@ def cloud_from_mesh(vertices, faces, *, normals=None, colors=None, name: str = "
         name, source: as in :class:`SplatCloud`.
     Returns:
         SplatCloud with circular splats, radius
-        ``MESH_SPLAT_RADIUS_FACTOR * longest incident edge``.
+        ``MESH_SPLAT_RADIUS_FACTOR * longest incident edge``, capped relative
+        to the neighbouring vertices' radii (see the module docstring).
     Raises:
         InputError: a face index outside 0..n-1 (naming the face row).
     """
@@ -108,12 +126,17 @@ def cloud_from_mesh(vertices, faces, *, normals=None, colors=None, name: str = "
         nrm[use] = given[use] / gl[use, None]
     radius = edge * MESH_SPLAT_RADIUS_FACTOR
     lonely = np.flatnonzero(edge <= 0)
-    tree = None
+    tree = cKDTree(V) if n > 1 else None
     if len(lonely) or not np.all(np.linalg.norm(nrm, axis=1) > 0):
-        tree = cKDTree(V) if n > 1 else None
         nrm = fill_missing_normals(V, nrm, tree=tree)
     if len(lonely):
         radius[lonely] = splat_radii(V, tree=tree, query=lonely)
+    if n > 2:
+        report(progress, "building mesh splats", 0.5)
+        dist, nb = knn(V, SIZE_NEIGHBOURS, tree=tree)
+        nb = neighbour_indices(V, SIZE_NEIGHBOURS, neighbours=nb)
+        radius = limit_radii(radius, nb, mesh_border_ring(n, F))
+        radius = limit_outlier_radii(radius, detect_outliers(V, tree=tree, distances=dist).mask, nb)
     t1, t2 = tangent_frame(nrm)
     report(progress, "building mesh splats", 1.0)
     return SplatCloud(V, t1 * radius[:, None], t2 * radius[:, None], colors, F,

@@ -1,0 +1,109 @@
+"""Outlier points of scans: statistical and isolated.
+
+* Statistical (as PCL's StatisticalOutlierRemoval and Open3D's
+  ``remove_statistical_outlier``): the mean distance of every point to its
+  ``OUTLIER_NEIGHBOURS`` nearest other points is compared with the
+  distribution over all points; a point beyond the mean plus
+  ``OUTLIER_STD_RATIO`` standard deviations is an outlier.  The statistics
+  are taken of the logarithm of the distances, which makes the test
+  independent of the scale and keeps regions that are merely sampled more
+  sparsely (a constant factor, a shift in log space) inside the distribution
+  (see the measurements in :mod:`splatedit.tolerances`).
+* Isolated: no other point within ``ISOLATED_SPACINGS`` times the median
+  nearest-neighbour distance.
+
+Both only flag; :meth:`splatedit.model.cloud.SplatCloud.subset` removes.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, ISOLATED_SPACINGS, OUTLIER_NEIGHBOURS,
+                                  OUTLIER_STD_RATIO)
+
+
+@dataclass(frozen=True)
+class OutlierFlags:
+    """Which points are outliers.
+
+    Attributes:
+        statistical: (n,) bool, beyond the mean + ratio * std of the log mean
+            neighbour distance.
+        isolated: (n,) bool, no other point within the isolation radius.
+        threshold: the mean neighbour distance above which a point is a
+            statistical outlier (model units; inf when none can be).
+        isolation_radius: the isolation radius (model units; inf when the
+            spacing is 0).
+    """
+
+    statistical: np.ndarray
+    isolated: np.ndarray
+    threshold: float
+    isolation_radius: float
+
+    @property
+    def mask(self) -> np.ndarray:
+        """(n,) bool, statistical or isolated."""
+        return self.statistical | self.isolated
+
+    @property
+    def count(self) -> int:
+        """Number of outliers (statistical or isolated)."""
+        return int(self.mask.sum())
+
+
+def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_STD_RATIO,
+                    isolated_spacings: float = ISOLATED_SPACINGS, *,
+                    tree: cKDTree | None = None, distances=None) -> OutlierFlags:
+    """Flag statistical and isolated outliers.
+
+    Args:
+        points: (n, 3) float64 positions (model units).
+        k: neighbours (other points) whose mean distance is tested, clamped
+            to n - 1.
+        ratio: standard deviations (of the log mean distance) above the mean.
+        isolated_spacings: isolation radius in median nearest-neighbour
+            distances (the median over points whose nearest neighbour is
+            not a duplicate).
+        tree: optional prebuilt ``cKDTree(points)``.
+        distances: optional (n, >= k + 1) sorted distances of a k-NN query
+            that includes the point itself (column 0), e.g. from
+            :func:`splatedit.model.estimate.knn`; saves the query.
+    Returns:
+        :class:`OutlierFlags`; nothing is flagged for fewer than 3 points.
+    """
+    pts = np.asarray(points, dtype=np.float64)
+    n = len(pts)
+    none = np.zeros(n, dtype=bool)
+    if n < 3:
+        return OutlierFlags(none, none.copy(), float("inf"), float("inf"))
+    k = int(min(max(k, 1), n - 1))
+    if distances is not None and distances.shape[1] >= k + 1:
+        mean_d = distances[:, 1:k + 1].mean(axis=1)
+        nearest = np.array(distances[:, 1])
+    else:
+        tree = cKDTree(pts) if tree is None else tree
+        mean_d = np.empty(n)
+        nearest = np.empty(n)
+        step = 8 * ESTIMATE_CHUNK_POINTS
+        for lo in range(0, n, step):
+            d, _ = tree.query(pts[lo:lo + step], k=k + 1, workers=-1)
+            mean_d[lo:lo + step] = d[:, 1:].mean(axis=1)
+            nearest[lo:lo + step] = d[:, 1]
+    pos = mean_d > 0
+    statistical = none.copy()
+    threshold = float("inf")
+    if pos.sum() >= 3:
+        logd = np.log(mean_d[pos])
+        mu, sd = float(logd.mean()), float(logd.std())
+        if sd > 0:
+            threshold = float(np.exp(mu + ratio * sd))
+            statistical = mean_d > threshold
+    nz = nearest[nearest > 0]
+    radius = float(isolated_spacings * np.median(nz)) if len(nz) else float("inf")
+    isolated = nearest > radius
+    return OutlierFlags(statistical, isolated, threshold, radius)

@@ -1,0 +1,53 @@
+"""What ``splatedit info`` reports about a cloud's cleanliness: outliers,
+boundary splats, the largest splat relative to the median."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from splatedit.model.cloud import SplatCloud
+from splatedit.model.estimate import knn
+from splatedit.model.outliers import OutlierFlags, detect_outliers
+from splatedit.model.sizing import boundary_points, mesh_boundary_vertices, neighbour_indices
+from splatedit.tolerances import OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
+
+
+@dataclass(frozen=True)
+class CloudQuality:
+    """Counts over one cloud.
+
+    Attributes:
+        outliers: the :class:`~splatedit.model.outliers.OutlierFlags` of the positions.
+        boundary: (n,) bool, splats on an open border (mesh: vertices of an
+            edge used by one face; point cloud: neighbours leave an angular
+            gap wider than ``BOUNDARY_GAP_DEG``).
+        radius_max_rel_median: the largest splat radius over the median radius.
+    """
+
+    outliers: OutlierFlags
+    boundary: np.ndarray
+    radius_max_rel_median: float
+
+    @property
+    def boundary_count(self) -> int:
+        return int(self.boundary.sum())
+
+
+def assess(cloud: SplatCloud) -> CloudQuality:
+    """Outliers, boundary splats and the radius spread of ``cloud``."""
+    pts = cloud.positions
+    n = cloud.n
+    radii = cloud.radii
+    spread = float(radii.max() / np.median(radii))
+    if n < 3:
+        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread)
+    # one k-NN query serves the outlier test and the boundary test
+    dist, idx = knn(pts, max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1))
+    flags = detect_outliers(pts, distances=dist)
+    if cloud.faces is not None and len(cloud.faces):
+        boundary = mesh_boundary_vertices(n, cloud.faces)
+    else:
+        nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=idx)
+        boundary = boundary_points(pts, cloud.normals, nb)
+    return CloudQuality(flags, boundary, spread)
