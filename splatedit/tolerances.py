@@ -108,7 +108,7 @@ BAND_SLACK_REL = 1e-9
 #: a handle's control frame whose edge vectors (scaled to unit size) span a
 #: volume below this is degenerate (its 4 points are nearly coplanar)
 FRAME_MIN_DET_REL = 1e-12
-#: fixed-band splats closer than this many point spacings to a handle band are
+#: fixed-band splats closer than this many point spacings to a handle splat are
 #: conflicting constraints (the displacement would jump from the handle's to 0
 #: within two sample spacings): they are left out of the fit and reported.
 #: Closure's handle margin (at least BAND_RINGS spacings) keeps closed

@@ -171,14 +171,16 @@ def set_target(sel: Selection, target: str, mask: np.ndarray) -> bool:
     return changed
 
 
-def apply_closure(sel: Selection, cloud, graph) -> np.ndarray:
+def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = None) -> np.ndarray:
     """Close ``sel`` in place (support and every handle, see
-    :func:`~splatedit.select.closure.close_selection`); returns the (n,) bool
-    mask of the splats closure added to the support or a handle."""
+    :func:`~splatedit.select.closure.close_selection`; ``changed``: the splats
+    painted or erased since the last closure, so only their neighbourhood is
+    worked on); returns the (n,) bool mask of the splats closure added to the
+    support or a handle."""
     from splatedit.select.closure import close_selection
     if not sel.support.any():
         return np.zeros(sel.n, bool)
-    res = close_selection(cloud, sel.support, list(sel.handles), graph=graph)
+    res = close_selection(cloud, sel.support, list(sel.handles), graph=graph, changed=changed)
     support = np.asarray(res.support, bool)
     handles = [np.asarray(h, bool) for h in res.handles]
     before = [sel.support] + list(sel.handles)
@@ -244,6 +246,9 @@ class SelectionTools:
         self.highlight_until = 0.0
         self.last_added = 0
         self.closure_pending = False                 # a selection changed while no graph was ready
+        #: (cloud, support, handles) right after the last closure: the next one
+        #: closes only around what changed since (cost follows the stroke)
+        self._last_closed = None
         self._failed = None                          # the cloud whose graph failed (not retried)
 
     # ------------------------------------------------------------ graph
@@ -318,7 +323,15 @@ class SelectionTools:
         if g is None:
             self.closure_pending = True
             return None
-        added = apply_closure(session.selection, session.cloud, g)
+        sel = session.selection
+        changed = None
+        last = self._last_closed
+        if last is not None and last[0] is session.cloud and len(last[2]) == len(sel.handles):
+            changed = last[1] ^ sel.support
+            for before, now in zip(last[2], sel.handles):
+                changed |= before ^ now
+        added = apply_closure(sel, session.cloud, g, changed)
+        self._last_closed = (session.cloud, sel.support.copy(), [h.copy() for h in sel.handles])
         self.closure_pending = False
         self.last_added = int(added.sum())
         if self.last_added:

@@ -158,15 +158,15 @@ class ConstraintGroup:
 
 @dataclass(frozen=True)
 class Conflict:
-    """Fixed splats that lay too close to a handle's band and were left out of
-    the fit (two different displacements almost at one place make an
-    ill-conditioned, tearing fit).
+    """Fixed splats that lay too close to a handle and were left out of the fit
+    (two different displacements almost at one place: an ill-conditioned fit
+    next to the handle's band, a tear anywhere).
 
     Attributes:
-        handle: index of the handle (group) whose band they touch.
+        handle: index of the handle (group) they touch.
         fixed_index: (c,) cloud indices of the dropped fixed-band splats.
         center: (3,) centroid of those splats (model units), to say where.
-        min_distance: smallest fixed-to-handle-band distance (model units).
+        min_distance: smallest fixed-to-handle distance (model units).
     """
     handle: int
     fixed_index: np.ndarray
@@ -202,7 +202,7 @@ class Constraints:
         support_index: (N,) sorted cloud indices of the support.
         free_index: (N_free,) sorted cloud indices of support minus handles.
         n_points: number of splats of the cloud the masks refer to.
-        conflicts: fixed-band splats dropped next to handle bands (see
+        conflicts: fixed-band splats dropped next to handles (see
             :class:`Conflict`), one entry per handle that had any.
     """
 
@@ -425,14 +425,15 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
                                       controls=frame, band_index=band, member_index=hidx))
 
     # conflicts: fixed-band splats within CONFLICT_RINGS spacings of a handle
-    # band get a different displacement almost at the same place: drop them
+    # splat get a different displacement almost at the same place (next to
+    # its band: an ill-conditioned fit; anywhere: a tear): drop and report them
     conflicts = []
     conflict_width = CONFLICT_RINGS * h * (1.0 + BAND_SLACK_REL)
     for i, g in enumerate(groups):
         if len(fixed_index) == 0:
             break
-        d, _ = cKDTree(g.points).query(pos[fixed_index], k=1, distance_upper_bound=conflict_width,
-                                       workers=-1)
+        d, _ = cKDTree(pos[g.member_index]).query(pos[fixed_index], k=1,
+                                                  distance_upper_bound=conflict_width, workers=-1)
         bad = np.isfinite(d)
         if bad.any():
             idx = fixed_index[bad]
