@@ -203,17 +203,15 @@ def _facing_back(cloud, front_tree: cKDTree, p_front: np.ndarray, n_front: np.nd
     d, j = front_tree.query(pos[cand], k=kk, distance_upper_bound=t, workers=_workers(len(cand)))
     d, j = d.reshape(len(cand), kk), j.reshape(len(cand), kk)
     n_cand = _unit_normals(cloud, cand)
-    keep = np.zeros(len(cand), bool)
-    for col in range(kk):
-        hit = np.flatnonzero(np.isfinite(d[:, col]) & ~keep)
-        if len(hit) == 0:
-            break
-        s = j[hit, col]
-        off = pos[cand[hit]] - p_front[s]
-        cone = CLOSURE_BACK_CONE_COS * np.linalg.norm(off, axis=1)
-        keep[hit] = ((np.einsum("ij,ij->i", n_cand[hit], n_front[s]) < -CLOSURE_OPPOSITE_COS)
-                     & (np.einsum("ij,ij->i", off, n_front[s]) < -cone)
-                     & (np.einsum("ij,ij->i", off, n_cand[hit]) > cone))
+    valid = np.isfinite(d)                                       # (c, kk)
+    jj = np.where(valid, j, 0)
+    off = pos[cand][:, None, :] - p_front[jj]                    # (c, kk, 3)
+    nf = n_front[jj]
+    cone = CLOSURE_BACK_CONE_COS * np.linalg.norm(off, axis=2)
+    ok = (valid & (np.einsum("ckx,cx->ck", nf, n_cand) < -CLOSURE_OPPOSITE_COS)
+          & (np.einsum("ckx,ckx->ck", off, nf) < -cone)
+          & (np.einsum("ckx,cx->ck", off, n_cand) > cone))
+    keep = ok.any(axis=1)
     return keep
 
 
