@@ -57,7 +57,7 @@ def accuracy_cases(large: bool = False):
             h2 = np.linalg.norm(xy + [0.4, 0.0], axis=1) <= 0.15
             yield f"plane{n}-2handles", plane, rad <= 0.8, [h1, h2]
     if large:
-        for n in (700, 1100, 1580):
+        for n in (700, 1100, 1570):
             plane = wavy_plane_cloud(n)
             xy = plane.positions[:, :2]
             sup = np.max(np.abs(xy), axis=1) <= 0.91
@@ -90,15 +90,20 @@ def bench_accuracy(cloud, support, handles, *, name: str, tols=TOLS) -> dict:
         out["iqr"].append(dict(tol=tol, centers=int(f.n_centers), seconds=round(dt, 3),
                                residual=f.residual, max_rel=float(err.max() / hmax),
                                mean_rel=float(err.mean() / hmax)))
+        print(json.dumps(dict(name=name, m=int(m), **out["iqr"][-1])), file=sys.stderr, flush=True)
     return out
 
 
 def main(argv=None) -> int:
+    """``[--large] [--only NAME ...] [--tols T,T,...]``: one JSON line per case."""
     args = sys.argv[1:] if argv is None else argv
+    tols = TOLS
+    if "--tols" in args:
+        tols = tuple(float(x) for x in args[args.index("--tols") + 1].split(","))
     for name, cloud, sup, hs in accuracy_cases(large="--large" in args):
         if "--only" in args and name not in args:
             continue
-        print(json.dumps(bench_accuracy(cloud, sup, hs, name=name)), flush=True)
+        print(json.dumps(bench_accuracy(cloud, sup, hs, name=name, tols=tols)), flush=True)
     return 0
 
 

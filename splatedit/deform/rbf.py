@@ -555,8 +555,8 @@ class TriharmonicRBF:
         limit = max(self.tol if self.method == "iqr" else 0.0, RESIDUAL_NOTE_MIN) * RESIDUAL_NOTE_FACTOR
         if self.residual > limit:
             self.notes.append(
-                f"the fitted field misses its constraints by {self.residual:.2g} relative, "
-                f"far more than the solver's {self.solver_residual:.2g}: the system is "
+                f"the fitted field misses its constraints by {self.residual:.2g} relative "
+                f"(the solver's own figure: {self.solver_residual:.2g}): the system is "
                 "ill-conditioned (near-duplicate constraint points with different values?)")
 
     # -- evaluation --------------------------------------------------------

@@ -224,13 +224,13 @@ def test_curve_entirely_in_the_fixed_band_is_an_error(plane):
 def test_curve_edit_matches_exact_solve_and_scipy(curve_edit):
     cloud, sup, curve, lu = curve_edit
     con = lu.constraints
-    iqr = DeformationBasis.fit(cloud, sup, curves=[curve], method="iqr", tol=1e-7)
+    iqr = DeformationBasis.fit(cloud, sup, curves=[curve], method="iqr")
     dq = np.random.default_rng(1).normal(scale=0.05, size=(curve.n_controls, 3))
     dc = lu.displacement([curve.control_displacement(dq)])
     rows = free_rows(lu)
     scale_ = np.abs(con.values @ dc).max()
     err = np.linalg.norm(lu.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
-    assert err.max() / scale_ < 0.01
+    assert err.max() / scale_ < 0.005
     oracle = RBFInterpolator(con.points, con.values @ dc, kernel="cubic", degree=2)
     theirs = oracle(cloud.positions[lu.indices[rows]])
     assert np.abs(lu.displacements(dc)[rows] - theirs).max() / scale_ < 1e-8
@@ -319,10 +319,10 @@ def test_curve_and_handle_in_one_edit(plane):
     with pytest.raises(ParameterError, match="one matrix per handle"):
         b.displacement([t])
     # IQR on the combined edit matches the exact solve
-    iqr = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="iqr", tol=1e-7)
+    iqr = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="iqr")
     rows = free_rows(b)
     err = np.linalg.norm(b.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
-    assert err.max() / np.abs(b.constraints.values @ dc).max() < 0.01
+    assert err.max() / np.abs(b.constraints.values @ dc).max() < 0.005
     assert b.stats["n_curve_samples"] == [len(g.points)]
 
 
