@@ -54,7 +54,7 @@ TEXT_BLOCK_BYTES = 1 << 24
 
 # --- RBF fitting --------------------------------------------------------
 #: the paper's relative L2 tolerance for the incremental QR (Sect. 5 and 8)
-IQR_DEFAULT_TOL = 3e-5
+IQR_DEFAULT_TOL = 1e-5
 #: method="auto" uses the exact dense solve up to this many constraints
 AUTO_EXACT_MAX_CONSTRAINTS = 3000
 #: columns per blocked Householder panel in the incremental QR
