@@ -53,7 +53,13 @@ MESH_NORMAL_MIN_REL = 1e-12
 TEXT_BLOCK_BYTES = 1 << 24
 
 # --- RBF fitting --------------------------------------------------------
-#: the paper's relative L2 tolerance for the incremental QR (Sect. 5 and 8)
+#: the incremental QR stops at ||r|| / ||b|| below this (per column, 2-norms
+#: over the constraints; scale-free, unlike the paper's ||r|| / (m ||b||) at
+#: 1e-7, which was 2.4-4% off the exact deformation at m = 4,000-6,000).
+#: Measured (splatedit.bench.accuracy; largest free-splat deviation from the
+#: exact LU deformation / handle displacement): 1e-5 gives 0.003-0.04% at
+#: m = 650-5,800 and 0.26% at m = 19,976; 3e-5 gives up to 0.28% at 4,228 but
+#: 1.1% at 19,976; 1e-4 1.2% at 4,228 and 4.3% at 19,976 (docs/PERFORMANCE.md)
 IQR_DEFAULT_TOL = 1e-5
 #: method="auto" uses the exact dense solve up to this many constraints
 AUTO_EXACT_MAX_CONSTRAINTS = 3000

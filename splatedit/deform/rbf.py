@@ -428,10 +428,11 @@ class TriharmonicRBF:
             starts to win: measured here (2 cores, OpenBLAS, incl. building
             the matrix) the LU fit takes 0.03-0.1 s at m=1000, 0.4 s at
             m=3000 (1.3 s with the machine loaded) and 1.6-2.5 s at m=5000,
-            growing as m^3; IQR at tol=1e-7 on surface-like constraints
-            needed 585-800 centers and 0.05-0.27 s at m=1000-5000, O(m n^2).
-            Below ~3000 the exact answer costs under half a second, so it
-            is preferred; above it LU's m^3 dominates.
+            growing as m^3; IQR costs O(m n^2) for n centres, and at the
+            default tol needs 60-97% of the constraints as centres on
+            realistic edits (docs/PERFORMANCE.md).  Below ~3000 the exact
+            answer costs under half a second, so it is preferred; above it
+            LU's m^3 and (m + 10)^2 memory dominate.
         tol : the relative residual ``||Ax - b|| / ||b||`` (per column,
             2-norms over the constraint rows) at which IQR stops (default
             IQR_DEFAULT_TOL).  Unlike the paper's ``/(m ||b||)`` it does not
