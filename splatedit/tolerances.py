@@ -238,7 +238,7 @@ EDITOR_AXIS_MIN_SCREEN_LEN = 1e-6
 #: inside out)
 EDITOR_MIN_SCALE_FACTOR = 1e-3
 
-# --- honest IQR residual and control-curve weights (issue 8, parts 6-7) ----
+# --- honest IQR residual (issue 8, part 7) -------------------------------
 #: a fit whose achieved residual ||f(x_i) - b_i|| / ||b|| exceeds
 #: RESIDUAL_NOTE_FACTOR * max(tol (IQR) or 0 (LU), RESIDUAL_NOTE_MIN) gets a
 #: note that the system is ill-conditioned.  Measured (splatedit.bench.accuracy):

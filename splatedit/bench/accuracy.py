@@ -66,8 +66,9 @@ def accuracy_cases(large: bool = False):
             yield f"plane{n}-square-2handles", plane, sup, [h1, h2]
 
 
-def bench_accuracy(cloud, support, handles, *, name: str, tols=TOLS) -> dict:
-    """One case (see the module docstring); a JSON-ready dict."""
+def bench_accuracy(cloud, support, handles, *, name: str, tols=TOLS, log=None) -> dict:
+    """One case (see the module docstring); a JSON-ready dict.  ``log``: an
+    optional callable given one dict per tolerance as it is measured."""
     con = build_constraints(cloud, support, handles)
     m = con.n_constraints
     pos = cloud.positions
@@ -90,7 +91,8 @@ def bench_accuracy(cloud, support, handles, *, name: str, tols=TOLS) -> dict:
         out["iqr"].append(dict(tol=tol, centers=int(f.n_centers), seconds=round(dt, 3),
                                residual=f.residual, max_rel=float(err.max() / hmax),
                                mean_rel=float(err.mean() / hmax)))
-        print(json.dumps(dict(name=name, m=int(m), **out["iqr"][-1])), file=sys.stderr, flush=True)
+        if log is not None:
+            log(dict(name=name, m=int(m), **out["iqr"][-1]))
     return out
 
 
@@ -103,7 +105,9 @@ def main(argv=None) -> int:
     for name, cloud, sup, hs in accuracy_cases(large="--large" in args):
         if "--only" in args and name not in args:
             continue
-        print(json.dumps(bench_accuracy(cloud, sup, hs, name=name, tols=tols)), flush=True)
+        line = bench_accuracy(cloud, sup, hs, name=name, tols=tols,
+                              log=lambda d: print(json.dumps(d), file=sys.stderr, flush=True))
+        print(json.dumps(line), flush=True)
     return 0
 
 
