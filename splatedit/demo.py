@@ -17,7 +17,7 @@ from splatedit.script import parse_script
 #: (bounding box about [-0.5, 0.5]^3, y up).
 DEMO_SCRIPT = {
     "version": 1,
-    "solver": {"method": "auto", "tol": 1e-7},
+    "solver": {"method": "auto"},
     "edits": [
         {   # bend the tall ear backwards about its base
             "support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},

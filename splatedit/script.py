@@ -25,11 +25,11 @@ Format (version 1)::
 
 An edit needs at least one handle or curve: exactly one of ``handle`` /
 ``handles`` (with ``transform`` / ``transforms``), and/or ``curves``.  A curve
-is the interpolating spline through its ``points`` (cubic from 4 points on,
-quadratic through 3, a segment through 2; see splatedit.deform.curves); the
-edit moves the *picked points* by ``move`` and the spline follows (its
-control points move by ``A^-1 move``), so the moved curve passes through
-``points + move``.  The curve need not lie on the surface; only its samples
+is the centripetal Catmull-Rom curve through its ``points`` (no overshoot; a
+segment through 2; see splatedit.deform.curves); the edit moves the *picked
+points* by ``move`` and every curve sample by a non-negative, smooth blend of
+the moves of the two picked points around it, so the moved curve passes
+through ``points + move`` and no part of it moves against the drags.  The curve need not lie on the surface; only its samples
 over the free part of the support constrain the edit.  Curves take the
 column blocks after the handles.
 

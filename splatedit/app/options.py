@@ -49,7 +49,7 @@ Deformation (the basis of all handles and the curve is fitted in the background;
     Esc                  discard the pending moves
 Control curve (paper Sect. 3 end, Fig. 3 and 7)
   K                      curve tool on / off (Shift+K: clear the curve)
-  Left click on support  add a curve point (2..16); the spline through them is drawn
+  Left click on support  add a curve point (2..16); the curve through them is drawn as it will act
   Left drag on a dot     move that point in the view plane (X / Y / Z: along an axis)
   Backspace              remove the last curve point
   Enter / Esc            apply the bent curve as an edit (the curve is consumed) / discard moves

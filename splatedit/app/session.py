@@ -11,8 +11,8 @@ States::
 
 The *rig* of an edit (paper Sect. 3 and 6 end): one support, one or more
 disjoint handles (one active, moved by the manipulator) and optionally one
-non-rigid control curve (2..16 picked points, an interpolating B-spline
-through them, :class:`~splatedit.deform.curves.ControlCurve`).  One basis is
+non-rigid control curve (2..16 picked points, a centripetal Catmull-Rom
+curve through them, :class:`~splatedit.deform.curves.ControlCurve`).  One basis is
 fitted for all of them at once: 4 columns per non-empty handle, k + 1 for
 the curve, at most ``RENDER_MAX_BASIS_COLUMNS`` (16) in total.  The *pose*
 is a pending matrix per handle plus a pending displacement per picked curve
@@ -443,12 +443,15 @@ class Session:
         return np.array(self.curve_points) + self.live_curve_moves(live)
 
     def curve_polyline(self, count: int = 160, live: bool = True) -> np.ndarray | None:
-        """Points of the moved curve c'(t) for drawing (None below 2 points)."""
+        """(>= count, 3) points of the moved curve ``c'(t) = c(t) + W(t) dq``
+        for drawing: exactly the targets the fitted deformation gives the
+        curve's samples (through every moved picked point; None below 2
+        points)."""
         c = self.curve()
         if c is None:
             return None
-        t = np.linspace(0.0, 1.0, count)
-        return c.evaluate(t, c.controls + c.control_displacement(self.live_curve_moves(live)))
+        t = np.union1d(np.linspace(0.0, 1.0, count), c.params)
+        return c.evaluate(t, c.points + self.live_curve_moves(live))
 
     # --------------------------------------------------------------- fitting
     def selection_key(self):
@@ -579,7 +582,7 @@ class Session:
         hidx, curve = self.basis_groups
         out = [self.handle_matrix(k, live) for k in hidx]
         if curve is not None:
-            out.append(curve.control_displacement(self.live_curve_moves(live)))
+            out.append(self.live_curve_moves(live))  # the curve's controls are its picked points
         return out
 
     def reset_pose(self) -> bool:

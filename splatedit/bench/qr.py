@@ -122,7 +122,7 @@ def bench_qr(m: int, seed: int = 0, naive_max: int = 1000, repeat: int = 1) -> d
     probe = surface_points(200, seed + 1) * 0.9
     rel_diff = float(np.max(np.abs(f_iqr(probe) - f_lu(probe))) / np.max(np.abs(f_lu(probe))))
     t_iqr_tol, f_tol = _best_of(
-        lambda: TriharmonicRBF.fit(pts, values, method="iqr", tol=1e-7), repeat)
+        lambda: TriharmonicRBF.fit(pts, values, method="iqr"), repeat)  # default tol
 
     m_naive = min(m, naive_max)
     if m_naive == m:
@@ -151,8 +151,10 @@ def bench_qr(m: int, seed: int = 0, naive_max: int = 1000, repeat: int = 1) -> d
         "ratio_iqr_vs_qr_r": round(t_iqr / t_r, 3),
         "r_diag_rel_err": r_err,
         "iqr_full_vs_lu_rel": rel_diff,
-        "iqr_tol1e-7_s": round(t_iqr_tol, 4),
-        "iqr_tol1e-7_centers": f_tol.n_centers,
+        "iqr_default_tol": f_tol.tol,
+        "iqr_default_tol_s": round(t_iqr_tol, 4),
+        "iqr_default_tol_centers": f_tol.n_centers,
+        "iqr_default_tol_residual": f_tol.residual,
     }
 
 

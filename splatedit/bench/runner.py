@@ -59,7 +59,16 @@ def _closure(quick: bool, progress=None) -> Iterator[dict]:
                              repeats=2 if quick else 3)
 
 
-BENCHES = {"solve": _solve, "closure": _closure, "groups": _groups, "qr": _qr, "render": _render, "editor": _editor}
+def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.accuracy import accuracy_cases, bench_accuracy
+    for name, cloud, support, handles in accuracy_cases(large=False):
+        if quick and cloud.n > 100_000:
+            continue
+        yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
+
+
+BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
+           "render": _render, "editor": _editor}
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:

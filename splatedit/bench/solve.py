@@ -4,7 +4,7 @@
 
 * constraints m and support size N (and the constraint-building time),
 * exact LU fit (centers = m) and its basis precompute (positions + Jacobians),
-* incremental QR fit (tol 1e-7) with its center count and basis precompute,
+* incremental QR fit (default tol) with its center count and basis precompute,
 * the max deviation of the IQR deformation from the LU one on the free splats
   for a sample handle transform, relative to the handle's displacement,
 * the CPU per-frame ``apply`` vs a plain numpy copy of the same bytes (the

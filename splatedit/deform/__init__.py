@@ -9,8 +9,8 @@ from splatedit.deform import transform
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.centers import farthest_point_order
 from splatedit.deform.constraints import Constraints, ConstraintGroup, build_constraints
-from splatedit.deform.curves import ControlCurve, bspline_basis
+from splatedit.deform.curves import ControlCurve
 from splatedit.deform.rbf import TriharmonicRBF
 
 __all__ = ["ConstraintGroup", "Constraints", "ControlCurve", "DeformationBasis", "TriharmonicRBF",
-           "bspline_basis", "build_constraints", "farthest_point_order", "transform"]
+           "build_constraints", "farthest_point_order", "transform"]

@@ -2,8 +2,8 @@
 
 One :class:`TriharmonicRBF` is fitted with all K columns of the affine
 weights ``M`` as right-hand sides at once (fixed band: 0): 4 per rigid handle
-(its frame's affine coordinates), k + 1 per control curve (the B-spline
-weights of its samples, paper Sect. 6 end), in the block layout of the
+(its frame's affine coordinates), k + 1 per control curve (the non-negative
+displacement weights of its samples, paper Sect. 6 end), in the block layout of the
 constraint groups (handles first, then curves).  Evaluating it and its
 gradient at every support splat gives the (N, K) bases with which, for
 control-point displacements ``dC`` (K, 3):
@@ -341,9 +341,8 @@ class DeformationBasis:
 
         * handle: a (4, 4) affine map ``m`` (or (3, 4)); ``dC = m(C) - C`` for
           its control frame C;
-        * curve: a (k + 1, 3) array of B-spline control-point displacements
-          ``db`` (use ``ControlCurve.control_displacement(dq)`` to move the
-          picked points by ``dq`` instead);
+        * curve: a (k + 1, 3) array ``dq`` of picked-point displacements
+          (the curve's controls are its picked points);
         * None: the group does not move.
 
         A single 2-D array is accepted when there is one group.

@@ -23,11 +23,14 @@ of ``M`` (paper Sect. 6): ``values`` is (m, 4h), one 4-column block per
 handle, zero in other handles' blocks and in the fixed band.
 
 Constraint groups.  A handle is one *group*: a set of constraint points, a
-(p, k) matrix of weight rows and k control points whose affine combination
-(weights) gives the points.  A rigid handle has k = 4 (its affine frame).
-A non-rigid **control curve** (paper Sect. 3 end and Sect. 6 end; see
-:mod:`splatedit.deform.curves`) is a group of curve samples ``c(t_i)`` with
-B-spline weights ``N_j(t_i)`` (p, k + 1) and its k + 1 spline control points.
+(p, k) matrix of affine weight rows (each sums to 1) and k control points; a
+move ``dC`` (k, 3) of the controls displaces point i by ``weights[i] @ dC``.
+A rigid handle has k = 4 (its affine frame, and ``points == weights @
+controls``).  A non-rigid **control curve** (paper Sect. 3 end and Sect. 6
+end; see :mod:`splatedit.deform.curves`) is a group of curve samples
+``c(t_i)`` with the non-negative displacement weights ``W(t_i)`` (p, k + 1)
+and its k + 1 picked points as controls (its samples lie on the Catmull-Rom
+shape, not at ``W @ q``).
 Groups are ordered handles first, then curves; their column blocks follow
 the same order.  The fixed band is not a group (its value is 0).
 
@@ -129,9 +132,11 @@ class ConstraintGroup:
         kind: ``"handle"`` (rigid control handle, k = 4) or ``"curve"``
             (control curve, k = its number of control points).
         points: (p, 3) constraint positions (model units).
-        weights: (p, k) rows of affine weights, ``points == weights @ controls``.
+        weights: (p, k) rows of affine weights (sum 1): a move ``dC`` (k, 3)
+            of the controls displaces ``points[i]`` by ``weights[i] @ dC``;
+            for a handle also ``points == weights @ controls``.
         controls: (k, 3) control points (the handle's frame C, or the curve's
-            B-spline control points b_j).
+            picked points q_j).
         band_index: (p,) cloud indices of the constraint points (the handle
             band), or None for samples that are not splats (curves).
         member_index: (q,) cloud indices of every splat that moves with the

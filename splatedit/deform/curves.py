@@ -1,54 +1,61 @@
 """Non-rigid control curves (paper Sect. 3 end, Sect. 6 end; Fig. 3 and 7).
 
-The user picks k + 1 >= 2 points ``q_0 .. q_k`` on or near the surface.  An
-interpolating B-spline ``c(t) = sum_j b_j N_j(t)``, ``t in [0, 1]``, is built
-through them; moving its control points ``b_j`` gives ``c'(t)``.  A dense
-sampling ``c(t_i)`` gives displacement constraints whose values are affine
-combinations of the control-point displacements, so the precomputed basis has
-k + 1 columns per curve and every frame is still ``p' = p + B dC``.
+The user picks k + 1 >= 2 points ``q_0 .. q_k`` on or near the surface and
+drags them.  Two things are built from them, deliberately separately:
 
-Construction (decisions):
+* the **shape** ``c(t)``, ``t in [0, 1]``: the centripetal Catmull-Rom spline
+  through the picked points (Barry-Goldman pyramid, knot intervals
+  ``|q_{j+1} - q_j|^(1/2)``; the end tangents come from reflected phantom
+  points ``2 q_0 - q_1`` and ``2 q_k - q_{k-1}``).  It is local (segment j
+  depends on ``q_{j-1} .. q_{j+2}``), C^1, and, unlike a global interpolating
+  cubic, does not overshoot: a curve picked from shoulder to hand does not
+  dip below its first point.  Two points give the straight segment.
+* the **displacement weights** ``W(t)`` (k + 1 per t): on segment j, with
+  ``s`` the fraction of the segment's knot interval, ``W_j = 1 - h(s)``,
+  ``W_{j+1} = h(s)``, all others 0, where ``h(s) = 6 s^5 - 15 s^4 + 10 s^3``
+  (quintic smoothstep).  They are non-negative, sum to 1 (affine), are 1 at
+  their own picked point and 0 at the others, and are C^2 (h' and h'' vanish
+  at the picked points).  A move ``dq`` (k + 1, 3) of the picked points
+  moves the curve to ``c'(t) = c(t) + W(t) dq``: it passes through
+  ``q_j + dq_j``, a common translation translates it, and dragging one
+  point moves every sample in the drag direction only (never backwards,
+  as the negative weights of an interpolating spline would).
 
-* **Degree** ``p = min(3, k)``: cubic from 4 points on, quadratic through 3
-  points, a straight segment through 2.
-* **Parameters** ``tbar_j``: chord length (cumulative distance between
-  consecutive picked points, scaled to [0, 1]).  Consecutive picked points
-  must be distinct.
-* **Knots**: clamped (``p + 1`` zeros and ones) with the interior knots the
-  averages of ``p`` consecutive parameters (de Boor's averaging), which makes
-  the interpolation matrix ``A[i, j] = N_j(tbar_i)`` square (k + 1 control
-  points for k + 1 picked points), banded and non-singular (Schoenberg-
-  Whitney).  For ``p = k`` this is the Bezier curve through the points.
-* **Control points** ``b = A^-1 q``.  The B-spline basis is a partition of
-  unity, so every row of ``A``, of ``A^-1`` and of the sample weights
-  ``N(t_i)`` sums to 1: samples are affine combinations of the control points
-  (weights ``N(t_i)`` >= 0) and also of the picked points
-  (``W = N(t_i) A^-1``).
-* **What moves**: the constraint group's controls are the B-spline control
-  points ``b_j`` (the paper's "moving its spline control points"; what the
-  editor drags).  Edit scripts move the *picked* points instead (friendlier:
-  the curve then passes through the moved points); :meth:`ControlCurve.
-  control_displacement` converts picked-point moves ``dq`` into control-point
-  moves ``db = A^-1 dq`` -- the same deformation either way.
-* **Sampling**: ``t_i`` equally spaced in arc length, both ends included;
-  ``n = ceil(length / spacing) + 1`` samples by default (spacing = the cloud's
-  point spacing), or an explicit count.  Samples are constraint points only,
-  not splats; the curve need not lie on the surface.
+Why not displace with the shape's own weights: Catmull-Rom (like any
+interpolating spline) gives the far points negative weights on a middle
+segment, so moving the tip up would pull part of the curve down.  A smooth
+non-negative interpolating partition of unity must have zero slope at the
+picked points (each weight is 1 = its maximum there and 0 = its minimum at
+the neighbours), so the moved curve keeps its original tangent direction at
+each picked point; that is the price of never moving backwards.
+
+Constraint group: the controls are the **picked points** themselves (the
+basis has k + 1 columns per curve and ``dC`` of a curve is ``dq``);
+:meth:`ControlCurve.control_displacement` is therefore the identity (kept
+for callers that convert picked-point moves).  The samples ``c(t_i)`` are
+constraint points whose displacement is ``W(t_i) dq``; note that
+``c(t_i) != W(t_i) q`` in general (the shape is not the weights' curve).
+
+Sampling: ``t_i`` equally spaced in arc length of ``c``, both ends included;
+``n = ceil(length / spacing) + 1`` samples by default (spacing = the cloud's
+point spacing), or an explicit count.  Samples are constraint points only,
+not splats; the curve need not lie on the surface.
 """
 
 from __future__ import annotations
 
 import math
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 
 import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.tolerances import CURVE_MIN_CHORD_REL
 
-#: highest spline degree (cubic)
-CURVE_DEGREE = 3
-#: polyline points per knot span used to measure arc length
+#: knot-interval exponent of the Catmull-Rom shape (0.5: centripetal, which
+#: has no cusps or self-intersections within a segment; 0 uniform, 1 chordal)
+CURVE_ALPHA = 0.5
+#: polyline points per segment used to measure arc length
 _ARC_POINTS_PER_SPAN = 64
 
 
@@ -66,35 +73,77 @@ def first_coincident_point(points) -> int | None:
     return int(small[0]) + 1 if len(small) else None
 
 
-def bspline_basis(t, knots, degree: int) -> np.ndarray:
-    """(len(t), len(knots) - degree - 1) values ``N_j^degree(t)`` of the
-    B-splines over ``knots`` (Cox-de Boor recursion, 0/0 := 0).
+def _segments(tau: np.ndarray, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """``(tt, seg, s)``: knot values ``tt = t * tau[-1]`` of the parameters
+    ``t`` (clamped into [0, 1]), their segment ``seg`` (0 .. k - 1) and the
+    fraction ``s`` (0 .. 1) of that segment's knot interval."""
+    tt = np.clip(np.atleast_1d(np.asarray(t, dtype=np.float64)), 0.0, 1.0) * tau[-1]
+    seg = np.clip(np.searchsorted(tau, tt, side="right") - 1, 0, len(tau) - 2)
+    s = (tt - tau[seg]) / (tau[seg + 1] - tau[seg])
+    return tt, seg, np.clip(s, 0.0, 1.0)
 
-    ``t`` outside [knots[degree], knots[-degree-1]] is clamped into the last
-    (or first) non-empty knot span, so ``t = 1`` of a clamped vector gives the
-    last basis function 1.
+
+def smoothstep5(s) -> np.ndarray:
+    """``6 s^5 - 15 s^4 + 10 s^3``: 0 -> 1 on [0, 1] with zero first and second
+    derivatives at both ends (the displacement weights' blend)."""
+    s = np.asarray(s, dtype=np.float64)
+    return s * s * s * (s * (6.0 * s - 15.0) + 10.0)
+
+
+def displacement_weights(tau: np.ndarray, t) -> np.ndarray:
+    """(len(t), k + 1) displacement weights ``W(t)`` over the knots ``tau``
+    (k + 1,) of the picked points (see the module docstring): non-negative,
+    rows sum to 1, ``W(t_j) = e_j``."""
+    _, seg, s = _segments(tau, t)
+    h = smoothstep5(s)
+    w = np.zeros((len(seg), len(tau)))
+    rows = np.arange(len(seg))
+    w[rows, seg] = 1.0 - h
+    w[rows, seg + 1] += h
+    return w
+
+
+def catmull_rom_weights(tau: np.ndarray, t) -> np.ndarray:
+    """(len(t), k + 1) weights ``S(t)`` of the centripetal Catmull-Rom shape:
+    ``c(t) = S(t) @ q`` (rows sum to 1; entries may be negative).
+
+    ``tau`` (k + 1,) are the knots of the picked points; the phantom points
+    ``2 q_0 - q_1`` and ``2 q_k - q_{k-1}`` (knot intervals copied from the
+    first / last segment) are folded into the real points' weights.
     """
-    u = np.asarray(knots, dtype=np.float64)
-    tt = np.atleast_1d(np.asarray(t, dtype=np.float64))
-    n_span = len(u) - 1
-    nonempty = np.flatnonzero(u[1:] > u[:-1])
-    if len(nonempty) == 0:
-        raise ParameterError("knots", "all knots coincide")
-    span = np.searchsorted(u, tt, side="right") - 1
-    span = np.clip(span, nonempty[0], nonempty[-1])
-    n = np.zeros((len(tt), n_span))
-    n[np.arange(len(tt)), span] = 1.0
-    for d in range(1, degree + 1):
-        nxt = np.zeros((len(tt), n_span - d))
-        for j in range(n_span - d):
-            left = u[j + d] - u[j]
-            right = u[j + d + 1] - u[j + 1]
-            if left > 0.0:
-                nxt[:, j] += (tt - u[j]) / left * n[:, j]
-            if right > 0.0:
-                nxt[:, j] += (u[j + d + 1] - tt) / right * n[:, j + 1]
-        n = nxt
-    return n
+    k = len(tau) - 1
+    tt, seg, _ = _segments(tau, t)
+    # knots of the four pyramid points of each segment, phantoms included
+    ext = np.concatenate([[tau[0] - (tau[1] - tau[0])], tau, [tau[-1] + (tau[-1] - tau[-2])]])
+    t0, t1, t2, t3 = (ext[seg + i] for i in range(4))
+
+    def lerp(ta, tb):  # weights (n, 2) of the two points at knots ta, tb
+        f = (tt - ta) / (tb - ta)
+        return np.column_stack([1.0 - f, f])
+
+    a1, a2, a3 = lerp(t0, t1), lerp(t1, t2), lerp(t2, t3)
+    b1, b2, c = lerp(t0, t2), lerp(t1, t3), lerp(t1, t2)
+    # Barry-Goldman pyramid, as weights on the four points P0..P3
+    n = len(tt)
+    A1 = np.zeros((n, 4)); A1[:, 0:2] = a1
+    A2 = np.zeros((n, 4)); A2[:, 1:3] = a2
+    A3 = np.zeros((n, 4)); A3[:, 2:4] = a3
+    B1 = b1[:, :1] * A1 + b1[:, 1:] * A2
+    B2 = b2[:, :1] * A2 + b2[:, 1:] * A3
+    p4 = c[:, :1] * B1 + c[:, 1:] * B2
+    # P_i = q_{seg - 1 + i}, with the phantoms expressed in real points
+    w = np.zeros((n, k + 1))
+    rows = np.arange(n)
+    for i in range(4):
+        j = seg - 1 + i
+        low, high = j < 0, j > k
+        mid = ~(low | high)
+        np.add.at(w, (rows[mid], j[mid]), p4[mid, i])
+        np.add.at(w, (rows[low], 0), 2.0 * p4[low, i])        # 2 q_0 - q_1
+        np.add.at(w, (rows[low], 1), -p4[low, i])
+        np.add.at(w, (rows[high], k), 2.0 * p4[high, i])      # 2 q_k - q_{k-1}
+        np.add.at(w, (rows[high], k - 1), -p4[high, i])
+    return w
 
 
 def _points(name: str, value) -> np.ndarray:
@@ -114,32 +163,25 @@ def _points(name: str, value) -> np.ndarray:
 
 @dataclass(frozen=True, eq=False)
 class ControlCurve:
-    """An interpolating B-spline through picked points (see module docstring).
+    """A control curve through picked points (see the module docstring).
 
     Build with :meth:`through`.  Attributes:
-        points: (k + 1, 3) picked (interpolation) points ``q_j``.
-        degree: ``min(3, k)``.
-        params: (k + 1,) chord-length parameters ``tbar_j`` (0 .. 1).
-        knots: (k + degree + 2,) clamped knot vector.
-        controls: (k + 1, 3) B-spline control points ``b_j``.
-        interpolation: (k + 1, k + 1) ``A[i, j] = N_j(tbar_i)``.
+        points: (k + 1, 3) picked points ``q_j`` (model units); also the
+            curve group's control points.
+        params: (k + 1,) parameters ``t_j`` of the picked points in [0, 1]
+            (centripetal knots ``sum |q_{i+1} - q_i|^(1/2)``, normalised).
         samples: number of constraint samples, or None for one per point
             spacing of the cloud (decided when the constraints are built).
     """
 
     points: np.ndarray
-    degree: int
     params: np.ndarray
-    knots: np.ndarray
-    controls: np.ndarray
-    interpolation: np.ndarray
     samples: int | None = None
-    _inverse: np.ndarray = field(default=None, repr=False)
 
     # ------------------------------------------------------------ building
     @classmethod
     def through(cls, points, *, samples: int | None = None) -> "ControlCurve":
-        """The interpolating spline through ``points`` (k + 1, 3), k >= 1.
+        """The curve through ``points`` (k + 1, 3), k >= 1.
 
         Raises:
             ParameterError: fewer than 2 points, non-finite values, two
@@ -150,38 +192,43 @@ class ControlCurve:
             if isinstance(samples, bool) or not isinstance(samples, (int, np.integer)) or samples < 2:
                 raise ParameterError("samples", f"must be an integer >= 2 or None, got {samples!r}")
             samples = int(samples)
-        k = len(q) - 1
         j = first_coincident_point(q)
         if j is not None:
             raise ParameterError("points", f"points {j - 1} and {j} coincide; consecutive "
                                  "curve points must be distinct")
-        chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
-        params = np.concatenate([[0.0], np.cumsum(chords)]) / chords.sum()
+        steps = np.linalg.norm(np.diff(q, axis=0), axis=1) ** CURVE_ALPHA
+        params = np.concatenate([[0.0], np.cumsum(steps)]) / steps.sum()
         params[-1] = 1.0
-        p = min(CURVE_DEGREE, k)
-        interior = [params[j:j + p].mean() for j in range(1, k - p + 1)]
-        knots = np.concatenate([np.zeros(p + 1), interior, np.ones(p + 1)])
-        a = bspline_basis(params, knots, p)
-        inv = np.linalg.inv(a)
-        controls = inv @ q
-        return cls(points=q, degree=p, params=params, knots=knots, controls=controls,
-                   interpolation=a, samples=samples, _inverse=inv)
+        return cls(points=q, params=params, samples=samples)
 
     # ----------------------------------------------------------- accessors
     @property
     def n_controls(self) -> int:
         """k + 1: the number of control points (= picked points = columns)."""
-        return len(self.controls)
+        return len(self.points)
+
+    @property
+    def controls(self) -> np.ndarray:
+        """(k + 1, 3) the group's control points: the picked points."""
+        return self.points
+
+    def shape_weights(self, t) -> np.ndarray:
+        """(len(t), k + 1) Catmull-Rom weights: ``c(t) = shape_weights(t) @ points``."""
+        return catmull_rom_weights(self.params, t)
 
     def basis(self, t) -> np.ndarray:
-        """(len(t), k + 1) B-spline weights ``N_j(t)``; rows sum to 1."""
-        return bspline_basis(t, self.knots, self.degree)
+        """(len(t), k + 1) displacement weights ``W(t)`` (>= 0, rows sum to 1)."""
+        return displacement_weights(self.params, t)
 
     def evaluate(self, t, controls=None) -> np.ndarray:
-        """Curve points ``c(t)`` (len(t), 3); with ``controls`` (k + 1, 3) the
-        moved curve ``c'(t)`` (e.g. ``curve.controls + db``)."""
-        b = self.controls if controls is None else self._check_moves("controls", controls)
-        return self.basis(t) @ b
+        """Curve points ``c(t)`` (len(t), 3); with ``controls`` (k + 1, 3), the
+        moved picked points ``q + dq``, the moved curve
+        ``c'(t) = c(t) + W(t) dq`` -- exactly the targets the deformation
+        gives its samples (what the editor draws)."""
+        c = self.shape_weights(t) @ self.points
+        if controls is None:
+            return c
+        return c + self.basis(t) @ (self._check_moves("controls", controls) - self.points)
 
     def _check_moves(self, name: str, value) -> np.ndarray:
         d = np.asarray(value, dtype=np.float64)
@@ -192,18 +239,21 @@ class ControlCurve:
         return d
 
     def control_displacement(self, point_moves) -> np.ndarray:
-        """Control-point displacements ``db = A^-1 dq`` (k + 1, 3) that move the
-        picked points by ``point_moves`` ``dq`` (k + 1, 3)."""
-        return self._inverse @ self._check_moves("point_moves", point_moves)
+        """Control-point displacements (k + 1, 3) that move the picked points
+        by ``point_moves`` (k + 1, 3): the same array (checked, copied), since
+        the controls are the picked points."""
+        return self._check_moves("point_moves", point_moves).copy()
 
     def length(self) -> float:
-        """Arc length (polyline with 64 points per knot span)."""
+        """Arc length (polyline with 64 points per segment)."""
         _, s = self._arc_table()
         return float(s[-1])
 
     def _arc_table(self):
-        spans = max(1, len(self.knots) - 2 * self.degree - 1)
-        t = np.linspace(0.0, 1.0, spans * _ARC_POINTS_PER_SPAN + 1)
+        k = self.n_controls - 1
+        f = np.linspace(0.0, 1.0, _ARC_POINTS_PER_SPAN + 1)[:-1]
+        p = self.params
+        t = np.concatenate([p[j] + f * (p[j + 1] - p[j]) for j in range(k)] + [[1.0]])
         c = self.evaluate(t)
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
         return t, s
@@ -227,14 +277,13 @@ class ControlCurve:
 
     def sample(self, spacing: float | None = None, count: int | None = None):
         """``(t, weights, points)``: parameters (see :meth:`sample_parameters`),
-        weights ``N(t_i)`` (p, k + 1) and points ``weights @ controls`` (p, 3)."""
+        displacement weights ``W(t_i)`` (p, k + 1) and the points ``c(t_i)``
+        (p, 3)."""
         t = self.sample_parameters(spacing, count)
-        w = self.basis(t)
-        return t, w, w @ self.controls
+        return t, self.basis(t), self.evaluate(t)
 
     def __repr__(self) -> str:
-        return (f"ControlCurve(points={self.n_controls}, degree={self.degree}, "
-                f"samples={self.samples})")
+        return f"ControlCurve(points={self.n_controls}, samples={self.samples})"
 
 
 def as_curve(value, name: str = "curve") -> ControlCurve:

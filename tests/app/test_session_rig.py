@@ -183,3 +183,33 @@ def test_column_budget(session):
     with pytest.raises(SplatEditError, match="at most 16"):
         s.add_curve_point([0.7, 0.0, 0.0])
     assert s.wait_fit() and s.basis.n_columns == 16
+
+
+def test_drawn_curve_is_the_curve_the_fit_uses(session):
+    """The editor draws c'(t) = c(t) + W(t) dq: before and after dragging the
+    tip up, the drawn polyline passes through the (moved) picked points, and
+    the fitted field carries every kept curve sample onto it, upwards only."""
+    s = session
+    paint_support(s)
+    p = s.cloud.positions
+    picks = [int(np.argmin(np.linalg.norm(p - [x, y, 0], axis=1))) for x, y in
+             ((-0.55, -0.1), (-0.3, 0.25), (0.1, 0.3), (0.5, -0.05))]
+    s.curve_mode = True
+    for i in picks:
+        assert s.add_curve_point(p[i])
+    assert s.wait_fit() and s.basis.stats["method"] == "lu"
+    g = s.basis.constraints.groups[0]
+
+    def on_polyline(points, poly, tol):
+        return np.min(np.linalg.norm(points[:, None, :] - poly[None], axis=2), axis=1).max() < tol
+
+    poly = s.curve_polyline(2000)
+    assert on_polyline(p[picks], poly, 1e-12) and on_polyline(g.points, poly, 2e-3)
+    assert typed_move(s, 2, "0.1", curve_point=3) == "pose"
+    moved = g.points + s.basis.rbf(g.points) @ s.current_dc()
+    poly = s.curve_polyline(2000)
+    assert on_polyline(s.curve_point_positions(), poly, 1e-12) and on_polyline(moved, poly, 2e-3)
+    np.testing.assert_allclose(moved, s.curve().evaluate(g.params, p[picks] + s.curve_moves), atol=1e-9)
+    lift = (moved - g.points)[:, 2]
+    assert lift.min() > -1e-9 and lift.max() > 0.099
+    np.testing.assert_allclose((moved - g.points)[:, :2], 0.0, atol=1e-9)

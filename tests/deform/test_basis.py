@@ -19,6 +19,7 @@ from splatedit.deform.transform import (
     scale,
     translate,
 )
+from splatedit.tolerances import IQR_DEFAULT_TOL
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 
@@ -293,7 +294,7 @@ def test_fit_errors_and_stats(plane):
     b = DeformationBasis.fit(plane, disc(plane, 0.5), [disc(plane, 0.15)], method="iqr", fill_holes=False)
     s = b.stats
     assert s["method"] == "iqr" and 0 < s["n_centers"] <= s["n_constraints"]
-    assert s["residual"] < 1e-7
+    assert s["residual"] <= IQR_DEFAULT_TOL  # achieved at every constraint
     assert s["fit_seconds"] > 0 and s["basis_seconds"] > 0
     assert s["n_support"] == disc(plane, 0.5).sum()
 
@@ -301,7 +302,7 @@ def test_fit_errors_and_stats(plane):
 # ------------------------------------------------------------ IQR accuracy
 def iqr_vs_exact(cloud, sup, handles, transforms):
     lu = DeformationBasis.fit(cloud, sup, handles, method="lu", fill_holes=False)
-    iqr = DeformationBasis.fit(cloud, sup, handles, method="iqr", tol=1e-7, fill_holes=False)
+    iqr = DeformationBasis.fit(cloud, sup, handles, method="iqr", fill_holes=False)  # default tol
     dc = lu.displacement(transforms)
     rows = free_rows(lu)
     dl, di = lu.displacements(dc), iqr.displacements(dc)
@@ -319,14 +320,14 @@ def test_iqr_matches_exact_on_a_dense_edit():
     assert iqr.stats["n_centers"] <= lu.stats["n_centers"]
     print(f"\nIQR vs LU, plane m={lu.stats['n_constraints']}: centers {iqr.stats['n_centers']}, "
           f"max rel err {err.max():.2e}, mean {err.mean():.2e}")
-    assert err.max() < 0.01
+    assert err.max() < 0.005
 
 
-def test_iqr_within_one_percent_of_exact_on_the_bundled_bunny_head_edit():
+def test_iqr_within_half_a_percent_of_exact_on_the_bundled_bunny_head_edit():
     """A realistic edit of a real scan (the bundled Stanford bunny, 37.7k splats):
-    lifting and turning the head, ~900 band constraints.  At the paper's tol=1e-7
-    every free splat's displacement is within 1% of the handle's displacement
-    of the exact solve, with fewer centres."""
+    lifting and turning the head, ~900 band constraints.  At the default tol
+    every free splat's displacement is within 0.5% of the handle's
+    displacement of the exact solve, with fewer centres."""
     from splatedit.data import default_model_path
     from splatedit.io import read
     cloud = read(default_model_path())
@@ -338,7 +339,7 @@ def test_iqr_within_one_percent_of_exact_on_the_bundled_bunny_head_edit():
     lu, iqr, err = iqr_vs_exact(cloud, sup, [hnd], [t])
     assert lu.stats["n_constraints"] > 500
     assert iqr.stats["n_centers"] < lu.stats["n_centers"]
-    assert err.max() < 0.01, err.max()
+    assert err.max() < 0.005, err.max()
 
 
 def test_iqr_matches_exact_on_the_bunny_ear(shared_data):
@@ -354,7 +355,7 @@ def test_iqr_matches_exact_on_the_bunny_ear(shared_data):
     lu, iqr, err = iqr_vs_exact(cloud, sup, [hnd], [t])
     print(f"\nIQR vs LU, bunny ear m={lu.stats['n_constraints']}: centers {iqr.stats['n_centers']}, "
           f"max rel err {err.max():.2e}")
-    assert err.max() < 0.01
+    assert err.max() < 0.005
     out = lu.apply(cloud, lu.displacement([t]))
     assert np.array_equal(out.positions[~sup], cloud.positions[~sup])
 
@@ -367,7 +368,7 @@ def test_two_handle_edit_matches_exact_solve_and_scipy(two):
     t1 = compose(rotate([1, 0, 0], 15, cloud.positions[h1].mean(0)), translate([0, 0, 0.2]))
     t2 = compose(scale(0.8, cloud.positions[h2].mean(0)), translate([0.05, 0.0, -0.1]))
     _, iqr, err = iqr_vs_exact(cloud, sup, [h1, h2], [t1, t2])
-    assert err.max() < 0.01
+    assert err.max() < 0.005
     con = lu.constraints
     dc = lu.displacement([t1, t2])
     rows = free_rows(lu)

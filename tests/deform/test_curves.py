@@ -14,7 +14,7 @@ from scipy.spatial import cKDTree
 from splatedit.bench.solve import wavy_plane_cloud
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import build_constraints
-from splatedit.deform.curves import ControlCurve, bspline_basis
+from splatedit.deform.curves import ControlCurve
 from splatedit.deform.transform import apply_affine, rotate, translate
 from splatedit.errors import ParameterError, SolverError
 
@@ -51,49 +51,92 @@ def free_rows(basis):
     return np.searchsorted(basis.indices, basis.constraints.free_index)
 
 
-# ------------------------------------------------------------ the spline
+# ------------------------------------------------------------ the curve
 @settings(max_examples=40, deadline=None)
 @given(st.integers(2, 17), st.integers(0, 10_000))
-def test_spline_interpolates_the_picked_points_with_affine_weights(n, seed):
+def test_curve_interpolates_the_picked_points_with_non_negative_affine_weights(n, seed):
     q = np.random.default_rng(seed).normal(size=(n, 3))
     c = ControlCurve.through(q)
-    assert c.n_controls == n and c.degree == min(3, n - 1)
+    assert c.n_controls == n and np.array_equal(c.controls, q)
     np.testing.assert_allclose(c.evaluate(c.params), q, rtol=0, atol=1e-12)
     t = np.linspace(0.0, 1.0, 97)
-    w = c.basis(t)
-    np.testing.assert_allclose(w.sum(axis=1), 1.0, rtol=0, atol=1e-14)
-    assert w.min() >= 0.0
-    np.testing.assert_allclose(c.evaluate(t)[[0, -1]], q[[0, -1]], atol=1e-12)
+    for w in (c.basis(t), c.shape_weights(t)):
+        np.testing.assert_allclose(w.sum(axis=1), 1.0, rtol=0, atol=1e-13)
+    assert c.basis(t).min() >= 0.0
+    np.testing.assert_allclose(c.basis(c.params), np.eye(n), atol=1e-15)
     # moving the picked points by dq: the moved curve passes through q + dq
     dq = np.random.default_rng(seed + 1).normal(size=(n, 3))
-    db = c.control_displacement(dq)
-    np.testing.assert_allclose(c.evaluate(c.params, c.controls + db), q + dq, atol=1e-11)
-    # and a common translation of the picked points translates the control points
-    np.testing.assert_allclose(c.control_displacement(np.tile([1.0, -2.0, 0.5], (n, 1))),
-                               np.tile([1.0, -2.0, 0.5], (n, 1)), atol=1e-12)
+    np.testing.assert_array_equal(c.control_displacement(dq), dq)
+    np.testing.assert_allclose(c.evaluate(c.params, q + dq), q + dq, atol=1e-12)
+    # and a common translation of the picked points translates the curve
+    shift = np.array([1.0, -2.0, 0.5])
+    np.testing.assert_allclose(c.evaluate(t, q + shift), c.evaluate(t) + shift, atol=1e-12)
 
 
-def test_two_points_give_the_segment_and_four_a_cubic():
+def barry_goldman(p, tau, t):
+    """Centripetal Catmull-Rom point at knot value t of the segment p[1]..p[2]
+    (the pyramid of linear interpolations written on the points)."""
+    def lerp(a, b, ta, tb):
+        return ((tb - t) * a + (t - ta) * b) / (tb - ta)
+    a1, a2, a3 = (lerp(p[i], p[i + 1], tau[i], tau[i + 1]) for i in range(3))
+    b1, b2 = lerp(a1, a2, tau[0], tau[2]), lerp(a2, a3, tau[1], tau[3])
+    return lerp(b1, b2, tau[1], tau[2])
+
+
+def test_shape_is_the_centripetal_catmull_rom_spline():
+    rng = np.random.default_rng(3)
+    q = rng.normal(size=(6, 3))
+    c = ControlCurve.through(q)
+    # knots: cumulative square roots of the chords, normalised
+    knots = np.concatenate([[0], np.cumsum(np.linalg.norm(np.diff(q, axis=0), axis=1) ** 0.5)])
+    np.testing.assert_allclose(c.params, knots / knots[-1], atol=1e-15)
+    for j in (1, 2, 3):  # interior segments: the pyramid on q[j-1 .. j+2]
+        for f in (0.2, 0.5, 0.9):
+            t = c.params[j] + f * (c.params[j + 1] - c.params[j])
+            ref = barry_goldman(q[j - 1:j + 3], knots[j - 1:j + 3], t * knots[-1])
+            np.testing.assert_allclose(c.evaluate([t])[0], ref, atol=1e-12)
+    # first segment: the reflected phantom point 2 q0 - q1, one chord's knot step before
+    ph = np.vstack([2 * q[0] - q[1], q[:3]])
+    tau = np.concatenate([[-knots[1]], knots[:3]])
+    t = 0.4 * c.params[1]
+    np.testing.assert_allclose(c.evaluate([t])[0], barry_goldman(ph, tau, t * knots[-1]), atol=1e-12)
+    # two points give the straight segment
     seg = ControlCurve.through([[0, 0, 0], [2, 0, 0]])
-    assert seg.degree == 1
-    np.testing.assert_allclose(seg.evaluate([0.25, 0.5]), [[0.5, 0, 0], [1, 0, 0]], atol=1e-15)
-    # four points: the cubic polynomial curve through them at the chord-length
-    # parameters (unique), i.e. Lagrange interpolation per coordinate
-    q = np.array([[0.0, 0.0, 0.0], [1.0, 0.5, 0.2], [1.5, 1.5, -0.3], [3.0, 1.0, 0.4]])
-    cub = ControlCurve.through(q)
-    assert cub.degree == 3 and len(cub.knots) == 8
-    chords = np.linalg.norm(np.diff(q, axis=0), axis=1)
-    np.testing.assert_allclose(cub.params, np.concatenate([[0], np.cumsum(chords)]) / chords.sum())
-    t = np.linspace(0, 1, 11)
-    lagrange = np.column_stack([np.polyval(np.polyfit(cub.params, q[:, d], 3), t) for d in range(3)])
-    np.testing.assert_allclose(cub.evaluate(t), lagrange, atol=1e-12)
+    p = seg.evaluate(np.linspace(0, 1, 11))
+    assert np.abs(p[:, 1:]).max() == 0.0 and np.all(np.diff(p[:, 0]) > 0)
 
 
-def test_bspline_basis_matches_the_recursion_definition_on_a_uniform_vector():
-    # uniform cubic B-spline on knots 0..7: at t = 3.5 (span 3) the
-    # non-zero values are 1/48, 23/48, 23/48, 1/48
-    w = bspline_basis([3.5], np.arange(8.0), 3)
-    np.testing.assert_allclose(w[0], [1 / 48, 23 / 48, 23 / 48, 1 / 48], atol=1e-15)
+def test_a_bent_arm_curve_does_not_overshoot():
+    """The issue's case: shoulder, elbow, wrist, hand.  The old global cubic
+    (chord-length B-spline through 4 points) dipped 0.020 below the shoulder
+    with the first points and 0.040 with the second (measured); the
+    centripetal curve stays within the points' range for the first and dips
+    0.0086 (a fifth, 2.6% of the first chord) for the second, whose elbow
+    chord is 15x shorter vertically than the next one."""
+    arm = np.array([[0.0, 0.0, 0.0], [0.3, 0.05, 0.0], [0.4, 0.4, 0.0], [0.45, 0.8, 0.0]])
+    p = ControlCurve.through(arm).evaluate(np.linspace(0.0, 1.0, 2001))
+    assert np.all(p.min(axis=0) >= arm.min(axis=0) - 1e-12)
+    assert np.all(p.max(axis=0) <= arm.max(axis=0) + 1e-12)
+    sharp = np.array([[0.0, 0.0, 0.0], [0.3, 0.02, 0.0], [0.35, 0.35, 0.0], [0.38, 0.7, 0.0]])
+    p = ControlCurve.through(sharp).evaluate(np.linspace(0.0, 1.0, 2001))
+    assert -0.01 < p[:, 1].min() and p[:, 1].max() <= 0.7 + 1e-12
+
+
+def test_displacement_weights_are_c2_hats():
+    c = ControlCurve.through(picked(5))
+    h = 1e-5
+    for j in range(1, 4):  # at interior picked points value 1, slope and curvature 0
+        t = c.params[j]
+        w = c.basis([t - h, t, t + h])
+        np.testing.assert_allclose(w[1], np.eye(5)[j], atol=1e-15)
+        assert np.abs(w[2] - w[0]).max() / (2 * h) < 1e-6
+        # (a cubic smoothstep would give 6 / dt^2, about 100, here)
+        assert np.abs(w[2] - 2 * w[1] + w[0]).max() / h ** 2 < 0.1
+    # local: a middle weight vanishes beyond its neighbouring picked points
+    t = np.linspace(0, 1, 501)
+    w2 = c.basis(t)[:, 2]
+    assert np.all(w2[(t <= c.params[1]) | (t >= c.params[3])] == 0.0)
+    assert np.all(np.diff(w2[(t >= c.params[1]) & (t <= c.params[2])]) >= 0)
 
 
 def test_samples_are_equally_spaced_in_arc_length():
@@ -102,7 +145,8 @@ def test_samples_are_equally_spaced_in_arc_length():
     gaps = np.linalg.norm(np.diff(p, axis=0), axis=1)
     assert len(p) == int(np.ceil(c.length() / 0.02)) + 1
     assert gaps.max() <= 0.02 and gaps.min() > 0.95 * gaps.max()
-    np.testing.assert_allclose(p, w @ c.controls, atol=1e-15)
+    np.testing.assert_allclose(p, c.evaluate(t), atol=1e-15)
+    np.testing.assert_allclose(w, c.basis(t), atol=1e-15)
     t8, _, p8 = ControlCurve.through(picked(6), samples=8).sample(spacing=0.02)
     assert len(p8) == 8 and t8[0] == 0.0 and t8[-1] == 1.0
 
@@ -127,8 +171,10 @@ def test_curve_group_constraints(plane):
     assert [g.kind for g in con.groups] == ["curve"] and con.n_columns == 5
     g = con.groups[0]
     assert g.band_index is None and len(g.member_index) == 0 and g.n_dropped == 0
-    np.testing.assert_allclose(g.weights @ g.controls, g.points, atol=1e-14)
+    np.testing.assert_allclose(curve.evaluate(g.params), g.points, atol=1e-14)
+    np.testing.assert_allclose(curve.basis(g.params), g.weights, atol=1e-15)
     np.testing.assert_allclose(g.weights.sum(axis=1), 1.0, atol=1e-14)
+    assert g.weights.min() >= 0.0 and np.array_equal(g.controls, curve.points)
     # no handles: the free region is the whole support
     np.testing.assert_array_equal(con.free_index, np.flatnonzero(sup))
     np.testing.assert_array_equal(con.values[con.rows(0), con.columns(0)], g.weights)
@@ -178,13 +224,13 @@ def test_curve_entirely_in_the_fixed_band_is_an_error(plane):
 def test_curve_edit_matches_exact_solve_and_scipy(curve_edit):
     cloud, sup, curve, lu = curve_edit
     con = lu.constraints
-    iqr = DeformationBasis.fit(cloud, sup, curves=[curve], method="iqr", tol=1e-7, fill_holes=False)
+    iqr = DeformationBasis.fit(cloud, sup, curves=[curve], method="iqr", fill_holes=False)
     dq = np.random.default_rng(1).normal(scale=0.05, size=(curve.n_controls, 3))
     dc = lu.displacement([curve.control_displacement(dq)])
     rows = free_rows(lu)
     scale_ = np.abs(con.values @ dc).max()
     err = np.linalg.norm(lu.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
-    assert err.max() / scale_ < 0.01
+    assert err.max() / scale_ < 0.005
     oracle = RBFInterpolator(con.points, con.values @ dc, kernel="cubic", degree=2)
     theirs = oracle(cloud.positions[lu.indices[rows]])
     assert np.abs(lu.displacements(dc)[rows] - theirs).max() / scale_ < 1e-8
@@ -273,10 +319,10 @@ def test_curve_and_handle_in_one_edit(plane):
     with pytest.raises(ParameterError, match="one matrix per handle"):
         b.displacement([t])
     # IQR on the combined edit matches the exact solve
-    iqr = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="iqr", tol=1e-7, fill_holes=False)
+    iqr = DeformationBasis.fit(plane, sup, [hnd], curves=[curve], method="iqr", fill_holes=False)
     rows = free_rows(b)
     err = np.linalg.norm(b.displacements(dc)[rows] - iqr.displacements(dc)[rows], axis=1)
-    assert err.max() / np.abs(b.constraints.values @ dc).max() < 0.01
+    assert err.max() / np.abs(b.constraints.values @ dc).max() < 0.005
     assert b.stats["n_curve_samples"] == [len(g.points)]
 
 
@@ -289,3 +335,32 @@ def test_translate_handle_and_curve_together_translates_everything(plane):
     shift = np.array([0.1, 0.0, -0.2])
     out = b.apply(plane, b.displacement([translate(shift), np.tile(shift, (4, 1))]))
     np.testing.assert_allclose(out.positions, plane.positions + shift, atol=1e-9)
+
+
+# ------------------------------------------------------- drag direction
+@pytest.mark.parametrize("direction", [[0.0, 0.0, 1.0], [0.6, 0.8, 0.0]])
+def test_dragging_one_point_of_a_bent_curve_moves_nothing_backwards(plane, direction):
+    """Drag each point of a bent 4-point curve alone: the curve samples move
+    only along the drag (exactly: their weights are >= 0) and at most by the
+    drag; the splats within one point spacing of the curve move backwards by
+    at most 3% of the drag, every splat by at most 10%.  Measured here: 0,
+    2.1% and 8.0%; the old B-spline weights gave 25%, 22% and 25%.  What
+    remains comes from the RBF itself (README, Edit scripts: curves)."""
+    sup = disc(plane, 0.7)
+    curve = ControlCurve.through(picked(4))
+    b = DeformationBasis.fit(plane, sup, curves=[curve], method="lu")
+    g = b.constraints.groups[0]
+    d = 0.05 * np.asarray(direction)
+    near = cKDTree(g.points).query(plane.positions[b.indices])[0] <= b.constraints.spacing
+    assert near.sum() >= 40
+    for j in range(curve.n_controls):
+        dq = np.zeros((curve.n_controls, 3))
+        dq[j] = d
+        dc = b.displacement([dq])
+        target = b.rbf(g.points) @ dc  # the fitted field at the samples
+        along = target @ d / (d @ d)
+        assert along.min() > -1e-9 and along.max() < 1 + 1e-9
+        np.testing.assert_allclose(target, along[:, None] * d, atol=1e-9 * np.linalg.norm(d))
+        splats = b.displacements(dc) @ d / (d @ d)
+        assert splats[near].min() > -0.03 and splats.min() > -0.10
+        assert splats.max() > 0.99  # the dragged point's neighbourhood follows
