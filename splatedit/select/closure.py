@@ -241,9 +241,11 @@ def _grow_back_sides(cloud, graph: NeighbourGraph, fronts: np.ndarray, n_front: 
     return np.flatnonzero(back)
 
 
-def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> np.ndarray:
+def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
+              edge: np.ndarray | None = None) -> np.ndarray:
     """Indices of ``allowed`` unselected splats in components that stay
-    within ``CLOSURE_ISLAND_RINGS`` rings of ``sel`` (rule 3)."""
+    within ``CLOSURE_ISLAND_RINGS`` rings of ``sel`` (rule 3) and do not
+    touch ``edge`` (splats with neighbours outside a region's graph)."""
     reach = graph.grow(sel, CLOSURE_ISLAND_RINGS, within=allowed | sel)
     last = graph.ring(graph.grow(sel, CLOSURE_ISLAND_RINGS - 1, within=allowed | sel))
     shell = np.flatnonzero(reach & ~sel)
@@ -259,16 +261,23 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> np
     leaks = ~reach[nb]
     row = np.repeat(np.arange(len(shell)), nb_counts)
     open_[labels[row[leaks]]] = True
+    if edge is not None:
+        open_[labels[edge[shell]]] = True
     return shell[~open_[labels]]
 
 
-def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray) -> tuple[np.ndarray, int, int]:
-    """Rules 2 and 3 for one mask inside ``allowed``: (closed mask, gaps, islands)."""
+def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
+                 edge: np.ndarray | None = None) -> tuple[np.ndarray, int, int]:
+    """Rules 2 and 3 for one mask inside ``allowed``: (closed mask, gaps,
+    islands).  ``edge``: splats of a region's graph with neighbours outside
+    it; what lies beyond is unknown, so nothing is added near them."""
     out = sel.copy()
     closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=allowed | out), CLOSURE_GAP_RINGS)
+    if edge is not None and edge.any():
+        closed &= ~graph.grow(edge, 2 * CLOSURE_GAP_RINGS)
     gaps = int((closed & ~out).sum())
     out |= closed
-    islands = _enclosed(graph, out, allowed)
+    islands = _enclosed(graph, out, allowed, edge)
     out[islands] = True
     return out, gaps, len(islands)
 
@@ -319,13 +328,14 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     sup[back] = True
     n_back = len(back)
     if changed is None:
-        region, sub = np.arange(n), graph
+        region, sub, edge = np.arange(n), graph, None
     else:
         touched = changed.copy()
         touched[back] = True
         region = _box_region(tree, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
         sub = graph.subgraph(region)
-    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], np.ones(len(region), bool))
+        edge = (graph.indptr[region + 1] - graph.indptr[region]) != np.diff(sub.indptr)
+    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], np.ones(len(region), bool), edge)
     sup[region] = sup_r
 
     # the handles: rules 1-3 inside the closed support, outside the other handles
@@ -341,7 +351,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         back = _back_sides(cloud, graph, tree, fronts(h), allowed & ~h, thickness[1 + i])
         h[back] = True
         n_back += len(back)
-        h_r, g, isl = _close_graph(sub, h[region], allowed[region])
+        h_r, g, isl = _close_graph(sub, h[region], allowed[region], edge)
         h[region] = h_r
         n_gaps, n_islands = n_gaps + g, n_islands + isl
 

@@ -195,3 +195,28 @@ def test_one_view_strokes_on_scans_do_not_tear(shared_data, name):
         basis = DeformationBasis.fit(cloud, sup, [hnd], graph=graph)
         for name_t, out in user_edits(cloud, graph, view, basis):
             assert count_tears(cloud.positions, out.positions, graph.spacing) == 0, (view, name_t)
+
+
+def test_a_region_cut_from_the_graph_fills_nothing_at_its_edge():
+    """A stroke is closed on the subgraph of a region around it.  The bottom
+    half of a grid is selected but for a strip 14 spacings wide that opens
+    into the unselected top half; a region that stops below the top half cuts
+    the strip off.  Inside the region the strip looks enclosed; the splats
+    with neighbours outside the region (its edge) tell that it is not."""
+    from splatedit.select.closure import _close_graph
+    n = 60
+    x, y = np.meshgrid(np.arange(n, dtype=float), np.arange(n, dtype=float))
+    pos = np.column_stack([x.ravel(), y.ravel(), np.zeros(n * n)])
+    g = NeighbourGraph.build(pos)
+    strip = (pos[:, 0] >= 20) & (pos[:, 0] <= 33) & (pos[:, 1] < 30)
+    sel = (pos[:, 1] < 30) & ~strip
+    full, _, _ = _close_graph(g, sel, np.ones(len(pos), bool))
+    assert not full[strip].all()                                 # the whole graph: not an island
+    region = np.flatnonzero(pos[:, 1] < 28)
+    sub = g.subgraph(region)
+    edge = (g.indptr[region + 1] - g.indptr[region]) != np.diff(sub.indptr)
+    blind, _, _ = _close_graph(sub, sel[region], np.ones(len(region), bool))
+    assert blind[strip[region]].all()                           # cut off, it looks like one
+    seen, _, _ = _close_graph(sub, sel[region], np.ones(len(region), bool), edge)
+    inner = strip[region] & (np.abs(pos[region, 0] - 26.5) < 3)
+    assert not seen[inner].any()
