@@ -157,10 +157,14 @@ CLOSURE_RAY_MAX = 500
 #: large (starting the threads took about 2 ms per call, more than a few
 #: thousand queries gain)
 CLOSURE_PARALLEL_QUERIES = 20000
-#: closure rule 1, growing the rays' hits over the graph: a neighbour joins the
-#: back side when one of its this many nearest painted splats (within T) lies
-#: across the part (the nearest one is often a rim splat seen edge-on)
-CLOSURE_BACK_NEIGHBOURS = 16
+#: closure rule 1, growing the rays' hits over the graph: a neighbour of a back
+#: splat is tested against that splat's front and the painted splats within
+#: this many rings of it (the front straight across moves by about a ring per
+#: ring of growth on a tapering part)
+CLOSURE_FRONT_RINGS = 2
+#: the selection's RMS radius (the thickness bound T) is taken from an even
+#: subsample of at most this many splats (it bounds, it does not measure)
+CLOSURE_RMS_SAMPLES = 4096
 #: closure rule 1: the painted splat lies within acos(this) of straight
 #: behind the candidate along both normals (a part's two sides face each
 #: other through its thickness; other surfaces within T lie off to the side)

@@ -52,12 +52,13 @@ from splatedit.select.graph import NeighbourGraph, unique_indices
 from splatedit.tolerances import (
     BAND_RINGS,
     CLOSURE_BACK_CONE_COS,
-    CLOSURE_BACK_NEIGHBOURS,
+    CLOSURE_FRONT_RINGS,
     CLOSURE_GAP_RINGS,
     CLOSURE_HANDLE_MARGIN_MAX_REL,
     CLOSURE_HANDLE_MARGIN_REL,
     CLOSURE_ISLAND_RINGS,
     CLOSURE_REGION_RINGS,
+    CLOSURE_RMS_SAMPLES,
     CLOSURE_OPPOSITE_COS,
     CLOSURE_PARALLEL_QUERIES,
     CLOSURE_RAY_HITS,
@@ -119,7 +120,17 @@ def _workers(n_queries: int) -> int:
 
 
 def _rms_radius(points: np.ndarray) -> float:
+    """RMS distance of ``points`` (k, 3) to their centroid (model units)."""
     return float(np.sqrt(np.mean(np.sum((points - points.mean(axis=0)) ** 2, axis=1))))
+
+
+def _mask_rms_radius(pos: np.ndarray, mask: np.ndarray) -> float:
+    """RMS radius of the splats ``mask`` (n,) bool, from an even subsample of
+    at most ``CLOSURE_RMS_SAMPLES`` of them (a bound, not a measurement)."""
+    idx = np.flatnonzero(mask)
+    if len(idx) == 0:
+        return 0.0
+    return _rms_radius(pos[idx[::max(1, len(idx) // CLOSURE_RMS_SAMPLES)]])
 
 
 def _unit_normals(cloud, index: np.ndarray) -> np.ndarray:
@@ -189,54 +200,81 @@ def _back_sides(cloud, graph: NeighbourGraph, tree: cKDTree, fronts: np.ndarray,
     keep = ((np.einsum("ij,ij->i", n_u, n_ray[rows]) < -CLOSURE_OPPOSITE_COS)
             & (np.einsum("ij,ij->i", off, n_ray[rows]) < -cone)
             & (np.einsum("ij,ij->i", off, n_u) > cone))
-    seeds = np.unique(u[keep]).astype(np.int64)
-    return _grow_back_sides(cloud, graph, fronts, n_front, allowed, seeds, t)
+    seeds, first = np.unique(u[keep], return_index=True)
+    seed_fronts = fronts[rays[rows[keep][first]]]
+    return _grow_back_sides(cloud, graph, fronts, n_front, allowed, seeds.astype(np.int64), seed_fronts, t)
 
 
-def _facing_back(cloud, front_tree: cKDTree, p_front: np.ndarray, n_front: np.ndarray,
-                 cand: np.ndarray, t: float) -> np.ndarray:
-    """(len(cand),) bool: candidate splats with one of their
-    ``CLOSURE_BACK_NEIGHBOURS`` nearest front splats (within ``t``) across the
-    part: normals opposite, each behind the other's surface within the cone."""
+def _across(cloud, cand: np.ndarray, front: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Facing test of candidate/front pairs (same-length index arrays): at
+    most ``t`` apart, normals opposite, each behind the other's surface
+    within the cone.  Returns
+    (passes (p,) bool, lateral offset of the candidate from the front's
+    normal line (p,), model units)."""
     pos = cloud.positions
-    kk = min(CLOSURE_BACK_NEIGHBOURS, len(p_front))
-    d, j = front_tree.query(pos[cand], k=kk, distance_upper_bound=t, workers=_workers(len(cand)))
-    d, j = d.reshape(len(cand), kk), j.reshape(len(cand), kk)
-    n_cand = _unit_normals(cloud, cand)
-    valid = np.isfinite(d)                                       # (c, kk)
-    jj = np.where(valid, j, 0)
-    off = pos[cand][:, None, :] - p_front[jj]                    # (c, kk, 3)
-    nf = n_front[jj]
-    cone = CLOSURE_BACK_CONE_COS * np.linalg.norm(off, axis=2)
-    ok = (valid & (np.einsum("ckx,cx->ck", nf, n_cand) < -CLOSURE_OPPOSITE_COS)
-          & (np.einsum("ckx,ckx->ck", off, nf) < -cone)
-          & (np.einsum("ckx,cx->ck", off, n_cand) > cone))
-    keep = ok.any(axis=1)
-    return keep
+    n_c, n_f = _unit_normals(cloud, cand), _unit_normals(cloud, front)
+    off = pos[cand] - pos[front]
+    along = np.einsum("ij,ij->i", off, n_f)
+    dist = np.linalg.norm(off, axis=1)
+    cone = CLOSURE_BACK_CONE_COS * dist
+    ok = ((dist <= t) & (np.einsum("ij,ij->i", n_c, n_f) < -CLOSURE_OPPOSITE_COS) & (along < -cone)
+          & (np.einsum("ij,ij->i", off, n_c) > cone))
+    lateral = np.sqrt(np.maximum(dist * dist - along * along, 0.0))
+    return ok, lateral
 
 
 def _grow_back_sides(cloud, graph: NeighbourGraph, fronts: np.ndarray, n_front: np.ndarray,
-                     allowed: np.ndarray, seeds: np.ndarray, t: float) -> np.ndarray:
-    """Grow the rays' hits over the neighbour graph: every allowed neighbour
-    of the back side found so far that passes the facing test against its
-    nearest front splats joins it (rays bunch up behind curved fronts and
-    leave parts of the back unreached).  Returns sorted indices."""
+                     allowed: np.ndarray, seeds: np.ndarray, seed_fronts: np.ndarray, t: float) -> np.ndarray:
+    """Grow the rays' hits over the neighbour graph (rays bunch up behind
+    curved fronts and leave parts of the back unreached): an allowed
+    neighbour of a back splat b joins the back side when it faces one of the
+    painted splats around b's own front (that front and its
+    ``CLOSURE_FRONT_RINGS`` rings on the graph) across the part, at most
+    ``t`` away; it takes the
+    one most straight across as its own front.  Cost: a few dozen vector
+    operations per ring of the back side, no k-d tree.  Returns sorted
+    indices."""
     if len(seeds) == 0:
         return seeds
-    p_front = cloud.positions[fronts]
-    front_tree = cKDTree(p_front)
-    back = np.zeros(graph.n, bool)
+    n = graph.n
+    is_front = np.zeros(n, bool)
+    is_front[fronts] = True
+    back = np.zeros(n, bool)
     back[seeds] = True
     tested = back.copy()
-    frontier = seeds
-    scratch = np.empty(graph.n, np.int64)
+    frontier, frontier_front = seeds, seed_fronts
+    scratch = np.empty(n, np.int64)
     while len(frontier):
-        ring = graph.neighbours_of(frontier)
-        ring = unique_indices(ring[~tested[ring] & allowed[ring]], scratch)
-        tested[ring] = True
-        if len(ring) == 0:
+        counts = graph.indptr[frontier + 1] - graph.indptr[frontier]
+        cand = graph.neighbours_of(frontier)
+        parent_front = np.repeat(frontier_front, counts)
+        keep = ~tested[cand] & allowed[cand]
+        cand, parent_front = cand[keep], parent_front[keep]
+        order = np.arange(len(cand))
+        scratch[cand] = order
+        first = scratch[cand] == order
+        cand, parent_front = cand[first], parent_front[first]
+        tested[cand] = True
+        if len(cand) == 0:
             break
-        frontier = ring[_facing_back(cloud, front_tree, p_front, n_front, ring, t)]
+        # the fronts to try: the parent's front and its rings (painted splats only)
+        pair_c, pair_f = np.arange(len(cand)), parent_front
+        ring_c, ring_f = pair_c, pair_f
+        for _ in range(CLOSURE_FRONT_RINGS):
+            k = graph.indptr[ring_f + 1] - graph.indptr[ring_f]
+            ring_c, ring_f = np.repeat(ring_c, k), graph.neighbours_of(ring_f)
+            pair_c, pair_f = np.concatenate([pair_c, ring_c]), np.concatenate([pair_f, ring_f])
+        on = is_front[pair_f]
+        pair_c, pair_f = pair_c[on], pair_f[on]
+        ok, lateral = _across(cloud, cand[pair_c], pair_f, t)
+        pair_c, pair_f, lateral = pair_c[ok], pair_f[ok], lateral[ok]
+        if len(pair_c) == 0:
+            break
+        best = np.lexsort((lateral, pair_c))            # per candidate, the straightest front first
+        pair_c, pair_f = pair_c[best], pair_f[best]
+        lead = np.ones(len(pair_c), bool)
+        lead[1:] = pair_c[1:] != pair_c[:-1]
+        frontier, frontier_front = cand[pair_c[lead]], pair_f[lead]
         back[frontier] = True
     return np.flatnonzero(back)
 
@@ -316,8 +354,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], nothing, nothing.copy())
     tree = graph.tree if graph.tree is not None else cKDTree(pos)
     diag = graph.diagonal
-    thickness = [CLOSURE_THIN_MAX_REL * _rms_radius(pos[m]) if m.any() else 0.0
-                 for m in [sup_in] + hs_in]
+    thickness = [CLOSURE_THIN_MAX_REL * _mask_rms_radius(pos, m) for m in [sup_in] + hs_in]
 
     def fronts(mask):
         return np.flatnonzero(mask if changed is None else mask & changed)
@@ -383,10 +420,12 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
 
 
 def _box_region(tree: cKDTree, pos: np.ndarray, touched: np.ndarray, reach: float) -> np.ndarray:
-    """Sorted indices of (at least) the splats within the box of ``touched``
-    grown by ``reach`` (model units): the ball around the box (a k-d tree
+    """Sorted indices of the splats within the box of ``touched`` grown by
+    ``reach`` (model units), found in the ball around the box (a k-d tree
     query, so the cost follows the region, not the cloud)."""
     tp = pos[touched]
     lo, hi = tp.min(axis=0) - reach, tp.max(axis=0) + reach
-    out = tree.query_ball_point((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2)
-    return np.sort(np.asarray(out, dtype=np.int64))
+    out = np.asarray(tree.query_ball_point((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2),
+                     dtype=np.int64)
+    inside = np.all((pos[out] >= lo) & (pos[out] <= hi), axis=1)
+    return np.sort(out[inside])
