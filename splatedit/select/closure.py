@@ -61,6 +61,7 @@ from splatedit.tolerances import (
     CLOSURE_RMS_SAMPLES,
     CLOSURE_OPPOSITE_COS,
     CLOSURE_PARALLEL_QUERIES,
+    CLOSURE_RAY_COARSE_DEPTH,
     CLOSURE_RAY_HITS,
     CLOSURE_RAY_MAX,
     CLOSURE_RAY_RADIUS_REL,
@@ -154,8 +155,9 @@ def _back_sides(cloud, graph: NeighbourGraph, tree: cKDTree, fronts: np.ndarray,
     the facing tests; the ray stops there either way, so a part further
     behind (the other ear) is never reached.  The hits are then grown over
     the graph (:func:`_grow_back_sides`).  Cost: a few nearest-neighbour
-    queries per front splat in the cloud's k-d tree, plus a facing test per
-    splat of the back side and its one-ring.
+    queries per ray (deeper than ``CLOSURE_RAY_COARSE_DEPTH`` spacings in the
+    graph's coarse subsample), plus a facing test per splat of the back side
+    and its one-ring.
     """
     pos = cloud.positions
     spacing = graph.spacing
@@ -180,9 +182,18 @@ def _back_sides(cloud, graph: NeighbourGraph, tree: cKDTree, fronts: np.ndarray,
         if len(live) == 0:
             break
         r = max(CLOSURE_RAY_RADIUS_REL * d, spacing)
-        dist, hit = tree.query(p_ray[live] - d * n_ray[live], k=kk, distance_upper_bound=r,
-                               workers=_workers(len(live)))
-        dist, hit = dist.reshape(len(live), kk), hit.reshape(len(live), kk)
+        q = p_ray[live] - d * n_ray[live]
+        if d > CLOSURE_RAY_COARSE_DEPTH * spacing:
+            # deep inside a thick part a k-d query must search a wide ball of
+            # empty space: the coarse subsample answers it with as few nodes
+            coarse_index, coarse_tree, coarse_spacing = graph.coarse
+            dist, hit = coarse_tree.query(q, k=kk, distance_upper_bound=max(r, coarse_spacing),
+                                          workers=_workers(len(live)))
+            dist, hit = dist.reshape(len(live), kk), hit.reshape(len(live), kk)
+            hit = np.where(np.isfinite(dist), coarse_index[np.minimum(hit, len(coarse_index) - 1)], 0)
+        else:
+            dist, hit = tree.query(q, k=kk, distance_upper_bound=r, workers=_workers(len(live)))
+            dist, hit = dist.reshape(len(live), kk), hit.reshape(len(live), kk)
         met = np.isfinite(dist[:, 0])
         within = np.isfinite(dist[met])
         rows_out.append(np.repeat(live[met], kk)[within.ravel()])
@@ -205,14 +216,12 @@ def _back_sides(cloud, graph: NeighbourGraph, tree: cKDTree, fronts: np.ndarray,
     return _grow_back_sides(cloud, graph, fronts, n_front, allowed, seeds.astype(np.int64), seed_fronts, t)
 
 
-def _across(cloud, cand: np.ndarray, front: np.ndarray, t: float) -> tuple[np.ndarray, np.ndarray]:
-    """Facing test of candidate/front pairs (same-length index arrays): at
-    most ``t`` apart, normals opposite, each behind the other's surface
-    within the cone.  Returns
-    (passes (p,) bool, lateral offset of the candidate from the front's
-    normal line (p,), model units)."""
-    pos = cloud.positions
-    n_c, n_f = _unit_normals(cloud, cand), _unit_normals(cloud, front)
+def _across(pos: np.ndarray, cand: np.ndarray, n_c: np.ndarray, front: np.ndarray, n_f: np.ndarray,
+            t: float) -> tuple[np.ndarray, np.ndarray]:
+    """Facing test of candidate/front pairs (same-length index arrays, with
+    their unit normals): at most ``t`` apart, normals opposite, each behind
+    the other's surface within the cone.  Returns (passes (p,) bool, lateral
+    offset of the candidate from the front's normal line (p,), model units)."""
     off = pos[cand] - pos[front]
     along = np.einsum("ij,ij->i", off, n_f)
     dist = np.linalg.norm(off, axis=1)
@@ -237,8 +246,9 @@ def _grow_back_sides(cloud, graph: NeighbourGraph, fronts: np.ndarray, n_front: 
     if len(seeds) == 0:
         return seeds
     n = graph.n
-    is_front = np.zeros(n, bool)
-    is_front[fronts] = True
+    slot = np.full(n, -1, np.int64)          # row of a front splat in n_front
+    slot[fronts] = np.arange(len(fronts))
+    pos = cloud.positions
     back = np.zeros(n, bool)
     back[seeds] = True
     tested = back.copy()
@@ -264,9 +274,10 @@ def _grow_back_sides(cloud, graph: NeighbourGraph, fronts: np.ndarray, n_front: 
             k = graph.indptr[ring_f + 1] - graph.indptr[ring_f]
             ring_c, ring_f = np.repeat(ring_c, k), graph.neighbours_of(ring_f)
             pair_c, pair_f = np.concatenate([pair_c, ring_c]), np.concatenate([pair_f, ring_f])
-        on = is_front[pair_f]
+        on = slot[pair_f] >= 0
         pair_c, pair_f = pair_c[on], pair_f[on]
-        ok, lateral = _across(cloud, cand[pair_c], pair_f, t)
+        n_cand = _unit_normals(cloud, cand)
+        ok, lateral = _across(pos, cand[pair_c], n_cand[pair_c], pair_f, n_front[slot[pair_f]], t)
         pair_c, pair_f, lateral = pair_c[ok], pair_f[ok], lateral[ok]
         if len(pair_c) == 0:
             break

@@ -18,12 +18,13 @@ proportional to the region it touches, not to the cloud.
 from __future__ import annotations
 
 from dataclasses import dataclass
+from functools import cached_property
 
 import numpy as np
 from scipy import sparse
 from scipy.spatial import cKDTree
 
-from splatedit.tolerances import GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
+from splatedit.tolerances import GRAPH_COARSE_STRIDE, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
 
 
 def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
@@ -100,6 +101,17 @@ class NeighbourGraph:
         indptr = np.zeros(len(index) + 1, np.int64)
         np.cumsum(np.bincount(row, minlength=len(index)), out=indptr[1:])
         return self._frozen(indptr, nb[keep].astype(np.int32), self.spacing, None, self.diagonal)
+
+    @cached_property
+    def coarse(self) -> tuple[np.ndarray, cKDTree, float]:
+        """(indices, k-d tree, spacing) of an even subsample of every
+        ``GRAPH_COARSE_STRIDE``-th splat (built on first use): for queries
+        far from the surface, which the full tree answers slowly."""
+        if self.tree is None:
+            raise ValueError("a subgraph has no positions for a coarse tree")
+        pts = self.tree.data
+        index = np.arange(0, len(pts), GRAPH_COARSE_STRIDE)
+        return index, cKDTree(pts[index]), self.spacing * GRAPH_COARSE_STRIDE ** 0.5
 
     @property
     def n(self) -> int:
