@@ -83,6 +83,7 @@ def cmd_info(args) -> int:
         "outliers": quality.outliers.count,
         "outliers_statistical": int(quality.outliers.statistical.sum()),
         "outliers_isolated": int(quality.outliers.isolated.sum()),
+        "stray_cluster_points": int(quality.stray_clusters.sum()),
     }
     if args.json:
         print(json.dumps(info))
@@ -123,15 +124,18 @@ def _remove_outliers(args, cloud):
     """``convert --remove-outliers``: drop statistical and isolated outliers
     of a point cloud (a mesh is refused: its faces would need re-indexing and
     a vertex used by faces is part of the surface)."""
-    from splatedit.model.outliers import detect_outliers
+    from splatedit.model.outliers import detect_outliers, stray_clusters
     if cloud.faces is not None:
         raise ParameterError("--remove-outliers", f"{args.input} is a triangle mesh "
                              f"({len(cloud.faces)} faces); outlier removal works on point clouds only")
     flags = detect_outliers(cloud.positions)
+    strays = stray_clusters(cloud.positions, flags.isolation_radius) & ~flags.mask
+    drop = flags.mask | strays
     args.progress.close()
-    print(f"removed {flags.count} outlier(s) of {cloud.n} points "
-          f"({int(flags.statistical.sum())} statistical, {int(flags.isolated.sum())} isolated)")
-    return cloud.subset(~flags.mask) if flags.count else cloud
+    print(f"removed {int(drop.sum())} outlier(s) of {cloud.n} points "
+          f"({int(flags.statistical.sum())} statistical, {int(flags.isolated.sum())} isolated, "
+          f"{int(strays.sum())} in small far clusters)")
+    return cloud.subset(~drop) if drop.any() else cloud
 
 
 def _run_edits(args, cloud, script_path):

@@ -11,6 +11,13 @@
   (see the measurements in :mod:`splatedit.tolerances`).
 * Isolated: no other point within ``ISOLATED_SPACINGS`` times the median
   nearest-neighbour distance.
+* Stray clusters (:func:`stray_clusters`): small groups of points far from
+  everything else (a LiDAR scan's birds, reflections, far-away debris), each
+  point's neighbours being in its own group, so neither test above sees
+  them: connected pieces of the k-nearest-neighbour graph cut at the
+  isolation radius that hold at most ``STRAY_CLUSTER_MAX_REL`` of the
+  points.  Used by ``convert --remove-outliers`` and ``info``, not by splat
+  sizing (a mesh's small separate parts are surface).
 
 Both only flag; :meth:`splatedit.model.cloud.SplatCloud.subset` removes.
 """
@@ -23,7 +30,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, ISOLATED_SPACINGS, OUTLIER_NEIGHBOURS,
-                                  OUTLIER_STD_RATIO)
+                                  OUTLIER_STD_RATIO, STRAY_CLUSTER_MAX_REL)
 
 
 @dataclass(frozen=True)
@@ -107,3 +114,38 @@ def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_
     radius = float(isolated_spacings * np.median(nz)) if len(nz) else float("inf")
     isolated = nearest > radius
     return OutlierFlags(statistical, isolated, threshold, radius)
+
+
+def stray_clusters(points, radius: float, *, k: int = OUTLIER_NEIGHBOURS,
+                   max_fraction: float = STRAY_CLUSTER_MAX_REL) -> np.ndarray:
+    """(n,) bool: points of small pieces of the cloud, far from the rest.
+
+    Args:
+        points: (n, 3) float64 positions (model units).
+        radius: edges of the k-nearest-neighbour graph longer than this
+            (model units; the isolation radius of :func:`detect_outliers`)
+            are cut.
+        k: neighbours per point.
+        max_fraction: pieces with at most this fraction of the points are
+            strays; the largest piece never is.
+    """
+    from scipy.sparse import coo_matrix
+    from scipy.sparse.csgraph import connected_components
+    pts = np.asarray(points, dtype=np.float64)
+    n = len(pts)
+    out = np.zeros(n, dtype=bool)
+    if n < 3 or not np.isfinite(radius):
+        return out
+    kk = int(min(k, n - 1))
+    d, j = cKDTree(pts).query(pts, k=kk + 1, workers=-1)
+    d, j = d[:, 1:].ravel(), j[:, 1:].ravel()
+    i = np.repeat(np.arange(n), kk)
+    keep = d <= radius
+    graph = coo_matrix((np.ones(int(keep.sum()), np.int8), (i[keep], j[keep])), shape=(n, n))
+    count, labels = connected_components(graph, directed=False)
+    if count < 2:
+        return out
+    sizes = np.bincount(labels, minlength=count)
+    small = sizes <= max_fraction * n
+    small[np.argmax(sizes)] = False
+    return small[labels]

@@ -8,7 +8,7 @@ from dataclasses import dataclass
 import numpy as np
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import knn
-from splatedit.model.outliers import OutlierFlags, detect_outliers
+from splatedit.model.outliers import OutlierFlags, detect_outliers, stray_clusters
 from splatedit.model.sizing import boundary_points, mesh_boundary_vertices, neighbour_indices
 from splatedit.tolerances import OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
 
@@ -23,11 +23,14 @@ class CloudQuality:
             edge used by one face; point cloud: neighbours leave an angular
             gap wider than ``BOUNDARY_GAP_DEG``).
         radius_max_rel_median: the largest splat radius over the median radius.
+        stray_clusters: (n,) bool, points of small far pieces that are not
+            already outliers (see :func:`~splatedit.model.outliers.stray_clusters`).
     """
 
     outliers: OutlierFlags
     boundary: np.ndarray
     radius_max_rel_median: float
+    stray_clusters: np.ndarray
 
     @property
     def boundary_count(self) -> int:
@@ -41,7 +44,7 @@ def assess(cloud: SplatCloud) -> CloudQuality:
     radii = cloud.radii
     spread = float(radii.max() / np.median(radii))
     if n < 3:
-        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread)
+        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread, np.zeros(n, dtype=bool))
     # one k-NN query serves the outlier test and the boundary test
     dist, idx = knn(pts, max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1))
     flags = detect_outliers(pts, distances=dist)
@@ -50,4 +53,5 @@ def assess(cloud: SplatCloud) -> CloudQuality:
     else:
         nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=idx)
         boundary = boundary_points(pts, cloud.normals, nb)
-    return CloudQuality(flags, boundary, spread)
+    strays = stray_clusters(pts, flags.isolation_radius) & ~flags.mask
+    return CloudQuality(flags, boundary, spread, strays)

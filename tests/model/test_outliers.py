@@ -65,3 +65,30 @@ def test_tiny_and_degenerate_inputs_flag_nothing():
     for pts in (np.zeros((1, 3)), np.eye(3)[:2], np.zeros((10, 3))):
         flags = detect_outliers(pts)
         assert flags.count == 0 and flags.mask.shape == (len(pts),)
+
+
+def test_small_far_clusters_are_strays_and_the_main_piece_is_not():
+    """A sampled sphere with three far clumps of 10 points: exactly the clumps."""
+    from splatedit.model.outliers import detect_outliers, stray_clusters
+    rng = np.random.default_rng(3)
+    s = rng.normal(size=(5000, 3))
+    s /= np.linalg.norm(s, axis=1, keepdims=True)
+    clumps = [c + 0.02 * rng.normal(size=(10, 3)) for c in ([30.0, 0, 0], [0, -40.0, 5], [8, 8, 60])]
+    pts = np.vstack([s] + clumps)
+    flags = detect_outliers(pts)
+    strays = stray_clusters(pts, flags.isolation_radius)
+    assert strays[5000:].all() and not strays[:5000].any()
+
+
+def test_remove_outliers_frames_the_lidar_scan(shared_data, tmp_path):
+    """poste_france.xyz: its far clumps of 8-28 points set a 258-unit bounding
+    box around a 21-unit object; --remove-outliers drops them."""
+    import subprocess
+    import sys
+    out = tmp_path / "poste.ply"
+    r = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "convert", str(shared_data / "poste_france.xyz"),
+                        str(out), "--remove-outliers"], capture_output=True, text=True, timeout=120)
+    assert r.returncode == 0, r.stderr
+    assert "in small far clusters" in r.stdout
+    from splatedit.io import read
+    assert read(out).diagonal < 30.0
