@@ -274,8 +274,20 @@ def cmd_bench(args) -> int:
 
 
 # ------------------------------------------------------------------- parser
+class _Parser(argparse.ArgumentParser):
+    """argparse with the one-line error contract: ``splatedit: error: render:
+    argument --size: ...`` on stderr and exit code 2, no usage block (``-h``
+    still prints the usage).  Sub-command parsers inherit the class."""
+
+    def error(self, message: str):
+        sub = self.prog.split(" ", 1)[1] if " " in self.prog else ""
+        where = f"{sub}: " if sub else ""
+        hint = f" (see 'splatedit {sub + ' ' if sub else ''}-h')"
+        self.exit(EXIT_BAD_INPUT, f"splatedit: error: {where}{message}{hint}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="splatedit", description=__doc__.split("\n")[0])
+    p = _Parser(prog="splatedit", description=__doc__.split("\n")[0])
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
     sub = p.add_subparsers(dest="command")
 
