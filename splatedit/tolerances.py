@@ -422,3 +422,13 @@ OUTLIER_RADIUS_REL_MEDIAN = 1.0
 #: apart with values 1 apart give 4.7 / 0.067 (their QR tail norm says 0)
 RESIDUAL_NOTE_MIN = 1e-9
 RESIDUAL_NOTE_FACTOR = 100.0
+
+# --- hostile inputs (issue 12) ----------------------------------------------
+#: largest |value| of a coordinate, normal component, radius or splat axis
+#: accepted from a file or in a SplatCloud.  Coordinates near 1e155 made the
+#: k-d tree's squared distances overflow (IndexError in normal estimation) and
+#: a radius of 1e160 gave NaN normals (|u x v| = 1e320); the fitting code takes
+#: up to 4th powers of coordinates (1e60 here, far inside float64).  1e15 is
+#: the float64 limit of a unit step (53-bit mantissa: 2^53 = 9.0e15), i.e.
+#: 1e9 km in millimetres: no real scan comes near it
+MAX_COORDINATE_ABS = 1e15

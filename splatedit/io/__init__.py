@@ -79,11 +79,16 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
         the path written.
     Raises:
         InputError: the file exists and ``overwrite`` is False, unsupported
-            extension, missing directory, write failure.
+            extension, missing directory, write failure, or ``cloud`` fails
+            :meth:`SplatCloud.validate` (NaN, values beyond
+            ``MAX_COORDINATE_ABS``, degenerate axes).
     """
     path = Path(path)
     ext = _ext(path, WRITE_EXTENSIONS, "writing")
     check_writable_target(path, overwrite=overwrite)
+    # every file we write must pass our own reader's checks: a cloud whose
+    # arrays were changed in place since construction is checked again
+    cloud.validate()
     report(progress, "writing", 0.0)
     try:
         with atomic_open(path, "wb") as fh:

@@ -43,3 +43,41 @@ def test_argument_errors_print_one_line_without_usage_block(capsys, argv, expect
     assert "usage:" not in line
     for sub in expected:
         assert sub in line, f"{sub!r} not in {line!r}"
+
+
+# ----------------------------------------- classes 1, 2, 11: hostile files
+_XYZ3 = "property double x\nproperty double y\nproperty double z\n"
+HOSTILE_FILES = [
+    # (id, file name, content, command (FILE / OUT placeholders), expected substrings)
+    ("duplicated property", "dup.ply",
+     "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float x\n"
+     "property float y\nproperty float z\nend_header\n0 0 0 0\n1 1 0 0\n0 0 1 0\n",
+     ["info", "FILE"], ["declared twice"]),
+    ("coordinates 1e155", "big.xyz", "".join(f"{i}e154 {i % 3}e154 {i % 5}e154\n" for i in range(1, 40)),
+     ["info", "FILE"], ["supported magnitude", "line 1"]),
+    ("off face count inf", "inf.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\ninf 0 1 2\n",
+     ["info", "FILE"], ["got inf", "line 6"]),
+    ("convert radius 1e160", "r.ply",
+     "ply\nformat ascii 1.0\nelement vertex 3\n" + _XYZ3 + "property double nx\nproperty double ny\n"
+     "property double nz\nproperty double radius\nend_header\n"
+     "0 0 0 0 0 1 1e160\n1 0 0 0 0 1 1\n0 1 0 0 0 1 1\n",
+     ["convert", "FILE", "OUT"], ["property 'radius'", "supported magnitude"]),
+    ("off face index 1e300", "i.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n",
+     ["info", "FILE"], ["vertex index 1e+300"]),
+]
+
+
+@pytest.mark.parametrize("name,content,cmd,expected", [c[1:] for c in HOSTILE_FILES],
+                         ids=[c[0] for c in HOSTILE_FILES])
+def test_hostile_files_exit_2_with_one_line_naming_the_file(tmp_path, capsys, name, content, cmd,
+                                                            expected):
+    path = tmp_path / name
+    path.write_text(content)
+    out = tmp_path / "out.ply"
+    argv = [str(path) if a == "FILE" else str(out) if a == "OUT" else a for a in cmd]
+    assert main(["-q", *argv]) == 2
+    line = one_error_line(capsys)
+    assert str(path) in line
+    for sub in expected:
+        assert sub in line, f"{sub!r} not in {line!r}"
+    assert not out.exists()
