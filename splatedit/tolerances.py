@@ -432,3 +432,13 @@ RESIDUAL_NOTE_FACTOR = 100.0
 #: the float64 limit of a unit step (53-bit mantissa: 2^53 = 9.0e15), i.e.
 #: 1e9 km in millimetres: no real scan comes near it
 MAX_COORDINATE_ABS = 1e15
+#: largest edit script read (bytes).  The demo script is 0.6 kB and a curve of
+#: 10,000 picked points about 0.5 MB; a larger file is not a script (and
+#: reading stops there instead of filling the memory from /dev/zero)
+MAX_SCRIPT_BYTES = 16 * 2**20
+#: a curve may have at most max(number of splats, this) samples (given or one
+#: per point spacing).  Kept samples are over free splats at least a spacing
+#: apart, so more than one per splat adds nothing; "samples": 10000000 ran 37 s
+#: into a MemoryError and a curve point at 1e9 asked for 1.25 TiB.  The floor
+#: keeps curves over small test clouds (a few hundred splats) legal
+CURVE_MAX_SAMPLES_FLOOR = 1024
