@@ -7,16 +7,20 @@ to stderr and exits with code 2, without a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
 import os
 import sys
 import time
+import warnings
 from pathlib import Path
 
 from splatedit.app.options import parse_size, positive_float
-from splatedit.errors import ParameterError, SplatEditError
+from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
+#: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
+EXIT_BROKEN_PIPE = 141
 
 
 # ------------------------------------------------------------------ progress
@@ -345,13 +349,31 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _route_warnings(progress: _Progress) -> None:
+    """Inside ``warnings.catch_warnings()``: an :class:`InputWarning` (input
+    partly ignored) is printed as one line ``splatedit: warning: ...``; numpy's
+    RuntimeWarnings (overflow in a cast, ...) are not for the user, whose
+    problems get their own message."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        progress.close()
+        print(f"splatedit: warning: {message}", file=sys.stderr, flush=True)
+
+    warnings.simplefilter("ignore", RuntimeWarning)
+    warnings.simplefilter("always", InputWarning)
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
     try:
-        return func(args) or 0
+        with warnings.catch_warnings():
+            _route_warnings(args.progress)
+            code = func(args) or 0
+        sys.stdout.flush()      # a closed pipe fails here, not in Python's exit flush
+        return code
     except SplatEditError as exc:
         args.progress.close()
         print(f"splatedit: error: {exc}", file=sys.stderr)
@@ -360,6 +382,13 @@ def main(argv: list[str] | None = None) -> int:
         args.progress.close()
         print("splatedit: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader of stdout went away (``splatedit info x.ply | head -1``):
+        # stop quietly, and keep Python's exit flush from failing again
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     finally:
         args.progress.close()
 

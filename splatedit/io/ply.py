@@ -20,10 +20,13 @@ Written file layout (binary little endian by default)::
 
 from __future__ import annotations
 
+import os
+import warnings
+
 import numpy as np
 import plyfile
 
-from splatedit.errors import InputError
+from splatedit.errors import InputError, InputWarning
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
@@ -199,6 +202,9 @@ def _read_ascii_fast(path, progress):
     nf_ = nf or 0
     if len(tab) < nv + nf_ or nv == 0:
         return None
+    if len(tab) > nv + nf_:
+        _warn_trailing(path, f"{len(tab) - nv - nf_} data line(s) from line {int(tab.line[nv + nf_])}",
+                       nv, nf)
     npr = len(vprops)
     if np.any(tab.count[:nv] != npr):
         return None
@@ -234,6 +240,50 @@ def _read_ascii_fast(path, progress):
     return vert, (flat, k, fprop)
 
 
+def _warn_trailing(path, what: str, nv: int, nf: int | None) -> None:
+    counts = f"'vertex {nv}'" + ("" if nf is None else f" and 'face {nf}'")
+    warnings.warn(InputWarning(f"{path}: {what} after the rows the header declares ({counts}) "
+                               f"were ignored: is a count in the header wrong?"), stacklevel=3)
+
+
+def _check_trailing(path, ply: plyfile.PlyData) -> None:
+    """Warn when a file read by plyfile holds data after its declared rows
+    (plyfile stops at the declared counts and says nothing)."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(1 << 20) if not ply.text else fh.read()   # binary: the header only
+            total = os.fstat(fh.fileno()).st_size
+    except OSError:
+        return
+    end = data.find(b"end_header")
+    nl = data.find(b"\n", end)
+    if end < 0 or nl < 0:
+        return
+    body = data[nl + 1:]
+    nv = ply["vertex"].count if "vertex" in ply else 0
+    nf = ply["face"].count if "face" in ply else None
+    if ply.text:
+        rows = sum(el.count for el in ply.elements)
+        lines = [i for i, ln in enumerate(body.split(b"\n")) if ln.strip()]
+        if len(lines) > rows:
+            first = data.count(b"\n", 0, nl + 1) + lines[rows] + 1
+            _warn_trailing(path, f"{len(lines) - rows} data line(s) from line {first}", nv, nf)
+        return
+    size = 0
+    for el in ply.elements:
+        for prop in el.properties:
+            col = el.data[prop.name]
+            if isinstance(prop, plyfile.PlyListProperty):
+                items = (col.size if col.dtype != object
+                         else sum(len(r) for r in col))
+                size += (el.count * np.dtype(prop.len_dtype).itemsize
+                         + items * np.dtype(prop.val_dtype).itemsize)
+            else:
+                size += el.count * np.dtype(prop.val_dtype).itemsize
+    if total - (nl + 1) > size:
+        _warn_trailing(path, f"{total - (nl + 1) - size} byte(s)", nv, nf)
+
+
 def read_ply(path, *, progress=None) -> SplatCloud:
     """Read a PLY point cloud, splat cloud or mesh.
 
@@ -251,6 +301,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         ply = _load(path)
         if "vertex" not in ply:
             raise InputError("no 'vertex' element", path=str(path))
+        _check_trailing(path, ply)
         data = ply["vertex"].data
         face_lists = _face_lists(ply, path)
     report(progress, "reading", 0.5)

@@ -81,3 +81,30 @@ def test_hostile_files_exit_2_with_one_line_naming_the_file(tmp_path, capsys, na
     for sub in expected:
         assert sub in line, f"{sub!r} not in {line!r}"
     assert not out.exists()
+
+
+# --------------------------------------------- class 3: trailing data is reported
+def test_ply_rows_after_the_declared_count_warn_naming_file_and_amount(tmp_path, capsys):
+    path = tmp_path / "trail.ply"
+    path.write_text("ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nend_header\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n1 1 0\n")
+    assert main(["-q", "info", str(path), "--json"]) == 0
+    captured = capsys.readouterr()
+    assert '"splats": 3' in captured.out
+    lines = captured.err.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("splatedit: warning: ")
+    assert str(path) in lines[0] and "2 data line(s) from line 11" in lines[0]
+
+
+# ------------------------------------------------ class 10: a closed stdout pipe
+def test_info_into_a_closed_pipe_ends_without_traceback(tmp_path):
+    import subprocess
+    import sys
+    from splatedit.data import default_model_path
+    proc = subprocess.Popen([sys.executable, "-m", "splatedit.cli", "-q", "info", str(default_model_path())],
+                            stdout=subprocess.PIPE, stderr=subprocess.PIPE)
+    proc.stdout.close()             # like `| head -0`: the reader is gone before the first line
+    err = proc.stderr.read().decode()
+    proc.stderr.close()
+    assert proc.wait(timeout=120) in (0, 141)
+    assert "Traceback" not in err and "BrokenPipeError" not in err and "Exception ignored" not in err, err

@@ -186,3 +186,41 @@ def test_written_file_with_largest_accepted_values_reads_back(tmp_path):
     write(tmp_path / "out.ply", cloud)
     back = read(tmp_path / "out.ply")
     assert np.array_equal(back.positions, cloud.positions) and np.isfinite(back.normals).all()
+
+
+
+@pytest.mark.parametrize("kind", ["ascii fast path", "ascii via plyfile", "binary with faces"])
+def test_data_after_the_declared_rows_warns_with_file_and_amount(tmp_path, kind):
+    """Issue 12 class 3: trailing rows are not dropped silently."""
+    from splatedit.errors import InputWarning
+    if kind == "ascii fast path":
+        path = tmp_path / "a.ply"
+        path.write_bytes(ascii_ply(XYZ_OK + ["0 0 1", "1 0 1"], count=4))
+        expect = "2 data line(s) from line 12"
+    elif kind == "ascii via plyfile":       # a list property: plyfile reads it
+        path = tmp_path / "b.ply"
+        path.write_bytes(ascii_ply([r + " 1 7" for r in XYZ_OK + ["0 0 1"]], count=4,
+                                   header_props="property float x\nproperty float y\nproperty float z\n"
+                                                "property list uchar int tag\n"))
+        expect = "1 data line(s) from line 13"
+    else:
+        path = make_ply(tmp_path / "c.ply", P, fdtype="f8", normals=N, faces=[[0, 1, 2], [1, 3, 4, 2]])
+        with open(path, "ab") as fh:
+            fh.write(b"\0" * 17)
+        expect = "17 byte(s)"
+    with pytest.warns(InputWarning) as record:
+        cloud = read(path)
+    assert cloud.n in (4, 5)
+    msg = str(record[0].message)
+    assert str(path) in msg and expect in msg, msg
+
+
+def test_exact_files_do_not_warn(tmp_path):
+    import warnings
+    path = make_ply(tmp_path / "c.ply", P, fdtype="f8", normals=N, faces=[[0, 1, 2], [1, 3, 4, 2]])
+    q = tmp_path / "a.ply"
+    q.write_bytes(ascii_ply(XYZ_OK))
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        read(path)
+        read(q)
