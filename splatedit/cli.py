@@ -98,9 +98,8 @@ def cmd_info(args) -> int:
 
 
 def cmd_convert(args) -> int:
-    from splatedit.io import read, write
-    from splatedit.io.atomic import check_writable_target
-    check_writable_target(args.output, overwrite=args.force, protect=args.input)
+    from splatedit.io import check_output_path, read, write
+    check_output_path(args.output, overwrite=args.force, protect=args.input)
     cloud = read(args.input, progress=args.progress)
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
@@ -147,9 +146,9 @@ def _run_edits(args, cloud, script_path):
 
 
 def cmd_deform(args) -> int:
-    from splatedit.io import read, write
-    from splatedit.io.atomic import check_writable_target
-    check_writable_target(args.output, overwrite=args.force, protect=args.input)
+    from splatedit.io import check_output_path, check_readable_file, read, write
+    check_output_path(args.output, overwrite=args.force, protect=args.input)
+    check_readable_file(args.edit)
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)

@@ -436,9 +436,12 @@ def load_script(path: str | Path) -> EditScript:
     """Read and validate an edit script file (errors name the file and JSON path)."""
     p = Path(path)
     try:
+        if not p.is_file():     # a FIFO would block, a directory cannot be read
+            raise EditScriptError("not a regular file" if p.exists() else "cannot read: No such file or directory",
+                                  path=str(p))
         raw = read_limited(p, MAX_SCRIPT_BYTES)
-    except OSError as exc:
-        raise EditScriptError(f"cannot read: {exc.strerror or exc}", path=str(p)) from None
+    except (OSError, ValueError) as exc:     # ValueError: a NUL byte in the name
+        raise EditScriptError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(p)) from None
     if raw is None:
         raise EditScriptError(f"larger than {MAX_SCRIPT_BYTES // 2**20} MiB: not an edit script",
                               path=str(p))

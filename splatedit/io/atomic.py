@@ -25,16 +25,31 @@ def check_writable_target(path: str | Path, *, overwrite: bool, protect: str | P
     """
     p = Path(path)
     parent = p.parent if str(p.parent) else Path(".")
-    if not parent.exists():
-        raise InputError("directory does not exist", path=str(parent))
-    if not parent.is_dir():
-        raise InputError("is not a directory", path=str(parent))
-    if p.is_dir():
-        raise InputError("is a directory", path=str(p))
-    if protect is not None and p.exists() and Path(protect).exists() and p.resolve() == Path(protect).resolve() and not overwrite:
-        raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
-    if p.exists() and not overwrite:
-        raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
+    try:
+        if not parent.exists():
+            raise InputError("directory does not exist", path=str(parent))
+        if not parent.is_dir():
+            raise InputError("is not a directory", path=str(parent))
+        if p.is_dir():
+            raise InputError("is a directory", path=str(p))
+        if p.exists() and not p.is_file():
+            raise InputError("is not a regular file (a FIFO, device or socket)", path=str(p))
+        if (protect is not None and p.exists() and Path(protect).exists()
+                and p.resolve() == Path(protect).resolve() and not overwrite):
+            raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
+        if p.exists() and not overwrite:
+            raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise InputError("directory is not writable", path=str(parent))
+        # the temporary file's name (see atomic_open) is the longest we create:
+        # a name too long for the file system fails here, before the work
+        os.stat(parent / f".{p.name}.{'x' * 8}.tmp")
+    except FileNotFoundError:
+        pass
+    except OSError as exc:      # a name too long, a loop of links, no permission to look
+        raise InputError(f"cannot write there: {exc.strerror or exc}", path=str(p)) from None
+    except ValueError as exc:   # an embedded NUL byte
+        raise InputError(f"not a usable file name: {exc}", path=repr(str(p))) from None
     return p
 
 

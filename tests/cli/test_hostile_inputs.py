@@ -108,3 +108,44 @@ def test_info_into_a_closed_pipe_ends_without_traceback(tmp_path):
     proc.stderr.close()
     assert proc.wait(timeout=120) in (0, 141)
     assert "Traceback" not in err and "BrokenPipeError" not in err and "Exception ignored" not in err, err
+
+
+# ------------------------------------------------------------- class 8: paths
+LONG = "a" * 252          # + ".ply": 256 bytes, over the usual 255-byte name limit
+
+PATH_ERRORS = [
+    # (id, argv with BUNNY / TMP placeholders, expected substrings)
+    ("info long name", ["info", f"TMP/{LONG}.ply"], ["name too long"]),
+    ("convert long output name", ["convert", "BUNNY", f"TMP/{LONG}.ply"], ["name too long"]),
+    ("render -o long name", ["render", "BUNNY", "-o", f"TMP/{LONG}.png"], ["name too long"]),
+    ("render --buffers long name", ["render", "BUNNY", "-o", "TMP/x.png", "--buffers", f"TMP/{LONG}.npz"],
+     ["name too long"]),
+    ("demo -o existing file", ["demo", "--no-render", "-o", "TMP/afile"], ["afile", "is not a directory"]),
+    ("demo -o under a file", ["demo", "--no-render", "-o", "TMP/afile/sub"], ["afile/sub", "Not a directory"]),
+    ("convert to .stl fails before reading", ["convert", "TMP/fifo.ply", "TMP/out.stl"],
+     ["out.stl", "unsupported file extension"]),
+    ("deform to .stl fails before the fit", ["deform", "BUNNY", "--edit", "TMP/fifo.json", "-o", "TMP/out.stl"],
+     ["out.stl", "unsupported file extension"]),
+    ("info on a FIFO", ["info", "TMP/fifo.ply"], ["fifo.ply", "not a regular file"]),
+    ("deform script is a FIFO", ["deform", "BUNNY", "--edit", "TMP/fifo.json", "-o", "TMP/out.ply"],
+     ["fifo.json", "not a regular file"]),
+    ("convert output is a FIFO", ["convert", "BUNNY", "TMP/fifo.ply", "-f"], ["fifo.ply", "not a regular file"]),
+]
+
+
+@pytest.mark.parametrize("argv,expected", [c[1:] for c in PATH_ERRORS], ids=[c[0] for c in PATH_ERRORS])
+def test_bad_paths_exit_2_with_one_line_before_any_work(tmp_path, capsys, argv, expected):
+    """A FIFO input would hang: every run here must end at once (the FIFOs
+    have no writer), and no output may appear."""
+    import os
+    from splatedit.data import default_model_path
+    os.mkfifo(tmp_path / "fifo.ply")
+    os.mkfifo(tmp_path / "fifo.json")
+    (tmp_path / "afile").write_text("x")
+    before = sorted(os.listdir(tmp_path))
+    argv = [a.replace("TMP", str(tmp_path)).replace("BUNNY", str(default_model_path())) for a in argv]
+    assert main(["-q", *argv]) == 2
+    line = one_error_line(capsys)
+    for sub in expected:
+        assert sub.lower() in line.lower(), f"{sub!r} not in {line!r}"
+    assert sorted(os.listdir(tmp_path)) == before
