@@ -9,6 +9,7 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
+import math
 import os
 import sys
 import time
@@ -62,6 +63,14 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
 
 
 # ------------------------------------------------------------------ commands
+def _sig(x, digits: int = 7) -> float | None:
+    """``x`` rounded to ``digits`` significant digits (not decimals: a model
+    in units of 1e-20 keeps its figures); None for NaN or infinity, which
+    JSON cannot hold."""
+    x = float(x)
+    return float(f"{x:.{digits}g}") if math.isfinite(x) else None
+
+
 def cmd_info(args) -> int:
     import numpy as np
     from splatedit.io import read
@@ -76,20 +85,20 @@ def cmd_info(args) -> int:
         "splats": cloud.n,
         "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
         "colors": cloud.colors is not None,
-        "bounds_min": lo.round(6).tolist(),
-        "bounds_max": hi.round(6).tolist(),
-        "diagonal": round(cloud.diagonal, 6),
-        "spacing": round(point_spacing(cloud.positions), 6),
-        "splat_radius_median": round(float(np.median(radii)), 6),
-        "splat_radius_max": round(float(radii.max()), 6),
-        "splat_radius_max_rel_median": round(quality.radius_max_rel_median, 3),
+        "bounds_min": [_sig(x) for x in lo],
+        "bounds_max": [_sig(x) for x in hi],
+        "diagonal": _sig(cloud.diagonal),
+        "spacing": _sig(point_spacing(cloud.positions)),
+        "splat_radius_median": _sig(np.median(radii)),
+        "splat_radius_max": _sig(radii.max()),
+        "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
         "boundary_splats": quality.boundary_count,
         "outliers": quality.outliers.count,
         "outliers_statistical": int(quality.outliers.statistical.sum()),
         "outliers_isolated": int(quality.outliers.isolated.sum()),
     }
     if args.json:
-        print(json.dumps(info))
+        print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
     else:
         width = max(map(len, info))
         for k, v in info.items():
@@ -159,17 +168,21 @@ def cmd_deform(args) -> int:
 
 def _camera_from_args(args, cloud):
     """The camera of ``splatedit render``: framing the model, then the flags override."""
+    import numpy as np
     from splatedit.render.camera import Camera
     w, h = args.size
     lo, hi = cloud.bounds()
-    base = Camera.frame(lo, hi, aspect=w / h)
+    rmax = float(cloud.radii.max())       # frames a single point by its splat
+    # all centres in one point: look at the splat face-on (from +z it may be edge-on)
+    direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
+    base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)
     if args.fov is not None and not 0.0 < args.fov < 179.0:
         raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
     fov = base.fov_deg if args.fov is None else args.fov
     if args.eye is None and args.target is None and args.up is None and args.fov is None:
         return base
     if args.eye is None and args.fov is not None and args.target is None and args.up is None:
-        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov)
+        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov, min_radius=rmax, direction=direction)
     target = base.target if args.target is None else args.target
     eye = base.eye if args.eye is None else args.eye
     up = base.up if args.up is None else args.up

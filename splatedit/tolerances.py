@@ -212,8 +212,6 @@ RENDER_CAMERA_MIN_UP_SINE = 1e-12
 #: Camera.clip_range: the bounding-sphere radius is at least this times
 #: max(1, eye distance), so that a single point still gets near < far
 RENDER_CLIP_MIN_RADIUS_REL = 1e-12
-#: Camera.frame: smallest bounding-sphere radius framed (model units; a single point)
-RENDER_FRAME_MIN_RADIUS = 1e-9
 #: Camera.frame: distance so that the bounding sphere fits the view, times this
 RENDER_FRAME_MARGIN = 1.05
 #: default vertical field of view, degrees
@@ -442,3 +440,9 @@ MAX_SCRIPT_BYTES = 16 * 2**20
 #: into a MemoryError and a curve point at 1e9 asked for 1.25 TiB.  The floor
 #: keeps curves over small test clouds (a few hundred splats) legal
 CURVE_MAX_SAMPLES_FLOOR = 1024
+#: Camera.frame: smallest bounding-sphere radius framed, relative to the
+#: largest coordinate of the box centre (a single point with no splat size
+#: given).  Replaces an absolute 1e-9 that framed a bunny scaled by 1e-10 as a
+#: dot (coverage 0.004 of the image instead of 0.235); 1e-12 is, like
+#: RENDER_CLIP_MIN_RADIUS_REL, 4500 float64 ulps: eye and centre stay distinct
+RENDER_FRAME_MIN_RADIUS_REL = 1e-12

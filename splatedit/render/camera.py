@@ -12,7 +12,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.tolerances import (RENDER_CAMERA_MIN_UP_SINE, RENDER_CLIP_MARGIN_REL, RENDER_CLIP_MIN_RADIUS_REL,
-                                  RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS,
+                                  RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS_REL,
                                   RENDER_NEAR_FAR_RATIO)
 
 
@@ -107,15 +107,23 @@ class Camera:
     # ----------------------------------------------------------------- framing
     @classmethod
     def frame(cls, bounds_min, bounds_max, aspect: float = 1.0, *, direction=(0.0, 0.0, 1.0),
-              up=(0.0, 1.0, 0.0), fov_deg: float = RENDER_FOV_DEG) -> "Camera":
+              up=(0.0, 1.0, 0.0), fov_deg: float = RENDER_FOV_DEG,
+              min_radius: float = 0.0) -> "Camera":
         """A camera looking at the box centre from ``direction`` (pointing from
         the centre to the eye) at the distance where the box's bounding sphere
-        fits the narrower field of view."""
+        fits the narrower field of view.
+
+        ``min_radius`` (model units): frame at least a sphere this large (pass
+        the largest splat radius, so that a single point or a pile of
+        identical points is framed by its splat).  Without it a degenerate box
+        gets RENDER_FRAME_MIN_RADIUS_REL of its centre's largest coordinate
+        (relative: a model of any scale keeps its size on screen)."""
         lo, hi = _vec3("bounds_min", bounds_min), _vec3("bounds_max", bounds_max)
         if aspect <= 0:
             raise ParameterError("aspect", f"must be positive, got {aspect}")
         c = 0.5 * (lo + hi)
-        r = max(0.5 * float(np.linalg.norm(hi - lo)), RENDER_FRAME_MIN_RADIUS)
+        r = max(0.5 * float(np.linalg.norm(hi - lo)), float(min_radius),
+                RENDER_FRAME_MIN_RADIUS_REL * float(np.abs(c).max()), np.finfo(np.float64).tiny)
         half_v = math.radians(fov_deg) / 2.0
         half_h = math.atan(math.tan(half_v) * aspect)
         dist = r / math.sin(min(half_v, half_h)) * RENDER_FRAME_MARGIN

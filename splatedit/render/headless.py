@@ -50,7 +50,11 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
     for out in outputs:
         _prepare_output(out)
     if camera is None:
-        camera = Camera.frame(*cloud.bounds(), aspect=w / h)
+        lo, hi = cloud.bounds()
+        # all centres in one point: look at the splat face-on (from +z it may be edge-on)
+        direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
+        camera = Camera.frame(lo, hi, aspect=w / h, min_radius=float(cloud.radii.max()),
+                              direction=direction)
     with Renderer(device_name=device_name) as r:
         r.set_cloud(cloud)
         if selection is not None:
