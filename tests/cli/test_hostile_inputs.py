@@ -149,3 +149,30 @@ def test_bad_paths_exit_2_with_one_line_before_any_work(tmp_path, capsys, argv, 
     for sub in expected:
         assert sub.lower() in line.lower(), f"{sub!r} not in {line!r}"
     assert sorted(os.listdir(tmp_path)) == before
+
+
+# ------------------------------------------------ class 10: silent nonsense
+@pytest.mark.parametrize("content", ["0.5 0.5 0.5\n", "1 2 3\n" * 100, "1e-20 2e-20 3e-20\n" * 7],
+                         ids=["one point", "100 identical points", "7 identical tiny points"])
+def test_degenerate_models_render_a_visible_splat(tmp_path, capsys, content):
+    """One point, or many in one place, rendered an all-white PNG with exit 0."""
+    from PIL import Image
+    import numpy as np
+    src = tmp_path / "p.xyz"
+    src.write_text(content)
+    out = tmp_path / "p.png"
+    assert main(["-q", "render", str(src), "-o", str(out), "--size", "64x48"]) == 0
+    img = np.asarray(Image.open(out))
+    covered = np.any(img != img[0, 0], axis=2).mean()
+    assert 0.1 < covered < 0.9
+
+
+def test_info_json_is_strict_json_with_significant_digits(tmp_path, capsys):
+    """No Infinity/NaN tokens, and a model in units of 1e-20 keeps its figures
+    (rounding to 6 decimals printed a diagonal of 0.0)."""
+    import json
+    src = tmp_path / "tiny.xyz"
+    src.write_text("".join(f"{x}e-20 {y}e-20 {(x * y) % 3}e-20\n" for x in range(6) for y in range(6)))
+    assert main(["-q", "info", str(src), "--json"]) == 0
+    info = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(f"non-JSON {c}"))
+    assert 7e-20 < info["diagonal"] < 8e-20 and info["spacing"] > 0
