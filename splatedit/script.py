@@ -642,6 +642,22 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
     return r, basis, d_c
 
 
+def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
+    """Why committing an edit failed validation.  A splat inside the support
+    was squashed by the deformation; a splat outside it was not touched, so
+    the model as a whole became too large for it (splat axes must be longer
+    than MIN_AXIS_LENGTH_REL of the diagonal) or beyond MAX_COORDINATE_ABS:
+    say how far the edit moves things instead of blaming that splat."""
+    row = exc.row
+    if row is not None and row in set(np.asarray(basis.indices).tolist()):
+        return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
+                "use a milder transform")
+    move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
+    return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
+            f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
+            f"({exc.reason}); use a milder transform")
+
+
 def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
                source: str | None = None, progress=None,
                on_edit: Callable[[EditReport], None] | None = None):
@@ -659,8 +675,7 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         try:   # commit validates: an extreme edit must not write an unreadable model
             new = basis.commit(cloud, d_c)
         except InputError as exc:
-            raise EditScriptError(f"the edit makes splats degenerate ({exc.reason}, splat "
-                                  f"{exc.row}); use a milder transform", json_path=edit.json_path,
+            raise EditScriptError(_degenerate_message(cloud, basis, d_c, exc), json_path=edit.json_path,
                                   path=source) from None
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         i_sup = basis.indices

@@ -13,7 +13,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.tolerances import (RENDER_CAMERA_MIN_UP_SINE, RENDER_CLIP_MARGIN_REL, RENDER_CLIP_MIN_RADIUS_REL,
                                   RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS_REL,
-                                  RENDER_NEAR_FAR_RATIO)
+                                  RENDER_NEAR_FAR_RATIO, MAX_COORDINATE_ABS)
 
 
 def _vec3(name, value) -> np.ndarray:
@@ -53,11 +53,22 @@ class Camera:
         if not 0.0 < float(fov_deg) < 179.0:
             raise ParameterError("fov_deg", f"must be in (0, 179), got {fov_deg}")
         self.fov_deg = float(fov_deg)
+        for name, vec in (("eye", self.eye), ("target", self.target)):
+            if np.abs(vec).max() > MAX_COORDINATE_ABS:
+                raise ParameterError(name, f"{vec.tolist()} is beyond the supported magnitude "
+                                           f"{MAX_COORDINATE_ABS:g}")
         fwd = self.target - self.eye
-        if np.linalg.norm(fwd) == 0.0:
+        if not np.any(fwd):
             raise ParameterError("target", "must differ from eye")
-        sine_bound = RENDER_CAMERA_MIN_UP_SINE * np.linalg.norm(fwd) * np.linalg.norm(self.up)
-        if np.linalg.norm(np.cross(fwd, self.up)) <= sine_bound:
+        if not np.any(self.up):
+            raise ParameterError("up", "must not be the zero vector")
+        # directions scaled to unit size first: |fwd| of 1e300 or |up| of 1e-300
+        # must not overflow / underflow the test into a false "parallel"
+        f = fwd / np.abs(fwd).max()
+        f /= np.linalg.norm(f)
+        u = self.up / np.abs(self.up).max()
+        u /= np.linalg.norm(u)
+        if np.linalg.norm(np.cross(f, u)) <= RENDER_CAMERA_MIN_UP_SINE:
             raise ParameterError("up", "must not be parallel to the view direction")
         if near is not None and far is not None and not 0.0 < near < far:
             raise ParameterError("near", f"need 0 < near < far, got near={near}, far={far}")
@@ -72,8 +83,9 @@ class Camera:
     def view_matrix(self) -> np.ndarray:
         """4x4 world -> eye (float64), right-handed, looking down -z."""
         f = self.target - self.eye
-        f = f / np.linalg.norm(f)
-        r = np.cross(f, self.up)
+        f = f / np.abs(f).max()          # unit-size first: no overflow / underflow
+        f /= np.linalg.norm(f)
+        r = np.cross(f, self.up / np.abs(self.up).max())
         r /= np.linalg.norm(r)
         u = np.cross(r, f)
         m = np.eye(4)

@@ -176,3 +176,53 @@ def test_info_json_is_strict_json_with_significant_digits(tmp_path, capsys):
     assert main(["-q", "info", str(src), "--json"]) == 0
     info = json.loads(capsys.readouterr().out, parse_constant=lambda c: pytest.fail(f"non-JSON {c}"))
     assert 7e-20 < info["diagonal"] < 8e-20 and info["spacing"] > 0
+
+
+# ------------------------------------------------------ class 11: wrong messages
+def test_far_eye_is_reported_as_eye_not_as_up(tmp_path, capsys):
+    from splatedit.data import default_model_path
+    assert main(["-q", "render", str(default_model_path()), "-o", str(tmp_path / "x.png"),
+                 "--eye=1e300,0,0"]) == 2
+    line = one_error_line(capsys)
+    assert "'--eye'" in line and "supported magnitude" in line and "--up" not in line
+
+
+def test_tiny_up_vector_is_a_direction(tmp_path, capsys):
+    """|up| = 1e-300 used to underflow into 'parallel to the view direction'."""
+    from splatedit.data import default_model_path
+    assert main(["-q", "render", str(default_model_path()), "-o", str(tmp_path / "x.png"), "--size", "32x32",
+                 "--eye", "3,0,0", "--target", "0,0,0", "--up", "0,1e-300,0"]) == 0
+
+
+def test_far_translation_names_the_move_not_an_untouched_splat(tmp_path, capsys):
+    import json
+    from splatedit.data import default_model_path
+    script = tmp_path / "e.json"
+    script.write_text(json.dumps({"version": 1, "edits": [
+        {"support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},
+         "handle": {"sphere": {"center": [0.0, 0.47, -0.1], "radius": 0.06}},
+         "transform": {"translate": [1e10, 0, 0]}}]}))
+    assert main(["-q", "deform", str(default_model_path()), "--edit", str(script), "-o",
+                 str(tmp_path / "o.ply")]) == 2
+    line = one_error_line(capsys)
+    assert "$.edits[0]" in line and "1e+10 model units" in line and "splat 0" not in line
+
+
+@pytest.mark.parametrize("name,content", [
+    ("f32.ply", "ply\nformat ascii 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                "property float z\nend_header\n0 0 0\n1e155 0 0\n0 1 0\n"),
+    ("big.xyz", "0 0 0\n1e300 0 0\n0 1e300 1\n"),
+    ("i.off", "OFF\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 1e300\n"),
+])
+def test_no_numpy_warning_lines_before_the_error(tmp_path, name, content):
+    """The real process (warnings shown as Python prints them): stderr is
+    the one error line only."""
+    import subprocess
+    import sys
+    path = tmp_path / name
+    path.write_text(content)
+    res = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "info", str(path)],
+                         capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith("splatedit: error: "), res.stderr
