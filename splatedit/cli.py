@@ -195,9 +195,10 @@ def _camera_from_args(args, cloud):
 def cmd_render(args) -> int:
     from splatedit.io import read
     from splatedit.io.atomic import check_writable_target
-    from splatedit.render.headless import render_to_png
+    from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
         raise ParameterError("--buffers", "must differ from the PNG path (-o)")
+    check_render_memory(args.size, args.buffers is not None)    # before reading anything
     for target in (args.output, args.buffers):
         if target is not None:
             check_writable_target(target, overwrite=args.force, protect=args.input)

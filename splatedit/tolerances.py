@@ -446,3 +446,16 @@ CURVE_MAX_SAMPLES_FLOOR = 1024
 #: dot (coverage 0.004 of the image instead of 0.235); 1e-12 is, like
 #: RENDER_CLIP_MIN_RADIUS_REL, 4500 float64 ulps: eye and centre stay distinct
 RENDER_FRAME_MIN_RADIUS_REL = 1e-12
+#: peak memory of `splatedit render` per image pixel (bytes), without and with
+#: --buffers.  Measured (bunny, lavapipe, peak RSS minus the 64x64 run's
+#: 183 MB): 2048x2048 takes 35 B/px, with --buffers 147 B/px; issue 12 saw
+#: 8.6 GB for 16384x16384 (32 B/px) and 9.2 GB for 8192x8192 --buffers
+#: (137 B/px).  A larger image than MemAvailable allows is refused up front
+RENDER_BYTES_PER_PIXEL = 36
+RENDER_BUFFERS_BYTES_PER_PIXEL = 150
+#: a PLY header whose counts need more than this many bytes beyond the file's
+#: size is refused before parsing (400,000,000 declared faces in a 188-byte
+#: file took 26 s and 3.2 GB to fail; now 0.4 s, 68 MB).  Smaller shortfalls
+#: go to the parser, which names the row where the data end (plyfile
+#: allocates the declared rows first: 1 MiB of rows is harmless)
+PLY_DECLARED_EXCESS_BYTES = 2**20

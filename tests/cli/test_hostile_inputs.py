@@ -226,3 +226,43 @@ def test_no_numpy_warning_lines_before_the_error(tmp_path, name, content):
     assert res.returncode == 2
     lines = res.stderr.strip().splitlines()
     assert len(lines) == 1 and lines[0].startswith("splatedit: error: "), res.stderr
+
+
+# ------------------------------------------------------ class 6: memory bombs
+@pytest.mark.parametrize("fmt", ["ascii", "binary_little_endian"])
+def test_ply_declaring_400_million_faces_fails_fast(tmp_path, capsys, fmt):
+    """A 188-byte file declaring 400,000,000 faces took 26 s and 3.2 GB."""
+    import time
+    import tracemalloc
+    path = tmp_path / "bomb.ply"
+    path.write_text(f"ply\nformat {fmt} 1.0\nelement vertex 3\nproperty float x\nproperty float y\n"
+                    "property float z\nelement face 400000000\nproperty list uchar int vertex_indices\n"
+                    "end_header\n0 0 0\n1 0 0\n0 1 0\n3 0 1 2\n")
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        assert main(["-q", "info", str(path)]) == 2
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 2.0 and peak < 50 * 2**20
+    line = one_error_line(capsys)
+    assert str(path) in line and "element 'face'" in line and "400000000" in line
+
+
+@pytest.mark.parametrize("argv", [["--size", "16384x16384"], ["--size", "8192x8192", "--buffers", "BUF"]],
+                         ids=["16384x16384", "8192x8192 --buffers"])
+def test_render_larger_than_available_memory_is_refused_before_reading(tmp_path, capsys, monkeypatch, argv):
+    """With 1 GiB available (patched), such renders are refused at once,
+    before the model is even read (the input here is a FIFO without writer:
+    reading it would hang)."""
+    import os
+    from splatedit.render import headless
+    monkeypatch.setattr(headless, "available_memory", lambda: 2**30)
+    fifo = tmp_path / "in.ply"
+    os.mkfifo(fifo)
+    argv = [a.replace("BUF", str(tmp_path / "b.npz")) for a in argv]
+    assert main(["-q", "render", str(fifo), "-o", str(tmp_path / "x.png"), *argv]) == 2
+    line = one_error_line(capsys)
+    assert "'--size'" in line and "GiB" in line and "1.0 GiB is available" in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["in.ply"]
