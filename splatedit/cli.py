@@ -11,7 +11,9 @@ import contextlib
 import json
 import math
 import os
+import signal
 import sys
+import threading
 import time
 import warnings
 from pathlib import Path
@@ -381,6 +383,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(argv)
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
+    restore = _sigterm_as_interrupt()
     try:
         with warnings.catch_warnings():
             _route_warnings(args.progress)
@@ -404,6 +407,22 @@ def main(argv: list[str] | None = None) -> int:
         return EXIT_BROKEN_PIPE
     finally:
         args.progress.close()
+        restore()
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _sigterm_as_interrupt():
+    """Handle SIGTERM like Ctrl+C (KeyboardInterrupt: temporary files are
+    removed, the target is untouched, exit code 130).  Returns a function
+    that puts the previous handler back (a no-op outside the main thread,
+    where signal handlers cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    return lambda: signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 if __name__ == "__main__":
