@@ -97,6 +97,60 @@ def test_generated_ply_files_keep_the_contract(tmp_path_factory, capsys, data):
         assert not out.exists()
 
 
+# ---------------------------------------------------------- OFF and XYZ text
+@st.composite
+def off_files(draw):
+    kw = draw(st.sampled_from(["OFF", "COFF", "NOFF", "CNOFF", "off", ""]))
+    nv, nf = draw(st.integers(0, 8)), draw(st.integers(0, 4))
+    counts = draw(st.sampled_from([f"{nv} {nf} 0", f"{nv} {nf} 0", f"{nv} {nf}", "1e9 1 0", "inf 1 0", "-1 0 0",
+                                   f"{nv} 99999999999 0"]))
+    rows = [" ".join(draw(st.lists(TOKENS, min_size=0, max_size=8))) for _ in range(draw(st.integers(0, 12)))]
+    # distinct, non-collinear vertices with a generated height
+    good = [f"{i} {(i * i) % 7} {draw(st.floats(-5, 5))!r}" for i in range(nv)]
+    index = st.integers(0, max(nv - 1, 0)) | st.sampled_from([-1, nv, 10 ** 30])
+    fl = [f"3 {draw(index)} {draw(index)} {draw(index)}" for _ in range(nf)]
+    body = draw(st.sampled_from([rows, good + fl, good + fl, good + rows]))
+    return (kw + "\n" + counts + "\n" + "\n".join(body) + "\n").encode()
+
+@st.composite
+def xyz_files(draw):
+    ncol = draw(st.sampled_from([3, 3, 6, 2, 4, 7]))
+    rows = draw(st.integers(0, 30))
+    if draw(st.integers(0, 3)) > 0:      # mostly plausible numbers: most of these read
+        body = "\n".join(" ".join(repr(draw(st.floats(-1e3, 1e3) | st.sampled_from([0.0, 1e14, 1e-300, 5.0])))
+                                  for _ in range(ncol)) for _ in range(rows))
+    else:
+        body = "\n".join(" ".join(draw(st.lists(TOKENS, min_size=1, max_size=7))) for _ in range(rows))
+    return body.encode()
+
+
+@SETTINGS
+@given(content=off_files(), command=st.sampled_from(["info", "convert"]))
+def test_generated_off_files_keep_the_contract(tmp_path_factory, capsys, content, command):
+    _text_file_contract(tmp_path_factory, capsys, content, ".off", command)
+
+
+@SETTINGS
+@given(content=xyz_files(), command=st.sampled_from(["info", "convert"]))
+def test_generated_xyz_files_keep_the_contract(tmp_path_factory, capsys, content, command):
+    _text_file_contract(tmp_path_factory, capsys, content, ".xyz", command)
+
+
+def _text_file_contract(tmp_path_factory, capsys, content: bytes, ext: str, command: str) -> None:
+    d = tmp_path_factory.mktemp("text")
+    path, out = d / f"in{ext}", d / "out.ply"
+    path.write_bytes(content)
+    argv = ["info", str(path), "--json"] if command == "info" else ["convert", str(path), str(out)]
+    code = main(["-q", *argv])
+    captured = capsys.readouterr()
+    event(f"{ext} exit {code}")
+    _check_contract(code, captured.err, path)
+    if code == 0 and command == "info":
+        assert json.loads(captured.out)["splats"] > 0
+    if code == 0 and command == "convert":
+        assert read(out).n > 0
+
+
 # ------------------------------------------------------------- edit scripts
 TEMPLATE = {"version": 1, "solver": {"method": "auto"}, "edits": [
     {"support": {"sphere": {"center": [0, 0, 1], "radius": 0.6}},
