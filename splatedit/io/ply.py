@@ -20,18 +20,16 @@ Written file layout (binary little endian by default)::
 
 from __future__ import annotations
 
-import os
-import warnings
-
 import numpy as np
 import plyfile
 
-from splatedit.errors import InputError, InputWarning
+from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
+from splatedit.io._plycheck import TYPES as _TYPES
+from splatedit.io._plycheck import check_declared_sizes, check_trailing, warn_trailing
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
-from splatedit.tolerances import PLY_DECLARED_EXCESS_BYTES
 
 _NORMALS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
 _COLORS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
@@ -116,11 +114,6 @@ def _faces(lists, n_vertices, path):
 
 
 # ------------------------------------------------------ fast ascii reading
-_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
-          "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
-          "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4", "double": "f8",
-          "float64": "f8"}
-
 
 def _add_property(element, name: str, dtype, path) -> None:
     """Append a property to a parsed header element; a name declared twice is
@@ -204,7 +197,7 @@ def _read_ascii_fast(path, progress):
     if len(tab) < nv + nf_ or nv == 0:
         return None
     if len(tab) > nv + nf_:
-        _warn_trailing(path, f"{len(tab) - nv - nf_} data line(s) from line {int(tab.line[nv + nf_])}",
+        warn_trailing(path, f"{len(tab) - nv - nf_} data line(s) from line {int(tab.line[nv + nf_])}",
                        nv, nf)
     npr = len(vprops)
     if np.any(tab.count[:nv] != npr):
@@ -241,92 +234,6 @@ def _read_ascii_fast(path, progress):
     return vert, (flat, k, fprop)
 
 
-def _warn_trailing(path, what: str, nv: int, nf: int | None) -> None:
-    counts = f"'vertex {nv}'" + ("" if nf is None else f" and 'face {nf}'")
-    warnings.warn(InputWarning(f"{path}: {what} after the rows the header declares ({counts}) "
-                               f"were ignored: is a count in the header wrong?"), stacklevel=3)
-
-
-def _check_trailing(path, ply: plyfile.PlyData) -> None:
-    """Warn when a file read by plyfile holds data after its declared rows
-    (plyfile stops at the declared counts and says nothing)."""
-    try:
-        with open(path, "rb") as fh:
-            data = fh.read(1 << 20) if not ply.text else fh.read()   # binary: the header only
-            total = os.fstat(fh.fileno()).st_size
-    except OSError:
-        return
-    end = data.find(b"end_header")
-    nl = data.find(b"\n", end)
-    if end < 0 or nl < 0:
-        return
-    body = data[nl + 1:]
-    nv = ply["vertex"].count if "vertex" in ply else 0
-    nf = ply["face"].count if "face" in ply else None
-    if ply.text:
-        rows = sum(el.count for el in ply.elements)
-        lines = [i for i, ln in enumerate(body.split(b"\n")) if ln.strip()]
-        if len(lines) > rows:
-            first = data.count(b"\n", 0, nl + 1) + lines[rows] + 1
-            _warn_trailing(path, f"{len(lines) - rows} data line(s) from line {first}", nv, nf)
-        return
-    size = 0
-    for el in ply.elements:
-        for prop in el.properties:
-            col = el.data[prop.name]
-            if isinstance(prop, plyfile.PlyListProperty):
-                items = (col.size if col.dtype != object
-                         else sum(len(r) for r in col))
-                size += (el.count * np.dtype(prop.len_dtype).itemsize
-                         + items * np.dtype(prop.val_dtype).itemsize)
-            else:
-                size += el.count * np.dtype(prop.val_dtype).itemsize
-    if total - (nl + 1) > size:
-        _warn_trailing(path, f"{total - (nl + 1) - size} byte(s)", nv, nf)
-
-
-_SIZES = {"i1": 1, "u1": 1, "i2": 2, "u2": 2, "i4": 4, "u4": 4, "f4": 4, "f8": 8}
-
-
-def _check_declared_sizes(path) -> None:
-    """Refuse a header whose element counts need more bytes than the file
-    holds, before any parsing allocates for them (a 188-byte file declaring
-    400,000,000 faces took 26 s and 3.2 GB to fail).  The least a row can
-    take: ascii, one character and a separator per scalar property and per
-    list length; binary, the scalar sizes and the list length fields.
-    Headers this cannot parse are left to plyfile."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-            total = os.fstat(fh.fileno()).st_size
-    except OSError:
-        return
-    end = head.find(b"end_header")
-    nl = head.find(b"\n", end)
-    if not head.startswith(b"ply") or end < 0 or nl < 0:
-        return
-    fmt, elements = None, []
-    for line in head[:end].decode("ascii", "replace").splitlines()[1:]:
-        w = line.split()
-        if len(w) >= 2 and w[0] == "format":
-            fmt = w[1]
-        elif len(w) == 3 and w[0] == "element" and w[2].isdigit():
-            elements.append([w[1], int(w[2]), 0])
-        elif elements and len(w) == 3 and w[0] == "property" and w[1] in _TYPES:
-            elements[-1][2] += 2 if fmt == "ascii" else _SIZES[_TYPES[w[1]]]
-        elif elements and len(w) == 5 and w[0] == "property" and w[1] == "list" and w[2] in _TYPES:
-            elements[-1][2] += 2 if fmt == "ascii" else _SIZES[_TYPES[w[2]]]
-    body = total - (nl + 1)
-    need = 0
-    for name, count, row in elements:
-        need += count * row
-        # small shortfalls are left to the parser, which names the row where the data end
-        if need > body and need - body > PLY_DECLARED_EXCESS_BYTES:
-            raise InputError(f"header declares {count} rows of element {name!r}, at least "
-                             f"{need} bytes of data, but the file has {body} bytes after its "
-                             f"header (truncated, or a wrong count)", path=str(path), element=name)
-
-
 def read_ply(path, *, progress=None) -> SplatCloud:
     """Read a PLY point cloud, splat cloud or mesh.
 
@@ -337,7 +244,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         InputError: naming the file and, where known, element/row/property.
     """
     report(progress, "reading", 0.0)
-    _check_declared_sizes(path)
+    check_declared_sizes(path)
     fast = _read_ascii_fast(path, progress)
     if fast is not None:
         data, face_lists = fast
@@ -345,7 +252,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         ply = _load(path)
         if "vertex" not in ply:
             raise InputError("no 'vertex' element", path=str(path))
-        _check_trailing(path, ply)
+        check_trailing(path, ply)
         data = ply["vertex"].data
         face_lists = _face_lists(ply, path)
     report(progress, "reading", 0.5)
