@@ -266,3 +266,18 @@ def test_render_larger_than_available_memory_is_refused_before_reading(tmp_path,
     line = one_error_line(capsys)
     assert "'--size'" in line and "GiB" in line and "1.0 GiB is available" in line
     assert sorted(p.name for p in tmp_path.iterdir()) == ["in.ply"]
+
+
+@pytest.mark.skipif(hasattr(__import__("os"), "geteuid") and __import__("os").geteuid() == 0,
+                    reason="root writes into read-only folders")
+@pytest.mark.parametrize("sub", ["", "new"], ids=["read-only folder", "under a read-only folder"])
+def test_demo_into_a_read_only_folder_is_one_line(tmp_path, capsys, sub):
+    ro = tmp_path / "ro"
+    ro.mkdir()
+    ro.chmod(0o555)
+    try:
+        assert main(["-q", "demo", "--no-render", "-o", str(ro / sub) if sub else str(ro)]) == 2
+        line = one_error_line(capsys)
+        assert str(ro) in line
+    finally:
+        ro.chmod(0o755)
