@@ -7,16 +7,23 @@ to stderr and exits with code 2, without a traceback.
 from __future__ import annotations
 
 import argparse
+import contextlib
 import json
+import math
 import os
+import signal
 import sys
+import threading
 import time
+import warnings
 from pathlib import Path
 
 from splatedit.app.options import parse_size, positive_float
-from splatedit.errors import ParameterError, SplatEditError
+from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
+#: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
+EXIT_BROKEN_PIPE = 141
 
 
 # ------------------------------------------------------------------ progress
@@ -58,6 +65,14 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
 
 
 # ------------------------------------------------------------------ commands
+def _sig(x, digits: int = 7) -> float | None:
+    """``x`` rounded to ``digits`` significant digits (not decimals: a model
+    in units of 1e-20 keeps its figures); None for NaN or infinity, which
+    JSON cannot hold."""
+    x = float(x)
+    return float(f"{x:.{digits}g}") if math.isfinite(x) else None
+
+
 def cmd_info(args) -> int:
     import numpy as np
     from splatedit.io import read
@@ -72,13 +87,13 @@ def cmd_info(args) -> int:
         "splats": cloud.n,
         "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
         "colors": cloud.colors is not None,
-        "bounds_min": lo.round(6).tolist(),
-        "bounds_max": hi.round(6).tolist(),
-        "diagonal": round(cloud.diagonal, 6),
-        "spacing": round(point_spacing(cloud.positions), 6),
-        "splat_radius_median": round(float(np.median(radii)), 6),
-        "splat_radius_max": round(float(radii.max()), 6),
-        "splat_radius_max_rel_median": round(quality.radius_max_rel_median, 3),
+        "bounds_min": [_sig(x) for x in lo],
+        "bounds_max": [_sig(x) for x in hi],
+        "diagonal": _sig(cloud.diagonal),
+        "spacing": _sig(point_spacing(cloud.positions)),
+        "splat_radius_median": _sig(np.median(radii)),
+        "splat_radius_max": _sig(radii.max()),
+        "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
         "boundary_splats": quality.boundary_count,
         "outliers": quality.outliers.count,
         "outliers_statistical": int(quality.outliers.statistical.sum()),
@@ -86,7 +101,7 @@ def cmd_info(args) -> int:
         "stray_cluster_points": int(quality.stray_clusters.sum()),
     }
     if args.json:
-        print(json.dumps(info))
+        print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
     else:
         width = max(map(len, info))
         for k, v in info.items():
@@ -95,9 +110,8 @@ def cmd_info(args) -> int:
 
 
 def cmd_convert(args) -> int:
-    from splatedit.io import read, write
-    from splatedit.io.atomic import check_writable_target
-    check_writable_target(args.output, overwrite=args.force, protect=args.input)
+    from splatedit.io import check_output_path, read, write
+    check_output_path(args.output, overwrite=args.force, protect=args.input)
     cloud = read(args.input, progress=args.progress)
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
@@ -147,9 +161,9 @@ def _run_edits(args, cloud, script_path):
 
 
 def cmd_deform(args) -> int:
-    from splatedit.io import read, write
-    from splatedit.io.atomic import check_writable_target
-    check_writable_target(args.output, overwrite=args.force, protect=args.input)
+    from splatedit.io import check_output_path, check_readable_file, read, write
+    check_output_path(args.output, overwrite=args.force, protect=args.input)
+    check_readable_file(args.edit)
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)
@@ -160,17 +174,21 @@ def cmd_deform(args) -> int:
 
 def _camera_from_args(args, cloud):
     """The camera of ``splatedit render``: framing the model, then the flags override."""
+    import numpy as np
     from splatedit.render.camera import Camera
     w, h = args.size
     lo, hi = cloud.bounds()
-    base = Camera.frame(lo, hi, aspect=w / h)
+    rmax = float(cloud.radii.max())       # frames a single point by its splat
+    # all centres in one point: look at the splat face-on (from +z it may be edge-on)
+    direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
+    base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)
     if args.fov is not None and not 0.0 < args.fov < 179.0:
         raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
     fov = base.fov_deg if args.fov is None else args.fov
     if args.eye is None and args.target is None and args.up is None and args.fov is None:
         return base
     if args.eye is None and args.fov is not None and args.target is None and args.up is None:
-        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov)
+        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov, min_radius=rmax, direction=direction)
     target = base.target if args.target is None else args.target
     eye = base.eye if args.eye is None else args.eye
     up = base.up if args.up is None else args.up
@@ -183,9 +201,10 @@ def _camera_from_args(args, cloud):
 def cmd_render(args) -> int:
     from splatedit.io import read
     from splatedit.io.atomic import check_writable_target
-    from splatedit.render.headless import render_to_png
+    from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
         raise ParameterError("--buffers", "must differ from the PNG path (-o)")
+    check_render_memory(args.size, args.buffers is not None)    # before reading anything
     for target in (args.output, args.buffers):
         if target is not None:
             check_writable_target(target, overwrite=args.force, protect=args.input)
@@ -278,8 +297,20 @@ def cmd_bench(args) -> int:
 
 
 # ------------------------------------------------------------------- parser
+class _Parser(argparse.ArgumentParser):
+    """argparse with the one-line error contract: ``splatedit: error: render:
+    argument --size: ...`` on stderr and exit code 2, no usage block (``-h``
+    still prints the usage).  Sub-command parsers inherit the class."""
+
+    def error(self, message: str):
+        sub = self.prog.split(" ", 1)[1] if " " in self.prog else ""
+        where = f"{sub}: " if sub else ""
+        hint = f" (see 'splatedit {sub + ' ' if sub else ''}-h')"
+        self.exit(EXIT_BAD_INPUT, f"splatedit: error: {where}{message}{hint}\n")
+
+
 def build_parser() -> argparse.ArgumentParser:
-    p = argparse.ArgumentParser(prog="splatedit", description=__doc__.split("\n")[0])
+    p = _Parser(prog="splatedit", description=__doc__.split("\n")[0])
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
     sub = p.add_subparsers(dest="command")
 
@@ -337,13 +368,32 @@ def build_parser() -> argparse.ArgumentParser:
     return p
 
 
+def _route_warnings(progress: _Progress) -> None:
+    """Inside ``warnings.catch_warnings()``: an :class:`InputWarning` (input
+    partly ignored) is printed as one line ``splatedit: warning: ...``; numpy's
+    RuntimeWarnings (overflow in a cast, ...) are not for the user, whose
+    problems get their own message."""
+    def show(message, category, filename, lineno, file=None, line=None):
+        progress.close()
+        print(f"splatedit: warning: {message}", file=sys.stderr, flush=True)
+
+    warnings.simplefilter("ignore", RuntimeWarning)
+    warnings.simplefilter("always", InputWarning)
+    warnings.showwarning = show
+
+
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
     args = parser.parse_args(argv)
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
+    restore = _sigterm_as_interrupt()
     try:
-        return func(args) or 0
+        with warnings.catch_warnings():
+            _route_warnings(args.progress)
+            code = func(args) or 0
+        sys.stdout.flush()      # a closed pipe fails here, not in Python's exit flush
+        return code
     except SplatEditError as exc:
         args.progress.close()
         print(f"splatedit: error: {exc}", file=sys.stderr)
@@ -352,8 +402,31 @@ def main(argv: list[str] | None = None) -> int:
         args.progress.close()
         print("splatedit: interrupted", file=sys.stderr)
         return 130
+    except BrokenPipeError:
+        # the reader of stdout went away (``splatedit info x.ply | head -1``):
+        # stop quietly, and keep Python's exit flush from failing again
+        with contextlib.suppress(OSError, ValueError, AttributeError):
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())
+        return EXIT_BROKEN_PIPE
     finally:
         args.progress.close()
+        restore()
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _sigterm_as_interrupt():
+    """Handle SIGTERM like Ctrl+C (KeyboardInterrupt: temporary files are
+    removed, the target is untouched, exit code 130).  Returns a function
+    that puts the previous handler back (a no-op outside the main thread,
+    where signal handlers cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    return lambda: signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 if __name__ == "__main__":

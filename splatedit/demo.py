@@ -11,6 +11,7 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
+from splatedit.errors import InputError
 from splatedit.script import parse_script
 
 #: The demo's edit script, in model coordinates of the bundled bunny
@@ -40,7 +41,14 @@ def run_demo(output_dir: Path, *, progress=None, log=print, render: bool = True,
     from splatedit.io.atomic import check_writable_target
     from splatedit.script import run_script
 
-    output_dir.mkdir(parents=True, exist_ok=True)
+    if output_dir.exists() and not output_dir.is_dir():
+        raise InputError("is not a directory (demo -o names the folder for its results)",
+                         path=str(output_dir))
+    try:
+        output_dir.mkdir(parents=True, exist_ok=True)
+    except OSError as exc:     # under a file, read-only, name too long
+        raise InputError(f"cannot create the output folder: {exc.strerror or exc}",
+                         path=str(output_dir)) from None
     out_ply = output_dir / "bunny-demo.ply"
     out_json = output_dir / "bunny-demo.json"
     for p in (out_ply, out_json):

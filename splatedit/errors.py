@@ -65,3 +65,9 @@ class ParameterError(SplatEditError):
 
 class SolverError(SplatEditError):
     """The deformation could not be fitted (for example an empty band)."""
+
+
+class InputWarning(UserWarning):
+    """Input that was read, but not all of it (e.g. rows after the counts a
+    PLY header declares).  Issued with :func:`warnings.warn`; the CLI prints
+    it as one line ``splatedit: warning: ...``.  The message names the file."""

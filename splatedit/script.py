@@ -55,7 +55,7 @@ import numpy as np
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.select.regions import Box, Indices, Region, Sphere
-from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL
+from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL, MAX_COORDINATE_ABS, MAX_SCRIPT_BYTES
 
 SCRIPT_VERSION = 1
 METHODS = ("auto", "iqr", "lu")
@@ -219,9 +219,14 @@ class _Ctx:
     def number(self, value, jp: str, *, positive: bool = False, nonnegative: bool = False) -> float:
         if isinstance(value, bool) or not isinstance(value, (int, float)):
             raise self.fail(jp, f"must be a number, got {_kind(value)}")
-        x = float(value)
+        try:
+            x = float(value)
+        except OverflowError:       # an integer literal like 10**400
+            x = math.inf
         if not math.isfinite(x):
-            raise self.fail(jp, "must be finite")
+            raise self.fail(jp, f"must be finite, got {x}" + (" (beyond 1.8e308)" if isinstance(value, int) else ""))
+        if abs(x) > MAX_COORDINATE_ABS:
+            raise self.fail(jp, f"{x:.6g} is beyond the supported magnitude {MAX_COORDINATE_ABS:g}")
         if positive and x <= 0:
             raise self.fail(jp, f"must be > 0, got {x:g}")
         if nonnegative and x < 0:
@@ -431,15 +436,50 @@ def load_script(path: str | Path) -> EditScript:
     """Read and validate an edit script file (errors name the file and JSON path)."""
     p = Path(path)
     try:
-        text = p.read_text(encoding="utf-8")
-    except OSError as exc:
-        raise EditScriptError(f"cannot read: {exc.strerror or exc}", path=str(p)) from None
+        if not p.is_file():     # a FIFO would block, a directory cannot be read
+            raise EditScriptError("not a regular file" if p.exists() else "cannot read: No such file or directory",
+                                  path=str(p))
+        raw = read_limited(p, MAX_SCRIPT_BYTES)
+    except (OSError, ValueError) as exc:     # ValueError: a NUL byte in the name
+        raise EditScriptError(f"cannot read: {getattr(exc, 'strerror', None) or exc}", path=str(p)) from None
+    if raw is None:
+        raise EditScriptError(f"larger than {MAX_SCRIPT_BYTES // 2**20} MiB: not an edit script",
+                              path=str(p))
     try:
-        data = json.loads(text)
+        text = raw.decode("utf-8")
+    except UnicodeDecodeError as exc:
+        line = raw.count(b"\n", 0, exc.start) + 1
+        raise EditScriptError(f"not UTF-8 text: byte 0x{raw[exc.start]:02x} at offset {exc.start} "
+                              f"(line {line})", path=str(p)) from None
+    return parse_script(decode_json(text, str(p)), source=str(p))
+
+
+def _int_or_float(digits: str):
+    """JSON integer literals: Python ints up to 18 digits, longer ones as
+    floats (inf beyond 1e308), so int('9' * 5000)'s ValueError and
+    float(10**400)'s OverflowError cannot happen; number checks then name
+    the JSON path."""
+    return int(digits) if len(digits.lstrip("-")) <= 18 else float(digits)
+
+
+def decode_json(text: str, source: str | None = None):
+    """``json.loads`` with errors as :class:`EditScriptError`: syntax errors
+    with line and column, nesting too deep for Python's recursion limit."""
+    try:
+        return json.loads(text, parse_int=_int_or_float)
     except json.JSONDecodeError as exc:
         raise EditScriptError(f"invalid JSON at line {exc.lineno} column {exc.colno}: {exc.msg}",
-                              path=str(p)) from None
-    return parse_script(data, source=str(p))
+                              path=source) from None
+    except RecursionError:
+        raise EditScriptError("invalid JSON: nested too deeply", path=source) from None
+
+
+def read_limited(path: Path, limit: int) -> bytes | None:
+    """The file's bytes, or None when it holds more than ``limit`` bytes (read
+    no further: a FIFO or /dev/zero must not fill the memory)."""
+    with open(path, "rb") as fh:
+        data = fh.read(limit + 1)
+    return None if len(data) > limit else data
 
 
 # -------------------------------------------------------------------- running
@@ -584,6 +624,7 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
         EditScriptError: bad regions/curves, or a fit that failed (JSON path of the edit).
     """
     from splatedit.deform.basis import DeformationBasis
+    from splatedit.deform.constraints import CurveSamplesError
 
     r = resolve_edit_inputs(cloud, edit, source)
     try:
@@ -593,9 +634,28 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
                                      max_centers=solver.max_centers, fill_holes=r.fill_holes,
                                      progress=progress)
         d_c = basis.displacement(r.inputs)
+    except CurveSamplesError as exc:
+        jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")
+        raise EditScriptError(str(exc).split(": ", 1)[1], json_path=jp, path=source) from None
     except SplatEditError as exc:
         raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
     return r, basis, d_c
+
+
+def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
+    """Why committing an edit failed validation.  A splat inside the support
+    was squashed by the deformation; a splat outside it was not touched, so
+    the model as a whole became too large for it (splat axes must be longer
+    than MIN_AXIS_LENGTH_REL of the diagonal) or beyond MAX_COORDINATE_ABS:
+    say how far the edit moves things instead of blaming that splat."""
+    row = exc.row
+    if row is not None and row in set(np.asarray(basis.indices).tolist()):
+        return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
+                "use a milder transform")
+    move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
+    return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
+            f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
+            f"({exc.reason}); use a milder transform")
 
 
 def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
@@ -615,8 +675,7 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         try:   # commit validates: an extreme edit must not write an unreadable model
             new = basis.commit(cloud, d_c)
         except InputError as exc:
-            raise EditScriptError(f"the edit makes splats degenerate ({exc.reason}, splat "
-                                  f"{exc.row}); use a milder transform", json_path=edit.json_path,
+            raise EditScriptError(_degenerate_message(cloud, basis, d_c, exc), json_path=edit.json_path,
                                   path=source) from None
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         i_sup = basis.indices

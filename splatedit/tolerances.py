@@ -224,8 +224,6 @@ RENDER_CAMERA_MIN_UP_SINE = 1e-12
 #: Camera.clip_range: the bounding-sphere radius is at least this times
 #: max(1, eye distance), so that a single point still gets near < far
 RENDER_CLIP_MIN_RADIUS_REL = 1e-12
-#: Camera.frame: smallest bounding-sphere radius framed (model units; a single point)
-RENDER_FRAME_MIN_RADIUS = 1e-9
 #: Camera.frame: distance so that the bounding sphere fits the view, times this
 RENDER_FRAME_MARGIN = 1.05
 #: default vertical field of view, degrees
@@ -441,3 +439,42 @@ STRAY_CLUSTER_MAX_REL = 0.005
 #: apart with values 1 apart give 4.7 / 0.067 (their QR tail norm says 0)
 RESIDUAL_NOTE_MIN = 1e-9
 RESIDUAL_NOTE_FACTOR = 100.0
+
+# --- hostile inputs (issue 12) ----------------------------------------------
+#: largest |value| of a coordinate, normal component, radius or splat axis
+#: accepted from a file or in a SplatCloud.  Coordinates near 1e155 made the
+#: k-d tree's squared distances overflow (IndexError in normal estimation) and
+#: a radius of 1e160 gave NaN normals (|u x v| = 1e320); the fitting code takes
+#: up to 4th powers of coordinates (1e60 here, far inside float64).  1e15 is
+#: the float64 limit of a unit step (53-bit mantissa: 2^53 = 9.0e15), i.e.
+#: 1e9 km in millimetres: no real scan comes near it
+MAX_COORDINATE_ABS = 1e15
+#: largest edit script read (bytes).  The demo script is 0.6 kB and a curve of
+#: 10,000 picked points about 0.5 MB; a larger file is not a script (and
+#: reading stops there instead of filling the memory from /dev/zero)
+MAX_SCRIPT_BYTES = 16 * 2**20
+#: a curve may have at most max(number of splats, this) samples (given or one
+#: per point spacing).  Kept samples are over free splats at least a spacing
+#: apart, so more than one per splat adds nothing; "samples": 10000000 ran 37 s
+#: into a MemoryError and a curve point at 1e9 asked for 1.25 TiB.  The floor
+#: keeps curves over small test clouds (a few hundred splats) legal
+CURVE_MAX_SAMPLES_FLOOR = 1024
+#: Camera.frame: smallest bounding-sphere radius framed, relative to the
+#: largest coordinate of the box centre (a single point with no splat size
+#: given).  Replaces an absolute 1e-9 that framed a bunny scaled by 1e-10 as a
+#: dot (coverage 0.004 of the image instead of 0.235); 1e-12 is, like
+#: RENDER_CLIP_MIN_RADIUS_REL, 4500 float64 ulps: eye and centre stay distinct
+RENDER_FRAME_MIN_RADIUS_REL = 1e-12
+#: peak memory of `splatedit render` per image pixel (bytes), without and with
+#: --buffers.  Measured (bunny, lavapipe, peak RSS minus the 64x64 run's
+#: 183 MB): 2048x2048 takes 35 B/px, with --buffers 147 B/px; issue 12 saw
+#: 8.6 GB for 16384x16384 (32 B/px) and 9.2 GB for 8192x8192 --buffers
+#: (137 B/px).  A larger image than MemAvailable allows is refused up front
+RENDER_BYTES_PER_PIXEL = 36
+RENDER_BUFFERS_BYTES_PER_PIXEL = 150
+#: a PLY header whose counts need more than this many bytes beyond the file's
+#: size is refused before parsing (400,000,000 declared faces in a 188-byte
+#: file took 26 s and 3.2 GB to fail; now 0.4 s, 68 MB).  Smaller shortfalls
+#: go to the parser, which names the row where the data end (plyfile
+#: allocates the declared rows first: 1 MiB of rows is harmless)
+PLY_DECLARED_EXCESS_BYTES = 2**20

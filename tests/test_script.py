@@ -105,6 +105,14 @@ BAD_SCRIPTS = [
     (["edits", 2, "curves", 1, "samples"], 2.5, "$.edits[2].curves[1].samples", "integer >= 2"),
     (["edits", 2, "curves", 1, "knots"], [0, 1], "$.edits[2].curves[1].knots", "unknown key"),
     (["edits", 3, "curves", 0], [[0, 0, 0]], "$.edits[3].curves[0]", "must be an object"),
+    # issue 12 class 5: numbers beyond what a model can hold, named by path
+    (["edits", 0, "transform", "translate", 0], 10 ** 400, "$.edits[0].transform.translate[0]", "finite"),
+    (["edits", 0, "transform", "translate", 1], -1e300, "$.edits[0].transform.translate[1]",
+     "beyond the supported magnitude"),
+    (["edits", 0, "transform", "rotate", "axis"], [1e308, 1e308, 0], "$.edits[0].transform.rotate.axis[0]",
+     "beyond the supported magnitude"),
+    (["edits", 2, "curves", 0, "points", 1], [1e20, 0, 0], "$.edits[2].curves[0].points[1][0]",
+     "beyond the supported magnitude"),
 ]
 
 
@@ -238,3 +246,65 @@ def test_edit_that_makes_splats_degenerate_is_refused_with_its_json_path():
          "handle": {"sphere": {"center": [0, 0, 1], "radius": 0.3}}, "transform": {"scale": 1e-9}}]}
     with pytest.raises(EditScriptError, match=r"\$\.edits\[0\]: the edit makes splats degenerate"):
         run_script(cloud, parse_script(doc))
+
+
+# ------------------------------------------- issue 12 class 5: hostile script files
+HOSTILE_SCRIPT_FILES = [
+    # (id, file bytes, expected substrings of the error)
+    ("10^400 integer literal", b'{"version": 1, "edits": [{"support": {"indices": [1' + b"0" * 400 + b']}}]}',
+     ["$.edits[0].support.indices[0]", "non-negative integer"]),
+    ("5000-digit integer", b'{"version": 1, "edits": [{"support": {"sphere": {"center": [0, 0, 0], "radius": '
+     + b"7" * 5000 + b"}}}]}", ["$.edits[0].support.sphere.radius", "finite"]),
+    ("100,000 nested brackets", b"[" * 100_000 + b"]" * 100_000, ["nested too deeply"]),
+    ("non-UTF-8 bytes", b'{"version": 1, "edits": [\xff\xfe]}', ["not UTF-8", "0xff", "offset 25", "line 1"]),
+]
+
+
+@pytest.mark.parametrize("data,expected", [c[1:] for c in HOSTILE_SCRIPT_FILES],
+                         ids=[c[0] for c in HOSTILE_SCRIPT_FILES])
+def test_hostile_script_file_is_one_edit_script_error(tmp_path, data, expected):
+    path = tmp_path / "edit.json"
+    path.write_bytes(data)
+    with pytest.raises(EditScriptError) as info:
+        load_script(path)
+    msg = str(info.value)
+    assert msg.startswith(f"{path}: ")
+    for sub in expected:
+        assert sub in msg, f"{sub!r} not in {msg!r}"
+
+
+@pytest.mark.parametrize("curve,json_path", [
+    ({"points": [[-0.1, 0.4, -0.05], [0, 0.45, -0.05]], "move": [[0, 0.02, 0]] * 2, "samples": 10_000_000},
+     "$.edits[0].curves[0].samples"),
+    ({"points": [[-0.1, 0.4, -0.05], [1e9, 0, 0]], "move": [[0, 0.02, 0]] * 2}, "$.edits[0].curves[0].points"),
+])
+def test_curve_sample_count_is_bounded_by_the_model_before_allocating(curve, json_path):
+    """"samples": 10^7 ran 37 s to a MemoryError, a point at 1e9 asked for
+    1.25 TiB: both are refused at once, naming the curve."""
+    import time
+    import tracemalloc
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    cloud = read(default_model_path())
+    doc = {"version": 1, "edits": [{"support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},
+                                    "curves": [curve]}]}
+    tracemalloc.start()
+    t0 = time.perf_counter()
+    try:
+        with pytest.raises(EditScriptError) as info:
+            run_script(cloud, parse_script(doc))
+        peak = tracemalloc.get_traced_memory()[1]
+    finally:
+        tracemalloc.stop()
+    assert time.perf_counter() - t0 < 5.0 and peak < 200 * 2**20
+    assert info.value.json_path == json_path and "more than the model can use" in str(info.value)
+
+
+def test_rotation_axis_of_extreme_magnitude_keeps_its_direction():
+    """[1e-200, 1e-200, 0] must rotate about the diagonal (its squared norm underflows)."""
+    from splatedit.deform.transform import rotation_matrix
+    r = rotation_matrix([1e-200, 1e-200, 0], 90.0)
+    ref = rotation_matrix([1.0, 1.0, 0], 90.0)
+    np.testing.assert_allclose(r, ref, atol=1e-15)
+    r = rotation_matrix([1e300, 1e300, 0], 90.0)
+    np.testing.assert_allclose(r, ref, atol=1e-15)

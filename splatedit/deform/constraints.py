@@ -76,7 +76,19 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError, SolverError
 from splatedit.model.spacing import point_spacing
-from splatedit.tolerances import BAND_RINGS, BAND_SLACK_REL, CONFLICT_RINGS, FRAME_MIN_DET_REL
+from splatedit.tolerances import (BAND_RINGS, BAND_SLACK_REL, CONFLICT_RINGS, CURVE_MAX_SAMPLES_FLOOR,
+                                  FRAME_MIN_DET_REL)
+
+
+class CurveSamplesError(SolverError):
+    """A curve asks for more samples than the model can use (see
+    ``CURVE_MAX_SAMPLES_FLOOR``); ``curve`` is its index, ``given`` whether
+    the count was given (else it follows from the curve's length)."""
+
+    def __init__(self, curve: int, given: bool, message: str):
+        super().__init__(message)
+        self.curve = curve
+        self.given = given
 
 
 # ----------------------------------------------------------------- frames
@@ -452,7 +464,15 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
     held = np.flatnonzero(~free)  # outside the support, or in a handle
     held_pts = pos[held]
     previous: list[np.ndarray] = []
+    max_samples = max(len(pos), CURVE_MAX_SAMPLES_FLOOR)
     for i, curve in enumerate(curve_objs):
+        count = curve.sample_count(spacing=h)
+        if count > max_samples:
+            why = ("given" if curve.samples is not None
+                   else f"one per point spacing of {h:.4g} model units along the curve")
+            raise CurveSamplesError(i, curve.samples is not None,
+                                    f"curve {i}: {count:.4g} samples ({why}) are more than the model "
+                                    f"can use: at most {max_samples} (one per splat)")
         t, w, samples = curve.sample(spacing=h)
         d_free, _ = free_tree.query(samples, k=1, workers=-1)
         reach = max(float(d_free.max()), drop_width)

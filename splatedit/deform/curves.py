@@ -258,6 +258,17 @@ class ControlCurve:
         s = np.concatenate([[0.0], np.cumsum(np.linalg.norm(np.diff(c, axis=0), axis=1))])
         return t, s
 
+    def sample_count(self, spacing: float | None = None) -> float:
+        """The number of samples :meth:`sample_parameters` would make
+        (``self.samples``, else ``ceil(length / spacing) + 1``), computed without
+        allocating them; a float (inf for a zero spacing) so a caller can refuse
+        absurd counts first."""
+        if self.samples is not None:
+            return float(self.samples)
+        if spacing is None or not (np.isfinite(spacing) and spacing > 0):
+            return math.inf
+        return max(2.0, math.ceil(self._arc_table()[1][-1] / spacing) + 1.0)
+
     def sample_parameters(self, spacing: float | None = None, count: int | None = None) -> np.ndarray:
         """Parameters ``t_i`` equally spaced in arc length, 0 and 1 included:
         ``count`` of them, else ``self.samples``, else

@@ -48,10 +48,11 @@ def rotation_matrix(axis, degrees: float) -> np.ndarray:
     """(3, 3) rotation by ``degrees`` about the unit direction of ``axis``
     (right-handed, Rodrigues' formula)."""
     a = _vec3("axis", axis)
-    length = float(np.linalg.norm(a))
-    if length == 0.0:
+    big = float(np.abs(a).max())
+    if big == 0.0:
         raise ParameterError("axis", "must be a non-zero vector")
-    k = a / length
+    a = a / big     # scaled first: the norm of [1e308, 1e308, 0] or [1e-200, 0, 1e-200]
+    k = a / float(np.linalg.norm(a))   # would overflow / underflow
     theta = np.deg2rad(_finite("degrees", degrees))
     kx = np.array([[0.0, -k[2], k[1]],
                    [k[2], 0.0, -k[0]],

@@ -19,6 +19,8 @@ file intact.  An existing file is replaced only with ``overwrite=True``.
 
 from __future__ import annotations
 
+import os
+import stat
 from pathlib import Path
 
 from splatedit.errors import InputError
@@ -29,7 +31,8 @@ from splatedit.io.xyz import read_xyz, write_xyz
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
 
-__all__ = ["read", "write", "convert", "READ_EXTENSIONS", "WRITE_EXTENSIONS"]
+__all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "READ_EXTENSIONS",
+           "WRITE_EXTENSIONS"]
 
 _READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_xyz,
             ".off": read_off}
@@ -60,9 +63,32 @@ def read(path, *, progress=None) -> SplatCloud:
         InputError: unknown extension, unreadable or malformed file.
     """
     reader = _READERS[_ext(path, READ_EXTENSIONS, "reading")]
-    if Path(path).is_dir():
-        raise InputError("is a directory, not a file", path=str(path))
+    check_readable_file(path)
     return reader(path, progress=progress)
+
+
+def check_readable_file(path) -> None:
+    """Raise :class:`InputError` unless ``path`` is an existing regular file:
+    a directory, a FIFO (reading it would wait forever for a writer), a
+    device, a name too long or with a NUL byte are refused by name."""
+    try:
+        st = os.stat(path)
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=str(path)) from None
+    except ValueError as exc:
+        raise InputError(f"not a usable file name: {exc}", path=repr(str(path))) from None
+    if stat.S_ISDIR(st.st_mode):
+        raise InputError("is a directory, not a file", path=str(path))
+    if not stat.S_ISREG(st.st_mode):
+        raise InputError("is not a regular file (a FIFO, device or socket); splatedit reads files",
+                         path=str(path))
+
+
+def check_output_path(path, *, overwrite: bool, protect=None, extensions=WRITE_EXTENSIONS) -> Path:
+    """Everything about an output path that can be checked before the work:
+    its extension (one of ``extensions``) and :func:`check_writable_target`."""
+    _ext(path, extensions, "writing")
+    return check_writable_target(path, overwrite=overwrite, protect=protect)
 
 
 def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = True,
@@ -79,11 +105,16 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
         the path written.
     Raises:
         InputError: the file exists and ``overwrite`` is False, unsupported
-            extension, missing directory, write failure.
+            extension, missing directory, write failure, or ``cloud`` fails
+            :meth:`SplatCloud.validate` (NaN, values beyond
+            ``MAX_COORDINATE_ABS``, degenerate axes).
     """
     path = Path(path)
     ext = _ext(path, WRITE_EXTENSIONS, "writing")
     check_writable_target(path, overwrite=overwrite)
+    # every file we write must pass our own reader's checks: a cloud whose
+    # arrays were changed in place since construction is checked again
+    cloud.validate()
     report(progress, "writing", 0.0)
     try:
         with atomic_open(path, "wb") as fh:

@@ -11,6 +11,7 @@ from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import estimate_splats
 from splatedit.model.mesh import cloud_from_mesh
+from splatedit.tolerances import MAX_COORDINATE_ABS
 
 
 def _located(message, path, element, row, prop, lines=None) -> InputError:
@@ -23,7 +24,8 @@ def _located(message, path, element, row, prop, lines=None) -> InputError:
 
 
 def check_finite(columns: dict, path, element: str = "vertex", lines=None) -> None:
-    """Raise InputError naming the first row/property holding NaN or inf.
+    """Raise InputError naming the first row/property holding NaN, inf or a
+    value beyond ``MAX_COORDINATE_ABS`` (1e15) in magnitude.
 
     Args:
         columns: property name -> (n,) numeric array.
@@ -31,15 +33,18 @@ def check_finite(columns: dict, path, element: str = "vertex", lines=None) -> No
     """
     first = None
     for name, col in columns.items():
-        bad = ~np.isfinite(col)
+        with np.errstate(invalid="ignore"):
+            bad = ~(np.abs(np.asarray(col, dtype=np.float64)) <= MAX_COORDINATE_ABS)
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
             if first is None or row < first[0]:
                 first = (row, name, col[row])
     if first is not None:
         row, name, val = first
-        what = "NaN" if np.isnan(val) else "infinite"
-        raise _located(f"value is {what}", path, element, row, name, lines)
+        what = ("value is NaN" if np.isnan(val) else "value is infinite" if np.isinf(val) else
+                f"value {float(val):.6g} is beyond the supported magnitude {MAX_COORDINATE_ABS:g} "
+                f"(rescale the model)")
+        raise _located(what, path, element, row, name, lines)
 
 
 def colors_from_columns(cols: list, names: list, path, element: str = "vertex",
@@ -88,7 +93,7 @@ def triangulate(flat, lengths, n_vertices: int, path, element: str = "face",
         InputError naming the polygon row with fewer than 3 vertices or an
         index outside 0..n_vertices-1.
     """
-    flat = np.asarray(flat, dtype=np.int64)
+    flat = np.asarray(flat)
     lengths = np.asarray(lengths, dtype=np.int64)
     m = len(lengths)
     if m == 0:
@@ -100,12 +105,17 @@ def triangulate(flat, lengths, n_vertices: int, path, element: str = "face",
                        row, prop, lines)
     off = np.zeros(m, dtype=np.int64)
     np.cumsum(lengths[:-1], out=off[1:])
-    bad = (flat < 0) | (flat >= n_vertices)
+    # range check on the values as stored (integral floats, uint64): casting
+    # first would wrap 1e300 or 2**63 to a negative int64
+    bad = ~((flat >= 0) & (flat < n_vertices))
     if bad.any():
         pos = int(np.flatnonzero(bad)[0])
         row = int(np.searchsorted(off, pos, side="right") - 1)
-        raise _located(f"vertex index {flat[pos]} out of range 0..{n_vertices - 1}", path,
+        val = flat[pos]
+        shown = f"{float(val):.6g}" if flat.dtype.kind == "f" else str(int(val))
+        raise _located(f"vertex index {shown} out of range 0..{n_vertices - 1}", path,
                        element, row, prop, lines)
+    flat = flat.astype(np.int64)
     if (lengths == 3).all():
         return flat.reshape(-1, 3)
     ntri = lengths - 2

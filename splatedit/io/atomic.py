@@ -1,12 +1,15 @@
 """Atomic file replacement: write to a temporary file beside the target, then rename.
 
 A crash or error half-way never leaves a truncated file where a good one was.
+A temporary file left by a killed process (SIGKILL cannot be caught) is
+recognised by its name and removed on the next write to the same target.
 """
 
 from __future__ import annotations
 
 import contextlib
 import os
+import re
 import tempfile
 from pathlib import Path
 from typing import IO, Iterator
@@ -25,16 +28,31 @@ def check_writable_target(path: str | Path, *, overwrite: bool, protect: str | P
     """
     p = Path(path)
     parent = p.parent if str(p.parent) else Path(".")
-    if not parent.exists():
-        raise InputError("directory does not exist", path=str(parent))
-    if not parent.is_dir():
-        raise InputError("is not a directory", path=str(parent))
-    if p.is_dir():
-        raise InputError("is a directory", path=str(p))
-    if protect is not None and p.exists() and Path(protect).exists() and p.resolve() == Path(protect).resolve() and not overwrite:
-        raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
-    if p.exists() and not overwrite:
-        raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
+    try:
+        if not parent.exists():
+            raise InputError("directory does not exist", path=str(parent))
+        if not parent.is_dir():
+            raise InputError("is not a directory", path=str(parent))
+        if p.is_dir():
+            raise InputError("is a directory", path=str(p))
+        if p.exists() and not p.is_file():
+            raise InputError("is not a regular file (a FIFO, device or socket)", path=str(p))
+        if (protect is not None and p.exists() and Path(protect).exists()
+                and p.resolve() == Path(protect).resolve() and not overwrite):
+            raise InputError("refusing to overwrite the input file (pass overwrite/--force to do so)", path=str(p))
+        if p.exists() and not overwrite:
+            raise InputError("file exists (pass overwrite/--force to replace it)", path=str(p))
+        if not os.access(parent, os.W_OK | os.X_OK):
+            raise InputError("directory is not writable", path=str(parent))
+        # the temporary file's name (see atomic_open) is the longest we create:
+        # a name too long for the file system fails here, before the work
+        os.stat(parent / (_temp_prefix(p) + "x" * 8 + _TEMP_SUFFIX))
+    except FileNotFoundError:
+        pass
+    except OSError as exc:      # a name too long, a loop of links, no permission to look
+        raise InputError(f"cannot write there: {exc.strerror or exc}", path=str(p)) from None
+    except ValueError as exc:   # an embedded NUL byte
+        raise InputError(f"not a usable file name: {exc}", path=repr(str(p))) from None
     return p
 
 
@@ -49,6 +67,54 @@ def _current_umask() -> int:
     except (OSError, ValueError, IndexError):
         pass
     return 0o022
+
+
+_TEMP_SUFFIX = ".tmp"
+
+
+def _temp_prefix(path: Path) -> str:
+    """Our temporary files for ``path``: ``.NAME.PID.RANDOM.tmp`` beside it;
+    the writer's process id tells a stale one (its writer is gone: killed
+    by SIGKILL or a power cut) from one being written right now."""
+    return f".{path.name}.{os.getpid()}."
+
+
+def remove_stale_temporaries(path: str | Path) -> list[Path]:
+    """Delete the temporary files a killed splatedit left beside ``path``:
+    regular files named ``.NAME.PID.RANDOM.tmp`` whose process PID no longer
+    runs.  Others' files and live writers' files are left alone.
+
+    Returns:
+        the paths removed.
+    """
+    p = Path(path)
+    directory = p.parent if str(p.parent) else Path(".")
+    pattern = re.compile(re.escape(f".{p.name}.") + r"(\d+)\.[A-Za-z0-9_]{8}" + re.escape(_TEMP_SUFFIX))
+    removed = []
+    try:
+        candidates = [e for e in os.scandir(directory) if e.name.startswith(f".{p.name}.")]
+    except OSError:
+        return removed
+    for entry in candidates:
+        m = pattern.fullmatch(entry.name)
+        if m is None or not entry.is_file(follow_symlinks=False) or _process_alive(int(m.group(1))):
+            continue
+        with contextlib.suppress(OSError):
+            os.unlink(entry.path)
+            removed.append(Path(entry.path))
+    return removed
+
+
+def _process_alive(pid: int) -> bool:
+    if pid == os.getpid():
+        return True
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except (PermissionError, OverflowError, OSError):
+        return True       # exists (another user's) or cannot tell: keep the file
+    return True
 
 
 @contextlib.contextmanager
@@ -69,8 +135,9 @@ def atomic_open(path: str | Path, mode: str = "wb") -> Iterator[IO]:
         perms = p.stat().st_mode & 0o777
     else:
         perms = 0o666 & ~_current_umask()
+    remove_stale_temporaries(p)
     try:
-        fd, tmp = tempfile.mkstemp(prefix=f".{p.name}.", suffix=".tmp", dir=directory)
+        fd, tmp = tempfile.mkstemp(prefix=_temp_prefix(p), suffix=_TEMP_SUFFIX, dir=directory)
     except OSError as exc:
         raise InputError(f"cannot write: {exc.strerror or exc}", path=str(p)) from None
     try:

@@ -119,10 +119,11 @@ def read_off(path, *, progress=None) -> SplatCloud:
     # faces
     fstart, fcount, fline = tab.start[nv:], tab.count[nv:], tab.line[nv:]
     k = tab.values[fstart] if nf else np.zeros(0)
-    bad = (k != np.floor(k)) | (k < 3) | (fcount < k + 1) | (fcount > k + 5)
+    finite = np.isfinite(k)
+    bad = ~finite | (k != np.floor(k)) | (k < 3) | (fcount < k + 1) | (fcount > k + 5)
     if bad.any():
         row = int(np.flatnonzero(bad)[0])
-        if k[row] != np.floor(k[row]) or k[row] < 3:
+        if not finite[row] or k[row] != np.floor(k[row]) or k[row] < 3:
             msg = f"face vertex count must be an integer >= 3, got {k[row]:g}"
         else:
             msg = f"face line has {fcount[row] - 1} numbers after its count {int(k[row])}"
@@ -138,7 +139,7 @@ def read_off(path, *, progress=None) -> SplatCloud:
         row = int(owner[np.flatnonzero(nonint)[0]])
         raise _error("face vertex index is not an integer", src, int(fline[row]),
                      element="face", row=row)
-    faces = triangulate(flat.astype(np.int64), k, nv, src, "face", "vertex_indices", fline)
+    faces = triangulate(flat, k, nv, src, "face", "vertex_indices", fline)
     return cloud_from_mesh(positions, faces, normals=normals, colors=colors,
                            name=Path(path).name, source=src, progress=progress)
 

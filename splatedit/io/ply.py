@@ -25,6 +25,8 @@ import plyfile
 
 from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
+from splatedit.io._plycheck import TYPES as _TYPES
+from splatedit.io._plycheck import check_declared_sizes, check_trailing, warn_trailing
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
@@ -50,6 +52,8 @@ def _wrap(exc: Exception, path) -> InputError:
         return InputError(f"{where}{exc.message}", path=str(path))
     if isinstance(exc, OSError):
         return InputError(f"cannot read file: {exc.strerror or exc}", path=str(path))
+    if isinstance(exc, ValueError) and "occurs more than once" in str(exc):
+        return InputError(f"header: a property is declared twice ({exc})", path=str(path))
     return InputError(f"malformed PLY file: {exc}", path=str(path))
 
 
@@ -103,22 +107,24 @@ def _faces(lists, n_vertices, path):
         return None
     flat, lengths, prop = lists
     if flat.dtype.kind not in "iu":
-        if flat.dtype.kind == "f" and np.all(flat == np.floor(flat)):
-            flat = flat.astype(np.int64)
-        else:
+        if not (flat.dtype.kind == "f" and np.all(flat == np.floor(flat))):
             raise InputError("vertex indices are not integers", path=str(path),
                              element="face", prop=prop)
     return triangulate(flat, lengths, n_vertices, str(path), "face", prop)
 
 
 # ------------------------------------------------------ fast ascii reading
-_TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2",
-          "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
-          "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4", "double": "f8",
-          "float64": "f8"}
+
+def _add_property(element, name: str, dtype, path) -> None:
+    """Append a property to a parsed header element; a name declared twice is
+    an error (numpy cannot hold two fields of one name, nor can we pick one)."""
+    if any(nm == name for nm, _ in element[2]):
+        raise InputError(f"header: property {name!r} is declared twice", path=str(path),
+                         element=element[0])
+    element[2].append((name, dtype))
 
 
-def _ascii_layout(data: bytes):
+def _ascii_layout(data: bytes, path=None):
     """Header of an ascii PLY that the vectorised reader handles: a ``vertex``
     element of scalar properties, optionally followed by a ``face`` element
     whose only property is the index list.  Returns (body offset, header line
@@ -144,10 +150,10 @@ def _ascii_layout(data: bytes):
         elif w[0] == "element" and len(w) == 3 and w[2].isdigit():
             elements.append((w[1], int(w[2]), []))
         elif w[0] == "property" and elements and len(w) == 3 and w[1] in _TYPES:
-            elements[-1][2].append((w[2], _TYPES[w[1]]))
+            _add_property(elements[-1], w[2], _TYPES[w[1]], path)
         elif (w[0] == "property" and elements and len(w) == 5 and w[1] == "list"
               and w[2] in _TYPES and w[3] in _TYPES):
-            elements[-1][2].append((w[4], None))
+            _add_property(elements[-1], w[4], None, path)
         else:
             return None
     if fmt != "ascii" or not elements or elements[0][0] != "vertex":
@@ -177,7 +183,7 @@ def _read_ascii_fast(path, progress):
             data = fh.read()
     except OSError:
         return None
-    layout = _ascii_layout(data)
+    layout = _ascii_layout(data, path)
     if layout is None:
         return None
     body, nhead, nv, vprops, nf, fprop = layout
@@ -190,6 +196,9 @@ def _read_ascii_fast(path, progress):
     nf_ = nf or 0
     if len(tab) < nv + nf_ or nv == 0:
         return None
+    if len(tab) > nv + nf_:
+        warn_trailing(path, f"{len(tab) - nv - nf_} data line(s) from line {int(tab.line[nv + nf_])}",
+                       nv, nf)
     npr = len(vprops)
     if np.any(tab.count[:nv] != npr):
         return None
@@ -201,6 +210,13 @@ def _read_ascii_fast(path, progress):
             info = np.iinfo(t)
             if not np.all((col == np.floor(col)) & (col >= info.min) & (col <= info.max)):
                 return None
+        elif t == "f4":
+            over = np.isfinite(col) & (np.abs(col) > np.finfo(np.float32).max)
+            if over.any():
+                row = int(np.flatnonzero(over)[0])
+                raise InputError(f"value {col[row]:.6g} does not fit the declared type float "
+                                 f"(float32 holds at most 3.4e+38)", path=str(path),
+                                 element="vertex", row=row, prop=nm)
         vert[nm] = col
     if nf is None:
         return vert, None
@@ -215,7 +231,7 @@ def _read_ascii_fast(path, progress):
     flat = tab.values[fstart[owner] + 1 + (np.arange(int(k.sum())) - kstart[owner])]
     if np.any(flat != np.floor(flat)):
         return None
-    return vert, (flat.astype(np.int64), k, fprop)
+    return vert, (flat, k, fprop)
 
 
 def read_ply(path, *, progress=None) -> SplatCloud:
@@ -228,6 +244,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         InputError: naming the file and, where known, element/row/property.
     """
     report(progress, "reading", 0.0)
+    check_declared_sizes(path)
     fast = _read_ascii_fast(path, progress)
     if fast is not None:
         data, face_lists = fast
@@ -235,6 +252,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         ply = _load(path)
         if "vertex" not in ply:
             raise InputError("no 'vertex' element", path=str(path))
+        check_trailing(path, ply)
         data = ply["vertex"].data
         face_lists = _face_lists(ply, path)
     report(progress, "reading", 0.5)

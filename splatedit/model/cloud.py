@@ -13,7 +13,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.tolerances import MIN_AXIS_LENGTH_REL, MIN_AXIS_SINE
+from splatedit.tolerances import MAX_COORDINATE_ABS, MIN_AXIS_LENGTH_REL, MIN_AXIS_SINE
 
 
 def _as_array(name, value, shape_tail, dtype, source):
@@ -69,7 +69,8 @@ class SplatCloud:
     def validate(self) -> None:
         """Check the invariants; raise :class:`InputError` naming the first bad row.
 
-        Invariants: at least one splat; finite positions and axes; axes longer
+        Invariants: at least one splat; finite positions and axes, at most
+        ``MAX_COORDINATE_ABS`` in magnitude; axes longer
         than ``MIN_AXIS_LENGTH_REL`` of the bounding-box diagonal and not
         parallel; faces index existing splats.
         """
@@ -83,18 +84,24 @@ class SplatCloud:
                 row = int(np.flatnonzero(bad)[0])
                 raise InputError(f"non-finite value {arr[row].tolist()}", path=src,
                                  element="vertex", row=row, prop=nm)
+            big = (np.abs(arr) > MAX_COORDINATE_ABS).any(axis=1)
+            if big.any():
+                row = int(np.flatnonzero(big)[0])
+                raise InputError(f"value {arr[row].tolist()} beyond the supported magnitude "
+                                 f"{MAX_COORDINATE_ABS:g} (rescale the model)", path=src,
+                                 element="vertex", row=row, prop=nm)
         diag = float(np.linalg.norm(self.positions.max(0) - self.positions.min(0)))
         min_len = MIN_AXIS_LENGTH_REL * max(diag, 1e-300)
         lu = np.linalg.norm(self.u, axis=1)
         lv = np.linalg.norm(self.v, axis=1)
         for nm, ln in (("u", lu), ("v", lv)):
-            bad = ln <= min_len
+            bad = ~(ln > min_len)
             if bad.any():
                 row = int(np.flatnonzero(bad)[0])
                 raise InputError(f"degenerate splat axis (length {ln[row]:.3g})", path=src,
                                  element="vertex", row=row, prop=nm)
         sine = np.linalg.norm(np.cross(self.u, self.v), axis=1) / (lu * lv)
-        bad = sine < MIN_AXIS_SINE
+        bad = ~(sine >= MIN_AXIS_SINE)     # NaN-safe: a NaN sine is degenerate too
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
             raise InputError("degenerate splat: axes u and v are parallel", path=src,

@@ -12,8 +12,8 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.tolerances import (RENDER_CAMERA_MIN_UP_SINE, RENDER_CLIP_MARGIN_REL, RENDER_CLIP_MIN_RADIUS_REL,
-                                  RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS,
-                                  RENDER_NEAR_FAR_RATIO)
+                                  RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS_REL,
+                                  RENDER_NEAR_FAR_RATIO, MAX_COORDINATE_ABS)
 
 
 def _vec3(name, value) -> np.ndarray:
@@ -53,11 +53,22 @@ class Camera:
         if not 0.0 < float(fov_deg) < 179.0:
             raise ParameterError("fov_deg", f"must be in (0, 179), got {fov_deg}")
         self.fov_deg = float(fov_deg)
+        for name, vec in (("eye", self.eye), ("target", self.target)):
+            if np.abs(vec).max() > MAX_COORDINATE_ABS:
+                raise ParameterError(name, f"{vec.tolist()} is beyond the supported magnitude "
+                                           f"{MAX_COORDINATE_ABS:g}")
         fwd = self.target - self.eye
-        if np.linalg.norm(fwd) == 0.0:
+        if not np.any(fwd):
             raise ParameterError("target", "must differ from eye")
-        sine_bound = RENDER_CAMERA_MIN_UP_SINE * np.linalg.norm(fwd) * np.linalg.norm(self.up)
-        if np.linalg.norm(np.cross(fwd, self.up)) <= sine_bound:
+        if not np.any(self.up):
+            raise ParameterError("up", "must not be the zero vector")
+        # directions scaled to unit size first: |fwd| of 1e300 or |up| of 1e-300
+        # must not overflow / underflow the test into a false "parallel"
+        f = fwd / np.abs(fwd).max()
+        f /= np.linalg.norm(f)
+        u = self.up / np.abs(self.up).max()
+        u /= np.linalg.norm(u)
+        if np.linalg.norm(np.cross(f, u)) <= RENDER_CAMERA_MIN_UP_SINE:
             raise ParameterError("up", "must not be parallel to the view direction")
         if near is not None and far is not None and not 0.0 < near < far:
             raise ParameterError("near", f"need 0 < near < far, got near={near}, far={far}")
@@ -72,8 +83,9 @@ class Camera:
     def view_matrix(self) -> np.ndarray:
         """4x4 world -> eye (float64), right-handed, looking down -z."""
         f = self.target - self.eye
-        f = f / np.linalg.norm(f)
-        r = np.cross(f, self.up)
+        f = f / np.abs(f).max()          # unit-size first: no overflow / underflow
+        f /= np.linalg.norm(f)
+        r = np.cross(f, self.up / np.abs(self.up).max())
         r /= np.linalg.norm(r)
         u = np.cross(r, f)
         m = np.eye(4)
@@ -107,15 +119,23 @@ class Camera:
     # ----------------------------------------------------------------- framing
     @classmethod
     def frame(cls, bounds_min, bounds_max, aspect: float = 1.0, *, direction=(0.0, 0.0, 1.0),
-              up=(0.0, 1.0, 0.0), fov_deg: float = RENDER_FOV_DEG) -> "Camera":
+              up=(0.0, 1.0, 0.0), fov_deg: float = RENDER_FOV_DEG,
+              min_radius: float = 0.0) -> "Camera":
         """A camera looking at the box centre from ``direction`` (pointing from
         the centre to the eye) at the distance where the box's bounding sphere
-        fits the narrower field of view."""
+        fits the narrower field of view.
+
+        ``min_radius`` (model units): frame at least a sphere this large (pass
+        the largest splat radius, so that a single point or a pile of
+        identical points is framed by its splat).  Without it a degenerate box
+        gets RENDER_FRAME_MIN_RADIUS_REL of its centre's largest coordinate
+        (relative: a model of any scale keeps its size on screen)."""
         lo, hi = _vec3("bounds_min", bounds_min), _vec3("bounds_max", bounds_max)
         if aspect <= 0:
             raise ParameterError("aspect", f"must be positive, got {aspect}")
         c = 0.5 * (lo + hi)
-        r = max(0.5 * float(np.linalg.norm(hi - lo)), RENDER_FRAME_MIN_RADIUS)
+        r = max(0.5 * float(np.linalg.norm(hi - lo)), float(min_radius),
+                RENDER_FRAME_MIN_RADIUS_REL * float(np.abs(c).max()), np.finfo(np.float64).tiny)
         half_v = math.radians(fov_deg) / 2.0
         half_h = math.atan(math.tan(half_v) * aspect)
         dist = r / math.sin(min(half_v, half_h)) * RENDER_FRAME_MARGIN

@@ -13,6 +13,36 @@ from splatedit.io.atomic import atomic_open, check_writable_target
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
+from splatedit.tolerances import RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the system can give without swapping (Linux
+    ``MemAvailable``), or None where that is unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def check_render_memory(size, buffers: bool = False) -> None:
+    """Refuse, before allocating anything, an image that would not fit in the
+    available memory (RENDER_BYTES_PER_PIXEL, RENDER_BUFFERS_BYTES_PER_PIXEL).
+
+    Raises:
+        ParameterError: naming ``--size`` with the estimate and what is free.
+    """
+    w, h = (int(s) for s in size)
+    need = w * h * (RENDER_BUFFERS_BYTES_PER_PIXEL if buffers else RENDER_BYTES_PER_PIXEL)
+    free = available_memory()
+    if free is not None and need > free:
+        what = " with --buffers" if buffers else ""
+        raise ParameterError("--size", f"{w}x{h}{what} needs about {need / 2**30:.1f} GiB of memory, "
+                                       f"only {free / 2**30:.1f} GiB is available; render a smaller image")
 
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
@@ -45,12 +75,17 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         raise ParameterError("size", f"must be (width, height), got {size!r}") from None
     if dC is not None and basis is None:
         raise ParameterError("dC", "given without a basis")
+    check_render_memory((w, h), buffers_path is not None)
     out_png = Path(out_png)
     outputs = [out_png] + ([Path(buffers_path)] if buffers_path is not None else [])
     for out in outputs:
         _prepare_output(out)
     if camera is None:
-        camera = Camera.frame(*cloud.bounds(), aspect=w / h)
+        lo, hi = cloud.bounds()
+        # all centres in one point: look at the splat face-on (from +z it may be edge-on)
+        direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
+        camera = Camera.frame(lo, hi, aspect=w / h, min_radius=float(cloud.radii.max()),
+                              direction=direction)
     with Renderer(device_name=device_name) as r:
         r.set_cloud(cloud)
         if selection is not None:

@@ -243,6 +243,8 @@ class Renderer:
         self._basis_buf = None
         self._dummy_basis = {}
         self.cloud = None
+        self.origin = np.zeros(3)
+        self.scale = 1.0
         self.n = 0
         self._basis_cols = 4
         self._basis_rows = np.zeros(0, dtype=np.int64)
@@ -339,8 +341,10 @@ class Renderer:
         self.n = 0
 
     def set_cloud(self, cloud: SplatCloud) -> None:
-        """Upload a cloud (float32 relative to its bounding-box centre); clears
-        selection and basis."""
+        """Upload a cloud (float32 relative to its bounding-box centre, in units
+        of :attr:`scale`, a power of two near its size, so that a model of
+        any size from 1e-15 to 1e15 renders the same); clears selection and
+        basis."""
         self._check_open()
         if not isinstance(cloud, SplatCloud):
             raise ParameterError("cloud", f"must be a SplatCloud, got {type(cloud).__name__}")
@@ -353,10 +357,13 @@ class Renderer:
         #: undeformed bounds padded by the largest splat radius; near/far come
         #: from these grown by the deformation's reach (:meth:`_clip_bounds`)
         self.bounds = (lo - r.max(), hi + r.max())
+        #: model units per GPU unit: eye space, positions, axes and dC are
+        #: divided by it (an exact power of two), depths multiplied back
+        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), float(r.max()))
         geom = np.empty((n, 9), dtype=np.float32)
-        geom[:, 0:3] = cloud.positions - self.origin
-        geom[:, 3:6] = cloud.u
-        geom[:, 6:9] = cloud.v
+        geom[:, 0:3] = (cloud.positions - self.origin) / self.scale
+        geom[:, 3:6] = cloud.u / self.scale
+        geom[:, 6:9] = cloud.v / self.scale
         colors = cloud.colors if cloud.colors is not None else np.tile(
             np.asarray(RENDER_DEFAULT_COLOR, np.uint8), (n, 1))
         self._geom = V.Buffer(self.dev, geom.nbytes, ("vertex", "storage"))
@@ -459,7 +466,9 @@ class Renderer:
             self._dC = np.zeros((k, 3))
             self._dC_dirty = True
         rows = np.zeros((len(idx), g, 4, 4), dtype=np.float32)
-        for j, a in enumerate(mats):
+        # gradients per GPU unit (positions are divided by scale); B is unitless
+        gpu_mats = [mats[0]] + [a * self.scale for a in mats[1:]]
+        for j, a in enumerate(gpu_mats):
             padded = np.zeros((len(idx), 4 * g))
             padded[:, :k] = a
             rows[:, :, j, :] = padded.reshape(len(idx), g, 4)
@@ -532,7 +541,7 @@ class Renderer:
     def _dC_block(self) -> np.ndarray:
         """dC zero-padded to 16 columns, as rows dC[3g + i] = (dC_{4g..4g+3})[i] (deform.glsl)."""
         pad = np.zeros((4 * _MAX_GROUPS, 3))
-        pad[:len(self._dC)] = self._dC
+        pad[:len(self._dC)] = self._dC / self.scale
         return np.ascontiguousarray(pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1), dtype=np.float32).reshape(-1)
 
     # ---------------------------------------------------------- pipelines
@@ -598,10 +607,16 @@ class Renderer:
     def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         if not isinstance(camera, Camera):
             raise ParameterError("camera", f"must be a Camera, got {type(camera).__name__}")
-        near, far = camera.clip_range(*self._clip_bounds())
-        view = camera.view_matrix()
-        view = view @ _translate(self.origin)       # model stored relative to origin
-        proj = camera.projection_matrix(width / height, near, far)
+        # everything on the GPU is in model units relative to origin, divided
+        # by scale: so is the camera (a similarity: the image is the same)
+        o, sc = self.origin, self.scale
+        gpu_cam = Camera((camera.eye - o) / sc, (camera.target - o) / sc, up=camera.up,
+                         fov_deg=camera.fov_deg, near=None if camera.near is None else camera.near / sc,
+                         far=None if camera.far is None else camera.far / sc)
+        lo, hi = self._clip_bounds()
+        near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
+        view = gpu_cam.view_matrix()
+        proj = gpu_cam.projection_matrix(width / height, near, far)
         p00, p11 = proj[0, 0], proj[1, 1]
         f = np.zeros(_UBO_BYTES // 4, dtype=np.float32)
         f[0:16] = view.T.reshape(-1)
@@ -621,7 +636,7 @@ class Renderer:
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
             self._dC_dirty = False
-        self._near_far = (near, far)
+        self._near_far = (near * sc, far * sc)     # model units
 
     def _use_prepass(self) -> bool:
         if not self.prepass:
@@ -839,7 +854,7 @@ class Renderer:
         fg = w >= RENDER_MIN_WEIGHT
         with np.errstate(invalid="ignore", divide="ignore"):
             color = np.where(fg[..., None], a[..., :3] / w[..., None], np.nan)
-            depth = np.where(fg, b[..., 3] / w, np.nan)
+            depth = np.where(fg, b[..., 3] / w * self.scale, np.nan)
             nrm = b[..., :3] / np.linalg.norm(b[..., :3], axis=-1, keepdims=True)
             nrm = np.where(fg[..., None], nrm, np.nan)
         return {"depth": depth.astype(np.float32), "normal": nrm.astype(np.float32),
@@ -925,7 +940,11 @@ class Renderer:
         return idx, depth
 
 
-def _translate(t) -> np.ndarray:
-    m = np.eye(4)
-    m[:3, 3] = t
-    return m
+def _unit_scale(diagonal: float, max_radius: float) -> float:
+    """The power of two nearest the model's size (its bounding-box diagonal,
+    or its largest splat for a single point): dividing by it is exact, and
+    it brings every model to about unit size for the float32 GPU side."""
+    size = max(diagonal, max_radius)
+    if not (size > 0 and np.isfinite(size)):
+        return 1.0
+    return float(2.0 ** round(float(np.log2(size))))

@@ -11,7 +11,7 @@ import pytest
 import splatedit.render.camera as camera_mod
 from splatedit.errors import ParameterError
 from splatedit.render.camera import Camera
-from splatedit.tolerances import RENDER_CLIP_MIN_RADIUS_REL, RENDER_FRAME_MIN_RADIUS
+from splatedit.tolerances import RENDER_CLIP_MIN_RADIUS_REL, RENDER_FRAME_MIN_RADIUS_REL
 
 
 def test_camera_has_no_tolerance_literals():
@@ -37,7 +37,11 @@ def test_degenerate_bounds_use_the_named_minimum_radii():
     cam = Camera.frame(p, p)                # a single point
     d = float(np.linalg.norm(cam.eye - p))
     assert d > 0 and np.isclose(d * np.sin(np.radians(cam.fov_deg / 2)),
-                                RENDER_FRAME_MIN_RADIUS * camera_mod.RENDER_FRAME_MARGIN)
+                                RENDER_FRAME_MIN_RADIUS_REL * 3.0 * camera_mod.RENDER_FRAME_MARGIN)
     near, far = cam.clip_range(p, p)
     assert 0 < near < far
+    # with the splat radius given, the point is framed by its splat
+    cam = Camera.frame(p, p, min_radius=0.25)
+    d = float(np.linalg.norm(cam.eye - p))
+    assert np.isclose(d * np.sin(np.radians(cam.fov_deg / 2)), 0.25 * camera_mod.RENDER_FRAME_MARGIN)
     assert far - d <= 2 * RENDER_CLIP_MIN_RADIUS_REL * max(1.0, d)
