@@ -26,11 +26,21 @@ def nearest_neighbour_distances(points: np.ndarray, k: int = 1, tree: cKDTree | 
 
 
 def point_spacing(points: np.ndarray, tree: cKDTree | None = None) -> float:
-    """Typical sample spacing: the median nearest-neighbour distance (model units).
+    """Typical sample spacing: the median distance of every point to its
+    nearest point at a *different* position (model units).
 
-    Duplicate points (distance 0) are ignored; returns 0.0 for fewer than 2
-    distinct points.
+    Coincident points (an unwelded triangle soup stores every vertex several
+    times) are looked through: the spacing is that of the distinct
+    positions.  Returns 0.0 for fewer than 2 distinct points.
     """
-    d = nearest_neighbour_distances(points, 1, tree)
-    d = d[d > 0]
-    return float(np.median(d)) if len(d) else 0.0
+    pts = np.asarray(points, dtype=np.float64)
+    if len(pts) < 2:
+        return 0.0
+    d = nearest_neighbour_distances(pts, 1, tree)
+    if (d > 0).mean() >= 0.5:       # the common case: few duplicates
+        d = d[d > 0]
+        return float(np.median(d)) if len(d) else 0.0
+    distinct = np.unique(pts, axis=0)
+    if len(distinct) < 2:
+        return 0.0
+    return float(np.median(nearest_neighbour_distances(distinct, 1)))

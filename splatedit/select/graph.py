@@ -69,7 +69,9 @@ class NeighbourGraph:
         kk = min(k, n - 1)
         d, j = tree.query(pts, k=kk + 1, workers=-1)
         d, j = d[:, 1:], j[:, 1:].astype(np.int32)
-        positive = d[:, 0][d[:, 0] > 0]
+        # the nearest neighbour at a different position (duplicates looked through)
+        first = np.where(d > 0, d, np.inf).min(axis=1)
+        positive = first[np.isfinite(first)]
         spacing = float(np.median(positive)) if len(positive) else 0.0
         scale = np.median(d, axis=1)
         i = np.repeat(np.arange(n, dtype=np.int32), kk)

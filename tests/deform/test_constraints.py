@@ -214,3 +214,25 @@ def test_fixed_duplicate_of_a_handle_splat_is_dropped_and_reported_as_a_conflict
     assert "fixed splats lie within" in con.conflicts[0].describe(con.spacing)
     # the kept constraints have distinct positions, so the fit is well posed
     assert len(np.unique(con.points, axis=0)) == len(con.points)
+
+
+def test_every_point_duplicated_edits_and_the_copies_move_together():
+    """An unwelded triangle soup stores each vertex several times: the spacing
+    is that of the distinct positions, bands and closure work, and the copies
+    of a splat end up at the same place (issue 12, class 4)."""
+    from splatedit.data import default_model_path
+    from splatedit.deform import DeformationBasis, transform
+    from splatedit.io import read
+    from splatedit.model.cloud import SplatCloud
+    from splatedit.model.spacing import point_spacing
+    c = read(default_model_path())
+    n = c.n
+    d = SplatCloud(np.vstack([c.positions] * 2), np.vstack([c.u] * 2), np.vstack([c.v] * 2))
+    assert point_spacing(d.positions) == point_spacing(c.positions) > 0
+    tip = c.positions[np.argmax(c.positions[:, 1])]
+    dist = np.linalg.norm(d.positions - tip, axis=1)
+    basis = DeformationBasis.fit(d, dist < 0.2, [dist < 0.05])
+    out = basis.apply(d, basis.displacement([transform.translate([0.05, 0.0, 0.0])]))
+    moved = np.linalg.norm(out.positions[:n] - c.positions, axis=1) > 0
+    assert moved.sum() > 1000
+    np.testing.assert_allclose(out.positions[:n], out.positions[n:], rtol=0, atol=1e-12)
