@@ -268,7 +268,7 @@ class SelectionTools:
         def work(progress):
             from splatedit.select.graph import NeighbourGraph
             progress("neighbour graph", 0.0)
-            return NeighbourGraph.build(positions)
+            return NeighbourGraph.build(positions).warm()   # its first closure pays nothing more
 
         if self._start_job is None:
             self._store(cloud, work(lambda *a: None))

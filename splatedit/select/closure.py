@@ -380,7 +380,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     else:
         touched = changed.copy()
         touched[back] = True
-        region = _box_region(tree, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
+        region = _box_region(graph, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
         sub = graph.subgraph(region)
         edge = (graph.indptr[region + 1] - graph.indptr[region]) != np.diff(sub.indptr)
     sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], np.ones(len(region), bool), edge)
@@ -430,13 +430,8 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     return ClosureResult(sup, hs, sup & ~sup_in, added_h, counts)
 
 
-def _box_region(tree: cKDTree, pos: np.ndarray, touched: np.ndarray, reach: float) -> np.ndarray:
+def _box_region(graph: NeighbourGraph, pos: np.ndarray, touched: np.ndarray, reach: float) -> np.ndarray:
     """Sorted indices of the splats within the box of ``touched`` grown by
-    ``reach`` (model units), found in the ball around the box (a k-d tree
-    query, so the cost follows the region, not the cloud)."""
+    ``reach`` (model units); the cost follows the box, not the cloud."""
     tp = pos[touched]
-    lo, hi = tp.min(axis=0) - reach, tp.max(axis=0) + reach
-    out = np.asarray(tree.query_ball_point((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2),
-                     dtype=np.int64)
-    inside = np.all((pos[out] >= lo) & (pos[out] <= hi), axis=1)
-    return np.sort(out[inside])
+    return graph.in_box(tp.min(axis=0) - reach, tp.max(axis=0) + reach)
