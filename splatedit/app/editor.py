@@ -738,16 +738,17 @@ class Editor:
                 self.prompt_fresh = False
             return
         if self.confirm_quit:
-            if k in (g.KEY_Y, g.KEY_Q, g.KEY_ESCAPE):
+            if k in (g.KEY_Y, g.KEY_Q):
                 self.running = False
-            else:
+            else:                      # N, Esc or anything else: stay
                 self.confirm_quit = False
+                self.say("quit cancelled")
             return
         if k in (g.KEY_F1, g.KEY_H) and not ctrl:
             self.show_help = not self.show_help
             return
         if s is None:
-            if k in (g.KEY_Q, g.KEY_ESCAPE):
+            if k == g.KEY_Q:           # Esc cancels and never quits
                 self.running = False
             return
         # ---- manipulation in progress
@@ -794,6 +795,9 @@ class Editor:
                 self.selection_tool("shrink")
             elif k == g.KEY_I:
                 self.selection_tool("invert")
+            elif k in (g.KEY_KP_1, g.KEY_KP_3, g.KEY_KP_7):   # Blender's habit: the opposite views
+                self.view_preset(*{g.KEY_KP_1: (math.pi, 0.0), g.KEY_KP_3: (-math.pi / 2, 0.0),
+                                   g.KEY_KP_7: (0.0, math.radians(-89.0))}[k])
             self.motion()
             return
         if k in (g.KEY_G, g.KEY_R, g.KEY_S):
@@ -858,13 +862,13 @@ class Editor:
             self.frame_all()
         elif k in (g.KEY_F, g.KEY_KP_DECIMAL):
             self.frame_selection()
-        elif k == g.KEY_KP_1:
+        elif k == g.KEY_KP_1:                       # (Ctrl: the opposite views, above)
             self.view_preset(0.0, 0.0)
         elif k == g.KEY_KP_3:
             self.view_preset(math.pi / 2, 0.0)
         elif k == g.KEY_KP_7:
             self.view_preset(0.0, math.radians(89.0))
-        elif k in (g.KEY_Q, g.KEY_ESCAPE):
+        elif k == g.KEY_Q:                          # Esc cancels and never quits
             self.request_quit()
         self.motion()
 
@@ -969,7 +973,7 @@ class Editor:
         s = self.session
         if s is not None and s.dirty and not self.confirm_quit:
             self.confirm_quit = True
-            self.say("unsaved changes: press Y (or Q/Esc) to quit without saving, N to stay")
+            self.say("unsaved changes: press Y (or Q) to quit without saving, N or Esc to stay")
         else:
             self.running = False
 

@@ -18,7 +18,7 @@ Camera
   Wheel                  zoom to the cursor
   Home                   frame the whole model
   F  or  numpad .        frame the selection (handle, else support)
-  Numpad 1 / 3 / 7       front / right / top view
+  Numpad 1 / 3 / 7       front / right / top view (Ctrl: back / left / bottom)
 Selection (paper Sect. 3: support = blue, handles = green, the active one brighter)
   Left drag              paint with the brush: 3D, every splat in the sphere under the circle
   V                      brush mode: 3D (front and back) / visible splats only
@@ -62,7 +62,8 @@ File and history
   Ctrl+Shift+S           save as: type a path, Enter
   Ctrl+E                 export only the edit script
   F1  or  H              show / hide this help
-  Q  or  Esc             quit (asks first when there are unsaved changes: Y, Q or Esc again quits, N stays)
+  Q                      quit (asks first when there are unsaved changes: Y or Q again quits, N or Esc stays;
+                         Esc never quits)
 """
 
 

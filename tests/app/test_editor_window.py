@@ -179,13 +179,27 @@ def test_full_edit_session(xvfb, tmp_path):
         ed.xdo("mousemove", gx, gy, "mousedown", "1", "mousemove", gx, int(round(pcy + 1.1 * grip_r)),
                "mousemove", gx, int(round(pcy + 1.25 * grip_r)), "sleep", "0.2", "mouseup", "1")
         s = ed.idle(lambda s: s["edits"] == 5 and s["dirty"], "scale grip edit")
-        # --- unsaved changes: quitting asks first
+        # --- Esc never quits: it cancels (nothing to cancel here) and leaves the window open
+        ed.xdo("key", "Escape")
+        s = ed.idle(lambda s: not s["confirm_quit"], "Esc handled")
+        assert ed.proc.poll() is None and s["running"]
+        # --- unsaved changes: quitting asks first; N or Esc stays
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation")
         time.sleep(0.3)
         assert ed.proc.poll() is None
         ed.xdo("key", "n")
         ed.wait(lambda s: not s["confirm_quit"], "quit cancelled")
+        ed.xdo("key", "q")
+        ed.wait(lambda s: s["confirm_quit"], "quit confirmation (2)")
+        ed.xdo("key", "Escape")
+        ed.wait(lambda s: not s["confirm_quit"], "quit cancelled by Esc")
+        assert ed.proc.poll() is None
+        # --- Ctrl + numpad: the opposite views (Blender's habit)
+        ed.xdo("key", "ctrl+KP_1")
+        ed.idle(lambda s: abs(abs(s["camera"]["yaw"]) - math.pi) < 1e-5, "back view")   # status rounds to 6 digits
+        ed.xdo("key", "ctrl+KP_7")
+        ed.idle(lambda s: s["camera"]["pitch"] < -1.5, "bottom view")
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation again")
         ed.xdo("key", "y")
