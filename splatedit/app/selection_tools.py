@@ -30,7 +30,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.app.brush import HANDLE, SUPPORT, Selection
+from splatedit.app.brush import SUPPORT, Selection
 from splatedit.tolerances import EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
 
 #: brush modes: the 3D sphere brush (default) and the visible-only brush

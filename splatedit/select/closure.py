@@ -48,7 +48,7 @@ from dataclasses import dataclass, field
 import numpy as np
 from scipy.spatial import cKDTree
 
-from splatedit.select.graph import NeighbourGraph, unique_indices
+from splatedit.select.graph import NeighbourGraph
 from splatedit.tolerances import (
     BAND_RINGS,
     CLOSURE_BACK_CONE_COS,
