@@ -478,3 +478,25 @@ RENDER_BUFFERS_BYTES_PER_PIXEL = 150
 #: go to the parser, which names the row where the data end (plyfile
 #: allocates the declared rows first: 1 MiB of rows is harmless)
 PLY_DECLARED_EXCESS_BYTES = 2**20
+
+# --- detail-preserving deformation (splatedit.deform.detail, issue 9) ------
+#: base-surface smoothing sigma in graph spacings (DetailLayer.scale).  The
+#: umbrella diffusion keeps a sinusoid of wavelength L by exp(-2 pi^2 sigma^2 / L^2):
+#: at 5 spacings, relief narrower than ~12 spacings (the bumps of the test
+#: plane: 16-spacing footprint, 95% of their height went to the offsets) is
+#: detail, shapes wider than ~40 spacings (kept 88%) stay in the base, so the
+#: base follows arms and ears of the bunny (~30-60 spacings) but not its fur
+DETAIL_SCALE_SPACINGS = 5.0
+#: umbrella step (fraction of the move to the neighbour mean per iteration);
+#: 0.5 is the usual stable, non-oscillating choice for k-NN umbrella smoothing
+DETAIL_STEP = 0.5
+#: cap on the iterations (sigma^2 / (step <e^2> / 2)); 5 spacings on a k = 10
+#: graph takes ~35 (mean squared edge ~2.9 spacings^2); the cap (sigma ~ 17
+#: spacings) bounds the precompute on a huge scale request
+DETAIL_MAX_ITERATIONS = 400
+#: neighbours of the PCA base normals on the smoothed points (as
+#: NORMAL_NEIGHBOURS: the smoothed surface is smooth at this radius)
+DETAIL_NORMAL_NEIGHBOURS = 16
+#: support rows per chunk of the detail mode's CPU apply (5 (c, 3) float64
+#: temporaries + three (c, K + 3) GEMM inputs: ~10 MB at K = 4)
+DETAIL_APPLY_CHUNK = 65536
