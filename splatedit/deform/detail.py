@@ -144,22 +144,24 @@ def decompose(cloud, index, *, graph: NeighbourGraph | None = None,
     inv = np.where(deg > 0, 1.0 / np.maximum(deg, 1), 0.0)
     p0 = pos[region]
     nrm = _splat_normals(cloud.u[region], cloud.v[region])
-    h = np.zeros(len(region))
     x = p0.copy()
     report(progress, DECOMPOSE_STAGE, 0.0)
     for it in range(iters):
         mean = (a @ x) * inv[:, None]
         move = np.einsum("ij,ij->i", mean - x, nrm)
         move[deg == 0] = 0.0
-        h += DETAIL_STEP * move
-        x = p0 + h[:, None] * nrm
+        x += (DETAIL_STEP * move)[:, None] * nrm
+        # the normal field is diffused alongside (a splat on a bump's flank
+        # ends up moving along the smoothed surface's normal, not its own)
+        nm = nrm + a @ nrm
+        nrm = nm / np.maximum(np.linalg.norm(nm, axis=1, keepdims=True), 1e-300)
         if it % 8 == 7:
             report(progress, DECOMPOSE_STAGE, (it + 1) / iters)
     report(progress, DECOMPOSE_STAGE, 1.0)
     rows = np.searchsorted(region, idx)
     k = min(DETAIL_NORMAL_NEIGHBOURS, len(region))
     nb_ = estimate_normals(x, k=k, tree=cKDTree(x), query=rows) if len(region) >= 3 else nrm[rows]
-    flip = np.einsum("ij,ij->i", nb_, nrm[rows]) < 0
+    flip = np.einsum("ij,ij->i", nb_, nrm[rows]) < 0   # oriented like the smoothed normals
     nb_[flip] *= -1.0
     lam = np.einsum("ij,ij->i", pos[idx] - x[rows], nb_)
     base = pos[idx] - lam[:, None] * nb_
