@@ -2,7 +2,7 @@
 // culling and the screen-space setup of prepare_splat(), written as compact
 // records for the two splat passes (drawn by prepared.vert with indirect
 // draws): quads fill slots 0.. upwards, square points slots n-1 downwards.
-// The including file defines BASIS_GROUPS.
+// The including file defines BASIS_GROUPS (and DETAIL for the detail mode).
 
 #include "frame.glsl"
 #define DEFORM_BINDING 8
@@ -33,6 +33,10 @@ layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };           
 
 #include "splat_math.glsl"
 #include "distortion.glsl"
+#ifdef DETAIL
+#define DETAIL_BINDING 9
+#include "detail.glsl"
+#endif
 
 // bound corner in pixels, 16.16 -> 12.4 fixed point (1/16 pixel), rounded outwards
 uint pack_px(vec2 ndc, float dir) {
@@ -68,9 +72,13 @@ void main() {
             for (int g = 0; g < BASIS_GROUPS; ++g)
                 deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
                              dp, Jm);
+#ifdef DETAIL
+            detail_attach(detail[i], dp, Jm, p, u, v);
+#else
             p += dp;
             u += Jm * u;
             v += Jm * v;
+#endif
         }
         vec3 srgb = unpackUnorm4x8(colors[i]).rgb;
         kind = prepare_splat(p, u, v, srgb, fl, S);

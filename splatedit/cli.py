@@ -247,12 +247,13 @@ def _gpu_edit(args, cloud):
         print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
               file=sys.stderr)
     from splatedit.deform.distortion import basis_distortion
-    dist = basis_distortion(basis, cloud, d_c)
+    detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
+    dist = basis.distortion(cloud, d_c) if detail else basis_distortion(basis, cloud, d_c)
     print(f"  distortion: {dist.summary()}")
     if dist.exceeds_warn:
         print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
               f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
-    return cloud, basis.rows_for_gpu(), d_c
+    return cloud, basis.rows_for_gpu() + ((detail(),) if detail else ()), d_c
 
 
 def cmd_demo(args) -> int:

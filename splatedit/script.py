@@ -8,7 +8,8 @@ Format (version 1)::
        {"support": REGION,
         "handle": REGION,                    # or "handles": [REGION, ...]
         "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
-        "curves": [CURVE, ...]}]}            # optional; see below
+        "curves": [CURVE, ...],              # optional; see below
+        "deformation": "linear"|"rotation"|"detail"}]}   # optional, default "linear"
 
     REGION    = {"sphere": {"center": [x,y,z], "radius": r}}      (a support region may add
                                                                 "fill_holes": false)
@@ -53,6 +54,7 @@ from typing import Any, Callable
 import numpy as np
 
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
+from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL, MAX_COORDINATE_ABS, MAX_SCRIPT_BYTES
@@ -126,6 +128,8 @@ class Edit:
     #: close the selection before fitting (``"fill_holes": false`` on the
     #: support region turns it off; see splatedit.select.closure)
     fill_holes: bool = True
+    #: the deformation model (key ``"deformation"``; splatedit.deform.modes)
+    deformation: DeformationMode = DeformationMode.LINEAR
 
 
 @dataclass(frozen=True)
@@ -187,6 +191,8 @@ class EditScript:
                 item["transforms"] = [transform(t) for t in e.transforms]
             if e.curves:
                 item["curves"] = [curve(c) for c in e.curves]
+            if e.deformation is not DeformationMode.LINEAR:
+                item["deformation"] = e.deformation.value
             edits.append(item)
         return {"version": SCRIPT_VERSION, "solver": solver, "edits": edits}
 
@@ -393,7 +399,8 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
     for i, e in enumerate(edits_in):
         jp = f"$.edits[{i}]"
         e = ctx.obj(e, jp, required=("support",),
-                    allowed=("support", "handle", "handles", "transform", "transforms", "curves"))
+                    allowed=("support", "handle", "handles", "transform", "transforms", "curves",
+                             "deformation"))
         sup_in, fill_holes = e["support"], True
         if isinstance(sup_in, dict) and "fill_holes" in sup_in:
             fill_holes = sup_in["fill_holes"]
@@ -428,7 +435,15 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             if not isinstance(ts, list) or len(ts) != len(hs):
                 raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
             transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
-        edits.append(Edit(support, handles, transforms, jp, curves, fill_holes))
+        mode = DeformationMode.LINEAR
+        if "deformation" in e:
+            if not isinstance(e["deformation"], str):
+                raise ctx.fail(f"{jp}.deformation", f"must be a string, got {_kind(e['deformation'])}")
+            try:
+                mode = DeformationMode.parse(e["deformation"])
+            except ValueError as exc:
+                raise ctx.fail(f"{jp}.deformation", str(exc)) from None
+        edits.append(Edit(support, handles, transforms, jp, curves, fill_holes, mode))
     return EditScript(tuple(edits), solver)
 
 
@@ -586,6 +601,7 @@ class ResolvedEdit:
     curves: list
     curve_moves: list
     fill_holes: bool = True
+    deformation: DeformationMode = DeformationMode.LINEAR
 
     @property
     def inputs(self) -> list:
@@ -610,7 +626,7 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
             raise EditScriptError(str(exc), json_path=f"{edit.json_path}.curves[{j}]",
                                   path=source) from None
         curves.append(cc)
-    return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes)
+    return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes, edit.deformation)
 
 
 def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
@@ -627,8 +643,15 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
     from splatedit.deform.constraints import CurveSamplesError
 
     r = resolve_edit_inputs(cloud, edit, source)
+    fit = DeformationBasis.fit
+    if r.deformation is DeformationMode.DETAIL:
+        from splatedit.deform.detail import DetailBasis
+        fit = DetailBasis.fit
+    elif r.deformation is not DeformationMode.LINEAR:
+        raise EditScriptError(f"deformation {r.deformation.value!r} is not available in this build",
+                              json_path=f"{edit.json_path}.deformation", path=source)
     try:
-        basis = DeformationBasis.fit(cloud, r.support, r.handles, curves=r.curves,
+        basis = fit(cloud, r.support, r.handles, curves=r.curves,
                                      method=method or solver.method,
                                      tol=solver.tol if tol is None else tol,
                                      max_centers=solver.max_centers, fill_holes=r.fill_holes,

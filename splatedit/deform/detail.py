@@ -49,6 +49,7 @@ from scipy.spatial import cKDTree
 
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import as_mask
+from splatedit.deform.distortion import distortion_from_axes
 from splatedit.errors import ParameterError
 from splatedit.model.estimate import estimate_normals, tangent_frame
 from splatedit.progress import report
@@ -376,6 +377,13 @@ class DetailBasis:
             rows = idx[s:e]
             outs[0][rows], outs[1][rows], outs[2][rows] = p, u, v
         return outs
+
+    def distortion(self, cloud, dC, **kw):
+        """:class:`DistortionStats` of the support splats' axes under ``dC``
+        (keywords as :func:`distortion_from_axes`)."""
+        _, u, v = self.apply_arrays(cloud, dC)
+        idx = self.indices
+        return distortion_from_axes(cloud.u[idx], cloud.v[idx], u[idx], v[idx], **kw)
 
     def apply(self, cloud, dC, *, validate: bool = False):
         """The deformed cloud (see :meth:`DeformationBasis.apply`)."""

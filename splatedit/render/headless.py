@@ -54,7 +54,8 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         size: (width, height) in pixels.
         camera: default ``Camera.frame`` of the cloud's bounds.
         basis: optional ``(indices, B, Bx, By, Bz)`` deformation basis rows
-            (see :meth:`Renderer.set_basis`); applied on the GPU with ``dC``
+            (see :meth:`Renderer.set_basis`), plus ``detail`` (N, 4) for the
+            detail mode (:meth:`Renderer.set_detail`); applied on the GPU with ``dC``
             ((K, 3) control-frame displacement, default zeros).  Chained edits
             are committed on the CPU by the caller: pass the final cloud and
             the last edit's basis.
@@ -91,8 +92,10 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         if selection is not None:
             r.set_selection(*selection)
         if basis is not None:
-            idx, B, Bx, By, Bz = basis
+            idx, B, Bx, By, Bz = basis[:5]
             r.set_basis(idx, B, Bx, By, Bz)
+            if len(basis) == 6:       # the detail mode's (n_b, lambda) rows
+                r.set_detail(idx, basis[5])
             r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
         img = r.render(camera, w, h)
         bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None

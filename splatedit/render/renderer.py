@@ -51,6 +51,8 @@ _PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", 
              V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
              V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "vert|comp"),
              V.Binding(7, "storage", "comp"), V.Binding(8, "uniform", "comp"))
+#: the detail mode's pre-pass adds (n_b, lambda) per splat (shaders_glsl/detail.glsl)
+_PREP_SET_DETAIL = _PREP_SET + (V.Binding(9, "storage", "comp"),)
 _REC_A_BYTES = 48
 _REC_B_BYTES = 32
 _WORKGROUP = 64
@@ -241,6 +243,8 @@ class Renderer:
         self._targets = None
         self._cloud_bufs = []
         self._basis_buf = None
+        self._detail_buf = None       # (n_b, lambda / scale) per splat, see set_detail
+        self._detail_reach = 0.0
         self._dummy_basis = {}
         self.cloud = None
         self.origin = np.zeros(3)
@@ -334,6 +338,7 @@ class Renderer:
         if self._basis_buf is not None:
             self._basis_buf.destroy()
             self._basis_buf = None
+        self._drop_detail()
         for b in self._dummy_basis.values():
             b.destroy()
         self._dummy_basis = {}
@@ -428,9 +433,10 @@ class Renderer:
         to a multiple of 4 columns internally.  Other splats are not deformed.
         Only the given rows (and the rows of the previous basis, which are
         cleared) are written to the GPU.  A new K resets the displacement to
-        zeros (K, 3)."""
+        zeros (K, 3).  Drops a :meth:`set_detail` (set it again after this)."""
         self._check_open()
         self._require_cloud()
+        self._drop_detail()
         idx = np.asarray(indices, dtype=np.int64).reshape(-1)
         mats = []
         for name, m in (("B", B), ("Bx", Bx), ("By", By), ("Bz", Bz)):
@@ -507,12 +513,48 @@ class Renderer:
         lo, hi = self.bounds
         if not len(self._basis_rows):
             return lo, hi
-        grow = self._basis_reach * float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+        move = float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+        grow = self._basis_reach * move + (self._detail_reach if move > 0 else 0.0)
         return lo - grow, hi + grow
+
+    def set_detail(self, indices, detail) -> None:
+        """Detail-preserving mode (splatedit.deform.detail): ``detail`` (N, 4)
+        = (base normal n_b, offset lambda in model units) of the splats
+        ``indices``, whose :meth:`set_basis` rows were evaluated at their base
+        points b = p - lambda n_b.  Uploaded once; per frame only dC changes.
+        Drawn by the compute pre-pass (images up to 4095 pixels); cleared by
+        :meth:`clear_basis` and :meth:`set_cloud`."""
+        self._check_open()
+        self._require_cloud()
+        idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+        d = np.asarray(detail, dtype=np.float64)
+        if d.shape != (len(idx), 4):
+            raise ParameterError("detail", f"must have shape ({len(idx)}, 4), got {d.shape}")
+        if not np.isfinite(d).all():
+            raise ParameterError("detail", "must be finite")
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
+            raise ParameterError("indices", f"must be in 0..{self.n - 1}")
+        if self._detail_buf is None:
+            self._free_prep()
+            self._detail_buf = V.Buffer(self.dev, self.n * 16, ("storage",), host_visible=True)
+        view = self._detail_buf.view(np.float32).reshape(self.n, 4)
+        view[:] = 0.0
+        view[idx, :3] = d[:, :3]
+        view[idx, 3] = d[:, 3] / self.scale
+        # an offset swings by at most 2 |lambda| when its normal turns (clip bounds)
+        self._detail_reach = 2.0 * float(np.abs(d[:, 3]).max(initial=0.0))
+
+    def _drop_detail(self):
+        if self._detail_buf is not None:
+            self._free_prep()
+            self._detail_buf.destroy()
+            self._detail_buf = None
+        self._detail_reach = 0.0
 
     def clear_basis(self) -> None:
         """Drop the deformation basis (every splat undeformed)."""
         self._check_open()
+        self._drop_detail()
         if self.cloud is None or self._basis_buf is None:
             return
         flags = self._flags.view(np.uint32)
@@ -639,9 +681,14 @@ class Renderer:
         self._near_far = (near * sc, far * sc)     # model units
 
     def _use_prepass(self) -> bool:
+        t = self._targets
+        if self._detail_buf is not None:   # the detail mode has no vertex-path variant
+            if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
+                raise ParameterError("size", f"the detail mode renders images up to {_PREP_MAX_SIZE} "
+                                             f"pixels wide and high, got {t.width}x{t.height}")
+            return True
         if not self.prepass:
             return False
-        t = self._targets
         if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
             return False
         # the basis is bound in windows (chunked dispatches), so only the
@@ -681,10 +728,15 @@ class Renderer:
                 basis = self._basis_binding()
                 chunks = []
                 for base, cnt, off, rng in self._basis_chunks(basis):
-                    dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET))
+                    detail = self._detail_buf
+                    dset = V.DescriptorSet(self.dev, self.cache.set_layout(
+                        _PREP_SET if detail is None else _PREP_SET_DETAIL))
                     objs.append(dset)
-                    dset.write({0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: (basis, off, rng),
-                                5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo})
+                    writes = {0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: (basis, off, rng),
+                              5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
+                    if detail is not None:
+                        writes[9] = detail
+                    dset.write(writes)
                     chunks.append((dset, base, cnt))
             except BaseException:
                 for o in reversed(objs):
@@ -698,8 +750,11 @@ class Renderer:
         (one dispatch per basis window)."""
         prep = self._prep_objects()
         g = self._basis_groups
-        comp = "prepare.comp" if g == 1 else f"prepare_k{4 * g}.comp"
-        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=12, push_stages="comp")
+        detail = self._detail_buf is not None
+        stem = "prepare_detail" if detail else "prepare"
+        comp = f"{stem}.comp" if g == 1 else f"{stem}_k{4 * g}.comp"
+        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=12,
+                              push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
         cb.fill_buffer(prep.draws, 0)
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
@@ -714,7 +769,8 @@ class Renderer:
                           "indirect_read|shader_read")
 
     def _prepared_pipeline(self, kind: str, mode: int):
-        layout = V.LayoutDesc(sets=(_PREP_SET,), push_bytes=4, push_stages="vert")
+        layout = V.LayoutDesc(sets=(_PREP_SET if self._detail_buf is None else _PREP_SET_DETAIL,),
+                              push_bytes=4, push_stages="vert")
         common = dict(depth_test=True, spec=((0, mode),),
                       topology="point_list" if mode == 2 else "triangle_strip")
         if kind == "depth":

@@ -1,0 +1,6 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Compute pre-pass of the detail-preserving mode, deformation basis with 4 columns.
+#define BASIS_GROUPS 1
+#define DETAIL 1
+#include "prepare_cs.glsl"
