@@ -67,8 +67,13 @@ def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
 
 
+def _detail(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.detail import bench_detail
+    yield from bench_detail(sizes=((200, 200), (500, 500)) if quick else ((300, 300), (1000, 1000)))
+
+
 BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
-           "render": _render, "editor": _editor}
+           "render": _render, "editor": _editor, "detail": _detail}
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
