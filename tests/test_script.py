@@ -308,3 +308,22 @@ def test_rotation_axis_of_extreme_magnitude_keeps_its_direction():
     np.testing.assert_allclose(r, ref, atol=1e-15)
     r = rotation_matrix([1e300, 1e300, 0], 90.0)
     np.testing.assert_allclose(r, ref, atol=1e-15)
+
+
+def test_deformation_key_selects_the_detail_mode_and_round_trips(tmp_path):
+    import json as _json
+    from splatedit.deform.modes import DeformationMode
+    from splatedit.errors import EditScriptError
+    from splatedit.script import load_script
+    doc = {"version": 1, "edits": [{"support": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+                                    "handle": {"sphere": {"center": [0, 0.4, 0], "radius": 0.1}},
+                                    "transform": {"translate": [0, 0.1, 0]}, "deformation": "Detail"}]}
+    p = tmp_path / "e.json"
+    p.write_text(_json.dumps(doc))
+    s = load_script(p)
+    assert s.edits[0].deformation is DeformationMode.DETAIL
+    assert s.to_json()["edits"][0]["deformation"] == "detail"
+    doc["edits"][0]["deformation"] = "bendy"
+    p.write_text(_json.dumps(doc))
+    with pytest.raises(EditScriptError, match=r"\$\.edits\[0\]\.deformation"):
+        load_script(p)
