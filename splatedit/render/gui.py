@@ -80,6 +80,7 @@ class Gui:
     def __init__(self, device, cache=None, *, ini_path: str | None = None, font_scale: float = 1.0):
         self.painter = GuiPainter(device, cache)
         self._closed = False
+        self._in_frame = False
         try:
             self.ctx = imgui.create_context()
             imgui.set_current_context(self.ctx)
@@ -122,16 +123,29 @@ class Gui:
     def new_frame(self, width: int, height: int, dt: float) -> None:
         """Start a frame for a ``width`` x ``height`` pixel target; ``dt`` seconds since the last."""
         io = self._current()
+        if self._in_frame:
+            self.discard_frame()
         io.display_size = (float(width), float(height))
         io.delta_time = float(dt) if dt > 0 else 1e-4       # ImGui asserts delta_time > 0
         imgui.new_frame()
+        self._in_frame = True
+
+    def discard_frame(self) -> None:
+        """End a frame that will not be drawn (e.g. the window is minimized)."""
+        self._current()
+        if self._in_frame:
+            imgui.end_frame()
+            self._in_frame = False
 
     def render(self, cmd, framebuffer, *, fmt: str, clear=None, final: str = "color") -> GuiFrameStats:
         """End the frame (``imgui.render``), apply ImGui's texture requests,
         upload the geometry and record the GUI pass into ``cmd`` (see
         :meth:`GuiPainter.record` for ``clear``/``final``)."""
         self._current()
+        if not self._in_frame:
+            raise RuntimeError("Gui.render() without Gui.new_frame()")
         imgui.render()
+        self._in_frame = False
         dd = imgui.get_draw_data()
         created, updated, destroyed = self._apply_texture_requests(dd)
         lists, draws, index_bytes = _geometry(dd, framebuffer.width, framebuffer.height)
@@ -144,6 +158,13 @@ class Gui:
         self.last_stats = GuiFrameStats(int(dd.total_vtx_count), int(dd.total_idx_count), n,
                                         created, updated, destroyed)
         return self.last_stats
+
+    def render_into(self, cmd, target, *, clear=None, final: str = "present") -> GuiFrameStats:
+        """:meth:`render` into ``target``, an image-like render target with a
+        ``framebuffer(render_pass)`` method and a ``format`` name (a swapchain
+        image in :meth:`SwapchainPresenter.render_frame`)."""
+        fb = target.framebuffer(self.painter.render_pass(target.format))
+        return self.render(cmd, fb, fmt=target.format, clear=clear, final=final)
 
     def _apply_texture_requests(self, dd) -> tuple[int, int, int]:
         S = imgui.ImTextureStatus
@@ -179,6 +200,9 @@ class Gui:
         if self._closed:
             return
         imgui.set_current_context(self.ctx)
+        if self._in_frame:
+            imgui.end_frame()
+            self._in_frame = False
         pio = imgui.get_platform_io()
         for i in range(len(pio.textures)):
             tex = pio.textures[i]
