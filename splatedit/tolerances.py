@@ -478,3 +478,18 @@ RENDER_BUFFERS_BYTES_PER_PIXEL = 150
 #: go to the parser, which names the row where the data end (plyfile
 #: allocates the declared rows first: 1 MiB of rows is harmless)
 PLY_DECLARED_EXCESS_BYTES = 2**20
+
+# ---------------------------------------------------------------- GUI (Dear ImGui on Vulkan)
+#: largest difference (8-bit levels, any channel) between a flat GUI area drawn
+#: by the GUI pipeline on lavapipe and the same colour alpha-blended in float
+#: from ImGui's 8-bit style colour over the 8-bit background.  Measured
+#: (tests/render/test_gui.py): 0 for the opaque window background, 0.4 for the
+#: translucent button colour (alpha 0.40: UNORM rounding of the blend); 2
+#: leaves a level of slack for other drivers' blend rounding
+GUI_COLOUR_TOL = 2
+#: a pixel is a glyph pixel when its brightness (mean of RGB) exceeds the
+#: window background's by this many levels.  Measured: ImGui's default font
+#: (13 px ProggyClean, white) over the 46-level window background gives 255 in
+#: glyph pixels and the background elsewhere ("Hello splats": 153 pixels above
+#: +10 and the same 153 above +60); 60 stays robust to antialiased fonts
+GUI_TEXT_CONTRAST = 60
