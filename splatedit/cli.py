@@ -362,7 +362,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_edit)
 
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
-    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "all"))
+    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "gui", "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
     s.set_defaults(func=cmd_bench)
     return p

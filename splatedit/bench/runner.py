@@ -67,8 +67,14 @@ def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
 
 
+def _gui(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.gui import bench_gui
+    yield from bench_gui(size=(640, 360) if quick else (1280, 720), repeats=10 if quick else 30)
+
+
 BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
-           "render": _render, "editor": _editor}
+           "render": _render, "editor": _editor,
+           "gui": _gui}
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
