@@ -19,6 +19,10 @@ import warnings
 from pathlib import Path
 
 from splatedit.app.options import parse_size, positive_float
+from splatedit.bench.runner import BENCHES
+
+#: the `splatedit bench` cases (one JSON line per case each)
+BENCH_NAMES = tuple(BENCHES)
 from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
@@ -363,7 +367,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_edit)
 
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
-    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "detail", "all"))
+    s.add_argument("what", choices=(*BENCH_NAMES, "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
     s.set_defaults(func=cmd_bench)
     return p

@@ -500,3 +500,17 @@ DETAIL_NORMAL_NEIGHBOURS = 16
 #: support rows per chunk of the detail mode's CPU apply (5 (c, 3) float64
 #: temporaries + three (c, K + 3) GEMM inputs: ~10 MB at K = 4)
 DETAIL_APPLY_CHUNK = 65536
+# ---------------------------------------------------------------- GUI (Dear ImGui on Vulkan)
+#: largest difference (8-bit levels, any channel) between a flat GUI area drawn
+#: by the GUI pipeline on lavapipe and the same colour alpha-blended in float
+#: from ImGui's 8-bit style colour over the 8-bit background.  Measured
+#: (tests/render/test_gui.py): 0 for the opaque window background, 0.4 for the
+#: translucent button colour (alpha 0.40: UNORM rounding of the blend); 2
+#: leaves a level of slack for other drivers' blend rounding
+GUI_COLOUR_TOL = 2
+#: a pixel is a glyph pixel when its brightness (mean of RGB) exceeds the
+#: window background's by this many levels.  Measured: ImGui's default font
+#: (13 px ProggyClean, white) over the 46-level window background gives 255 in
+#: glyph pixels and the background elsewhere ("Hello splats": 153 pixels above
+#: +10 and the same 153 above +60); 60 stays robust to antialiased fonts
+GUI_TEXT_CONTRAST = 60

@@ -72,8 +72,23 @@ def _detail(quick: bool, progress=None) -> Iterator[dict]:
     yield from bench_detail(sizes=((200, 200), (500, 500)) if quick else ((300, 300), (1000, 1000)))
 
 
-BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
-           "render": _render, "editor": _editor, "detail": _detail}
+def _gui(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.gui import bench_gui
+    yield from bench_gui(size=(640, 360) if quick else (1280, 720), repeats=10 if quick else 30)
+
+
+#: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
+BENCHES = {
+    "solve": _solve,
+    "groups": _groups,
+    "qr": _qr,
+    "accuracy": _accuracy,
+    "closure": _closure,
+    "render": _render,
+    "editor": _editor,
+    "detail": _detail,
+    "gui": _gui,
+}
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:

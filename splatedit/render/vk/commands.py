@@ -25,10 +25,18 @@ _FENCE_TIMEOUT_NS = 600 * 10**9
 class CommandBuffer:
     """A primary command buffer for one submission; :meth:`submit_and_wait` blocks on a fence."""
 
-    def __init__(self, device: Device):
+    def __init__(self, device: Device, handle=None):
+        """``handle``: record into an existing command buffer that its owner
+        allocated, submits and frees (e.g. the swapchain presenter's); the
+        object then owns nothing and :meth:`submit_and_wait` is unavailable."""
         self.dev = device
         self.handle = None
         self._fence = None
+        self._keep = []  # python objects referenced by recorded commands
+        self._owned = handle is None
+        if handle is not None:
+            self.handle = handle
+            return
         d = device.device
         info = vk.VkCommandBufferAllocateInfo(commandPool=device._pool,
                                               level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
@@ -37,7 +45,6 @@ class CommandBuffer:
         track("command_buffer", 1)
         self._fence = call(vk.vkCreateFence, d, vk.VkFenceCreateInfo(), None)
         track("fence", 1)
-        self._keep = []  # python objects referenced by recorded commands
 
     def begin(self):
         call(vk.vkBeginCommandBuffer, self.handle, vk.VkCommandBufferBeginInfo(
@@ -60,6 +67,10 @@ class CommandBuffer:
 
     def destroy(self):
         d = self.dev.device
+        if not self._owned:
+            self.handle = None
+            self._keep.clear()
+            return
         if self._fence is not None:
             vk.vkDestroyFence(d, self._fence, None)
             track("fence", -1)
@@ -88,6 +99,18 @@ class CommandBuffer:
                                       imageExtent=vk.VkExtent3D(w, h, 1))
         vk.vkCmdCopyImageToBuffer(self.handle, image.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
                                   buf.handle, 1, [region])
+
+    def copy_buffer_to_image(self, buf, image, rect=None, buf_offset=0):
+        """Copy tightly packed texels at ``buf_offset`` into ``rect`` = (x, y, w, h)
+        of an image in TRANSFER_DST layout."""
+        x, y, w, h = rect if rect is not None else (0, 0, image.width, image.height)
+        sub = vk.VkImageSubresourceLayers(aspectMask=image.aspect, mipLevel=0, baseArrayLayer=0,
+                                          layerCount=1)
+        region = vk.VkBufferImageCopy(bufferOffset=buf_offset, bufferRowLength=0, bufferImageHeight=0,
+                                      imageSubresource=sub, imageOffset=vk.VkOffset3D(x, y, 0),
+                                      imageExtent=vk.VkExtent3D(w, h, 1))
+        vk.vkCmdCopyBufferToImage(self.handle, buf.handle, image.handle,
+                                  vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, [region])
 
     # ------------------------------------------------------------- barriers
     def host_read_barrier(self):
@@ -171,6 +194,19 @@ class CommandBuffer:
 
     def draw_indirect(self, buf, offset=0, draw_count=1, stride=16):
         vk.vkCmdDrawIndirect(self.handle, buf.handle, offset, draw_count, stride)
+
+    def bind_index_buffer(self, buf, offset: int = 0, uint32: bool = False):
+        vk.vkCmdBindIndexBuffer(self.handle, buf.handle, offset,
+                                vk.VK_INDEX_TYPE_UINT32 if uint32 else vk.VK_INDEX_TYPE_UINT16)
+
+    def draw_indexed(self, index_count, instance_count=1, first_index=0, vertex_offset=0, first_instance=0):
+        vk.vkCmdDrawIndexed(self.handle, index_count, instance_count, first_index, vertex_offset,
+                            first_instance)
+
+    def set_scissor(self, x: int, y: int, w: int, h: int):
+        """Scissor rectangle in framebuffer pixels (the pipeline's scissor is dynamic)."""
+        sc = vk.VkRect2D(offset=vk.VkOffset2D(int(x), int(y)), extent=vk.VkExtent2D(int(w), int(h)))
+        vk.vkCmdSetScissor(self.handle, 0, 1, [sc])
 
     def dispatch(self, x, y=1, z=1):
         vk.vkCmdDispatch(self.handle, x, y, z)

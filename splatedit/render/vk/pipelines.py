@@ -136,6 +136,7 @@ class GraphicsDesc:
     depth_write: bool = False
     depth_compare: str = "less"
     blend_add: tuple[bool, ...] = ()            # per colour attachment: additive (ONE, ONE)
+    blend_alpha: bool = False                   # all colour attachments: "over" (SRC_ALPHA, 1-SRC_ALPHA)
     color_write: bool = True
     spec: tuple[tuple[int, int], ...] = ()      # (constant_id, int32 value), both stages
 
@@ -233,12 +234,14 @@ class Framebuffer:
 
 
 class Sampler:
-    """Nearest-neighbour, clamp-to-edge sampler (the resolve pass uses texelFetch)."""
+    """Clamp-to-edge sampler: nearest-neighbour (the resolve pass uses texelFetch)
+    or, with ``linear=True``, bilinear (GUI textures)."""
 
-    def __init__(self, device: Device):
+    def __init__(self, device: Device, linear: bool = False):
         self.dev = device
+        filt = vk.VK_FILTER_LINEAR if linear else vk.VK_FILTER_NEAREST
         info = vk.VkSamplerCreateInfo(
-            magFilter=vk.VK_FILTER_NEAREST, minFilter=vk.VK_FILTER_NEAREST,
+            magFilter=filt, minFilter=filt,
             mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
             addressModeU=vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
             addressModeV=vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
@@ -481,11 +484,13 @@ class PipelineCache:
         blends = []
         for i in range(len(d.render_pass.colors)):
             add = d.blend_add[i] if i < len(d.blend_add) else False
+            one, inv = vk.VK_BLEND_FACTOR_ONE, vk.VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA
             blends.append(vk.VkPipelineColorBlendAttachmentState(
-                blendEnable=vk.VK_TRUE if add else vk.VK_FALSE,
-                srcColorBlendFactor=vk.VK_BLEND_FACTOR_ONE, dstColorBlendFactor=vk.VK_BLEND_FACTOR_ONE,
+                blendEnable=vk.VK_TRUE if (add or d.blend_alpha) else vk.VK_FALSE,
+                srcColorBlendFactor=vk.VK_BLEND_FACTOR_SRC_ALPHA if d.blend_alpha else one,
+                dstColorBlendFactor=inv if d.blend_alpha else one,
                 colorBlendOp=vk.VK_BLEND_OP_ADD,
-                srcAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE, dstAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE,
+                srcAlphaBlendFactor=one, dstAlphaBlendFactor=inv if d.blend_alpha else one,
                 alphaBlendOp=vk.VK_BLEND_OP_ADD, colorWriteMask=rgba if d.color_write else 0))
         cb = vk.VkPipelineColorBlendStateCreateInfo(attachmentCount=len(blends), pAttachments=blends or None)
         dyn_states = [vk.VK_DYNAMIC_STATE_VIEWPORT, vk.VK_DYNAMIC_STATE_SCISSOR]

@@ -38,6 +38,7 @@ import vulkan as vk
 from splatedit.errors import SplatEditError
 from splatedit.render.vk.core import Device, VulkanError, _result_name, call, track
 from splatedit.render.vk.resources import Buffer
+from splatedit.render.vk.swapchain_target import SwapchainTarget
 
 _UINT64_MAX = 0xFFFFFFFFFFFFFFFF
 
@@ -79,6 +80,8 @@ class SwapchainPresenter:
         self.needs_recreate = False
         self.frames_presented = 0
         self._images = []
+        self.targets: list[SwapchainTarget] = []   # the images as render targets (GPU path)
+        self.gpu_targets = False                   # True when the images can be colour attachments
         self._render_done = []
         self._acquired = None
         self._fence = None
@@ -203,10 +206,14 @@ class SwapchainPresenter:
         if caps.maxImageCount:
             count = min(count, caps.maxImageCount)
         old = self.swapchain
+        usage = vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT
+        self.gpu_targets = bool(caps.supportedUsageFlags & vk.VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT)
+        if self.gpu_targets:
+            usage |= vk.VK_IMAGE_USAGE_COLOR_ATTACHMENT_BIT
         info = vk.VkSwapchainCreateInfoKHR(
             surface=self.surface, minImageCount=count, imageFormat=fmt.format,
             imageColorSpace=fmt.colorSpace, imageExtent=vk.VkExtent2D(width=w, height=h),
-            imageArrayLayers=1, imageUsage=vk.VK_IMAGE_USAGE_TRANSFER_DST_BIT,
+            imageArrayLayers=1, imageUsage=usage,
             imageSharingMode=vk.VK_SHARING_MODE_EXCLUSIVE,
             preTransform=caps.currentTransform,
             compositeAlpha=vk.VK_COMPOSITE_ALPHA_OPAQUE_BIT_KHR,
@@ -215,6 +222,7 @@ class SwapchainPresenter:
         new = call(self._fn["vkCreateSwapchainKHR"], self.device, info, None, name="vkCreateSwapchainKHR")
         track("swapchain", 1)
         self.swapchain = new
+        self._destroy_targets()          # views of the old swapchain's images go before it
         if old is not None:
             self._fn["vkDestroySwapchainKHR"](self.device, old, None)
             track("swapchain", -1)
@@ -225,6 +233,9 @@ class SwapchainPresenter:
         self._render_done = []
         for _ in self._images:
             self._render_done.append(self._new_semaphore())
+        if self.gpu_targets:
+            self.targets = [SwapchainTarget(self.dev, img, fmt.format, w, h, i)
+                            for i, img in enumerate(self._images)]
         self.extent = (w, h)
         self._ensure_staging(w * h * 4)
         self.needs_recreate = False
@@ -235,6 +246,11 @@ class SwapchainPresenter:
             return
         self._free_staging()
         self._staging = Buffer(self.dev, size, ("transfer_src",), host_visible=True)
+
+    def _destroy_targets(self) -> None:
+        for t in self.targets:
+            t.destroy()
+        self.targets = []
 
     def _free_staging(self) -> None:
         if self._staging is not None:
@@ -255,6 +271,98 @@ class SwapchainPresenter:
         w, h = self._glfw.get_framebuffer_size(self.window)
         return int(w), int(h)
 
+    def _acquire(self):
+        """Wait for the previous frame, acquire an image; its index, or None when
+        nothing can be shown now (minimized, or the swapchain was re-created)."""
+        fw, fh = self.framebuffer_size()
+        if fw == 0 or fh == 0:
+            return None
+        if self.needs_recreate or self.swapchain is None or (fw, fh) != self.extent:
+            if not self._recreate():
+                return None
+        d = self.device
+        call(vk.vkWaitForFences, d, 1, [self._fence], vk.VK_TRUE, _UINT64_MAX)
+        idx_ptr = vk.ffi.new("uint32_t*")
+        try:
+            self._fn["vkAcquireNextImageKHR"](d, self.swapchain, _UINT64_MAX, self._acquired,
+                                              vk.VK_NULL_HANDLE, idx_ptr)
+        except vk.VkErrorOutOfDateKhr:
+            self._recreate()
+            return None
+        except vk.VkSuboptimalKhr:
+            # the image *was* acquired (suboptimal is a success code): use it, recreate after
+            self.needs_recreate = True
+        except (vk.VkError, vk.VkException) as exc:
+            raise VulkanError("vkAcquireNextImageKHR", _result_name(exc)) from None
+        return int(idx_ptr[0])
+
+    def _begin_commands(self):
+        cmd = self._cmd
+        call(vk.vkResetCommandBuffer, cmd, 0)
+        call(vk.vkBeginCommandBuffer, cmd, vk.VkCommandBufferBeginInfo(
+            flags=vk.VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT))
+        return cmd
+
+    def _submit_and_present(self, index: int, wait_stage: int) -> None:
+        cmd = self._cmd
+        call(vk.vkEndCommandBuffer, cmd)
+        call(vk.vkResetFences, self.device, 1, [self._fence])
+        done = self._render_done[index]
+        submit = vk.VkSubmitInfo(waitSemaphoreCount=1, pWaitSemaphores=[self._acquired],
+                                 pWaitDstStageMask=[wait_stage],
+                                 commandBufferCount=1, pCommandBuffers=[cmd],
+                                 signalSemaphoreCount=1, pSignalSemaphores=[done])
+        call(vk.vkQueueSubmit, self.queue, 1, [submit], self._fence)
+        present = vk.VkPresentInfoKHR(waitSemaphoreCount=1, pWaitSemaphores=[done],
+                                      swapchainCount=1, pSwapchains=[self.swapchain],
+                                      pImageIndices=[index])
+        try:
+            self._fn["vkQueuePresentKHR"](self.queue, present)
+        except (vk.VkErrorOutOfDateKhr, vk.VkSuboptimalKhr):
+            self.needs_recreate = True
+        except (vk.VkError, vk.VkException) as exc:
+            raise VulkanError("vkQueuePresentKHR", _result_name(exc)) from None
+        self.frames_presented += 1
+
+    def render_frame(self, record) -> bool:
+        """GPU path: draw the frame on the device straight into the swapchain image.
+
+        ``record(cmd, target)`` records commands into ``cmd`` (a
+        :class:`~splatedit.render.vk.commands.CommandBuffer` wrapping the
+        presenter's command buffer) that draw into ``target`` (a
+        :class:`~splatedit.render.vk.swapchain_target.SwapchainTarget`, in
+        UNDEFINED layout: clear it or draw over all of it; use
+        ``target.framebuffer(render_pass)``).  Whatever layout it is left in,
+        it is then transitioned to PRESENT_SRC and presented.  The previous
+        frame has finished on the GPU when ``record`` runs, so buffers it used
+        may be rewritten.  Returns False when nothing was shown (as :meth:`present`).
+        """
+        if self.device is None:
+            return False
+        if not self.gpu_targets and self.swapchain is not None:
+            raise PresentError("the window's swapchain images cannot be colour attachments")
+        index = self._acquire()
+        if index is None:
+            return False
+        from splatedit.render.vk.commands import CommandBuffer
+        target = self.targets[index]
+        target.layout = vk.VK_IMAGE_LAYOUT_UNDEFINED
+        cb = CommandBuffer(self.dev, handle=self._begin_commands())
+        try:
+            record(cb, target)
+            if target.layout != vk.VK_IMAGE_LAYOUT_PRESENT_SRC_KHR:
+                cb.image_barrier(target, "present", "color_output|transfer", "color_write|transfer_write",
+                                 "bottom", "none")
+        except BaseException:
+            vk.vkResetCommandBuffer(self._cmd, 0)    # drop the partial recording; the fence stays signalled
+            self._recreate()                          # the acquired image's semaphore is pending
+            raise
+        finally:
+            cb.destroy()
+        self._submit_and_present(index, vk.VK_PIPELINE_STAGE_COLOR_ATTACHMENT_OUTPUT_BIT
+                                 | vk.VK_PIPELINE_STAGE_TRANSFER_BIT)
+        return True
+
     def present(self, rgba: np.ndarray) -> bool:
         """Show ``rgba`` ((h, w, 4) uint8, row 0 at the top).
 
@@ -268,27 +376,9 @@ class SwapchainPresenter:
         img = np.asarray(rgba)
         if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8:
             raise ValueError(f"present() needs an (h, w, 4) uint8 image, got {img.shape} {img.dtype}")
-        fw, fh = self.framebuffer_size()
-        if fw == 0 or fh == 0:
+        index = self._acquire()
+        if index is None:
             return False
-        if self.needs_recreate or self.swapchain is None or (fw, fh) != self.extent:
-            if not self._recreate():
-                return False
-        d = self.device
-        call(vk.vkWaitForFences, d, 1, [self._fence], vk.VK_TRUE, _UINT64_MAX)
-        idx_ptr = vk.ffi.new("uint32_t*")
-        try:
-            self._fn["vkAcquireNextImageKHR"](d, self.swapchain, _UINT64_MAX, self._acquired,
-                                              vk.VK_NULL_HANDLE, idx_ptr)
-        except vk.VkErrorOutOfDateKhr:
-            self._recreate()
-            return False
-        except vk.VkSuboptimalKhr:
-            # the image *was* acquired (suboptimal is a success code): use it, recreate after
-            self.needs_recreate = True
-        except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkAcquireNextImageKHR", _result_name(exc)) from None
-        index = int(idx_ptr[0])
         w, h = self.extent
         # --- pixels into the staging buffer (BGRA or RGBA, exactly w x h)
         dst = self._staging.view()[:w * h * 4].reshape(h, w, 4)
@@ -305,10 +395,7 @@ class SwapchainPresenter:
             dst[:ch, :cw, 3] = 255
         # --- record: undefined -> transfer dst, copy, -> present src
         image = self._images[index]
-        cmd = self._cmd
-        call(vk.vkResetCommandBuffer, cmd, 0)
-        call(vk.vkBeginCommandBuffer, cmd, vk.VkCommandBufferBeginInfo(
-            flags=vk.VK_COMMAND_BUFFER_USAGE_ONE_TIME_SUBMIT_BIT))
+        cmd = self._begin_commands()
         rng = vk.VkImageSubresourceRange(aspectMask=vk.VK_IMAGE_ASPECT_COLOR_BIT, baseMipLevel=0,
                                          levelCount=1, baseArrayLayer=0, layerCount=1)
         to_dst = vk.VkImageMemoryBarrier(
@@ -334,24 +421,7 @@ class SwapchainPresenter:
         vk.vkCmdPipelineBarrier(cmd, vk.VK_PIPELINE_STAGE_TRANSFER_BIT,
                                 vk.VK_PIPELINE_STAGE_BOTTOM_OF_PIPE_BIT, 0, 0, None, 0, None, 1,
                                 [to_present])
-        call(vk.vkEndCommandBuffer, cmd)
-        call(vk.vkResetFences, d, 1, [self._fence])
-        done = self._render_done[index]
-        submit = vk.VkSubmitInfo(waitSemaphoreCount=1, pWaitSemaphores=[self._acquired],
-                                 pWaitDstStageMask=[vk.VK_PIPELINE_STAGE_TRANSFER_BIT],
-                                 commandBufferCount=1, pCommandBuffers=[cmd],
-                                 signalSemaphoreCount=1, pSignalSemaphores=[done])
-        call(vk.vkQueueSubmit, self.queue, 1, [submit], self._fence)
-        present = vk.VkPresentInfoKHR(waitSemaphoreCount=1, pWaitSemaphores=[done],
-                                      swapchainCount=1, pSwapchains=[self.swapchain],
-                                      pImageIndices=[index])
-        try:
-            self._fn["vkQueuePresentKHR"](self.queue, present)
-        except (vk.VkErrorOutOfDateKhr, vk.VkSuboptimalKhr):
-            self.needs_recreate = True
-        except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkQueuePresentKHR", _result_name(exc)) from None
-        self.frames_presented += 1
+        self._submit_and_present(index, vk.VK_PIPELINE_STAGE_TRANSFER_BIT)
         return True
 
     # -------------------------------------------------------------- cleanup
@@ -367,6 +437,7 @@ class SwapchainPresenter:
             except Exception:  # pragma: no cover - device lost
                 pass
             self._free_staging()
+            self._destroy_targets()
             for s in self._render_done:
                 self._destroy_semaphore(s)
             self._render_done = []
