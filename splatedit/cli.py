@@ -20,10 +20,10 @@ from pathlib import Path
 
 from splatedit.app.options import parse_size, positive_float
 from splatedit.bench.runner import BENCHES
+from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 #: the `splatedit bench` cases (one JSON line per case each)
 BENCH_NAMES = tuple(BENCHES)
-from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 EXIT_BAD_INPUT = 2
 #: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
