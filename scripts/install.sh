@@ -5,6 +5,10 @@
 #   validation layer (the test suite runs with it on), Xvfb + xdotool (window
 #   tests) and the DejaVu fonts (editor overlay).
 #   Python: this package and its test extras from PyPI.
+#   Node.js (Debian's nodejs + npm when no node is on PATH) and PlayCanvas's
+#   splat-transform into ./.node: the independent reader of our Gaussian PLYs
+#   in tests/io/test_splat_transform.py (2.7.1 is the newest release that runs
+#   on Debian 12's Node 18; 3.x needs Node >= 22).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 
@@ -30,4 +34,24 @@ if [ ! -x .venv/bin/python ]; then
 fi
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[test]'
+
+splat_transform_version=2.7.1
+if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then
+    if command -v apt-get >/dev/null 2>&1; then
+        echo "install.sh: installing Debian packages: nodejs npm"
+        export DEBIAN_FRONTEND=noninteractive
+        apt-get update -q
+        apt-get install -y -q --no-install-recommends nodejs npm
+    else
+        echo "install.sh: no node/npm; the splat-transform reader test will be skipped" >&2
+    fi
+fi
+if command -v npm >/dev/null 2>&1; then
+    installed=$(node -p "require('./.node/node_modules/@playcanvas/splat-transform/package.json').version" \
+                2>/dev/null || true)
+    if [ "$installed" != "$splat_transform_version" ]; then
+        npm install --prefix .node --no-audit --no-fund --loglevel=error \
+            "@playcanvas/splat-transform@$splat_transform_version" >/dev/null
+    fi
+fi
 echo "install.sh: ready (.venv)"

@@ -77,9 +77,49 @@ def _sig(x, digits: int = 7) -> float | None:
     return float(f"{x:.{digits}g}") if math.isfinite(x) else None
 
 
+def _print_info(info: dict, as_json: bool) -> None:
+    if as_json:
+        print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
+    else:
+        width = max(map(len, info))
+        for k, v in info.items():
+            print(f"{k:<{width}}  {v}")
+
+
+def _gaussian_info(args) -> dict:
+    """``info`` of a Gaussian splatting PLY: kind, count, SH degree, opacity and
+    scale percentiles, anisotropy, bounding box, kept extra properties."""
+    import numpy as np
+    from splatedit.io import read_gaussians
+    g = read_gaussians(args.file, progress=args.progress)
+    lo, hi = g.bounds()
+    pct = (5, 50, 95)
+    s = np.exp(g.log_scales.astype(np.float64))
+    srt = np.sort(s, axis=1)
+    return {
+        "file": str(args.file),
+        "kind": g.kind.value,
+        "gaussians": len(g),
+        "sh_degree": g.sh_degree,
+        "normals": g.normals is not None,
+        "extra_properties": list(g.extra),
+        "bounds_min": [_sig(x) for x in lo],
+        "bounds_max": [_sig(x) for x in hi],
+        "diagonal": _sig(np.linalg.norm(hi - lo)),
+        "opacity_p5_p50_p95": [_sig(x, 4) for x in np.percentile(g.opacities(), pct)],
+        "opacity_below_0.5": int((g.opacity_logits < 0).sum()),
+        "scale_max_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, -1], pct)],
+        "scale_min_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, 0], pct)],
+        "anisotropy_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, -1] / srt[:, -2], pct)],
+    }
+
+
 def cmd_info(args) -> int:
     import numpy as np
-    from splatedit.io import read
+    from splatedit.io import is_gaussian_file, read
+    if is_gaussian_file(args.file):
+        _print_info(_gaussian_info(args), args.json)
+        return 0
     from splatedit.model.quality import assess
     from splatedit.model.spacing import point_spacing
     cloud = read(args.file, progress=args.progress)
@@ -104,18 +144,21 @@ def cmd_info(args) -> int:
         "outliers_isolated": int(quality.outliers.isolated.sum()),
         "stray_cluster_points": int(quality.stray_clusters.sum()),
     }
-    if args.json:
-        print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
-    else:
-        width = max(map(len, info))
-        for k, v in info.items():
-            print(f"{k:<{width}}  {v}")
+    _print_info(info, args.json)
     return 0
 
 
 def cmd_convert(args) -> int:
-    from splatedit.io import check_output_path, read, write
+    from splatedit.io import check_output_path, is_gaussian_file, read, write
     check_output_path(args.output, overwrite=args.force, protect=args.input)
+    if is_gaussian_file(args.input) and not args.to_splats and Path(args.output).suffix.lower() == ".ply":
+        from splatedit.io import read_gaussians, write_gaussians
+        if args.remove_outliers:
+            raise ParameterError("--remove-outliers", "works on point clouds, not on Gaussian scenes")
+        g = read_gaussians(args.input, progress=args.progress)
+        write_gaussians(args.output, g, overwrite=args.force)
+        print(f"wrote {args.output}: {len(g)} Gaussians ({g.kind.value}, SH degree {g.sh_degree})")
+        return 0
     cloud = read(args.input, progress=args.progress)
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
@@ -165,14 +208,36 @@ def _run_edits(args, cloud, script_path):
 
 
 def cmd_deform(args) -> int:
-    from splatedit.io import check_output_path, check_readable_file, read, write
+    from splatedit.io import check_output_path, check_readable_file, is_gaussian_file, read, write
     check_output_path(args.output, overwrite=args.force, protect=args.input)
     check_readable_file(args.edit)
+    if is_gaussian_file(args.input):
+        return _deform_gaussians(args)
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)
     write(args.output, out, overwrite=args.force)
     print(f"wrote {args.output}: {out.n} splats, {len(reports)} edit(s) in {time.perf_counter() - t0:.2f} s")
+    return 0
+
+
+def _deform_gaussians(args) -> int:
+    """``deform`` of a Gaussian scene: edits select centres; covariances and
+    spherical harmonics follow the Jacobian; the output is a Gaussian PLY."""
+    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.io import read_gaussians, write_gaussians
+    from splatedit.script import load_script
+    if Path(args.output).suffix.lower() != ".ply":
+        raise ParameterError("--output", f"{args.input} is a Gaussian scene: the output must be a .ply")
+    script = load_script(args.edit)
+    g = read_gaussians(args.input, progress=args.progress)
+    t0 = time.perf_counter()
+    out, reports = run_script_gaussians(g, script, method=args.method, tol=args.tol,
+                                        source=str(args.edit), progress=args.progress,
+                                        on_edit=lambda rep: _print_edit(args, rep))
+    write_gaussians(args.output, out, overwrite=args.force)
+    print(f"wrote {args.output}: {len(out)} Gaussians, {len(reports)} edit(s) in "
+          f"{time.perf_counter() - t0:.2f} s")
     return 0
 
 
@@ -330,9 +395,13 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print one JSON object")
     s.set_defaults(func=cmd_info)
 
-    s = sub.add_parser("convert", help="convert PLY/XYZ/OFF to a splat PLY (estimates normals and sizes when missing)")
+    s = sub.add_parser("convert", help="convert PLY/XYZ/OFF to a splat PLY (estimates normals and sizes when "
+                       "missing); a Gaussian splatting PLY stays one (see --to-splats)")
     s.add_argument("input")
     s.add_argument("output")
+    s.add_argument("--to-splats", action="store_true",
+                   help="Gaussian input: write plain splats (lossy: a disc per Gaussian from its two "
+                        "largest axes at 2 sigma, colour from the DC term)")
     s.add_argument("--remove-outliers", action="store_true",
                    help="drop statistical and isolated outlier points (point clouds only)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists")

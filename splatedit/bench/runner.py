@@ -77,6 +77,12 @@ def _gui(quick: bool, progress=None) -> Iterator[dict]:
     yield from bench_gui(size=(640, 360) if quick else (1280, 720), repeats=10 if quick else 30)
 
 
+def _gaussians(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.gaussians import bench_gaussian_deform
+    for n in ((20_000, 100_000) if quick else (100_000, 1_000_000)):
+        yield bench_gaussian_deform(n, repeat=1 if quick else 3)
+
+
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
@@ -88,6 +94,7 @@ BENCHES = {
     "editor": _editor,
     "detail": _detail,
     "gui": _gui,
+    "gaussians": _gaussians,
 }
 
 

@@ -12,3 +12,10 @@ def default_model_path() -> Path:
     as a triangle mesh; :func:`splatedit.io.read` turns it into vertex splats
     and keeps its faces)."""
     return _HERE / "bunny.ply"
+
+
+def gaussian_scene_path() -> Path:
+    """Path of ``bunny_gaussians.ply``: a 3D Gaussian Splatting test scene of
+    5,000 Gaussians with SH degree 3 fitted to the bunny's splats
+    (data_tools/make_gaussian_scene.py; see PROVENANCE.md)."""
+    return _HERE / "bunny_gaussians.ply"

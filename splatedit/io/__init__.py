@@ -5,12 +5,20 @@ Public API::
     read(path, *, progress=None) -> SplatCloud
     write(path, cloud, *, overwrite=False, binary=True, axes=True, progress=None) -> Path
     convert(in_path, out_path, *, overwrite=False, binary=True, progress=None) -> SplatCloud
+    is_gaussian_file(path) -> bool
+    read_gaussians(path, *, progress=None) -> GaussianCloud
+    write_gaussians(path, scene, *, overwrite=False, progress=None) -> Path
 
 The format follows the file extension (case-insensitive): ``.ply``;
 ``.xyz``, ``.txt``, ``.pts`` (XYZ text); ``.off``.  Splats come from the file
 (our ``ux..vz`` PLY properties) or are derived: see
 :func:`splatedit.io._build.build_cloud`.  Every problem with an input file is
 an :class:`~splatedit.errors.InputError` naming the file.
+
+Gaussian splatting PLYs (3DGS/2DGS, see :mod:`splatedit.io.gaussians`) are
+read losslessly by :func:`read_gaussians`; :func:`read` gives their proxy
+splats (a disc per Gaussian, :meth:`GaussianCloud.proxy_splats`), so every
+splat tool can open them.
 
 Writing is atomic: the data go to a temporary file in the target directory
 that replaces the target only when complete, so a failed write leaves any old
@@ -25,14 +33,16 @@ from pathlib import Path
 
 from splatedit.errors import InputError
 from splatedit.io.atomic import atomic_open, check_writable_target
+from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply, write_gaussian_ply
 from splatedit.io.off import read_off, write_off
 from splatedit.io.ply import read_ply, write_ply
 from splatedit.io.xyz import read_xyz, write_xyz
 from splatedit.model.cloud import SplatCloud
+from splatedit.model.gaussians import GaussianCloud
 from splatedit.progress import report
 
 __all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "READ_EXTENSIONS",
-           "WRITE_EXTENSIONS"]
+           "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians"]
 
 _READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_xyz,
             ".off": read_off}
@@ -62,9 +72,61 @@ def read(path, *, progress=None) -> SplatCloud:
     Raises:
         InputError: unknown extension, unreadable or malformed file.
     """
-    reader = _READERS[_ext(path, READ_EXTENSIONS, "reading")]
+    ext = _ext(path, READ_EXTENSIONS, "reading")
+    reader = _READERS[ext]
     check_readable_file(path)
+    if ext == ".ply" and is_gaussian_ply(path):
+        return read_gaussian_ply(path, progress=progress).proxy_splats()
     return reader(path, progress=progress)
+
+
+def is_gaussian_file(path) -> bool:
+    """True for a ``.ply`` whose vertex element holds Gaussian splatting
+    properties (``f_dc_0``, or ``scale_0`` and ``rot_0``).  Anything but an
+    existing regular file is False (a FIFO is never opened: it could block)."""
+    try:
+        regular = stat.S_ISREG(os.stat(path).st_mode)
+    except (OSError, ValueError):
+        return False
+    return regular and Path(path).suffix.lower() == ".ply" and is_gaussian_ply(path)
+
+
+def read_gaussians(path, *, progress=None) -> GaussianCloud:
+    """Read a 3DGS/2DGS PLY losslessly (:func:`splatedit.io.gaussians.read_gaussian_ply`).
+
+    Raises:
+        InputError: not a .ply, unreadable, or not a valid Gaussian scene
+            (the message names the file and the property).
+    """
+    _ext(path, (".ply",), "reading Gaussians")
+    check_readable_file(path)
+    if not is_gaussian_ply(path):
+        raise InputError("is not a Gaussian splatting PLY (its vertex element has no f_dc_0, "
+                         "scale_0 or rot_0 property)", path=str(path))
+    return read_gaussian_ply(path, progress=progress)
+
+
+def write_gaussians(path, scene: GaussianCloud, *, overwrite: bool = False, progress=None) -> Path:
+    """Save a Gaussian scene atomically as a binary little-endian 3DGS/2DGS PLY
+    (the scene's own property order and types; unknown properties kept).
+
+    Raises:
+        InputError: not a .ply target, an existing file without ``overwrite``,
+            a write failure, or a scene with non-finite values.
+    """
+    path = Path(path)
+    _ext(path, (".ply",), "writing Gaussians")
+    check_writable_target(path, overwrite=overwrite)
+    from splatedit.io.gaussians import check_gaussians
+    check_gaussians(scene)
+    report(progress, "writing", 0.0)
+    try:
+        with atomic_open(path, "wb") as fh:
+            write_gaussian_ply(fh, scene, comment=f"written by splatedit from {scene.name or 'a Gaussian scene'}")
+    except OSError as exc:
+        raise InputError(f"cannot write: {exc.strerror or exc}", path=str(path)) from None
+    report(progress, "writing", 1.0)
+    return path
 
 
 def check_readable_file(path) -> None:

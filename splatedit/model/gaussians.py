@@ -43,6 +43,10 @@ class GaussianCloud:
         extra: unknown per-vertex properties kept for writing back, name -> (n,) array, file order.
         kind: 3DGS or 2DGS.
         name, source: for display and error messages.
+        layout: the file's vertex properties in file order, ``(name, numpy
+            dtype string)`` (e.g. ``("x", "<f4")``), or None for a scene made
+            in memory; the writer keeps this order and these types so that an
+            unedited round trip is bit for bit.
     """
 
     positions: np.ndarray
@@ -55,6 +59,7 @@ class GaussianCloud:
     kind: GaussianKind = GaussianKind.GS3D
     name: str = ""
     source: str | None = field(default=None, repr=False)
+    layout: tuple[tuple[str, str], ...] | None = field(default=None, repr=False)
 
     def __len__(self) -> int:
         return len(self.positions)
@@ -64,14 +69,14 @@ class GaussianCloud:
         """Degree d of the spherical harmonics, from (d + 1)^2 coefficients."""
         return int(round(np.sqrt(self.sh.shape[1]))) - 1
 
-    def unit_rotations(self) -> np.ndarray:
-        """(n, 4) float64 unit quaternions (w, x, y, z)."""
-        q = self.rotations.astype(np.float64)
+    def unit_rotations(self, index=None) -> np.ndarray:
+        """(n, 4) float64 unit quaternions (w, x, y, z); only rows ``index`` when given."""
+        q = (self.rotations if index is None else self.rotations[index]).astype(np.float64)
         return q / np.linalg.norm(q, axis=1, keepdims=True)
 
-    def rotation_matrices(self) -> np.ndarray:
-        """(n, 3, 3) float64 rotation matrices of the unit quaternions."""
-        w, x, y, z = self.unit_rotations().T
+    def rotation_matrices(self, index=None) -> np.ndarray:
+        """(n, 3, 3) float64 rotation matrices of the unit quaternions; only rows ``index`` when given."""
+        w, x, y, z = self.unit_rotations(index).T
         return np.stack([
             np.stack([1 - 2 * (y * y + z * z), 2 * (x * y - w * z), 2 * (x * z + w * y)], -1),
             np.stack([2 * (x * y + w * z), 1 - 2 * (x * x + z * z), 2 * (y * z - w * x)], -1),
@@ -94,3 +99,47 @@ class GaussianCloud:
     def opacities(self) -> np.ndarray:
         """(n,) float64 opacities in [0, 1] (sigmoid of the logits)."""
         return 1.0 / (1.0 + np.exp(-self.opacity_logits.astype(np.float64)))
+
+    def bounds(self) -> tuple[np.ndarray, np.ndarray]:
+        """(min, max) corners of the axis-aligned bounding box of the centres."""
+        return self.positions.min(axis=0), self.positions.max(axis=0)
+
+    def dc_colors(self) -> np.ndarray:
+        """(n, 3) float64 view-independent colours in [0, 1]: ``0.5 + C0 * DC``, clamped."""
+        from splatedit.model.spherical_harmonics import C0
+        return np.clip(0.5 + C0 * self.sh[:, 0, :].astype(np.float64), 0.0, 1.0)
+
+    def replace(self, **changes) -> "GaussianCloud":
+        """A new scene with some arrays replaced (the others are shared)."""
+        import dataclasses
+        return dataclasses.replace(self, **changes)
+
+    def proxy_splats(self, sigmas: float | None = None):
+        """The scene as a plain :class:`~splatedit.model.cloud.SplatCloud`: one
+        elliptical disc per Gaussian, centred on it, spanned by its two largest
+        axes scaled to ``sigmas`` standard deviations (default
+        ``GAUSSIAN_PROXY_SIGMAS``), coloured by the DC term.  Selections, the
+        selection closure and the deformation bases work on it unchanged
+        (index i of the proxy is Gaussian i); it is also the lossy
+        Gaussian -> splat conversion.  Axes shorter than
+        ``GAUSSIAN_PROXY_MIN_AXIS_REL`` of the bounding-box diagonal (needle
+        Gaussians) are lengthened to that, so the proxy is a valid cloud."""
+        from splatedit.model.cloud import SplatCloud
+        from splatedit.tolerances import GAUSSIAN_PROXY_MIN_AXIS_REL, GAUSSIAN_PROXY_SIGMAS
+        k = GAUSSIAN_PROXY_SIGMAS if sigmas is None else float(sigmas)
+        r = self.rotation_matrices()
+        s = self.scales()
+        order = np.argsort(-s, axis=1, kind="stable")[:, :2]            # two largest axes
+        rows = np.arange(len(s))
+        axes = []
+        lo, hi = self.bounds()
+        floor = GAUSSIAN_PROXY_MIN_AXIS_REL * max(float(np.linalg.norm(hi - lo)), 1e-300)
+        for j in range(2):
+            col = order[:, j]
+            a = r[rows, :, col] * (k * np.maximum(s[rows, col], floor / k))[:, None]
+            axes.append(a)
+        colors = np.empty((len(s), 4), dtype=np.uint8)
+        colors[:, :3] = np.round(self.dc_colors() * 255.0)
+        colors[:, 3] = 255
+        return SplatCloud(self.positions, axes[0], axes[1], colors, name=self.name,
+                          source=self.source)
