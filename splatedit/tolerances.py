@@ -478,3 +478,12 @@ RENDER_BUFFERS_BYTES_PER_PIXEL = 150
 #: go to the parser, which names the row where the data end (plyfile
 #: allocates the declared rows first: 1 MiB of rows is harmless)
 PLY_DECLARED_EXCESS_BYTES = 2**20
+
+# ---------------------------------------------------------------- rotation-aware handles (issue 9)
+#: a handle whose polar rotation is smaller than this (radians) takes the
+#: linear path (pure translations bitwise).  The blended rotation is about the
+#: screw axis, whose distance from the handle grows like |t| / angle: at 1e-6
+#: rad a unit translation puts the centre 1e6 away and R(s)(p - c) - (p - c)
+#: loses about 1e-10 to cancellation, while the two modes differ there by
+#: angle * |t| (1e-6): below that the linear path is both closer and exact
+ROTATION_MIN_ANGLE = 1e-6

@@ -47,7 +47,10 @@ from splatedit.deform.constraints import (
     as_mask,
     build_constraints,
 )
+from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
+from splatedit.deform.rotation import (RotationDisplacement, blend_jacobians, blend_terms, decompose,
+                                       split_displacement)
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
@@ -335,7 +338,7 @@ class DeformationBasis:
             np.ascontiguousarray(sub[:, j, :]) for j in range(4))
 
     # ----------------------------------------------------------- per frame
-    def displacement(self, transforms) -> np.ndarray:
+    def displacement(self, transforms, mode: DeformationMode = DeformationMode.LINEAR):
         """Control-point displacements ``dC`` (K, 3) from one input per group
         (handles first, then curves, as in :attr:`group_kinds`):
 
@@ -346,7 +349,16 @@ class DeformationBasis:
         * None: the group does not move.
 
         A single 2-D array is accepted when there is one group.
+
+        ``mode``: LINEAR (the paper) returns the (K, 3) array; ROTATION returns a
+        :class:`~splatedit.deform.rotation.RotationDisplacement` (residual dC
+        plus each handle's rotation, see :mod:`splatedit.deform.rotation`),
+        which :meth:`apply`, :meth:`displacements`, :meth:`jacobians` and the
+        renderer take in place of dC.  DETAIL is not handled here.
         """
+        mode = DeformationMode(mode)
+        if mode is DeformationMode.DETAIL:
+            raise ParameterError("mode", "the 'detail' deformation is not yet supported")
         if isinstance(transforms, np.ndarray) and transforms.ndim == 2:
             transforms = [transforms]
         transforms = list(transforms)
@@ -355,7 +367,13 @@ class DeformationBasis:
                                  f"displacement array per curve ({self.n_groups} groups: "
                                  f"{', '.join(self.group_kinds)}), got {len(transforms)}")
         dc = np.zeros((self.n_columns, 3))
+        rotations = []
         for i, (t, grp) in enumerate(zip(transforms, self.constraints.groups)):
+            if grp.kind == "handle" and mode is DeformationMode.ROTATION:
+                m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
+                rot, m = decompose(m, grp.controls)
+                rotations.append(rot)
+                t = None if t is None else m
             if t is None:
                 continue
             cols = self.columns_for_group(i)
@@ -371,6 +389,8 @@ class DeformationBasis:
                 if not np.isfinite(d).all():
                     raise ParameterError(f"transforms[{i}]", "must be finite")
                 dc[cols] = d
+        if mode is DeformationMode.ROTATION:
+            return RotationDisplacement(dc, tuple(rotations))
         return dc
 
     def _check_dc(self, dC) -> np.ndarray:
@@ -381,16 +401,29 @@ class DeformationBasis:
             raise ParameterError("dC", "must be finite")
         return d
 
+    def _handle_blocks(self) -> list[slice]:
+        return [self.columns_for_group(g) for g, grp in enumerate(self.constraints.groups)
+                if grp.kind == "handle"]
+
     def displacements(self, dC) -> np.ndarray:
-        """(N, 3) displacements ``B dC`` of the support splats."""
-        return self.B @ self._check_dc(dC)
+        """(N, 3) displacements of the support splats: ``B dC`` (plus the
+        blended rotations of a RotationDisplacement)."""
+        d, rot = split_displacement(dC)
+        out = self.B @ self._check_dc(d)
+        if rot is not None:
+            out += blend_terms(rot, self._pack, self._handle_blocks())[0]
+        return out
 
     def jacobians(self, dC) -> np.ndarray:
-        """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats."""
-        d = self._check_dc(dC)
+        """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats
+        (dC: (K, 3) or a RotationDisplacement)."""
+        d, rot = split_displacement(dC)
+        d = self._check_dc(d)
         jt = np.einsum("njk,ki->nji", self._pack[:, 1:, :], d)  # jt[n, j, i] = (J - I)[i, j]
         out = jt.transpose(0, 2, 1).copy()
         out += np.eye(3)
+        if rot is not None:
+            out += blend_jacobians(rot, self._pack, self._handle_blocks())
         return out
 
     def _check_cloud(self, cloud):
@@ -447,7 +480,10 @@ class DeformationBasis:
         base cloud the basis was built on).  Splats outside the support are
         copied bitwise; ``dC == 0`` returns bitwise copies."""
         self._check_cloud(cloud)
-        d = self._check_dc(dC)
+        d, rot = split_displacement(dC)
+        d = self._check_dc(d)
+        if rot is not None:
+            return self._apply_rotation(cloud, d, rot)
         srcs = (cloud.positions, cloud.u, cloud.v)
         if not d.any():
             return tuple(s.copy() for s in srcs)
@@ -470,6 +506,16 @@ class DeformationBasis:
         if len(c["filler"]):  # fixed splats computed through: restore them bitwise
             for s, o in zip(srcs, outs):
                 o[c["filler"]] = s[c["filler"]]
+        return outs
+
+    def _apply_rotation(self, cloud, d, rot: RotationDisplacement):
+        """apply_arrays of a rotating frame: the linear GEMM with the residual
+        dC, plus the blended rotations at the support splats."""
+        outs = self.apply_arrays(cloud, d)
+        idx = self.indices
+        dp, (du, dv) = blend_terms(rot, self._pack, self._handle_blocks(), (cloud.u[idx], cloud.v[idx]))
+        for o, x in zip(outs, (dp, du, dv)):
+            o[idx] += x
         return outs
 
     def apply(self, cloud, dC, *, validate: bool = False):
