@@ -8,7 +8,8 @@ Format (version 1)::
        {"support": REGION,
         "handle": REGION,                    # or "handles": [REGION, ...]
         "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
-        "curves": [CURVE, ...]}]}            # optional; see below
+        "curves": [CURVE, ...],              # optional; see below
+        "deformation": "rotation"}]}         # optional: "rotation" (default) | "linear" | "detail"
 
     REGION    = {"sphere": {"center": [x,y,z], "radius": r}}      (a support region may add
                                                                 "fill_holes": false)
@@ -39,6 +40,13 @@ to the handle's centroid.  Edits run one after another: each edit's result is
 the base of the next (the paper's Bunny: ears, then head).  Every error names
 the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis`` or
 ``$.edits[1].curves[0].move[2]``.
+
+``deformation`` picks how the handles' maps spread over the support
+(:class:`~splatedit.deform.modes.DeformationMode`): ``"rotation"`` (the
+default) blends each handle's rotation over the support, so bends and twists
+of 90 degrees and more keep their cross-sections; ``"linear"`` is the paper's
+deformation (exact for translations, large rotations shrink the middle);
+``"detail"`` is not supported yet.  Curves move the same way in both modes.
 """
 
 from __future__ import annotations
@@ -53,6 +61,7 @@ from typing import Any, Callable
 import numpy as np
 
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
+from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL, MAX_COORDINATE_ABS, MAX_SCRIPT_BYTES
@@ -126,6 +135,8 @@ class Edit:
     #: close the selection before fitting (``"fill_holes": false`` on the
     #: support region turns it off; see splatedit.select.closure)
     fill_holes: bool = True
+    #: how the handles' maps spread over the support (``"deformation"``)
+    deformation: DeformationMode = DeformationMode.ROTATION
 
 
 @dataclass(frozen=True)
@@ -187,6 +198,7 @@ class EditScript:
                 item["transforms"] = [transform(t) for t in e.transforms]
             if e.curves:
                 item["curves"] = [curve(c) for c in e.curves]
+            item["deformation"] = DeformationMode(e.deformation).value
             edits.append(item)
         return {"version": SCRIPT_VERSION, "solver": solver, "edits": edits}
 
@@ -393,7 +405,8 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
     for i, e in enumerate(edits_in):
         jp = f"$.edits[{i}]"
         e = ctx.obj(e, jp, required=("support",),
-                    allowed=("support", "handle", "handles", "transform", "transforms", "curves"))
+                    allowed=("support", "handle", "handles", "transform", "transforms", "curves",
+                             "deformation"))
         sup_in, fill_holes = e["support"], True
         if isinstance(sup_in, dict) and "fill_holes" in sup_in:
             fill_holes = sup_in["fill_holes"]
@@ -428,7 +441,19 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             if not isinstance(ts, list) or len(ts) != len(hs):
                 raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
             transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
-        edits.append(Edit(support, handles, transforms, jp, curves, fill_holes))
+        mode = DeformationMode.ROTATION
+        if "deformation" in e:
+            if not isinstance(e["deformation"], str):
+                raise ctx.fail(f"{jp}.deformation", f"must be one of \"rotation\", \"linear\", \"detail\", "
+                               f"got {_kind(e['deformation'])}")
+            try:
+                mode = DeformationMode.parse(e["deformation"])
+            except ValueError as exc:
+                raise ctx.fail(f"{jp}.deformation", str(exc)) from None
+            if mode is DeformationMode.DETAIL:
+                raise ctx.fail(f"{jp}.deformation", "the 'detail' deformation is not yet supported "
+                               "(use 'rotation' or 'linear')")
+        edits.append(Edit(support, handles, transforms, jp, curves, fill_holes, mode))
     return EditScript(tuple(edits), solver)
 
 
@@ -506,6 +531,8 @@ class EditReport:
     #: distortion of the support splats (splatedit.deform.distortion): per-splat
     #: stretch max(s1, 1/s2) and area change s1 s2 of the committed axes
     distortion: DistortionStats | None = None
+    #: the edit's deformation mode ("rotation", "linear")
+    mode: str = DeformationMode.ROTATION.value
 
     def distortion_line(self) -> str:
         """``  distortion: stretch max 1.84x, 0 > 3x, 0 > 4x, area change 0.71..2.30``."""
@@ -529,7 +556,7 @@ class EditReport:
         closed = f" (closure added {self.closure_added})" if self.closure_added else ""
         groups = [f"handle {hs}"] if self.handles else []
         groups += [f"curve {k} points/{n} samples" for k, n in self.curves]
-        return (f"edit {self.index}: support {self.support} splats{closed}, {', '.join(groups)}, "
+        return (f"edit {self.index}: {self.mode} deformation, support {self.support} splats{closed}, {', '.join(groups)}, "
                 f"{self.constraints} constraints, {self.method} with {self.centers} centers "
                 f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
                 f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
@@ -619,7 +646,9 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
 
     ``method``/``tol`` override ``solver`` when given.
     Returns:
-        (ResolvedEdit, DeformationBasis, dC (K, 3) control displacements)
+        (ResolvedEdit, DeformationBasis, displacement): the displacement is what
+        ``DeformationBasis.displacement`` returns in the edit's mode (a (K, 3)
+        dC for "linear", a RotationDisplacement for "rotation")
     Raises:
         EditScriptError: bad regions/curves, or a fit that failed (JSON path of the edit).
     """
@@ -633,7 +662,7 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
                                      tol=solver.tol if tol is None else tol,
                                      max_centers=solver.max_centers, fill_holes=r.fill_holes,
                                      progress=progress)
-        d_c = basis.displacement(r.inputs)
+        d_c = basis.displacement(r.inputs, mode=edit.deformation)
     except CurveSamplesError as exc:
         jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")
         raise EditScriptError(str(exc).split(": ", 1)[1], json_path=jp, path=source) from None
@@ -652,6 +681,7 @@ def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
     if row is not None and row in set(np.asarray(basis.indices).tolist()):
         return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
                 "use a milder transform")
+    d_c = getattr(d_c, "dC", d_c)    # a RotationDisplacement: its residual dC
     move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
     return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
             f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
@@ -689,7 +719,7 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                          [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
                          stats.get("closure_added", 0),
                          [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts],
-                         dist)
+                         dist, DeformationMode(edit.deformation).value)
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)
