@@ -352,7 +352,8 @@ class DeformationBasis:
 
         ``mode``: LINEAR (the paper) returns the (K, 3) array; ROTATION returns a
         :class:`~splatedit.deform.rotation.RotationDisplacement` (residual dC
-        plus each handle's rotation, see :mod:`splatedit.deform.rotation`),
+        plus each handle's rotation, see :mod:`splatedit.deform.rotation`)
+        when a handle rotates, else the same (K, 3) array as LINEAR (bitwise),
         which :meth:`apply`, :meth:`displacements`, :meth:`jacobians` and the
         renderer take in place of dC.  DETAIL is not handled here.
         """
@@ -389,7 +390,7 @@ class DeformationBasis:
                 if not np.isfinite(d).all():
                     raise ParameterError(f"transforms[{i}]", "must be finite")
                 dc[cols] = d
-        if mode is DeformationMode.ROTATION:
+        if mode is DeformationMode.ROTATION and any(r.w.any() for r in rotations):
             return RotationDisplacement(dc, tuple(rotations))
         return dc
 

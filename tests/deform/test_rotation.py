@@ -57,7 +57,9 @@ def test_pure_translation_is_the_linear_mode_bitwise(bar):
     cloud, basis = bar
     t = translate((0.4, -1.0, 2.0))
     d = basis.displacement([t], mode=ROT)
-    assert isinstance(d, RotationDisplacement) and not d.rotating
+    assert not isinstance(d, RotationDisplacement)     # no rotation: the plain dC
+    assert isinstance(basis.displacement([compose(t, rotate((0, 0, 1), 0.01))], mode=ROT),
+                      RotationDisplacement)
     a, b = basis.apply(cloud, d), basis.apply(cloud, basis.displacement([t], mode=LIN))
     for name in ("positions", "u", "v"):
         assert np.array_equal(getattr(a, name), getattr(b, name))
