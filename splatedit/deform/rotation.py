@@ -182,21 +182,42 @@ def arc_coefficients(theta: float, s: np.ndarray):
         (a1, a2, b1, b2), each (N,) float64.
     """
     x = np.asarray(s, dtype=np.float64) * theta
-    small = np.abs(x) < _SERIES_X
-    xs = np.where(small, 1.0, x)          # keep the closed forms finite where unused
-    sn, cs = np.sin(xs), np.cos(xs)
-    x2 = x * x
-    f1 = np.where(small, 1.0 - x2 / 6.0, sn / xs)                              # sin x / x
-    f2 = np.where(small, x / 2.0 - x * x2 / 24.0, (1.0 - cs) / xs)             # (1 - cos x) / x
-    g1 = np.where(small, -x / 3.0 + x * x2 / 30.0, (xs * cs - sn) / (xs * xs))  # d/dx f1
-    g2 = np.where(small, 0.5 - x2 / 8.0, (xs * sn - 1.0 + cs) / (xs * xs))      # d/dx f2
+    with np.errstate(divide="ignore", invalid="ignore"):   # x = 0 rows are replaced below
+        sn, h = np.sin(x), np.sin(0.5 * x)
+        omc = 2.0 * h * h                                   # 1 - cos x without cancellation
+        inv = 1.0 / x
+        f1 = sn * inv                                       # sin x / x
+        f2 = omc * inv                                      # (1 - cos x) / x
+        g1 = ((1.0 - omc) - f1) * inv                       # d/dx f1 = (x cos x - sin x) / x^2
+        g2 = (sn - f2) * inv                                # d/dx f2 = (x sin x - 1 + cos x) / x^2
+    small = np.flatnonzero(np.abs(x) < _SERIES_X)
+    if len(small):
+        xs = x[small]
+        x2 = xs * xs
+        f1[small] = 1.0 - x2 / 6.0
+        f2[small] = xs / 2.0 - xs * x2 / 24.0
+        g1[small] = -xs / 3.0 + xs * x2 / 30.0
+        g2[small] = 0.5 - x2 / 8.0
     return theta * f1, theta * f2, theta * theta * g1, theta * theta * g2
+
+
+def _cross(k: np.ndarray, y: np.ndarray) -> np.ndarray:
+    """``k x y`` for a (3,) k and (N, 3) rows y (np.cross is slower for this shape)."""
+    out = np.empty_like(y)
+    out[:, 0] = k[1] * y[:, 2] - k[2] * y[:, 1]
+    out[:, 1] = k[2] * y[:, 0] - k[0] * y[:, 2]
+    out[:, 2] = k[0] * y[:, 1] - k[1] * y[:, 0]
+    return out
 
 
 def _k(k: np.ndarray, y: np.ndarray, c1: np.ndarray, c2: np.ndarray) -> np.ndarray:
     """``c1 (k x y) + c2 (k x (k x y))`` row-wise; (N, 3)."""
-    ky = np.cross(k, y)
-    return c1[:, None] * ky + c2[:, None] * np.cross(k, ky)
+    ky = _cross(k, y)
+    out = _cross(k, ky)
+    out *= c2[:, None]
+    ky *= c1[:, None]
+    out += ky
+    return out
 
 
 def blend_terms(rot: RotationDisplacement, pack: np.ndarray, column_blocks, vectors=()):
@@ -230,8 +251,9 @@ def blend_terms(rot: RotationDisplacement, pack: np.ndarray, column_blocks, vect
         fv = _k(k, v, b1, b2)
         grad_s = sub[:, 1:, :].sum(axis=2)            # (N, 3)
         for out, u in zip(dv, vectors):
-            gu = np.einsum("njk,nj->nk", sub[:, 1:, :], u) @ r.offsets   # grad v_h u
-            out += _k(k, gu, a1, a2) + fv * np.einsum("nj,nj->n", grad_s, u)[:, None]
+            gu = (sub[:, 1, :] * u[:, :1] + sub[:, 2, :] * u[:, 1:2] + sub[:, 3, :] * u[:, 2:]) @ r.offsets
+            out += _k(k, gu, a1, a2)                                       # F(s) grad v_h u
+            out += fv * (grad_s * u).sum(axis=1)[:, None]
     return dp, dv
 
 
