@@ -49,8 +49,8 @@ from splatedit.deform.constraints import (
 )
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
-from splatedit.deform.rotation import (RotationDisplacement, blend_jacobians, blend_terms, decompose,
-                                       split_displacement)
+from splatedit.deform.rotation import (apply_rotation, blend_jacobians, blend_terms, handle_blocks,
+                                       rotation_displacement, split_displacement)
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
@@ -363,18 +363,14 @@ class DeformationBasis:
         if isinstance(transforms, np.ndarray) and transforms.ndim == 2:
             transforms = [transforms]
         transforms = list(transforms)
+        if mode is DeformationMode.ROTATION and len(transforms) == self.n_groups:
+            return rotation_displacement(self, transforms)
         if len(transforms) != self.n_groups:
             raise ParameterError("transforms", f"need one matrix per handle and one (k + 1, 3) "
                                  f"displacement array per curve ({self.n_groups} groups: "
                                  f"{', '.join(self.group_kinds)}), got {len(transforms)}")
         dc = np.zeros((self.n_columns, 3))
-        rotations = []
         for i, (t, grp) in enumerate(zip(transforms, self.constraints.groups)):
-            if grp.kind == "handle" and mode is DeformationMode.ROTATION:
-                m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
-                rot, m = decompose(m, grp.controls)
-                rotations.append(rot)
-                t = None if t is None else m
             if t is None:
                 continue
             cols = self.columns_for_group(i)
@@ -390,8 +386,6 @@ class DeformationBasis:
                 if not np.isfinite(d).all():
                     raise ParameterError(f"transforms[{i}]", "must be finite")
                 dc[cols] = d
-        if mode is DeformationMode.ROTATION and any(r.w.any() for r in rotations):
-            return RotationDisplacement(dc, tuple(rotations))
         return dc
 
     def _check_dc(self, dC) -> np.ndarray:
@@ -402,17 +396,13 @@ class DeformationBasis:
             raise ParameterError("dC", "must be finite")
         return d
 
-    def _handle_blocks(self) -> list[slice]:
-        return [self.columns_for_group(g) for g, grp in enumerate(self.constraints.groups)
-                if grp.kind == "handle"]
-
     def displacements(self, dC) -> np.ndarray:
         """(N, 3) displacements of the support splats: ``B dC`` (plus the
         blended rotations of a RotationDisplacement)."""
         d, rot = split_displacement(dC)
         out = self.B @ self._check_dc(d)
         if rot is not None:
-            out += blend_terms(rot, self._pack, self._handle_blocks())[0]
+            out += blend_terms(rot, self._pack, handle_blocks(self))[0]
         return out
 
     def jacobians(self, dC) -> np.ndarray:
@@ -424,7 +414,7 @@ class DeformationBasis:
         out = jt.transpose(0, 2, 1).copy()
         out += np.eye(3)
         if rot is not None:
-            out += blend_jacobians(rot, self._pack, self._handle_blocks())
+            out += blend_jacobians(rot, self._pack, handle_blocks(self))
         return out
 
     def _check_cloud(self, cloud):
@@ -484,7 +474,7 @@ class DeformationBasis:
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
         if rot is not None:
-            return self._apply_rotation(cloud, d, rot)
+            return apply_rotation(self, cloud, d, rot)
         srcs = (cloud.positions, cloud.u, cloud.v)
         if not d.any():
             return tuple(s.copy() for s in srcs)
@@ -507,16 +497,6 @@ class DeformationBasis:
         if len(c["filler"]):  # fixed splats computed through: restore them bitwise
             for s, o in zip(srcs, outs):
                 o[c["filler"]] = s[c["filler"]]
-        return outs
-
-    def _apply_rotation(self, cloud, d, rot: RotationDisplacement):
-        """apply_arrays of a rotating frame: the linear GEMM with the residual
-        dC, plus the blended rotations at the support splats."""
-        outs = self.apply_arrays(cloud, d)
-        idx = self.indices
-        dp, (du, dv) = blend_terms(rot, self._pack, self._handle_blocks(), (cloud.u[idx], cloud.v[idx]))
-        for o, x in zip(outs, (dp, du, dv)):
-            o[idx] += x
         return outs
 
     def apply(self, cloud, dC, *, validate: bool = False):

@@ -64,6 +64,7 @@ from scipy.linalg import polar
 from scipy.spatial.transform import Rotation
 
 from splatedit.deform.modes import DeformationMode
+from splatedit.deform.transform import as_affine
 from splatedit.tolerances import ROTATION_MIN_ANGLE
 
 
@@ -155,6 +156,43 @@ class RotationDisplacement:
     def rotating(self) -> list[int]:
         """Handles with a non-zero rotation."""
         return [i for i, r in enumerate(self.rotations) if r.w.any()]
+
+
+def handle_blocks(basis) -> list[slice]:
+    """Column slices of a DeformationBasis' handles (4 columns each, in order)."""
+    return [basis.columns_for_group(g) for g, kind in enumerate(basis.group_kinds) if kind == "handle"]
+
+
+def rotation_displacement(basis, transforms: list):
+    """``DeformationBasis.displacement(transforms, mode=ROTATION)``: each
+    handle's (4, 4) map (None: identity) decomposed, the residual maps (and the
+    curves' inputs) through the linear ``displacement``.  Returns a
+    RotationDisplacement, or the plain (K, 3) dC when no handle rotates (then
+    bitwise the linear mode's)."""
+    rotations, inputs = [], []
+    for i, (t, kind) in enumerate(zip(transforms, basis.group_kinds)):
+        if kind == "handle":
+            m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
+            rot, res = decompose(m, basis.constraints.groups[i].controls)
+            rotations.append(rot)
+            t = None if t is None else res
+        inputs.append(t)
+    dc = basis.displacement(inputs)
+    if any(r.w.any() for r in rotations):
+        return RotationDisplacement(dc, tuple(rotations))
+    return dc
+
+
+def apply_rotation(basis, cloud, dC: np.ndarray, rot: "RotationDisplacement"):
+    """``DeformationBasis.apply_arrays`` of a rotating frame: the linear GEMM
+    with the residual (K, 3) ``dC``, plus the blended rotations at the support
+    splats.  Returns (positions, u, v) (n, 3) float64."""
+    outs = basis.apply_arrays(cloud, dC)
+    idx = basis.indices
+    dp, (du, dv) = blend_terms(rot, basis._pack, handle_blocks(basis), (cloud.u[idx], cloud.v[idx]))
+    for o, x in zip(outs, (dp, du, dv)):
+        o[idx] += x
+    return outs
 
 
 def split_displacement(dC) -> tuple[np.ndarray, RotationDisplacement | None]:
