@@ -678,8 +678,7 @@ class Session:
             d["job"] = None
             if job.error is None:
                 d["result"] = job.result
-        key = d0.tobytes() + (b"" if rot is None else
-                              b"".join(r.w.tobytes() + r.offsets.tobytes() for r in rot.rotations))
+        key = dc.tobytes()
         if d["job"] is None and (d["result"] is None or d["result"][0] != key):
             basis, cloud = src
 

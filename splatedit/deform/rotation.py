@@ -157,6 +157,15 @@ class RotationDisplacement:
         """Handles with a non-zero rotation."""
         return [i for i, r in enumerate(self.rotations) if r.w.any()]
 
+    def any(self) -> bool:
+        """Whether anything moves (like ``ndarray.any`` of a plain dC)."""
+        return bool(self.rotating) or bool(np.any(self.dC))
+
+    def tobytes(self) -> bytes:
+        """The frame's contents as bytes (a cache key, like ``ndarray.tobytes``)."""
+        return np.asarray(self.dC, dtype=np.float64).tobytes() + b"".join(
+            np.concatenate([r.w, r.center, r.offsets.ravel()]).tobytes() for r in self.rotations)
+
 
 def handle_blocks(basis) -> list[slice]:
     """Column slices of a DeformationBasis' handles (4 columns each, in order)."""
