@@ -2,11 +2,14 @@
 // DEFORM_BINDING, defined by the including file).  dC of a basis with up to
 // RENDER_MAX_BASIS_COLUMNS = 16 columns, zero-padded to whole groups of 4:
 // dC[3g + i] = (dC_{4g}, .., dC_{4g+3})[i], i = x, y, z.  Only this 192-byte
-// block is uploaded when the displacement changes.
+// block is uploaded when the displacement changes.  rot: per group g the
+// rotation of handle g (rotation-aware mode, rotation.glsl): rot[4g] = (unit
+// axis, angle; 0 = none), rot[4g + 1 + i] = (D_0, .., D_3)[i] (frame offsets).
 // Mirrors splatedit/render/renderer.py:_DEFORM_UBO_BYTES.
 
 const int MAX_BASIS_GROUPS = 4;
 
 layout(std140, set = 0, binding = DEFORM_BINDING) uniform Deform {
     vec4 dC[3 * MAX_BASIS_GROUPS];
+    vec4 rot[4 * MAX_BASIS_GROUPS];
 } D;

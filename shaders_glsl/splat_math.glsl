@@ -17,12 +17,16 @@ const int SPLAT_POINT = 2;
 
 // p' = p + sum_k B_k dC_k;  J_ij = delta_ij + sum_k dC_k[i] B{j}_k;  u' = J u, v' = J v
 // (one group of 4 columns; dp and Jm = J - I accumulate over groups)
+#include "rotation.glsl"
+
 void deform_group(int g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inout mat3 Jm) {
     vec4 dx = D.dC[3 * g], dy = D.dC[3 * g + 1], dz = D.dC[3 * g + 2];
     dp += vec3(dot(B, dx), dot(B, dy), dot(B, dz));
     Jm[0] += vec3(dot(dx, Bx), dot(dy, Bx), dot(dz, Bx));
     Jm[1] += vec3(dot(dx, By), dot(dy, By), dot(dz, By));
     Jm[2] += vec3(dot(dx, Bz), dot(dy, Bz), dot(dz, Bz));
+    if (D.rot[4 * g].w != 0.0)             // a rotating handle (rotation-aware mode)
+        rotation_blend(D.rot[4 * g], D.rot[4 * g + 1], D.rot[4 * g + 2], D.rot[4 * g + 3], B, Bx, By, Bz, dp, Jm);
 }
 
 // Offset of the screen-space extent of the projected ellipse along one axis,

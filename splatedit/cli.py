@@ -309,9 +309,10 @@ def _gpu_edit(args, cloud):
                                     progress=args.progress)
     args.progress.close()
     st = basis.stats
-    print(f"edit {len(script.edits) - 1}: support {len(basis.indices)} splats, {st['method']} with "
-          f"{st['n_centers']} centers (residual {st['residual']:.2e}), {d_c.shape[0]} basis columns "
-          f"uploaded to the GPU")
+    mode = script.edits[-1].deformation.value
+    print(f"edit {len(script.edits) - 1}: {mode} deformation, support {len(basis.indices)} splats, "
+          f"{st['method']} with {st['n_centers']} centers (residual {st['residual']:.2e}), "
+          f"{basis.n_columns} basis columns uploaded to the GPU")
     for c in basis.constraints.conflicts:
         print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
               file=sys.stderr)

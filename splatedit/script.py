@@ -9,7 +9,7 @@ Format (version 1)::
         "handle": REGION,                    # or "handles": [REGION, ...]
         "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
         "curves": [CURVE, ...],              # optional; see below
-        "deformation": "linear"|"rotation"|"detail"}]}   # optional, default "linear"
+        "deformation": "rotation"}]}         # optional: "rotation" (default) | "linear" | "detail"
 
     REGION    = {"sphere": {"center": [x,y,z], "radius": r}}      (a support region may add
                                                                 "fill_holes": false)
@@ -40,6 +40,13 @@ to the handle's centroid.  Edits run one after another: each edit's result is
 the base of the next (the paper's Bunny: ears, then head).  Every error names
 the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis`` or
 ``$.edits[1].curves[0].move[2]``.
+
+``deformation`` picks how the handles' maps spread over the support
+(:class:`~splatedit.deform.modes.DeformationMode`): ``"rotation"`` (the
+default) blends each handle's rotation over the support, so bends and twists
+of 90 degrees and more keep their cross-sections; ``"linear"`` is the paper's
+deformation (exact for translations, large rotations shrink the middle);
+``"detail"`` is not supported yet.  Curves move the same way in both modes.
 """
 
 from __future__ import annotations
@@ -128,8 +135,8 @@ class Edit:
     #: close the selection before fitting (``"fill_holes": false`` on the
     #: support region turns it off; see splatedit.select.closure)
     fill_holes: bool = True
-    #: the deformation model (key ``"deformation"``; splatedit.deform.modes)
-    deformation: DeformationMode = DeformationMode.LINEAR
+    #: how the handles' maps spread over the support (``"deformation"``)
+    deformation: DeformationMode = DeformationMode.ROTATION
 
 
 @dataclass(frozen=True)
@@ -191,8 +198,7 @@ class EditScript:
                 item["transforms"] = [transform(t) for t in e.transforms]
             if e.curves:
                 item["curves"] = [curve(c) for c in e.curves]
-            if e.deformation is not DeformationMode.LINEAR:
-                item["deformation"] = e.deformation.value
+            item["deformation"] = DeformationMode(e.deformation).value
             edits.append(item)
         return {"version": SCRIPT_VERSION, "solver": solver, "edits": edits}
 
@@ -435,10 +441,11 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             if not isinstance(ts, list) or len(ts) != len(hs):
                 raise ctx.fail(f"{jp}.transforms", f"must be a list with one transform per handle ({len(hs)})")
             transforms = tuple(_transform(ctx, t, f"{jp}.transforms[{k}]") for k, t in enumerate(ts))
-        mode = DeformationMode.LINEAR
+        mode = DeformationMode.ROTATION
         if "deformation" in e:
             if not isinstance(e["deformation"], str):
-                raise ctx.fail(f"{jp}.deformation", f"must be a string, got {_kind(e['deformation'])}")
+                raise ctx.fail(f"{jp}.deformation", f"must be one of \"rotation\", \"linear\", \"detail\", "
+                               f"got {_kind(e['deformation'])}")
             try:
                 mode = DeformationMode.parse(e["deformation"])
             except ValueError as exc:
@@ -521,6 +528,8 @@ class EditReport:
     #: distortion of the support splats (splatedit.deform.distortion): per-splat
     #: stretch max(s1, 1/s2) and area change s1 s2 of the committed axes
     distortion: DistortionStats | None = None
+    #: the edit's deformation mode ("rotation", "linear")
+    mode: str = DeformationMode.ROTATION.value
 
     def distortion_line(self) -> str:
         """``  distortion: stretch max 1.84x, 0 > 3x, 0 > 4x, area change 0.71..2.30``."""
@@ -544,7 +553,7 @@ class EditReport:
         closed = f" (closure added {self.closure_added})" if self.closure_added else ""
         groups = [f"handle {hs}"] if self.handles else []
         groups += [f"curve {k} points/{n} samples" for k, n in self.curves]
-        return (f"edit {self.index}: support {self.support} splats{closed}, {', '.join(groups)}, "
+        return (f"edit {self.index}: {self.mode} deformation, support {self.support} splats{closed}, {', '.join(groups)}, "
                 f"{self.constraints} constraints, {self.method} with {self.centers} centers "
                 f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
                 f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
@@ -601,7 +610,7 @@ class ResolvedEdit:
     curves: list
     curve_moves: list
     fill_holes: bool = True
-    deformation: DeformationMode = DeformationMode.LINEAR
+    deformation: DeformationMode = DeformationMode.ROTATION
 
     @property
     def inputs(self) -> list:
@@ -635,7 +644,9 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
 
     ``method``/``tol`` override ``solver`` when given.
     Returns:
-        (ResolvedEdit, DeformationBasis, dC (K, 3) control displacements)
+        (ResolvedEdit, DeformationBasis, displacement): the displacement is what
+        ``DeformationBasis.displacement`` returns in the edit's mode (a (K, 3)
+        dC for "linear", a RotationDisplacement for "rotation")
     Raises:
         EditScriptError: bad regions/curves, or a fit that failed (JSON path of the edit).
     """
@@ -647,16 +658,13 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
     if r.deformation is DeformationMode.DETAIL:
         from splatedit.deform.detail import DetailBasis
         fit = DetailBasis.fit
-    elif r.deformation is not DeformationMode.LINEAR:
-        raise EditScriptError(f"deformation {r.deformation.value!r} is not available in this build",
-                              json_path=f"{edit.json_path}.deformation", path=source)
     try:
         basis = fit(cloud, r.support, r.handles, curves=r.curves,
                                      method=method or solver.method,
                                      tol=solver.tol if tol is None else tol,
                                      max_centers=solver.max_centers, fill_holes=r.fill_holes,
                                      progress=progress)
-        d_c = basis.displacement(r.inputs)
+        d_c = basis.displacement(r.inputs, mode=edit.deformation)
     except CurveSamplesError as exc:
         jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")
         raise EditScriptError(str(exc).split(": ", 1)[1], json_path=jp, path=source) from None
@@ -675,6 +683,7 @@ def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
     if row is not None and row in set(np.asarray(basis.indices).tolist()):
         return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
                 "use a milder transform")
+    d_c = getattr(d_c, "dC", d_c)    # a RotationDisplacement: its residual dC
     move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
     return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
             f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
@@ -712,7 +721,7 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                          [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
                          stats.get("closure_added", 0),
                          [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts],
-                         dist)
+                         dist, DeformationMode(edit.deformation).value)
         reports.append(rep)
         if on_edit is not None:
             on_edit(rep)

@@ -327,3 +327,54 @@ def test_deformation_key_selects_the_detail_mode_and_round_trips(tmp_path):
     p.write_text(_json.dumps(doc))
     with pytest.raises(EditScriptError, match=r"\$\.edits\[0\]\.deformation"):
         load_script(p)
+
+
+@pytest.mark.parametrize("value, message", [
+    ("sideways", "unknown deformation mode 'sideways'"),
+    (3, "must be one of"),
+])
+def test_bad_deformation_mode_names_its_json_path(value, message):
+    data = copy.deepcopy(GOOD)
+    data["edits"][1]["deformation"] = value
+    with pytest.raises(EditScriptError) as info:
+        parse_script(data)
+    assert info.value.json_path == "$.edits[1].deformation" and message in str(info.value)
+
+
+def test_deformation_mode_defaults_to_rotation_and_round_trips():
+    from splatedit.deform.modes import DeformationMode
+    data = copy.deepcopy(GOOD)
+    data["edits"][0]["deformation"] = "Linear"
+    s = parse_script(data)
+    n = len(s.edits)
+    assert [e.deformation for e in s.edits] == [DeformationMode.LINEAR] + [DeformationMode.ROTATION] * (n - 1)
+    out = s.to_json()
+    assert [e["deformation"] for e in out["edits"]] == ["linear"] + ["rotation"] * (n - 1)
+    assert parse_script(out) == s
+
+
+def test_script_modes_differ_only_in_rotation_and_report_the_mode():
+    """A 120-degree rotation of the bunny's ear: the rotation mode keeps the
+    ear's size (its splats' spread about their centroid) where the linear mode
+    shrinks it; the report line names the mode."""
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    cloud = read(default_model_path())
+    lo, hi = cloud.bounds()
+    ear = cloud.positions[np.argmax(cloud.positions[:, 1])]
+    size = float(np.linalg.norm(hi - lo))
+    base = {"support": {"sphere": {"center": ear.tolist(), "radius": 0.35 * size}},
+            "handle": {"sphere": {"center": ear.tolist(), "radius": 0.08 * size}},
+            "transform": {"rotate": {"axis": [0, 0, 1], "degrees": 120}}}
+    spread = {}
+    for mode in ("linear", "rotation"):
+        s = parse_script({"version": 1, "edits": [dict(base, deformation=mode)]})
+        out, reps = run_script(cloud, s)
+        assert reps[0].line().startswith(f"edit 0: {mode} deformation, ")
+        dp = np.linalg.norm(out.positions - cloud.positions, axis=1)
+        moved = dp > 1e-3 * size
+        mid = moved & (np.linalg.norm(cloud.positions - ear, axis=1) > 0.1 * size)
+        spread[mode] = np.linalg.norm(out.positions[mid] - out.positions[mid].mean(0), axis=1).mean() / \
+            np.linalg.norm(cloud.positions[mid] - cloud.positions[mid].mean(0), axis=1).mean()
+    print(spread)
+    assert spread["rotation"] > spread["linear"]

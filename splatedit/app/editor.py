@@ -852,6 +852,8 @@ class Editor:
             self.selection_tool("connected", *self.mouse, whole=shift)
         elif k == g.KEY_D and not shift:
             self.toggle_distortion_map()
+        elif k == g.KEY_M:
+            self.say(f"deformation: {s.cycle_deformation().value}")
         elif k == g.KEY_C:
             s.clear(HANDLE if shift else None)
         elif k == g.KEY_LEFT_BRACKET:
@@ -1208,7 +1210,8 @@ class Editor:
         mode = "3D" if self.tools.mode == seltools.BRUSH_3D else "VISIBLE"
         lines.append((f"brush: {tgt} {mode}{erase}  radius {self.brush_radius:.0f} px   (Tab, V, E, [ ])",
                       ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
-        lines.append(f"support {st['support']:,}   handle {st['handle']:,}")
+        lines.append(f"support {st['support']:,}   handle {st['handle']:,}   "
+                     f"deformation {s.deformation.value.upper()} (M)")
         hs = s.selection.handles
         if len(hs) > 1 or s.curve_points or s.curve_mode:
             sizes = " ".join(f"[{n:,}]" if k == s.selection.active else f"{n:,}"

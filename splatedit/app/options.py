@@ -39,6 +39,8 @@ Deformation (the basis of all handles and the curve is fitted in the background;
   Left drag on an arrow  move the active handle along that axis (gizmo: X red, Y green, Z blue)
   Left drag on a ring    rotate the active handle about that axis, through its centre
   Left drag outer circle scale the active handle about its centre (outward: larger)
+  M                      deformation of new edits: ROTATION (default: handles' rotations are blended,
+                         bends and twists keep their thickness) / LINEAR (the paper's)
   G / R / S              grab / rotate / scale the active handle with the mouse
     X / Y / Z            constrain to that world axis (again: free)
     0-9 . -              type a value: distance, degrees or factor (G X 0.1 Enter)

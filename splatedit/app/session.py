@@ -46,6 +46,7 @@ import numpy as np
 from splatedit.app.brush import HANDLE, SUPPORT, Selection
 from splatedit.app.history import History, Snapshot
 from splatedit.app.jobs import Cancelled, Job
+from splatedit.deform.modes import DeformationMode
 from splatedit.deform.transform import compose, rotate, scale, translate
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_AXIS_MIN_SCREEN_LEN, EDITOR_MIN_SCALE_FACTOR, IQR_DEFAULT_TOL,
@@ -227,6 +228,8 @@ class Session:
     def __init__(self, cloud, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
                  max_centers: int | None = None, fit_sync: bool = False, on_change=None):
         self.method, self.tol, self.max_centers = method, tol, max_centers
+        #: deformation mode of new edits (the editor's M key; carried into exported scripts)
+        self.deformation = DeformationMode.ROTATION
         self.fit_sync = fit_sync
         self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="splatedit-fit")
         self.on_change = on_change or (lambda: None)
@@ -629,11 +632,21 @@ class Session:
     def current_matrix(self) -> np.ndarray:
         return np.eye(4) if self.manip is None else self.manip.matrix()
 
-    def current_dc(self) -> np.ndarray | None:
-        """dC of the whole pose, live manipulation included (None without basis)."""
+    def current_dc(self):
+        """dC of the whole pose, live manipulation included (None without
+        basis), in the session's :attr:`deformation` mode (a
+        RotationDisplacement in rotation mode)."""
         if self.basis is None:
             return None
-        return self.basis.displacement(self.inputs())
+        return self.basis.displacement(self.inputs(), mode=self.deformation)
+
+    def cycle_deformation(self) -> DeformationMode:
+        """Switch the mode of new edits: rotation <-> linear ("detail" is not
+        available yet); the live pose is shown in the new mode at once."""
+        self.deformation = (DeformationMode.LINEAR if self.deformation is DeformationMode.ROTATION
+                            else DeformationMode.ROTATION)
+        self.on_change()
+        return self.deformation
 
     def distortion(self):
         """:class:`~splatedit.deform.distortion.DistortionStats` of the support
@@ -647,8 +660,14 @@ class Session:
         100k support splats, see docs/PERFORMANCE.md).  ``fit_sync`` sessions
         compute synchronously (tests)."""
         dc = self.current_dc()
-        if dc is None or not dc.any():
+        if dc is None:
             return None
+        from splatedit.deform.rotation import split_displacement
+        d0, rot = split_displacement(dc)
+        if rot is None and not d0.any():
+            return None
+        if rot is None:
+            dc = d0
         from splatedit.deform.distortion import DistortionProbe
         src = (self.basis, self.cloud)
         d = getattr(self, "_dist", None)
@@ -666,6 +685,9 @@ class Session:
             def work(progress):
                 if d["probe"] is None:
                     d["probe"] = DistortionProbe(basis, cloud)
+                if rot is not None:     # exact Jacobians with the blended rotations
+                    from splatedit.deform.distortion import basis_distortion
+                    return key, basis_distortion(basis, cloud, dc)
                 return key, d["probe"].stats(dc)
             d["job"] = Job("distortion", work, self.on_change, sync=self.fit_sync)
             if d["job"].done:
@@ -732,7 +754,7 @@ class Session:
             self.on_change()
             return False
         t0 = time.perf_counter()
-        dc = self.basis.displacement(inputs)
+        dc = self.basis.displacement(inputs, mode=self.deformation)
         # the same arrays and the same checks as ``splatedit deform`` and as reading the
         # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
         # length is relative to the *whole* cloud's diagonal, which the edit may change)
@@ -746,7 +768,8 @@ class Session:
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
         edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
                     tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
-                    fill_holes=False)  # the editor's closed selection, replayed as is
+                    fill_holes=False,  # the editor's closed selection, replayed as is
+                    deformation=self.deformation)
         self.manip = None
         self.manip_target = None
         self.cloud = new

@@ -95,7 +95,8 @@ class Viewport:
         self.basis = basis
 
     def set_dc(self, dc) -> None:
-        self.dc = None if dc is None else np.asarray(dc, float)
+        from splatedit.deform.rotation import RotationDisplacement
+        self.dc = dc if dc is None or isinstance(dc, RotationDisplacement) else np.asarray(dc, float)
 
     # ------------------------------------------------------------- syncing
     def _sync(self, slot: _Slot, level=None) -> None:
@@ -140,7 +141,11 @@ class Viewport:
             slot.dc = None
         if basis is not None:
             dc = self.dc if self.dc is not None else np.zeros((basis.n_columns, 3))
-            if slot.dc is None or not np.array_equal(slot.dc, dc):
+            if not isinstance(dc, np.ndarray):      # a RotationDisplacement (immutable)
+                if slot.dc is not dc:
+                    slot.r.set_displacement(dc)
+                    slot.dc = dc
+            elif not isinstance(slot.dc, np.ndarray) or not np.array_equal(slot.dc, dc):
                 slot.r.set_displacement(dc)
                 slot.dc = dc.copy()
 

@@ -45,6 +45,20 @@ def _basis(points: np.ndarray):
     return B, g[..., 0], g[..., 1], g[..., 2]
 
 
+def _rotation_displacement(dC, lo, hi):
+    """``dC`` as the residual of one handle turned by 120 degrees about a tilted
+    axis: every splat takes the rotation branch of the pre-pass (all its
+    math, closed forms), while the frame offsets are small (1e-3 of the model)
+    so that the deformed geometry, and with it culling and the record writes,
+    stays that of the linear case the ratio is taken against."""
+    from splatedit.deform.rotation import HandleRotation, RotationDisplacement
+    size = float(np.max(hi - lo))
+    axis = np.array([0.3, 1.0, 0.2]) / np.linalg.norm([0.3, 1.0, 0.2])
+    offsets = 1e-3 * size * (np.vstack([[0.0, 0.0, 0.0], np.eye(3)]) + 0.5)
+    rot = HandleRotation(axis * np.radians(120.0), 0.5 * (lo + hi), offsets)
+    return RotationDisplacement(np.asarray(dC, dtype=np.float64), (rot,))
+
+
 def _frames(r: Renderer, cam, w, h, repeats):
     """(median, best) per-pass GPU times over ``repeats`` frames after a warm-up."""
     r.render(cam, w, h)                          # warm-up (pipeline JIT)
@@ -87,6 +101,9 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
         heat, heat_best = _frames(r, cam, w, h, repeats)
     finally:
         r.distortion_map = False
+    # the same basis as one rotation-aware handle turned 120 degrees (rotation.glsl)
+    r.set_displacement(_rotation_displacement(dC, lo, hi))
+    rot, rot_best = _frames(r, cam, w, h, repeats)
     # a contiguous support region: the 10% of the splats nearest to one point
     d2 = np.sum((cloud.positions - cloud.positions[0]) ** 2, axis=1)
     idx = np.sort(np.argpartition(d2, max(n // 10 - 1, 0))[:max(n // 10, 1)])
@@ -114,6 +131,9 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
         "ms_frame_heat_map": round(heat["total"], 2),
         "heat_map_over_deformed_prepass": round(heat["prepass"] / full["prepass"], 3),
         "heat_map_over_deformed_prepass_best": round(heat_best["prepass"] / full_best["prepass"], 3),
+        "ms_prepass_rotation_all": round(rot["prepass"], 2),
+        "rotation_over_deformed_prepass": round(rot["prepass"] / full["prepass"], 3),
+        "rotation_over_deformed_prepass_best": round(rot_best["prepass"] / full_best["prepass"], 3),
         "deformed_10pct_over_plain_best": round(tenth_best["total"] / plain_best["total"], 3),
         "loadavg_1min": _loadavg(),
         "wall_s": round(time.perf_counter() - t0, 1),
@@ -160,6 +180,9 @@ def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repea
       the distortion heat map (``Renderer.distortion_map``: the per-splat
       stretch in the pre-pass); ``heat_map_over_deformed_prepass`` (and
       ``_best``) their ratio;
+    * ``ms_prepass_rotation_all`` / ``rotation_over_deformed_prepass`` (and
+      ``_best``): the pre-pass with the same basis as a rotation-aware handle
+      turned 120 degrees (``DeformationMode.ROTATION``), over the linear one;
     * ``loadavg_1min``: /proc/loadavg at the end of the case (NaN elsewhere);
     * ``wall_s``: wall-clock seconds of the case.
     """

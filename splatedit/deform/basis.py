@@ -47,7 +47,10 @@ from splatedit.deform.constraints import (
     as_mask,
     build_constraints,
 )
+from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
+from splatedit.deform.rotation import (apply_rotation, blend_jacobians, blend_terms, handle_blocks,
+                                       rotation_displacement, split_displacement)
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
@@ -335,7 +338,7 @@ class DeformationBasis:
             np.ascontiguousarray(sub[:, j, :]) for j in range(4))
 
     # ----------------------------------------------------------- per frame
-    def displacement(self, transforms) -> np.ndarray:
+    def displacement(self, transforms, mode: DeformationMode = DeformationMode.LINEAR):
         """Control-point displacements ``dC`` (K, 3) from one input per group
         (handles first, then curves, as in :attr:`group_kinds`):
 
@@ -346,10 +349,24 @@ class DeformationBasis:
         * None: the group does not move.
 
         A single 2-D array is accepted when there is one group.
+
+        ``mode``: LINEAR (the paper) returns the (K, 3) array; ROTATION returns a
+        :class:`~splatedit.deform.rotation.RotationDisplacement` (residual dC
+        plus each handle's rotation, see :mod:`splatedit.deform.rotation`)
+        when a handle rotates, else the same (K, 3) array as LINEAR (bitwise),
+        which :meth:`apply`, :meth:`displacements`, :meth:`jacobians` and the
+        renderer take in place of dC.  DETAIL belongs to
+        :class:`~splatedit.deform.detail.DetailBasis` (its base deformation is ROTATION).
         """
+        mode = DeformationMode(mode)
+        if mode is DeformationMode.DETAIL:
+            raise ParameterError("mode", "the 'detail' deformation needs a DetailBasis "
+                                 "(splatedit.deform.detail.DetailBasis.fit)")
         if isinstance(transforms, np.ndarray) and transforms.ndim == 2:
             transforms = [transforms]
         transforms = list(transforms)
+        if mode is DeformationMode.ROTATION and len(transforms) == self.n_groups:
+            return rotation_displacement(self, transforms)
         if len(transforms) != self.n_groups:
             raise ParameterError("transforms", f"need one matrix per handle and one (k + 1, 3) "
                                  f"displacement array per curve ({self.n_groups} groups: "
@@ -382,15 +399,24 @@ class DeformationBasis:
         return d
 
     def displacements(self, dC) -> np.ndarray:
-        """(N, 3) displacements ``B dC`` of the support splats."""
-        return self.B @ self._check_dc(dC)
+        """(N, 3) displacements of the support splats: ``B dC`` (plus the
+        blended rotations of a RotationDisplacement)."""
+        d, rot = split_displacement(dC)
+        out = self.B @ self._check_dc(d)
+        if rot is not None:
+            out += blend_terms(rot, self._pack, handle_blocks(self))[0]
+        return out
 
     def jacobians(self, dC) -> np.ndarray:
-        """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats."""
-        d = self._check_dc(dC)
+        """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats
+        (dC: (K, 3) or a RotationDisplacement)."""
+        d, rot = split_displacement(dC)
+        d = self._check_dc(d)
         jt = np.einsum("njk,ki->nji", self._pack[:, 1:, :], d)  # jt[n, j, i] = (J - I)[i, j]
         out = jt.transpose(0, 2, 1).copy()
         out += np.eye(3)
+        if rot is not None:
+            out += blend_jacobians(rot, self._pack, handle_blocks(self))
         return out
 
     def _check_cloud(self, cloud):
@@ -447,7 +473,10 @@ class DeformationBasis:
         base cloud the basis was built on).  Splats outside the support are
         copied bitwise; ``dC == 0`` returns bitwise copies."""
         self._check_cloud(cloud)
-        d = self._check_dc(dC)
+        d, rot = split_displacement(dC)
+        d = self._check_dc(d)
+        if rot is not None:
+            return apply_rotation(self, cloud, d, rot)
         srcs = (cloud.positions, cloud.u, cloud.v)
         if not d.any():
             return tuple(s.copy() for s in srcs)

@@ -50,6 +50,8 @@ from scipy.spatial import cKDTree
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import as_mask
 from splatedit.deform.distortion import distortion_from_axes
+from splatedit.deform.modes import DeformationMode
+from splatedit.deform.rotation import blend_terms, handle_blocks, split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.estimate import estimate_normals, tangent_frame
 from splatedit.progress import report
@@ -326,9 +328,14 @@ class DetailBasis:
     def columns_for_group(self, i: int) -> slice:
         return self.base_basis.columns_for_group(i)
 
-    def displacement(self, transforms) -> np.ndarray:
-        """dC (K, 3), see :meth:`DeformationBasis.displacement`."""
-        return self.base_basis.displacement(transforms)
+    def displacement(self, transforms, mode: DeformationMode = DeformationMode.DETAIL):
+        """The base deformation's per-frame input, see
+        :meth:`DeformationBasis.displacement`: the base is deformed
+        rotation-aware (``mode`` DETAIL or ROTATION: a RotationDisplacement when a
+        handle rotates, else dC (K, 3)) or linearly (``mode`` LINEAR: dC)."""
+        mode = DeformationMode(mode)
+        base_mode = DeformationMode.LINEAR if mode is DeformationMode.LINEAR else DeformationMode.ROTATION
+        return self.base_basis.displacement(transforms, mode=base_mode)
 
     def rows_for_gpu(self, handle: int | None = None):
         """``(indices, B, Bx, By, Bz)`` at the base points (all groups; the
@@ -363,16 +370,23 @@ class DetailBasis:
         ``DETAIL_APPLY_CHUNK`` rows beyond the cached hot-path arrays."""
         bb = self.base_basis
         bb._check_cloud(cloud)
-        d = bb._check_dc(dC)
+        d, rot = split_displacement(dC)
+        d = bb._check_dc(d)
         outs = (cloud.positions.copy(), cloud.u.copy(), cloud.v.copy())
-        if not d.any():
+        if not d.any() and rot is None:
             return outs
+        blocks = handle_blocks(bb) if rot is not None else None
         arrs = self._cpu_arrays()
         mx = np.vstack([d, np.eye(3)])
         idx, lay = self.indices, self.layer
         for s in range(0, len(idx), DETAIL_APPLY_CHUNK):
             e = min(len(idx), s + DETAIL_APPLY_CHUNK)
             mb, jt1, jt2 = (a[s:e] @ mx for a in arrs)
+            if rot is not None:     # the rotation-aware base: arc terms at the base points
+                dp, (d1, d2) = blend_terms(rot, bb._pack[s:e], blocks, (self._t[0][s:e], self._t[1][s:e]))
+                mb += dp
+                jt1 += d1
+                jt2 += d2
             p, u, v = _attach(mb, jt1, jt2, lay.offset[s:e], self._cu[s:e], self._cv[s:e], self.frames)
             rows = idx[s:e]
             outs[0][rows], outs[1][rows], outs[2][rows] = p, u, v

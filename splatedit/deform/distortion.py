@@ -226,9 +226,12 @@ class DistortionProbe:
 
 def basis_distortion(basis, cloud, dC, **kw) -> DistortionStats:
     """Distortion of ``basis``' support splats (in ``basis.indices`` order)
-    under ``dC`` (K, 3), exact float64: the Jacobians ``basis.jacobians(dC)``
-    applied to the cloud's axes, chunked."""
-    d = basis._check_dc(dC)
+    under ``dC`` (K, 3) or a RotationDisplacement, exact float64: the
+    Jacobians ``basis.jacobians(dC)`` applied to the cloud's axes, chunked."""
+    from splatedit.deform.rotation import blend_terms, split_displacement
+    d, rot = split_displacement(dC)
+    d = basis._check_dc(d)
+    blocks = [basis.columns_for_group(g) for g, k in enumerate(basis.group_kinds) if k == "handle"]
     idx = basis.indices
     chunk = kw.pop("chunk", DISTORTION_CHUNK)
     n = len(idx)
@@ -239,6 +242,10 @@ def basis_distortion(basis, cloud, dC, **kw) -> DistortionStats:
         for src, dst in ((u0, u1), (v0, v1)):
             w = sum(src[:, j:j + 1] * g[s:e] for j, g in enumerate((basis.Bx, basis.By, basis.Bz)))
             dst[s:e] = src + w @ d
+        if rot is not None:
+            extra = blend_terms(rot, basis._pack[s:e], blocks, (u0, v0))[1]
+            u1[s:e] += extra[0]
+            v1[s:e] += extra[1]
     return distortion_from_axes(cloud.u[idx], cloud.v[idx], u1, v1, chunk=chunk, **kw)
 
 

@@ -21,6 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
@@ -40,9 +41,10 @@ _UBO_BYTES = 272
 _GEOM_STRIDE = 36           # centre, u, v as float32
 _MAX_SIZE = 16384
 
-#: dC of up to 16 columns as 3 vec4 per group of 4 (shaders_glsl/deform.glsl)
+#: dC of up to 16 columns as 3 vec4 per group of 4, then per group the handle
+#: rotation as 4 vec4 (axis + angle, frame offsets; shaders_glsl/deform.glsl)
 _MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
-_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS
+_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS + 64 * _MAX_GROUPS
 #: vertex path: frame UBO, deformation UBO
 _SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"), V.Binding(1, "uniform", "vert"))
 #: compute pre-pass + prepared draws: frame UBO, cloud (geometry, colours,
@@ -254,6 +256,7 @@ class Renderer:
         self._basis_rows = np.zeros(0, dtype=np.int64)
         self._basis_reach = 0.0       # see _clip_bounds
         self._dC = np.zeros((4, 3))
+        self._rot = None            # RotationDisplacement of the frame, or None
         self._dC_dirty = True
         self.dC_ubo = None
         self.last_timings_ms: dict[str, float] = {}
@@ -386,6 +389,7 @@ class Renderer:
         self._basis_reach = 0.0
         self._basis_cols = 4
         self._dC = np.zeros((4, 3))
+        self._rot = None
         self._dC_dirty = True
 
     @property
@@ -470,6 +474,7 @@ class Renderer:
             self._basis_cols = k
         if self._dC.shape[0] != k:
             self._dC = np.zeros((k, 3))
+            self._rot = None
             self._dC_dirty = True
         rows = np.zeros((len(idx), g, 4, 4), dtype=np.float32)
         # gradients per GPU unit (positions are divided by scale); B is unitless
@@ -514,6 +519,9 @@ class Renderer:
         if not len(self._basis_rows):
             return lo, hi
         move = float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+        if self._rot is not None:   # |F(s) v| <= (|sin x / x| + |(1 - cos x) / x|) angle |v| <= 2 angle |v|
+            move += max(2.0 * r.angle * float(np.linalg.norm(r.offsets, axis=1).max())
+                        for r in self._rot.rotations)
         grow = self._basis_reach * move + (self._detail_reach if move > 0 else 0.0)
         return lo - grow, hi + grow
 
@@ -571,20 +579,34 @@ class Renderer:
         splat displacement (:meth:`_clip_bounds`), so geometry moved outside
         the undeformed model is not clipped."""
         self._check_open()
-        a = np.asarray(dC, dtype=np.float64)
+        a, rot = split_displacement(dC)
+        if rot is not None and len(rot.rotations) > _MAX_GROUPS:
+            raise ParameterError("dC", f"the renderer blends at most {_MAX_GROUPS} handle rotations")
+        a = np.asarray(a, dtype=np.float64)
         if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols:
             raise ParameterError("dC", f"must have shape ({self._basis_cols}, 3) (the basis has "
                                        f"{self._basis_cols} columns), got {a.shape}")
         if not np.isfinite(a).all():
             raise ParameterError("dC", "must be finite")
         self._dC = a.copy()
+        self._rot = rot
         self._dC_dirty = True
 
     def _dC_block(self) -> np.ndarray:
-        """dC zero-padded to 16 columns, as rows dC[3g + i] = (dC_{4g..4g+3})[i] (deform.glsl)."""
+        """dC zero-padded to 16 columns, as rows dC[3g + i] = (dC_{4g..4g+3})[i],
+        then per group g the rotation of handle g: rot[4g] = (axis, angle)
+        (angle 0: none), rot[4g + 1 + i] = (offsets_{0..3})[i] (deform.glsl)."""
         pad = np.zeros((4 * _MAX_GROUPS, 3))
         pad[:len(self._dC)] = self._dC / self.scale
-        return np.ascontiguousarray(pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1), dtype=np.float32).reshape(-1)
+        dc = pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1)
+        rot = np.zeros((_MAX_GROUPS, 4, 4))
+        if self._rot is not None:
+            for g in self._rot.rotating:
+                r = self._rot.rotations[g]
+                rot[g, 0, :3] = r.w / r.angle
+                rot[g, 0, 3] = r.angle
+                rot[g, 1:, :] = (r.offsets / self.scale).T   # translation-free: no origin shift
+        return np.ascontiguousarray(np.concatenate([dc, rot.reshape(-1)]), dtype=np.float32)
 
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):

@@ -138,3 +138,39 @@ def test_background_fit_stale_results_are_dropped():
         assert s.basis_key == s.selection_key()
     finally:
         s.close()
+
+
+def test_rotation_mode_is_the_default_cycles_and_is_exported(tmp_path, session):
+    """A 150-degree rotation in the session's default (rotation) mode keeps the
+    handle's neighbourhood wide where the linear mode pulls it in; M's cycle
+    switches the mode and the exported script carries it per edit."""
+    from splatedit.deform.modes import DeformationMode
+    from splatedit.deform.rotation import RotationDisplacement
+    s = session
+    r = paint_regions(s)
+    assert s.deformation is DeformationMode.ROTATION
+    assert s.wait_fit()
+    assert s.begin(ROTATE, view(), (150, 100))
+    s.manip.set_axis(0)
+    for ch in "150":
+        s.manip.type_char(ch)
+    assert isinstance(s.current_dc(), RotationDisplacement)
+    assert s.cycle_deformation() is DeformationMode.LINEAR
+    assert isinstance(s.current_dc(), np.ndarray)
+    assert s.cycle_deformation() is DeformationMode.ROTATION
+    base = s.cloud
+    assert s.commit()
+    ring = (r > 0.35) & (r < 0.45)
+    ring_r = lambda c: np.linalg.norm(c.positions[ring] - c.positions[ring].mean(0), axis=1).mean()  # noqa: E731
+    doc = s.edit_script().to_json()
+    assert doc["edits"][0]["deformation"] == "rotation"
+    from splatedit.deform.basis import DeformationBasis
+    from splatedit.script import parse_script, resolve_edit
+    script = parse_script(doc)
+    sup, hands, mats = resolve_edit(base, script.edits[0])
+    b = DeformationBasis.fit(base, sup, hands, method=script.solver.method, tol=script.solver.tol,
+                             fill_holes=False)
+    out = b.apply(base, b.displacement(mats, mode=script.edits[0].deformation))
+    assert np.array_equal(out.positions, s.cloud.positions)
+    lin = b.apply(base, b.displacement(mats))
+    assert ring_r(s.cloud) > ring_r(lin)

@@ -82,7 +82,7 @@ def test_handles_move_rigidly_outside_stays_bitwise(scene):
     assert np.abs(out.u[h] - sc.cloud.u[h] @ r.T).max() < 1e-9
     rest = np.setdiff1d(np.arange(len(sc.cloud.positions)), det.indices)
     assert len(rest) and np.array_equal(out.positions[rest], sc.cloud.positions[rest])
-    zero = det.apply(sc.cloud, np.zeros_like(det.displacement([m])))
+    zero = det.apply(sc.cloud, det.displacement([np.eye(4)]))
     assert np.array_equal(zero.positions, sc.cloud.positions)
 
 

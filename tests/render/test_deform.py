@@ -184,3 +184,29 @@ def test_basis_errors(renderer):
     with pytest.raises(ParameterError, match="finite"):
         renderer.set_displacement(np.full((5, 3), np.nan))
     renderer.set_displacement(np.zeros((5, 3)))
+
+
+@pytest.mark.parametrize("prepass", [True, False])
+@pytest.mark.parametrize("kind, degrees", [("bend", 120.0), ("twist", 180.0)])
+def test_rotation_mode_gpu_matches_cpu(renderer, prepass, kind, degrees):
+    """Rotation-aware handles (rotation.glsl) on the GPU against
+    DeformationBasis.apply, on the bench bar with a real fitted basis."""
+    from splatedit.bench.bars import bar_basis, bar_transform, open_cylinder
+    from splatedit.deform.modes import DeformationMode
+    base = open_cylinder()
+    basis = bar_basis(base)
+    d = basis.displacement([bar_transform(base, kind, degrees)], mode=DeformationMode.ROTATION)
+    assert d.rotating
+    deformed = basis.apply(base, d)
+    cam = Camera.frame(*deformed.bounds(), 1.0, direction=(0.4, -0.8, 1.0))
+
+    def setup():
+        renderer.set_basis(*basis.rows_for_gpu())
+        renderer.set_displacement(d)
+    saved = renderer.prepass
+    renderer.prepass = prepass
+    try:
+        img = _compare(renderer, base, deformed, cam, setup)
+    finally:
+        renderer.prepass = saved
+    assert (img[..., :3] < 250).any()

@@ -1,0 +1,210 @@
+"""Rotation-aware handles (issue 9): bar bends and twists keep their cross-sections,
+translations are the paper's deformation bitwise, small rotations stay close to
+it, the Jacobian is exact (finite differences) and normals follow the surface."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from splatedit.bench.bars import CASES, bar_basis, bar_case, bar_transform, open_cylinder
+from splatedit.bench.solve import wavy_plane_cloud
+from splatedit.deform.basis import DeformationBasis
+from splatedit.deform.modes import DeformationMode
+from splatedit.deform.rotation import (
+    RotationDisplacement,
+    arc_coefficients,
+    decompose,
+    rotation_part,
+)
+from splatedit.deform.transform import compose, rotate, scale, translate
+from splatedit.errors import ParameterError
+from splatedit.model.estimate import estimate_normals
+
+LIN, ROT = DeformationMode.LINEAR, DeformationMode.ROTATION
+
+
+@pytest.fixture(scope="module")
+def bar():
+    cloud = open_cylinder()
+    return cloud, bar_basis(cloud)
+
+
+@pytest.mark.parametrize("kind, degrees", CASES)
+def test_bar_middle_cross_section_keeps_its_radius(bar, kind, degrees):
+    cloud, basis = bar
+    lin = bar_case(cloud, basis, kind, degrees, LIN)[0]
+    rot = bar_case(cloud, basis, kind, degrees, ROT)[0]
+    print(f"{kind} {degrees:g} deg: linear {lin.min_radius:.3f}..{lin.max_radius:.3f} R, "
+          f"rotation {rot.min_radius:.3f}..{rot.max_radius:.3f} R")
+    assert 0.9 <= rot.min_radius and rot.max_radius <= 1.1
+    assert lin.min_radius < 0.75          # the baseline does collapse (the test can fail)
+
+
+def test_handle_moves_exactly_by_its_map_and_fixed_part_stays(bar):
+    cloud, basis = bar
+    m = compose(translate((0.3, -0.2, 0.5)), rotate((1.0, 1.0, 0.0), 140.0, (2.0, 0.0, 3.0)),
+                scale(1.2, (0.0, 0.0, 7.5)))
+    out = basis.apply(cloud, basis.displacement([m], mode=ROT))
+    h = basis.constraints.handle_index[0]
+    want = cloud.positions[h] @ m[:3, :3].T + m[:3, 3]
+    assert np.abs(out.positions[h] - want).max() < 1e-9
+    fixed = cloud.positions[:, 2] < 1.0
+    assert np.array_equal(out.positions[fixed], cloud.positions[fixed])
+
+
+def test_pure_translation_is_the_linear_mode_bitwise(bar):
+    cloud, basis = bar
+    t = translate((0.4, -1.0, 2.0))
+    d = basis.displacement([t], mode=ROT)
+    assert not isinstance(d, RotationDisplacement)     # no rotation: the plain dC
+    assert isinstance(basis.displacement([compose(t, rotate((0, 0, 1), 0.01))], mode=ROT),
+                      RotationDisplacement)
+    a, b = basis.apply(cloud, d), basis.apply(cloud, basis.displacement([t], mode=LIN))
+    for name in ("positions", "u", "v"):
+        assert np.array_equal(getattr(a, name), getattr(b, name))
+
+
+@pytest.mark.parametrize("kind", ["bend", "twist"])
+def test_ten_degrees_stays_close_to_the_linear_mode(bar, kind):
+    """The issue's target: a 10-degree rotation stays within 2 % of the linear
+    mode's displacement (the arc share ramps in with the angle: without the
+    ramp the arc alone differs by 3.3 %); lengths agree to 1 %; at 5 degrees the
+    difference is smaller still."""
+    cloud, basis = bar
+    t = bar_transform(cloud, kind, 10.0)
+    dl = basis.displacements(basis.displacement([t], mode=LIN))
+    dr = basis.displacements(basis.displacement([t], mode=ROT))
+    err = np.linalg.norm(dr - dl, axis=1)
+    nl, nr = np.linalg.norm(dl, axis=1), np.linalg.norm(dr, axis=1)
+    rel_vec = err.max() / nl.max()
+    rel_len = np.abs(nr - nl).max() / nl.max()
+    print(f"{kind} 10 deg: max |d_rot - d_lin| / max |d_lin| = {rel_vec:.4f}, lengths {rel_len:.4f}")
+    assert rel_len < 0.01
+    assert rel_vec < 0.02
+    # a smaller angle keeps closer still (ramp and second order together)
+    t5 = bar_transform(cloud, kind, 5.0)
+    e5 = np.linalg.norm(basis.displacements(basis.displacement([t5], mode=ROT))
+                        - basis.displacements(basis.displacement([t5], mode=LIN)), axis=1).max()
+    n5 = np.linalg.norm(basis.displacements(basis.displacement([t5], mode=LIN)), axis=1).max()
+    assert (e5 / n5) < 0.5 * rel_vec
+
+
+@pytest.fixture(scope="module")
+def plane():
+    cloud = wavy_plane_cloud(50)
+    r = np.linalg.norm(cloud.positions[:, :2], axis=1)
+    return cloud, DeformationBasis.fit(cloud, r < 0.8, [r < 0.25], method="lu", fill_holes=False)
+
+
+def test_jacobian_matches_finite_differences_of_the_deformation(plane):
+    """J from the basis gradients vs central differences of p' along u and v
+    (the support splats' positions moved by +-h; the bases are re-evaluated
+    through the fitted RBF at the moved points: free splats only)."""
+    cloud, basis = plane
+    m = compose(rotate((0.3, 1.0, 0.2), 110.0, (0.1, 0.0, 0.4)), scale(1.1))
+    d = basis.displacement([m], mode=ROT)
+    jac = basis.jacobians(d)
+    con = basis.constraints
+    rows = np.searchsorted(basis.indices, con.free_index)[::7]
+    p = cloud.positions[basis.indices[rows]]
+
+    def deformed(x):
+        val, grad = basis.rbf.value_and_gradient(x)
+        pack = np.concatenate([val[:, None, :], grad.transpose(0, 2, 1)], axis=1)
+        from splatedit.deform.rotation import blend_terms
+        return x + val @ d.dC + blend_terms(d, pack, [basis.columns_for_group(0)])[0]
+
+    h = 1e-5
+    for j in range(3):
+        e = np.zeros(3)
+        e[j] = h
+        fd = (deformed(p + e) - deformed(p - e)) / (2 * h)
+        assert np.abs(fd - jac[rows, :, j]).max() < 1e-5 * max(1.0, np.abs(jac).max())
+
+
+def test_normals_follow_the_surface_median_under_3_degrees(bar):
+    cloud, basis = bar
+    for kind, deg in (("bend", 120.0), ("twist", 180.0)):
+        out = bar_case(cloud, basis, kind, deg, ROT)[1]
+        n = np.cross(out.u, out.v)
+        n /= np.linalg.norm(n, axis=1, keepdims=True)
+        est = estimate_normals(out.positions)
+        ang = np.degrees(np.arccos(np.clip(np.abs((n * est).sum(1)), 0.0, 1.0)))
+        sup = basis.indices
+        print(f"{kind} {deg:g}: normal error median {np.median(ang[sup]):.2f} deg, "
+              f"95th percentile {np.percentile(ang[sup], 95):.2f}")
+        assert np.median(ang[sup]) < 3.0
+
+
+def test_rotation_part_and_decomposition_recover_the_pivot():
+    m = rotate((0.0, 1.0, 1.0), 75.0, (3.0, -1.0, 2.0))
+    ctl = np.vstack([[0.0, 0.0, 0.0], np.eye(3)])
+    rot, res = decompose(m, ctl)
+    assert np.allclose(rotation_part(m), m[:3, :3])
+    assert abs(rot.degrees - 75.0) < 1e-9
+    # the centre lies on the axis through the pivot, the residual is the identity
+    axis = np.array([0.0, 1.0, 1.0]) / np.sqrt(2.0)
+    off = rot.center - np.array([3.0, -1.0, 2.0])
+    assert np.linalg.norm(off - axis * (off @ axis)) < 1e-9
+    assert np.allclose(res, np.eye(4), atol=1e-12)
+    # a mirror stays in the stretch: R is a proper rotation
+    assert np.linalg.det(rotation_part(np.diag([-1.0, 1.0, 1.0, 1.0]))) > 0.0
+
+
+def test_arc_coefficients_series_agree_with_the_closed_forms():
+    theta = 2.0
+    x = np.array([0.999e-3, -0.5e-3, 1e-9])        # series side of the switch
+    a1, a2, b1, b2 = arc_coefficients(theta, x / theta)
+    closed = (np.sin(x) / x, (1 - np.cos(x)) / x,
+              (x * np.cos(x) - np.sin(x)) / x**2, (x * np.sin(x) - 1 + np.cos(x)) / x**2)
+    # the closed forms themselves keep about 10 digits at x = 1e-3 (cancellation)
+    assert np.allclose(a1[:2] / theta, closed[0][:2], rtol=1e-12)
+    assert np.allclose(a2[:2] / theta, closed[1][:2], rtol=1e-9)
+    assert np.allclose(b1[:2] / theta**2, closed[2][:2], rtol=1e-5)
+    assert np.allclose(b2[:2] / theta**2, closed[3][:2], rtol=1e-5)
+    # and have the right limits at 0: F(0) = theta K, F'(0) = theta^2 K^2 / 2
+    assert abs(a1[2] - theta) < 1e-15 and abs(a2[2]) < 1e-8
+    assert abs(b1[2]) < 1e-8 and abs(b2[2] - theta**2 / 2) < 1e-15
+
+
+def test_detail_mode_on_a_plain_basis_points_to_the_detail_basis(plane):
+    _, basis = plane
+    with pytest.raises(ParameterError, match="needs a DetailBasis"):
+        basis.displacement([np.eye(4)], mode=DeformationMode.DETAIL)
+
+
+def test_two_rotating_handles_and_a_curve_each_keep_their_own_motion(bar):
+    """Both ends of the bar are handles turned opposite ways (fixed part: none
+    besides a middle band), plus a curve along the side: every handle moves
+    exactly by its map, the curve's columns are its plain displacements, and
+    a ring between a handle and the fixed band keeps its radius (each rotation
+    blended by its own field; near the curve, whose samples have zero weight
+    in the handles' fields, the curve's constraint wins as in the linear mode)."""
+    from splatedit.bench.bars import middle_ring
+    cloud, _ = bar
+    z = cloud.positions[:, 2]
+    fixed = (z > 3.8) & (z < 4.2)
+    support = ~fixed
+    lo, hi = support & (z < 1.0), support & (z > 7.0)
+    curve = np.array([[1.0, 0.0, 5.0], [1.0, 0.0, 6.0]])
+    basis = DeformationBasis.fit(cloud, support, [lo, hi], curves=[curve], method="lu", fill_holes=False)
+    m_lo = rotate((0.0, 0.0, 1.0), -120.0, cloud.positions[lo].mean(0))
+    m_hi = rotate((0.0, 0.0, 1.0), 120.0, cloud.positions[hi].mean(0))
+    k = basis.constraints.groups[2].n_columns
+    move = np.zeros((k, 3))
+    move[:, 0] = 0.05
+    d = basis.displacement([m_lo, m_hi, move], mode=ROT)
+    assert isinstance(d, RotationDisplacement) and d.rotating == [0, 1]
+    assert np.array_equal(d.dC[basis.columns_for_group(2)], move)
+    out = basis.apply(cloud, d)
+    for m, h in ((m_lo, basis.constraints.handle_index[0]), (m_hi, basis.constraints.handle_index[1])):
+        assert np.abs(out.positions[h] - (cloud.positions[h] @ m[:3, :3].T + m[:3, 3])).max() < 1e-9
+    assert np.array_equal(out.positions[fixed], cloud.positions[fixed])
+    # the lower half has no curve: its ring turns; the linear mode's shrinks
+    ring = np.flatnonzero(np.abs(z - 2.0) < 1e-9)
+    lin = basis.apply(cloud, basis.displacement([m_lo, m_hi, move]))
+    radius = lambda p: np.linalg.norm(p - p.mean(0), axis=1)  # noqa: E731
+    r_rot, r_lin = radius(out.positions[ring]), radius(lin.positions[ring])
+    assert 0.9 < r_rot.min() and r_rot.max() < 1.1, (r_rot.min(), r_rot.max())
+    assert r_lin.min() < 0.8
