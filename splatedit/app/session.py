@@ -143,56 +143,86 @@ class Manipulation:
         a[self.axis] = 1.0
         return a
 
+    def _translation(self, typed) -> np.ndarray:
+        """(3,) grab displacement, model units."""
+        v = self.view
+        if typed is not None:
+            a = self._axis_vec() if self.axis is not None else np.array([1.0, 0.0, 0.0])
+            return a * typed
+        dx = self.mouse[0] - self.start[0]
+        dy = self.mouse[1] - self.start[1]
+        if self.axis is None:
+            return (v.right * dx - v.up * dy) * v.world_per_px
+        a = self._axis_vec()
+        # the mouse motion along the axis's screen direction
+        sa = np.array([a @ v.right, -(a @ v.up)])
+        L = float(np.hypot(*sa))
+        if L < EDITOR_AXIS_MIN_SCREEN_LEN:
+            return np.zeros(3)
+        return a * ((dx * sa[0] + dy * sa[1]) / (L * L) * v.world_per_px)
+
+    def _angle_deg(self, typed) -> float:
+        """Rotation angle (degrees, right-handed about :meth:`_rot_axis`)."""
+        if typed is not None:
+            return float(typed)
+        v = self.view
+        cx, cy = v.pivot_px
+        a0 = math.atan2(self.start[1] - cy, self.start[0] - cx)
+        a1 = math.atan2(self.mouse[1] - cy, self.mouse[0] - cx)
+        # y is down: a growing atan2 is a clockwise sweep on screen, which is a
+        # negative (right-handed) rotation about the axis pointing at the viewer
+        ang = -(a1 - a0)
+        if float(self._rot_axis() @ v.back) < 0:
+            ang = -ang
+        ang = (ang + math.pi) % (2 * math.pi) - math.pi      # the same rotation, in (-180, 180]
+        return math.degrees(ang)
+
+    def _rot_axis(self) -> np.ndarray:
+        return self._axis_vec() if self.axis is not None else self.view.back
+
+    def _factor(self, typed) -> float:
+        if typed is not None:
+            f = typed
+        else:
+            cx, cy = self.view.pivot_px
+            r0 = math.hypot(self.start[0] - cx, self.start[1] - cy)
+            r1 = math.hypot(self.mouse[0] - cx, self.mouse[1] - cy)
+            f = r1 / max(r0, 1.0)
+        return max(f, EDITOR_MIN_SCALE_FACTOR)
+
+    def _typed_ok(self):
+        return self.typed_value() if self.problem() is None else None
+
     def matrix(self) -> np.ndarray:
         """The manipulation's (4, 4) matrix; a typed value that cannot be
         applied (:meth:`problem`, shown by :meth:`describe`) is ignored: the
         mouse's value is used meanwhile."""
-        v = self.view
-        typed = self.typed_value() if self.problem() is None else None
-        dx = self.mouse[0] - self.start[0]
-        dy = self.mouse[1] - self.start[1]
+        typed = self._typed_ok()
         if self.mode == GRAB:
-            if typed is not None:
-                a = self._axis_vec() if self.axis is not None else np.array([1.0, 0.0, 0.0])
-                return translate(a * typed)
-            d = (v.right * dx - v.up * dy) * v.world_per_px
-            if self.axis is not None:
-                a = self._axis_vec()
-                # the mouse motion along the axis's screen direction
-                sa = np.array([a @ v.right, -(a @ v.up)])
-                L = float(np.hypot(*sa))
-                if L < EDITOR_AXIS_MIN_SCREEN_LEN:
-                    return np.eye(4)
-                t = (dx * sa[0] + dy * sa[1]) / (L * L) * v.world_per_px
-                d = a * t
-            return translate(d)
+            return translate(self._translation(typed))
         if self.mode == ROTATE:
-            axis = self._axis_vec() if self.axis is not None else v.back
-            if typed is not None:
-                ang = math.radians(typed)
-            else:
-                cx, cy = v.pivot_px
-                a0 = math.atan2(self.start[1] - cy, self.start[0] - cx)
-                a1 = math.atan2(self.mouse[1] - cy, self.mouse[0] - cx)
-                # y is down: a growing atan2 is a clockwise sweep on screen, which is a
-                # negative (right-handed) rotation about the axis pointing at the viewer
-                ang = -(a1 - a0)
-                if float(axis @ v.back) < 0:
-                    ang = -ang
-            return rotate(axis, math.degrees(ang), self.pivot)
+            return rotate(self._rot_axis(), self._angle_deg(typed), self.pivot)
         if self.mode == SCALE:
-            if typed is not None:
-                f = typed
-            else:
-                cx, cy = v.pivot_px
-                r0 = math.hypot(self.start[0] - cx, self.start[1] - cy)
-                r1 = math.hypot(self.mouse[0] - cx, self.mouse[1] - cy)
-                f = r1 / max(r0, 1.0)
-            f = max(f, EDITOR_MIN_SCALE_FACTOR)
+            f = self._factor(typed)
             if self.axis is None:
                 return scale(f, self.pivot)
             return _axis_scaling(self.axis, f, self.pivot)
         raise ValueError(self.mode)
+
+    def readout(self) -> str:
+        """The live value of the move, as the overlay shows it next to the
+        cursor: grab distance (model units) and its X/Y/Z components, rotate
+        angle (degrees), scale factor; "typed" when it comes from the keys."""
+        typed = self._typed_ok()
+        src = "  (typed)" if typed is not None else ""
+        ax = f" {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
+        if self.mode == GRAB:
+            d = self._translation(typed)
+            return (f"distance{ax} {float(np.linalg.norm(d)):.4g}   "
+                    f"({d[0]:+.3g}, {d[1]:+.3g}, {d[2]:+.3g}){src}")
+        if self.mode == ROTATE:
+            return f"angle{ax} {self._angle_deg(typed):+.1f} deg{src}"
+        return f"factor{ax} {self._factor(typed):.3f}x{src}"
 
     def describe(self) -> str:
         name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]

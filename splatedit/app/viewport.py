@@ -27,6 +27,7 @@ import time
 
 import numpy as np
 
+from splatedit.app import revision
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.render.camera import Camera
 
@@ -65,6 +66,9 @@ class Viewport:
         self.pyramid = None
         #: draw the distortion heat map instead of the shaded colours (Renderer.distortion_map)
         self.distortion_map = False
+        #: display options (Renderer.grey_shading, Renderer.splat_scale)
+        self.grey = False
+        self.splat_scale = 1.0
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -101,6 +105,8 @@ class Viewport:
     def _sync(self, slot: _Slot, level=None) -> None:
         cloud = self.cloud
         slot.r.distortion_map = self.distortion_map
+        slot.r.grey_shading = self.grey
+        slot.r.splat_scale = self.splat_scale
         if level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
@@ -112,7 +118,7 @@ class Viewport:
             slot.r.set_cloud(cloud)
             slot.cloud = cloud
             slot.sel = slot.basis = slot.dc = None
-        if slot.sel != (self.sel_version, id(cloud)):
+        if slot.sel != (self.sel_version, revision.of(cloud)):
             s, h, i = self.support, self.handle, self.inactive
             if s is not None and len(s) == cloud.n:
                 if i is None:
@@ -122,7 +128,7 @@ class Viewport:
                 slot.r.set_selection(s, h, i)
             else:
                 slot.r.set_selection(None, None)
-            slot.sel = (self.sel_version, id(cloud))
+            slot.sel = (self.sel_version, revision.of(cloud))
         basis = self.basis
         if slot.basis is not basis:
             if basis is None:
@@ -175,7 +181,7 @@ class Viewport:
         level, div = cfg
         n = self.cloud.n
         count = n if level is None else level.n
-        key = (id(level) if level is not None else None, div)
+        key = (revision.of(level) if level is not None else None, div)
         if key in self._measured:
             ms, px, _ = self._measured[key]
             return ms * pixels / max(px, 1)
@@ -215,7 +221,7 @@ class Viewport:
                 img = pad
         ms = (time.perf_counter() - t0) * 1e3
         count = self.cloud.n if level is None else level.n
-        key = (id(level) if level is not None else None, div)
+        key = (revision.of(level) if level is not None else None, div)
         old = self._measured.get(key)
         if old is not None and old[1] == w * h and ms > old[0]:
             ms_avg = 0.5 * (old[0] + ms)       # slower: average out one-off spikes
@@ -326,6 +332,8 @@ class BackgroundRefiner:
                     vp.set_basis(st["basis"])
                     vp.set_dc(st["dc"])
                     vp.distortion_map = bool(st.get("distortion_map", False))
+                    vp.grey = bool(st.get("grey", False))
+                    vp.splat_scale = float(st.get("splat_scale", 1.0))
                     img = vp.render(st["camera"], st["w"], st["h"])
                     self.last_ms = vp.last_info["ms"]
                     if st.get("pick_key") is not None and st.get("dc") is None:
