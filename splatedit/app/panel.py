@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from splatedit.app import overlay as ov
 from splatedit.app import selection_tools as seltools
-from splatedit.app.brush import SUPPORT
+from splatedit.select.selection import SUPPORT
 from splatedit.app.keymap import help_lines
 from splatedit.app.tools.curve import CURVE_RGB
 from splatedit.tolerances import EDITOR_HELP_MARGIN_PX, EDITOR_HELP_PAGE_OVERLAP

@@ -43,7 +43,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.app.brush import HANDLE, SUPPORT, Selection
+from splatedit.app import revision
+from splatedit.select.selection import HANDLE, SUPPORT, Selection
 from splatedit.app.history import History, Snapshot
 from splatedit.app.jobs import Cancelled, Job
 from splatedit.deform.transform import compose, rotate, scale, translate
@@ -486,7 +487,7 @@ class Session:
     # --------------------------------------------------------------- fitting
     def selection_key(self):
         curve = tuple(p.tobytes() for p in self.curve_points) if len(self.curve_points) >= 2 else ()
-        return (id(self.cloud),) + self.selection.key() + (curve,)
+        return (revision.of(self.cloud),) + self.selection.key() + (curve,)
 
     def request_fit(self) -> None:
         """Start (or restart) a background fit of all non-empty handles and

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.session import GRAB, ROTATE, SCALE, Manipulation, Session, ViewInfo
 from splatedit.model import SplatCloud
 from tests.app.sessions import plane_cloud, view

@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.session import Session, ViewInfo, GRAB
 from splatedit.errors import SplatEditError
 from splatedit.model import SplatCloud

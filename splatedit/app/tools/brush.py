@@ -9,7 +9,8 @@ import numpy as np
 from splatedit.app import overlay as ov
 from splatedit.app import revision
 from splatedit.app import selection_tools as seltools
-from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, picker_for_view, stroke_points
+from splatedit.app.brush import BrushPicker, picker_for_view, stroke_points
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.tolerances import (EDITOR_BRUSH_KEY_STEP, EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX,

@@ -11,7 +11,7 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
 from splatedit.app.tools.base import DragMode
