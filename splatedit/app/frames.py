@@ -14,6 +14,7 @@ from splatedit.app import overlay as ov
 from splatedit.app import revision
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
+from splatedit.app.viewport import FrameInfo
 from splatedit.tolerances import EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_REFINE_DELAY_S
 
 
@@ -111,7 +112,7 @@ class FrameScheduler:
             self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
             # the frame budget is for the whole frame: leave room for overlay + present
             vp = ed.viewport
-            extra = max(self.frame_ms - vp.last_info.get("ms", 0.0), 0.0)
+            extra = max(self.frame_ms - (vp.last_info.ms if vp.last_info else 0.0), 0.0)
             self.frame_overhead_ms = 0.8 * self.frame_overhead_ms + 0.2 * extra
             vp.budget_ms = max(self.budget_ms - self.frame_overhead_ms, 0.3 * self.budget_ms)
         self._rendered_interactive = False
@@ -144,8 +145,7 @@ class FrameScheduler:
             img = self.refiner.take(key)
             if img is not None and img.shape[:2] == (h, w):
                 self.scene, self.scene_interactive = img, False
-                ed.viewport.last_info = {"ms": self.refiner.last_ms, "splats": ed.session.cloud.n,
-                                         "div": 1, "lod": False, "interactive": False}
+                ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
         frame = self.scene.copy()
         if frame.shape[:2] != (h, w):
             fr = np.full((h, w, 4), 255, np.uint8)
@@ -161,7 +161,7 @@ class FrameScheduler:
         self._rendered_interactive = interactive
         self.scene_key = key
         info = ed.viewport.last_info
-        self.scene_interactive = bool(interactive and (info.get("lod") or info.get("div", 1) > 1))
+        self.scene_interactive = bool(interactive and info is not None and (info.lod or info.div > 1))
 
     def request_refine(self, key) -> None:
         from splatedit.app.viewport import BackgroundRefiner

@@ -71,26 +71,25 @@ def panel_lines(ed) -> list:
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"
     lines.append((f"brush: {tgt} {mode}{erase}  radius {brush.radius:.0f} px   (Tab, V, E, [ ])",
                   ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
-    lines.append(f"support {st['support']:,}   handle {st['handle']:,}")
+    lines.append(f"support {st.support:,}   handle {st.handle:,}")
     hs = s.selection.handles
     if len(hs) > 1 or s.curve_points or s.curve_mode:
         sizes = " ".join(f"[{n:,}]" if k == s.selection.active else f"{n:,}"
-                         for k, n in enumerate(st["handle_sizes"]))
+                         for k, n in enumerate(st.handle_sizes))
         tool = " K:ON" if s.curve_mode else ""
-        lines.append((f"handles {len(hs)}: {sizes}   curve {st['curve_points']} pts{tool}   "
-                      f"columns {st['columns']}/16", CURVE_RGB if s.curve_mode else (235, 235, 235)))
+        lines.append((f"handles {len(hs)}: {sizes}   curve {st.curve_points} pts{tool}   "
+                      f"columns {st.columns}/16", CURVE_RGB if s.curve_mode else (235, 235, 235)))
     if s.pose_pending and s.manip is None:
         lines.append(("pending moves: Enter applies them as one edit, Esc discards", (255, 230, 120)))
-    state = st["state"]
-    if state == "fitting":
-        lines.append(f"solver: {st.get('stage', 'fitting')} {st.get('fraction', 0) * 100:.0f}% "
-                     f"({st.get('elapsed', 0):.1f} s)")
-    elif "centers" in st:
-        lines.append(f"solver: {st['method']}, {st['centers']} centers / {st['constraints']} "
-                     f"constraints, residual {st['residual']:.1e}")
-        lines.append(f"        precompute {st['fit_seconds']:.2f} s fit + {st['basis_seconds']:.2f} s basis")
-    elif state == "error":
-        lines.append((f"solver: {st['error'][:90]}", (255, 120, 120)))
+    fit, prog = st.fit, st.progress
+    if prog is not None:
+        lines.append(f"solver: {prog.stage} {prog.fraction * 100:.0f}% ({prog.elapsed:.1f} s)")
+    elif fit is not None:
+        lines.append(f"solver: {fit.method}, {fit.centers} centers / {fit.constraints} "
+                     f"constraints, residual {fit.residual:.1e}")
+        lines.append(f"        precompute {fit.fit_seconds:.2f} s fit + {fit.basis_seconds:.2f} s basis")
+    elif st.error:
+        lines.append((f"solver: {st.error[:90]}", (255, 120, 120)))
     else:
         lines.append("solver: paint a support (1) then a handle (2)")
     if s.manip is not None:
@@ -102,10 +101,9 @@ def panel_lines(ed) -> list:
         lines.append(f"view: up {up.label} ({up.source.value})" + ("  grey shading" if vp.grey else "")
                      + (f"  splats {vp.splat_scale:.2f}x" if vp.splat_scale != 1.0 else "") + "   (U, M, Shift+[ ])")
     info = vp.last_info
-    if info:
-        what = f"{info['splats']:,} splats" + (" LOD" if info.get("lod") else "") + \
-            (f" 1/{info['div']} res" if info.get("div", 1) > 1 else "")
-        lines.append(f"frame: render {info['ms']:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
+    if info is not None:
+        what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div} res" if info.div > 1 else "")
+        lines.append(f"frame: render {info.ms:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
     lines.append(f"edits {len(s.edits)}{'  unsaved' if s.dirty else ''}   undo {s.history.position}"
                  f"/{len(s.history) - 1}")
     if ed.message and time.perf_counter() - ed.message_time < 8:

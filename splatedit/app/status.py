@@ -3,6 +3,7 @@ of what the window shows, rewritten atomically whenever it changes."""
 
 from __future__ import annotations
 
+import dataclasses
 import json
 import os
 
@@ -37,21 +38,22 @@ def status_dict(ed) -> dict:
           "interactive_frames": len(vp.interactive_frames_ms),
           "interactive_ms_median": (round(float(np.median(vp.interactive_frames_ms[-30:])), 1)
                                     if vp.interactive_frames_ms else None),
-          "last_render": {k: (round(v, 1) if isinstance(v, float) else v) for k, v in vp.last_info.items()},
+          "last_render": {} if vp.last_info is None else
+          {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "script": str(ed.saved_script) if ed.saved_script else None}
     if s is None:
         return st
     ss = s.stats()
     tools = ed.brush.tools
-    st.update(n=s.cloud.n, state=ss["state"], support=ss["support"], handle=ss["handle"],
+    st.update(n=s.cloud.n, state=ss.state, support=ss.support, handle=ss.handle,
               edits=len(s.edits), dirty=s.dirty, undo_position=s.history.position,
               history=len(s.history), manip=None if s.manip is None else s.manip.mode,
               readout=ed.gizmo.readout_text(),
-              brush=s.brush_target, fit_error=ss.get("error"), handles=ss["handles"],
-              active_handle=ss["active_handle"], handle_sizes=ss["handle_sizes"],
-              curve_points=ss["curve_points"], curve_mode=s.curve_mode,
-              pose_pending=ss["pose_pending"], columns=ss["columns"],
+              brush=s.brush_target, fit_error=ss.error, handles=ss.handles,
+              active_handle=ss.active_handle, handle_sizes=list(ss.handle_sizes),
+              curve_points=ss.curve_points, curve_mode=s.curve_mode,
+              pose_pending=ss.pose_pending, columns=ss.columns,
               basis_columns=None if s.basis is None else s.basis.n_columns,
               brush_mode=tools.mode, closure_added=tools.last_added,
               closure_highlight=tools.highlighted(s.cloud) is not None)

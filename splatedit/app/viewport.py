@@ -25,6 +25,8 @@ from __future__ import annotations
 
 import time
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from splatedit.app import revision
@@ -47,6 +49,16 @@ class _Slot:
         self.basis = None      # basis object uploaded (or False = cleared)
         self.level = None
         self.dc = None
+
+
+@dataclass(frozen=True)
+class FrameInfo:
+    """The last frame the viewport drew."""
+    ms: float            # GPU time of the frame (milliseconds)
+    splats: int          # splats drawn (a level of detail: fewer)
+    div: int             # resolution divisor (1: full resolution)
+    lod: bool            # a level of detail was drawn
+    interactive: bool    # drawn as a fast frame while moving
 
 
 class Viewport:
@@ -73,7 +85,7 @@ class Viewport:
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
         self._last_key = None
-        self.last_info: dict = {}
+        self.last_info: FrameInfo | None = None
         self.full_frames_ms: list[float] = []
         self.interactive_frames_ms: list[float] = []
 
@@ -234,8 +246,7 @@ class Viewport:
             est = ms / max(count, 1)
             self.ms_per_splat = est if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + est)
         (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
-        self.last_info = {"ms": ms, "splats": count, "div": div, "lod": level is not None,
-                          "interactive": interactive}
+        self.last_info = FrameInfo(ms, count, div, level is not None, interactive)
         return np.ascontiguousarray(img)
 
     def pick(self, cam: OrbitCamera, w: int, h: int):
@@ -335,7 +346,7 @@ class BackgroundRefiner:
                     vp.grey = bool(st.get("grey", False))
                     vp.splat_scale = float(st.get("splat_scale", 1.0))
                     img = vp.render(st["camera"], st["w"], st["h"])
-                    self.last_ms = vp.last_info["ms"]
+                    self.last_ms = vp.last_info.ms
                     if st.get("pick_key") is not None and st.get("dc") is None:
                         # the brush's pick map of the same view, while we are at it
                         idx, depth = vp.pick(st["camera"], st["w"], st["h"])
