@@ -182,7 +182,7 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.CAMERA, "", "", Action.VIEW_BACK, ("ctrl+kp_1",)),
     Binding(S.CAMERA, "", "", Action.VIEW_LEFT, ("ctrl+kp_3",)),
     Binding(S.CAMERA, "", "", Action.VIEW_BOTTOM, ("ctrl+kp_7",)),
-    Binding(S.CAMERA, "U", "up axis: detected from the model; U cycles +Z, +Y, +X, -Z, -Y, -X (panel shows it)",
+    Binding(S.CAMERA, "U", "up axis: detected from the model; U cycles +Y, +Z, +X, -Y, -Z, -X (panel shows it)",
             Action.CYCLE_UP_AXIS, ("u",)),
     # ---- selection
     Binding(S.SELECTION, "Left drag", "paint with the brush: 3D, every splat in the sphere under the circle",

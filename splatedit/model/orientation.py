@@ -55,7 +55,7 @@ class UpAxis:
 
 
 #: the order U cycles through
-CYCLE = ((2, 1), (1, 1), (0, 1), (2, -1), (1, -1), (0, -1))
+CYCLE = ((1, 1), (2, 1), (0, 1), (1, -1), (2, -1), (0, -1))
 
 
 def next_up(current: UpAxis) -> UpAxis:
