@@ -22,7 +22,6 @@ import time
 from pathlib import Path
 
 from splatedit.app import files
-from splatedit.app import overlay as ov
 from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
 from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
 from splatedit.app.frames import FrameScheduler
@@ -30,7 +29,7 @@ from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.jobs import Job
 from splatedit.app.keymap import Action, Context, lookup
 from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.panel import PANEL_MARGIN, HelpView, panel_lines, place_panel
+from splatedit.app.panel import HelpView, compose_overlay
 from splatedit.app.session import Session
 from splatedit.app.status import StatusWriter
 from splatedit.app.tools.base import DragMode
@@ -39,8 +38,8 @@ from splatedit.app.tools.camera import CameraTool
 from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
 from splatedit.errors import ParameterError, SplatEditError
-from splatedit.tolerances import (EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS, EDITOR_SPLAT_SCALE_MAX,
-                                  EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP, IQR_DEFAULT_TOL)
+from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
+                                  IQR_DEFAULT_TOL)
 
 #: wheel notch -> help lines scrolled
 HELP_WHEEL_LINES = 3
@@ -171,65 +170,10 @@ class Editor:
         self.jobs["load"] = files.load_job(self.path, self.wake)
 
     def on_loaded(self, cloud) -> None:
-        import numpy as np
-        self.cloud_name = cloud.name or self.cloud_name
-        self.session = Session(cloud, method=self.method, tol=self.tol, max_centers=self.max_centers,
-                               on_change=self.wake)
-        self.viewport.set_cloud(cloud)
-        if cloud.n >= EDITOR_LOD_MIN_SPLATS and self.viewport.ms_per_splat is None:
-            # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
-            # that a huge model's first full-quality frame is already drawn in the background
-            w, h = self.size
-            self.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
-        r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
-        self.cam.scene_radius = max(r, 1e-9)
-        self.camera.detect_up(cloud, self.path)
-        self.camera.frame_all()
-        self.window.set_title(f"splatedit - {self.cloud_name}")
-        if self.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
-            def work(progress):
-                from splatedit.model.lod import LodPyramid
-                return LodPyramid(cloud, progress=progress)
-            self.jobs["lod"] = Job("levels of detail", work, self.wake)
-        self.brush.tools.prepare(cloud)
-        self.say(f"loaded {self.cloud_name}: {cloud.n:,} splats (up axis {self.camera.up.label}, "
-                 f"{self.camera.up.source.value}; U changes it)")
+        files.on_loaded(self, cloud)
 
     def poll_jobs(self) -> None:
-        for name, job in list(self.jobs.items()):
-            if not job.done:
-                continue
-            del self.jobs[name]
-            if job.error is not None:
-                if name == "load":
-                    # reported by run_editor's caller as any bad input: "splatedit: error: ..."
-                    err = job.error
-                    self.load_error = err if isinstance(err, SplatEditError) else SplatEditError(
-                        f"{self.path}: cannot read the model: {err}")
-                    self.exit_code = 2
-                    self.running = False
-                else:
-                    self.say(f"{job.name} failed: {job.error}")
-                    if name == "graph":
-                        self.brush.tools.poll()
-                continue
-            if name == "load":
-                self.on_loaded(job.result)
-            elif name == "lod":
-                self.viewport.set_pyramid(job.result)
-                counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
-                self.say(f"levels of detail ready ({counts} splats)")
-            elif name == "save":
-                ply, script, pos = job.result
-                self.session.history.mark_saved(pos)
-                self.saved_path, self.saved_script = ply, script
-                self.say(f"saved {ply} and {script.name}")
-            elif name == "export":
-                self.saved_script = job.result
-                self.say(f"edit script written to {job.result}")
-            elif name == "graph":
-                if self.brush.tools.poll() and self.brush.tools.closure_pending and self.session is not None:
-                    self.brush.close_pending_selection()
+        files.poll_jobs(self)
 
     # ---------------------------------------------------------------- input
     def handle_events(self, events) -> None:
@@ -430,46 +374,7 @@ class Editor:
 
     # -------------------------------------------------------------- overlay
     def overlay_patches(self, w: int, h: int) -> list:
-        patches = []
-        s = self.session
-        if s is not None:
-            patches += self.brush.underlay(w, h)
-            for tool in (self.curve, self.gizmo, self.brush):
-                patches += tool.overlay(w, h)
-        panel = ov.text_panel(tuple(panel_lines(self))) if self.panel_visible else None
-        box = None
-        if panel is not None:
-            avoid = self.gizmo.avoid_box(w, h) if s is not None else None
-            box = place_panel((w, h), (panel.shape[1], panel.shape[0]), avoid)
-        help_patch = self.help.patch((w, h), box)
-        if help_patch is not None and self.help.covers_panel:
-            panel = box = None             # too small a window for both: the help steps in front
-        self.panel_box = None if box is None else (box.x, box.y, box.w, box.h)
-        y = PANEL_MARGIN
-        if box is not None:
-            patches.append(ov.Patch(box.x, box.y, panel))
-            y = box.bottom + 6 if box.y == PANEL_MARGIN else PANEL_MARGIN
-        x = box.x if box is not None else PANEL_MARGIN
-        bars = [(j.stage, j.fraction) for j in self.jobs.values()]
-        if s is not None and s.fit_job is not None:
-            bars.append((s.fit_job.stage, s.fit_job.fraction))
-        for stage, frac in bars:
-            bar = ov.progress_bar(360, frac, f"{stage} {frac * 100:3.0f}%")
-            patches.append(ov.Patch(x, y, bar))
-            y += bar.shape[0] + 4
-        if help_patch is not None:
-            patches.append(help_patch)
-        center_msg = None
-        if self.confirm_quit:
-            center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
-                          "(Ctrl+S saves)")
-        elif self.prompt is not None:
-            center_msg = ("Save as (type a path; Enter: save, Esc: cancel):",
-                          self.prompt + ("" if self.prompt_fresh else "_"))
-        if center_msg:
-            img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
-            patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))
-        return patches
+        return compose_overlay(self, w, h)
 
     # --------------------------------------------------------------- status
     def write_status(self) -> None:

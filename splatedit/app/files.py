@@ -7,8 +7,11 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
+import numpy as np
+
 from splatedit.app.jobs import Job
-from splatedit.errors import InputError
+from splatedit.errors import InputError, SplatEditError
+from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
 
 
 def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
@@ -118,3 +121,67 @@ def export_script(ed, target: Path) -> None:
         return spath
 
     ed.jobs["export"] = Job("exporting", work, ed.wake)
+
+
+def on_loaded(ed, cloud) -> None:
+    """A model finished loading: a new session, camera and up axis, levels of detail."""
+    ed.cloud_name = cloud.name or ed.cloud_name
+    from splatedit.app.session import Session
+    ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
+                           on_change=ed.wake)
+    ed.viewport.set_cloud(cloud)
+    if cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
+        # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
+        # that a huge model's first full-quality frame is already drawn in the background
+        w, h = ed.size
+        ed.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
+    r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
+    ed.cam.scene_radius = max(r, 1e-9)
+    ed.camera.detect_up(cloud, ed.path)
+    ed.camera.frame_all()
+    ed.window.set_title(f"splatedit - {ed.cloud_name}")
+    if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
+        def work(progress):
+            from splatedit.model.lod import LodPyramid
+            return LodPyramid(cloud, progress=progress)
+        ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
+    ed.brush.tools.prepare(cloud)
+    ed.say(f"loaded {ed.cloud_name}: {cloud.n:,} splats (up axis {ed.camera.up.label}, "
+             f"{ed.camera.up.source.value}; U changes it)")
+
+def poll_jobs(ed) -> None:
+    """Collect the editor's finished jobs (load, levels of detail, save, export, graph)."""
+    for name, job in list(ed.jobs.items()):
+        if not job.done:
+            continue
+        del ed.jobs[name]
+        if job.error is not None:
+            if name == "load":
+                # reported by run_editor's caller as any bad input: "splatedit: error: ..."
+                err = job.error
+                ed.load_error = err if isinstance(err, SplatEditError) else SplatEditError(
+                    f"{ed.path}: cannot read the model: {err}")
+                ed.exit_code = 2
+                ed.running = False
+            else:
+                ed.say(f"{job.name} failed: {job.error}")
+                if name == "graph":
+                    ed.brush.tools.poll()
+            continue
+        if name == "load":
+            ed.on_loaded(job.result)
+        elif name == "lod":
+            ed.viewport.set_pyramid(job.result)
+            counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
+            ed.say(f"levels of detail ready ({counts} splats)")
+        elif name == "save":
+            ply, script, pos = job.result
+            ed.session.history.mark_saved(pos)
+            ed.saved_path, ed.saved_script = ply, script
+            ed.say(f"saved {ply} and {script.name}")
+        elif name == "export":
+            ed.saved_script = job.result
+            ed.say(f"edit script written to {job.result}")
+        elif name == "graph":
+            if ed.brush.tools.poll() and ed.brush.tools.closure_pending and ed.session is not None:
+                ed.brush.close_pending_selection()

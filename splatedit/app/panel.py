@@ -189,3 +189,48 @@ class HelpView:
             self._cache = (key, ov.Patch(box.x, box.y, img))
         self.box = Box(box.x, box.y, self._cache[1].rgba.shape[1], self._cache[1].rgba.shape[0])
         return self._cache[1]
+
+
+def compose_overlay(ed, w: int, h: int) -> list:
+    """Every overlay patch of a frame, back to front: the tools' drawings,
+    the panel (off the gizmo), progress bars, the help, a centred question."""
+    patches = []
+    s = ed.session
+    if s is not None:
+        patches += ed.brush.underlay(w, h)
+        for tool in (ed.curve, ed.gizmo, ed.brush):
+            patches += tool.overlay(w, h)
+    panel = ov.text_panel(tuple(panel_lines(ed))) if ed.panel_visible else None
+    box = None
+    if panel is not None:
+        avoid = ed.gizmo.avoid_box(w, h) if s is not None else None
+        box = place_panel((w, h), (panel.shape[1], panel.shape[0]), avoid)
+    help_patch = ed.help.patch((w, h), box)
+    if help_patch is not None and ed.help.covers_panel:
+        panel = box = None             # too small a window for both: the help steps in front
+    ed.panel_box = None if box is None else (box.x, box.y, box.w, box.h)
+    y = PANEL_MARGIN
+    if box is not None:
+        patches.append(ov.Patch(box.x, box.y, panel))
+        y = box.bottom + 6 if box.y == PANEL_MARGIN else PANEL_MARGIN
+    x = box.x if box is not None else PANEL_MARGIN
+    bars = [(j.stage, j.fraction) for j in ed.jobs.values()]
+    if s is not None and s.fit_job is not None:
+        bars.append((s.fit_job.stage, s.fit_job.fraction))
+    for stage, frac in bars:
+        bar = ov.progress_bar(360, frac, f"{stage} {frac * 100:3.0f}%")
+        patches.append(ov.Patch(x, y, bar))
+        y += bar.shape[0] + 4
+    if help_patch is not None:
+        patches.append(help_patch)
+    center_msg = None
+    if ed.confirm_quit:
+        center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
+                      "(Ctrl+S saves)")
+    elif ed.prompt is not None:
+        center_msg = ("Save as (type a path; Enter: save, Esc: cancel):",
+                      ed.prompt + ("" if ed.prompt_fresh else "_"))
+    if center_msg:
+        img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
+        patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))
+    return patches

@@ -42,9 +42,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.app import revision
+from splatedit.app.distortion_feed import DistortionFeed
 from splatedit.app.fitting import FitProgress, FitScheduler, FitStats
 from splatedit.app.history import History, Snapshot
-from splatedit.app.jobs import Job
 from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.rig import Rig, _matrix_tuple
 from splatedit.errors import SplatEditError
@@ -109,6 +109,7 @@ class Session:
         self.brush_target = SUPPORT
         self.version = 0          # bumps whenever cloud or selection changes
         self.last_commit_seconds = 0.0
+        self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)
@@ -469,39 +470,12 @@ class Session:
     def distortion(self):
         """:class:`~splatedit.deform.distortion.DistortionStats` of the support
         for the current pose (live manipulation included), or None without a
-        basis, when nothing is moved, or before the first figures are ready.
-
-        Computed off the UI thread (a background job per pose, one at a time;
-        ``on_change`` is called when it is done), so a drag never waits for it:
-        the figures shown may be those of the pose one job earlier (a
-        DistortionProbe is built once per (basis, cloud); then about 5 ms per
-        100k support splats, see docs/PERFORMANCE.md).  ``fit_sync`` sessions
-        compute synchronously (tests)."""
+        basis, when nothing is moved, or before the first figures are ready
+        (computed off the UI thread: :class:`~splatedit.app.distortion_feed.DistortionFeed`)."""
         dc = self.current_dc()
         if dc is None or not dc.any():
             return None
-        from splatedit.deform.distortion import DistortionProbe
-        src = (self.basis, self.cloud)
-        d = getattr(self, "_dist", None)
-        if d is None or d["src"][0] is not src[0] or d["src"][1] is not src[1]:
-            d = self._dist = {"src": src, "probe": None, "job": None, "result": None}
-        job = d["job"]
-        if job is not None and job.done:
-            d["job"] = None
-            if job.error is None:
-                d["result"] = job.result
-        key = dc.tobytes()
-        if d["job"] is None and (d["result"] is None or d["result"][0] != key):
-            basis, cloud = src
-
-            def work(progress):
-                if d["probe"] is None:
-                    d["probe"] = DistortionProbe(basis, cloud)
-                return key, d["probe"].stats(dc)
-            d["job"] = Job("distortion", work, self.on_change, sync=self.fit_sync)
-            if d["job"].done:
-                return self.distortion()
-        return None if d["result"] is None else d["result"][1]
+        return self._distortion.stats(self.basis, self.cloud, dc)
 
     def cancel(self) -> None:
         self.manip = None
