@@ -9,7 +9,6 @@ from __future__ import annotations
 import math
 import time
 
-import numpy as np
 import pytest
 
 from tests.app.window_harness import WINDOW, EditorProcess, _foreground_centre

@@ -59,3 +59,24 @@ def test_u_cycles_through_all_six_signed_axes():
         seen.append(up.label)
         assert up.source is UpSource.USER and np.isclose(np.abs(up.vector).sum(), 1.0)
     assert sorted(seen) == sorted(["+X", "+Y", "+Z", "-X", "-Y", "-Z"])
+
+
+def test_a_ply_header_comment_names_the_up_axis(tmp_path):
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    from splatedit.io.ply import write_ply
+    from splatedit.model.orientation import header_up_hint
+
+    def write(path, cloud, overwrite, comment):
+        with open(path, "wb") as fh:
+            write_ply(fh, cloud, comment=comment)
+    c = read(str(default_model_path()))
+    for comment, label in (("up_axis Z", "+Z"), ("scanned Z-up, metres", "+Z"), ("up: -y", "-Y"),
+                           ("upaxis=+X", "+X")):
+        p = tmp_path / "m.ply"
+        write(p, c, True, comment)
+        up = detect_up_axis(c.normals, c.positions, p)
+        assert (up.label, up.source) == (label, UpSource.FILE_HEADER), comment
+    write(p, c, True, "made by splatedit; backup copy")   # "backup" is no hint
+    assert header_up_hint(p) is None
+    assert detect_up_axis(c.normals, c.positions, p).source is UpSource.DEFAULT
