@@ -270,11 +270,14 @@ class Editor:
             return
         s = self.session
         manip = s is not None and s.manip is not None
-        contexts = [Context.HELP] if self.help.shown else []
+        # a running move keeps its keys (Esc cancels it, digits type) even under the help
+        helping = [Context.HELP] if self.help.shown else []
         if s is None:
-            contexts.append(Context.ANY)
+            contexts = helping + [Context.ANY]
+        elif manip:
+            contexts = [Context.MANIP] + helping + [Context.ANY]
         else:
-            contexts += [Context.MANIP if manip else Context.IDLE, Context.ANY]
+            contexts = helping + [Context.IDLE, Context.ANY]
         action = lookup(k, ctrl, shift, contexts)
         if action is None:
             if s is not None:

@@ -32,6 +32,12 @@ recorded as script edits (``indices`` support + ``indices`` handles +
 ``matrix`` transforms + ``curves`` with ``points`` and ``move``) and :meth:`Session.edit_script` returns an
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
+
+Parts kept in their own modules: the rig's pose and curve
+(:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
+a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
+figures (:mod:`splatedit.app.distortion_feed`), the selection masks
+(:mod:`splatedit.select.selection`).
 """
 
 from __future__ import annotations

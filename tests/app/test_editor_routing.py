@@ -124,6 +124,13 @@ def test_a_click_on_a_fitted_handle_grabs_it_and_typed_keys_go_to_the_move(ed):
         key(ed, k)
     assert s.manip.axis == 2 and s.manip.typed == "0.2"
     assert ed.gizmo.readout_text().startswith("distance Z 0.2")
+    key(ed, glfw.KEY_F1)                                      # the help open: Esc still cancels the move
+    key(ed, glfw.KEY_ESCAPE)
+    assert s.manip is None and ed.help.shown
+    key(ed, glfw.KEY_F1)
+    key(ed, glfw.KEY_G)
+    for k in (glfw.KEY_Z, glfw.KEY_KP_0, glfw.KEY_PERIOD, glfw.KEY_2):
+        key(ed, k)
     key(ed, glfw.KEY_ENTER)
     assert s.manip is None and len(s.edits) == 1
     assert np.allclose(s.cloud.positions[r < 0.2, 2], 0.2)
