@@ -1,5 +1,7 @@
 // Per-frame uniform block shared by every splatedit shader (std140, set 0 binding 0).
-// Mirrors splatedit/render/renderer.py:_frame_ubo().
+// Declared once as FRAME_UBO in splatedit/render/uniforms.py (the renderer fills it by
+// field name in Renderer._write_ubo); tests/render/test_uniforms.py checks that this block
+// has the same members, types and std140 offsets.
 
 layout(std140, set = 0, binding = 0) uniform Frame {
     mat4 view;          // world -> eye (right-handed, camera looks down -z)
@@ -13,6 +15,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 light;         // ambient, diffuse, specular, shininess
     vec4 misc;          // gaussian sharpness, 1/gamma, min weight, point-size threshold (pixels)
     uvec4 options;      // backface culling, apply gamma, display (0 shaded, 1 stretch heat map), -
+    vec4 display;       // splat size scale, grey albedo (sRGB; < 0: the file's colours), -, -
 } F;
 
 // Per-splat flag bits (renderer.py FLAG_*).

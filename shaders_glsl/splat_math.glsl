@@ -56,7 +56,7 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
     S.psize = 1.0;
     mat3 R3 = mat3(F.view);
     vec3 c = (F.view * vec4(p, 1.0)).xyz;
-    vec3 ue = R3 * u, ve = R3 * v;
+    vec3 ue = R3 * (u * F.display.x), ve = R3 * (v * F.display.x);   // display: splat size scale
     vec3 nraw = cross(ue, ve);
     float area = length(nraw);
     float rad = max(length(ue), length(ve));
@@ -109,7 +109,7 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
     vec2 cpx = (S.cc * 0.5 + 0.5) * F.viewport.xy;
     S.center = vec4(cpx, 1.0 / (lp * lp), F.depth_params.z * rad);
 
-    vec3 col = pow(srgb, vec3(2.2));
+    vec3 col = pow(F.display.y >= 0.0 ? vec3(F.display.y) : srgb, vec3(2.2));   // grey shading mode
     if ((flags & FLAG_SUPPORT) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
     if ((flags & FLAG_HANDLE) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
     if ((flags & FLAG_INACTIVE) != 0u) col *= 0.35;

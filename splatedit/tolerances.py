@@ -556,3 +556,32 @@ ROTATION_MIN_ANGLE = 1e-6
 #: 0.9 % of linear (issue target 2 %), 30 degrees and more are fully
 #: rotation-aware (the bar tests at 90-180 degrees are unchanged)
 ROTATION_FULL_DEGREES = 30.0
+# ---------------------------------------------------------------------------
+# Editor architecture: up axis, help paging, display options (issue 10)
+# ---------------------------------------------------------------------------
+#: a normal counts as aligned with a world axis when |n . axis| >= this
+#: (25.8 degrees).  Floors and flat undersides of scans fall well inside it
+UP_AXIS_ALIGNED_COS = 0.9
+#: ground signal: at least this fraction of all normals aligned with one axis.
+#: Measured: hippo1.ply (a scan resting on its flat underside, Z-up) has 37% of
+#: its normals within the cone of Z; the bunny (Y-up, no floor) 9-16% on every
+#: axis, the kitten 10-12%
+UP_AXIS_GROUND_MIN_FRACTION = 0.25
+#: ... and at least this many times the fraction of the next axis (hippo: 37%
+#: against 0%; the bunny's largest, 16% on Z, is 1.3x its next)
+UP_AXIS_GROUND_DOMINANCE = 2.0
+#: splat size scale steps (Shift+[ / Shift+]) and its range: 0.25x makes a
+#: dense scan's splats visibly separate points, 4x closes the holes of a
+#: sparse one (poste_france at 1x shows gaps of ~2 splat radii)
+EDITOR_SPLAT_SCALE_STEP = 1.25
+EDITOR_SPLAT_SCALE_MIN = 0.25
+EDITOR_SPLAT_SCALE_MAX = 4.0
+#: the help window keeps this many pixels free at the window's edges, and one
+#: PageDown moves by its visible lines minus this overlap (context kept)
+EDITOR_HELP_MARGIN_PX = 12
+EDITOR_HELP_PAGE_OVERLAP = 2
+#: grey albedo (sRGB) of the uniform-grey shading mode (M): 0.72 (0.485
+#: linear) keeps a lit pixel under 1.0 with RENDER_LIGHT (0.485 * (0.2 + 0.8)
+#: + 0.25 = 0.735), so highlights do not clip, and a grazing one (ambient
+#: only, 0.1 linear) still reads against the white background
+RENDER_GREY_ALBEDO = 0.72

@@ -2,18 +2,34 @@
 
 Modules (the pure ones are unit-tested without a window or GPU):
 
-* :mod:`~splatedit.app.editor` - the window, input mapping, overlay, main
-  loop; entry point :func:`~splatedit.app.editor.run_editor`; the key and
-  mouse bindings are :data:`~splatedit.app.editor.CONTROLS`.
-* :mod:`~splatedit.app.session` - document state machine: selection ->
-  background fit -> G/R/S manipulation -> commit/cancel, undo/redo, edit
-  script export (pure).
-* :mod:`~splatedit.app.brush` - screen-space brush on pick maps (pure).
+* :mod:`~splatedit.app.editor` - the thin main loop: window events go to the
+  tools, keys through the keymap to actions; entry point
+  :func:`~splatedit.app.editor.run_editor`.
+* :mod:`~splatedit.app.tools` - the tools, each owning its mouse input, its
+  actions, its overlay and its help entries: camera, brush (selection tools),
+  gizmo (G/R/S, live readout), curve.
+* :mod:`~splatedit.app.keymap` - the one declarative table of key and mouse
+  bindings; generates the F1 help, ``splatedit edit --help`` and README's
+  controls list (pure).
+* :mod:`~splatedit.app.frames` - frame scheduling: interactive / full
+  quality / background refinement, overlay compositing, present.
+* :mod:`~splatedit.app.panel` - the status panel (placed off the gizmo), the
+  paged F1 help window, progress bars, questions.
+* :mod:`~splatedit.app.status` - the ``--status-file`` test hook.
+* :mod:`~splatedit.app.files` - model checks, loading, saving, exporting.
+* :mod:`~splatedit.app.session` - the document: selection, edits, history,
+  edit-script export; with :mod:`~splatedit.app.rig` (pose, curve),
+  :mod:`~splatedit.app.fitting` (background fits, :class:`FitStats`) and
+  :mod:`~splatedit.app.manipulation` (a G/R/S move and its readout) (pure).
+* :mod:`~splatedit.app.revision` - revision numbers, the cache keys that
+  replace ``id()``.
+* :mod:`~splatedit.app.brush` - screen-space brush on pick maps (pure); the
+  selection itself is :class:`splatedit.select.selection.Selection`.
 * :mod:`~splatedit.app.camera_control` - turntable orbit/pan/dolly-to-cursor
-  camera (pure numpy).
+  camera about an up axis (pure numpy).
 * :mod:`~splatedit.app.history` - undo snapshots (pure).
 * :mod:`~splatedit.app.viewport` - renderer(s), levels of detail, frame
-  budget, background refinement.
+  budget, background refinement; :class:`FrameInfo` of the last frame.
 * :mod:`~splatedit.app.overlay` - Pillow text panels composited on the CPU.
 * :mod:`~splatedit.app.bench` - :func:`bench_editor_frames` (``splatedit bench editor``).
 

@@ -24,6 +24,7 @@ Validation is off (it adds per-call overhead unrelated to the editor).
 
 from __future__ import annotations
 
+import dataclasses
 import time
 from typing import Iterator
 
@@ -94,7 +95,7 @@ def _drag_frames(vp, cam, w, h, basis, frames, scale):
     for k in range(frames):
         vp.set_dc(rng.normal(size=(basis.n_columns, 3)) * scale * (k + 1) / frames)
         vp.render(cam, w, h, interactive=True)
-        out.append(vp.last_info["ms"])
+        out.append(vp.last_info.ms)
     return round(float(np.median(out)), 1)
 
 
@@ -131,7 +132,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
             vp.set_basis(basis)
             vp.set_dc(None)
             vp.render(cam, w, h)                       # upload + warm-up
-            idle = [vp.render(cam, w, h) is not None and vp.last_info["ms"] for _ in range(2)]
+            idle = [vp.render(cam, w, h) is not None and vp.last_info.ms for _ in range(2)]
             # dragging the handle: a new dC every frame
             piv = cloud.positions[hnd].mean(0)
             drag, info = [], {}
@@ -141,8 +142,8 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
                 m[:3, 3] = np.array([0.0, 1.0, 0.5]) * 0.02 * (k + 1) * cloud.diagonal
                 vp.set_dc(basis.displacement([m]))
                 frame = vp.render(cam, w, h, interactive=True)
-                drag.append(vp.last_info["ms"])
-                info = dict(vp.last_info)
+                drag.append(vp.last_info.ms)
+                info = dataclasses.asdict(vp.last_info)
             tc = time.perf_counter()
             panel = ov.text_panel(tuple(f"line {i} of the status panel, 1234 ms" for i in range(9)))
             for p in (ov.Patch(8, 8, panel), ov.Patch(600, 300, ov.ring(24))):
@@ -153,7 +154,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
             for k in range(frames):
                 cam.orbit(15, 0)
                 vp.render(cam, w, h, interactive=True)
-                orbit.append(vp.last_info["ms"])
+                orbit.append(vp.last_info.ms)
             del piv
             extra = {}
             if rigs:
@@ -167,7 +168,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
                 vp.set_dc(None)
                 vp.render(cam, w, h)
                 vp.render(cam, w, h)
-                extra["idle16_ms"] = round(vp.last_info["ms"], 1)
+                extra["idle16_ms"] = round(vp.last_info.ms, 1)
                 extra["drag4h_ms"] = _drag_frames(vp, cam, w, h, b4, frames, scale)
                 del b4
                 t0 = time.perf_counter()

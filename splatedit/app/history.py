@@ -18,6 +18,8 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from splatedit.app import revision
+
 
 @dataclass(frozen=True)
 class Snapshot:
@@ -89,8 +91,8 @@ class History:
     def _memory(self) -> int:
         seen, total = set(), 0
         for s in self._states:
-            if id(s.cloud) not in seen:
-                seen.add(id(s.cloud))
+            if revision.of(s.cloud) not in seen:
+                seen.add(revision.of(s.cloud))
                 total += _cloud_bytes(s.cloud)
             total += len(s.support) + sum(len(b) for b in s.handles)
         return total

@@ -30,7 +30,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.app.brush import SUPPORT, Selection
+from splatedit.app import revision
+from splatedit.select.selection import SUPPORT, Selection
 from splatedit.tolerances import EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
 
 #: brush modes: the 3D sphere brush (default) and the visible-only brush
@@ -238,7 +239,7 @@ class SelectionTools:
     def __init__(self, start_job=None):
         self.mode = BRUSH_3D
         self._start_job = start_job
-        self._graphs: dict[int, tuple[object, object]] = {}   # id(cloud) -> (cloud, graph)
+        self._graphs: dict[int, tuple[object, object]] = {}   # cloud revision -> (cloud, graph)
         self._job = None
         self._job_cloud = None
         self.highlight: np.ndarray | None = None     # (n,) bool: what closure added last
@@ -259,7 +260,7 @@ class SelectionTools:
     def prepare(self, cloud) -> None:
         """Start building the neighbour graph of ``cloud`` unless it is cached
         or being built."""
-        if id(cloud) in self._graphs or self._job_cloud is cloud or self._failed is cloud:
+        if revision.of(cloud) in self._graphs or self._job_cloud is cloud or self._failed is cloud:
             return
         if self._job is not None:
             self._job.cancel.set()
@@ -278,7 +279,7 @@ class SelectionTools:
 
     def _store(self, cloud, graph) -> None:
         # keep the graphs of the last few base clouds (undo / redo switch between them)
-        self._graphs[id(cloud)] = (cloud, graph)
+        self._graphs[revision.of(cloud)] = (cloud, graph)
         while len(self._graphs) > 3:
             self._graphs.pop(next(iter(self._graphs)))
 
@@ -300,17 +301,17 @@ class SelectionTools:
         """The neighbour graph of ``cloud``, or None while it is being built
         (``wait``: block for it when the cloud has at most
         EDITOR_GRAPH_SYNC_MAX_SPLATS splats)."""
-        got = self._graphs.get(id(cloud))
+        got = self._graphs.get(revision.of(cloud))
         if got is not None and got[0] is cloud:
             return got[1]
         self.prepare(cloud)
-        got = self._graphs.get(id(cloud))
+        got = self._graphs.get(revision.of(cloud))
         if got is not None:
             return got[1]
         if wait and self._job is not None and cloud.n <= EDITOR_GRAPH_SYNC_MAX_SPLATS:
             self._job.wait()
             self.poll()
-            got = self._graphs.get(id(cloud))
+            got = self._graphs.get(revision.of(cloud))
             return got[1] if got is not None else None
         return None
 

@@ -32,178 +32,36 @@ recorded as script edits (``indices`` support + ``indices`` handles +
 ``matrix`` transforms + ``curves`` with ``points`` and ``move``) and :meth:`Session.edit_script` returns an
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
+
+Parts kept in their own modules: the rig's pose and curve
+(:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
+a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
+figures (:mod:`splatedit.app.distortion_feed`), the selection masks
+(:mod:`splatedit.select.selection`).
 """
 
 from __future__ import annotations
 
-import math
 import time
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.app.brush import HANDLE, SUPPORT, Selection
+from splatedit.app import revision
+from splatedit.app.distortion_feed import DistortionFeed
+from splatedit.app.fitting import FitProgress, FitScheduler, FitStats
 from splatedit.app.history import History, Snapshot
-from splatedit.app.jobs import Cancelled, Job
+from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
+from splatedit.app.rig import Rig, _matrix_tuple
 from splatedit.deform.modes import DeformationMode
-from splatedit.deform.transform import compose, rotate, scale, translate
 from splatedit.errors import SplatEditError
-from splatedit.tolerances import (EDITOR_AXIS_MIN_SCREEN_LEN, EDITOR_MIN_SCALE_FACTOR, IQR_DEFAULT_TOL,
-                                  RENDER_MAX_BASIS_COLUMNS)
+from splatedit.select.selection import HANDLE, SUPPORT, Selection
+from splatedit.tolerances import IQR_DEFAULT_TOL, RENDER_MAX_BASIS_COLUMNS
 
-GRAB, ROTATE, SCALE = "grab", "rotate", "scale"
 #: basis columns per rigid handle
 HANDLE_COLUMNS = 4
 #: at most this many picked points per control curve
 MAX_CURVE_POINTS = 16
-AXIS_NAMES = "XYZ"
-
-
-def _axis_scaling(axis: int, factor: float, center) -> np.ndarray:
-    """Scale by ``factor`` (> 0) along world axis ``axis`` about ``center``."""
-    s = np.eye(4)
-    s[axis, axis] = factor
-    c = np.asarray(center, float)
-    return compose(translate(-c), s, translate(c))
-
-
-# ------------------------------------------------------------ manipulation
-@dataclass
-class ViewInfo:
-    """What a manipulation needs to know about the view when it starts."""
-    right: np.ndarray
-    up: np.ndarray
-    back: np.ndarray
-    pivot_px: tuple[float, float]
-    world_per_px: float          # at the pivot's depth
-
-
-@dataclass
-class Manipulation:
-    """A G/R/S transform of the handle being dragged or typed.
-
-    Mouse: grab moves the pivot with the mouse in the view plane (projected on
-    the constraint axis if any); rotate turns about the view axis (or the
-    constraint axis) by the angle the mouse sweeps around the pivot's pixel;
-    scale multiplies by the ratio of the mouse's distances to the pivot's
-    pixel (along the constraint axis only, if any).  A typed number replaces
-    the mouse value: grab distance in model units (along the axis, X when
-    none), rotate degrees, scale factor.
-    """
-    mode: str
-    pivot: np.ndarray
-    view: ViewInfo
-    start: tuple[float, float]
-    mouse: tuple[float, float] = None
-    axis: int | None = None
-    typed: str = ""
-
-    def __post_init__(self):
-        if self.mouse is None:
-            self.mouse = self.start
-
-    def set_axis(self, axis: int) -> None:
-        """X/Y/Z key: constrain to that axis; pressing it again removes it."""
-        self.axis = None if self.axis == axis else axis
-
-    def type_char(self, ch: str) -> bool:
-        if ch in "0123456789.":
-            self.typed += ch
-        elif ch == "-":
-            self.typed = self.typed[1:] if self.typed.startswith("-") else "-" + self.typed
-        else:
-            return False
-        return True
-
-    def backspace(self) -> None:
-        self.typed = self.typed[:-1]
-
-    def typed_value(self) -> float | None:
-        t = self.typed
-        if t in ("", "-", ".", "-."):
-            return None
-        try:
-            return float(t)
-        except ValueError:
-            return None
-
-    def problem(self) -> str | None:
-        """Why the typed value cannot be applied (None when it can): a scale
-        factor must be > 0 (a negative one mirrors the handle and turns its
-        normals inside out, 0 flattens it)."""
-        v = self.typed_value()
-        if v is not None and not math.isfinite(v):
-            return "the typed value is too large"
-        if self.mode == SCALE and v is not None and not v > 0:
-            return f"the scale factor must be > 0, got {self.typed}"
-        return None
-
-    def _axis_vec(self) -> np.ndarray:
-        a = np.zeros(3)
-        a[self.axis] = 1.0
-        return a
-
-    def matrix(self) -> np.ndarray:
-        """The manipulation's (4, 4) matrix; a typed value that cannot be
-        applied (:meth:`problem`, shown by :meth:`describe`) is ignored: the
-        mouse's value is used meanwhile."""
-        v = self.view
-        typed = self.typed_value() if self.problem() is None else None
-        dx = self.mouse[0] - self.start[0]
-        dy = self.mouse[1] - self.start[1]
-        if self.mode == GRAB:
-            if typed is not None:
-                a = self._axis_vec() if self.axis is not None else np.array([1.0, 0.0, 0.0])
-                return translate(a * typed)
-            d = (v.right * dx - v.up * dy) * v.world_per_px
-            if self.axis is not None:
-                a = self._axis_vec()
-                # the mouse motion along the axis's screen direction
-                sa = np.array([a @ v.right, -(a @ v.up)])
-                L = float(np.hypot(*sa))
-                if L < EDITOR_AXIS_MIN_SCREEN_LEN:
-                    return np.eye(4)
-                t = (dx * sa[0] + dy * sa[1]) / (L * L) * v.world_per_px
-                d = a * t
-            return translate(d)
-        if self.mode == ROTATE:
-            axis = self._axis_vec() if self.axis is not None else v.back
-            if typed is not None:
-                ang = math.radians(typed)
-            else:
-                cx, cy = v.pivot_px
-                a0 = math.atan2(self.start[1] - cy, self.start[0] - cx)
-                a1 = math.atan2(self.mouse[1] - cy, self.mouse[0] - cx)
-                # y is down: a growing atan2 is a clockwise sweep on screen, which is a
-                # negative (right-handed) rotation about the axis pointing at the viewer
-                ang = -(a1 - a0)
-                if float(axis @ v.back) < 0:
-                    ang = -ang
-            return rotate(axis, math.degrees(ang), self.pivot)
-        if self.mode == SCALE:
-            if typed is not None:
-                f = typed
-            else:
-                cx, cy = v.pivot_px
-                r0 = math.hypot(self.start[0] - cx, self.start[1] - cy)
-                r1 = math.hypot(self.mouse[0] - cx, self.mouse[1] - cy)
-                f = r1 / max(r0, 1.0)
-            f = max(f, EDITOR_MIN_SCALE_FACTOR)
-            if self.axis is None:
-                return scale(f, self.pivot)
-            return _axis_scaling(self.axis, f, self.pivot)
-        raise ValueError(self.mode)
-
-    def describe(self) -> str:
-        name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]
-        prep = "about" if self.mode == ROTATE else "along"
-        ax = f" {prep} {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
-        val = f"  value: {self.typed}" if self.typed else ""
-        bad = self.problem()
-        if bad:
-            val += f"  ({bad})"
-        return f"{name}{ax}{val}   (Enter/click: apply, Esc/right click: cancel)"
 
 
 def columns_needed(n_handles: int, n_curve_points: int) -> int:
@@ -211,13 +69,29 @@ def columns_needed(n_handles: int, n_curve_points: int) -> int:
     return HANDLE_COLUMNS * n_handles + (n_curve_points if n_curve_points >= 2 else 0)
 
 
-def _matrix_tuple(m) -> tuple:
-    return tuple(tuple(float(x) for x in row) for row in np.asarray(m, float))
+@dataclass(frozen=True)
+class SessionStats:
+    """What the panel and the status file show of a session."""
+    state: str                  # select / fitting / ready / manipulate / error
+    support: int                # splats
+    handle: int                 # splats of the active handle
+    edits: int
+    handles: int
+    active_handle: int
+    handle_sizes: tuple
+    curve_points: int
+    pose_pending: bool
+    columns: int                # basis columns the rig needs (the basis' own once fitted)
+    fit: FitStats | None        # figures of the fitted basis
+    progress: FitProgress | None   # the running fit
+    error: str | None           # why there is no basis
 
 
 class Session:
-    """Document + selection (support, handles, curve) + fitting + pose +
-    manipulation + history.
+    """The document (cloud, edits, history) with its selection, its rig
+    (:class:`~splatedit.app.rig.Rig`: pose and curve), the fit scheduling
+    (:class:`~splatedit.app.fitting.FitScheduler`) and the running
+    manipulation.
 
     Args:
         cloud: the loaded :class:`SplatCloud`.
@@ -228,50 +102,51 @@ class Session:
     def __init__(self, cloud, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
                  max_centers: int | None = None, fit_sync: bool = False, on_change=None):
         self.method, self.tol, self.max_centers = method, tol, max_centers
-        #: deformation mode of new edits (the editor's M key; carried into exported scripts)
+        #: deformation mode of new edits (the editor's B key; carried into exported scripts)
         self.deformation = DeformationMode.ROTATION
         self.fit_sync = fit_sync
-        self._pool = ThreadPoolExecutor(max_workers=1, thread_name_prefix="splatedit-fit")
         self.on_change = on_change or (lambda: None)
+        self.fit = FitScheduler(sync=fit_sync, on_change=self.on_change)
         self.cloud = cloud
         self.selection = Selection(cloud.n)
-        self.pose: list[np.ndarray] = [np.eye(4)]      # pending matrix per handle
-        self.curve_points: list[np.ndarray] = []       # picked points (3,) of the control curve
-        self.curve_moves = np.zeros((0, 3))            # pending displacement per picked point
-        self.curve_mode = False                        # the editor's curve tool is on
+        self.rig = Rig()
         self.edits: tuple = ()
         self.history = History()
         self.history.reset(self._snapshot("open"))
-        self.basis = None
-        self.basis_key = None
-        self.basis_groups = None      # (fitted handle indices, ControlCurve or None) of the basis
-        self.fit_job: Job | None = None
-        self.fit_error: str | None = None
         self.manip: Manipulation | None = None
         self.manip_target = None      # ("handle", i) or ("curve", j)
         self.brush_target = SUPPORT
         self.version = 0          # bumps whenever cloud or selection changes
         self.last_commit_seconds = 0.0
-        self._curve_cache = (None, None)
+        self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
+
+    # ------------------------------------------- the rig and the fit's state
+    # (kept as attributes of the session: the editor, the tools and the tests use them)
+    def _delegate(owner: str, name: str, doc: str):  # noqa: N805 - a property factory
+        return property(lambda self: getattr(getattr(self, owner), name),
+                        lambda self, v: setattr(getattr(self, owner), name, v), doc=doc)
+
+    pose = _delegate("rig", "pose", "pending (4, 4) matrix per handle")
+    curve_points = _delegate("rig", "curve_points", "picked points (3,) of the control curve")
+    curve_moves = _delegate("rig", "curve_moves", "(k, 3) pending displacement per picked point")
+    curve_mode = _delegate("rig", "curve_mode", "the editor's curve tool is on")
+    basis = _delegate("fit", "basis", "the fitted DeformationBasis (None while fitting / without handle)")
+    basis_key = _delegate("fit", "key", "the selection key the basis was fitted for")
+    basis_groups = _delegate("fit", "groups", "(fitted handle indices, ControlCurve or None) of the basis")
+    fit_job = _delegate("fit", "job", "the running fit Job, or None")
+    fit_error = _delegate("fit", "error", "why there is no basis, or None")
+    del _delegate
 
     # ---------------------------------------------------------- snapshots
-    def _rig(self) -> tuple:
-        return (tuple(tuple(float(x) for x in p) for p in self.curve_points),
-                tuple(tuple(float(x) for x in d) for d in self.curve_moves),
-                tuple(_matrix_tuple(m) for m in self.pose))
-
     def _snapshot(self, label: str) -> Snapshot:
         return Snapshot.make(self.cloud, self.selection.support, self.selection.handles, self.edits,
-                             label, active=self.selection.active, rig=self._rig())
+                             label, active=self.selection.active, rig=self.rig.as_tuple())
 
     def _restore(self, snap: Snapshot) -> None:
         self.cloud = snap.cloud
         s, _ = snap.masks()
         self.selection = Selection(len(s), s, handles=snap.handle_masks(), active=snap.active)
-        pts, moves, pose = snap.rig if snap.rig else ((), (), ())
-        self.curve_points = [np.array(p, float) for p in pts]
-        self.curve_moves = np.array(moves, float).reshape(-1, 3)
-        self.pose = [np.array(m, float) for m in pose]
+        self.rig.restore(snap.rig)
         self._sync_pose()
         self.edits = snap.edits
         self.manip = None
@@ -281,8 +156,7 @@ class Session:
         self.on_change()
 
     def _sync_pose(self) -> None:
-        n = len(self.selection.handles)
-        self.pose = (self.pose + [np.eye(4) for _ in range(n)])[:n]
+        self.rig.sync_pose(len(self.selection.handles))
 
     def push(self, label: str) -> None:
         """Record the current state (after a stroke, clear, pose change or commit)."""
@@ -396,13 +270,7 @@ class Session:
     # ---------------------------------------------------------------- curve
     def curve(self):
         """The :class:`ControlCurve` through the picked points (None below 2)."""
-        if len(self.curve_points) < 2:
-            return None
-        key = tuple(p.tobytes() for p in self.curve_points)
-        if self._curve_cache[0] != key:
-            from splatedit.deform.curves import ControlCurve
-            self._curve_cache = (key, ControlCurve.through(np.array(self.curve_points, dtype=np.float64)))
-        return self._curve_cache[1]
+        return self.rig.curve()
 
     def add_curve_point(self, point) -> bool:
         """Append a picked point (2..16 per curve; consecutive ones distinct)."""
@@ -434,8 +302,7 @@ class Session:
     def clear_curve(self) -> bool:
         if self.manip is not None or not self.curve_points:
             return False
-        self.curve_points = []
-        self.curve_moves = np.zeros((0, 3))
+        self.rig.clear_curve()
         self.push("clear curve")
         return True
 
@@ -458,24 +325,15 @@ class Session:
 
     # --------------------------------------------------------------- fitting
     def selection_key(self):
-        curve = tuple(p.tobytes() for p in self.curve_points) if len(self.curve_points) >= 2 else ()
-        return (id(self.cloud),) + self.selection.key() + (curve,)
+        return (revision.of(self.cloud),) + self.selection.key() + (self.rig.curve_key(),)
 
     def request_fit(self) -> None:
         """Start (or restart) a background fit of all non-empty handles and
         the curve (when it has at least 2 points)."""
         key = self.selection_key()
-        if self.basis is not None and self.basis_key == key:
+        if self.fit.current(key):
             return
-        if self.fit_job is not None:
-            if self.fit_job.key == key:
-                return
-            self.fit_job.cancel.set()
-            self.fit_job = None
-        self.basis = None
-        self.basis_key = None
-        self.basis_groups = None
-        self.fit_error = None
+        self.fit.clear()
         hidx = self.selection.nonempty()
         curve = self.curve()
         if not hidx and curve is None:
@@ -498,35 +356,17 @@ class Session:
                                         tol=self.tol, max_centers=self.max_centers, progress=progress,
                                         fill_holes=False)  # closed visibly after each stroke
 
-        # fits run one at a time on the session's pool (a cancelled one ends at its
+        # fits run one at a time on the scheduler's worker (a cancelled one ends at its
         # next progress report); fit_sync runs it here
-        job = Job("fitting", work, None if self.fit_sync else self.on_change, key=key,
-                  executor=self._pool, sync=self.fit_sync)
-        job.groups = (tuple(hidx), curve)
-        self.fit_job = job
+        self.fit.start(key, (tuple(hidx), curve), work)
 
     def poll(self) -> bool:
         """Collect a finished fit; True when the state changed."""
-        job = self.fit_job
-        if job is None or not job.done:
-            return False
-        self.fit_job = None
-        key, groups = job.key, job.groups
-        if key != self.selection_key():
+        got = self.fit.poll(self.selection_key())
+        if got is None:             # fitted for a selection that has changed since
             self.request_fit()
             return True
-        exc = job.error
-        if exc is None:
-            self.basis = job.result
-            self.basis_key = key
-            self.basis_groups = groups
-        elif isinstance(exc, Cancelled):
-            return False
-        elif isinstance(exc, SplatEditError):
-            self.fit_error = str(exc)
-        else:   # a bug (its traceback is printed by the job), but keep the editor alive
-            self.fit_error = f"internal error while fitting: {exc!r}"
-        return True
+        return got
 
     def wait_fit(self, timeout: float = 120.0) -> bool:
         """Block until the fit finishes (tests and scripted use)."""
@@ -561,8 +401,7 @@ class Session:
     @property
     def pose_pending(self) -> bool:
         """Some handle or curve point has a pending (uncommitted) move."""
-        return (any(not np.array_equal(m, np.eye(4)) for m in self.pose)
-                or bool(self.curve_moves.any()))
+        return self.rig.pending
 
     def handle_matrix(self, k: int, live: bool = True) -> np.ndarray:
         """Pending matrix of handle ``k`` (with the running manipulation when ``live``)."""
@@ -594,8 +433,7 @@ class Session:
             self.cancel()
         if not self.pose_pending:
             return False
-        self.pose = [np.eye(4) for _ in self.selection.handles]
-        self.curve_moves = np.zeros_like(self.curve_moves)
+        self.rig.reset_pose(len(self.selection.handles))
         self.push("reset pose")
         return True
 
@@ -651,48 +489,12 @@ class Session:
     def distortion(self):
         """:class:`~splatedit.deform.distortion.DistortionStats` of the support
         for the current pose (live manipulation included), or None without a
-        basis, when nothing is moved, or before the first figures are ready.
-
-        Computed off the UI thread (a background job per pose, one at a time;
-        ``on_change`` is called when it is done), so a drag never waits for it:
-        the figures shown may be those of the pose one job earlier (a
-        DistortionProbe is built once per (basis, cloud); then about 5 ms per
-        100k support splats, see docs/PERFORMANCE.md).  ``fit_sync`` sessions
-        compute synchronously (tests)."""
+        basis, when nothing is moved, or before the first figures are ready
+        (computed off the UI thread: :class:`~splatedit.app.distortion_feed.DistortionFeed`)."""
         dc = self.current_dc()
-        if dc is None:
+        if dc is None or not dc.any():
             return None
-        from splatedit.deform.rotation import split_displacement
-        d0, rot = split_displacement(dc)
-        if rot is None and not d0.any():
-            return None
-        if rot is None:
-            dc = d0
-        from splatedit.deform.distortion import DistortionProbe
-        src = (self.basis, self.cloud)
-        d = getattr(self, "_dist", None)
-        if d is None or d["src"][0] is not src[0] or d["src"][1] is not src[1]:
-            d = self._dist = {"src": src, "probe": None, "job": None, "result": None}
-        job = d["job"]
-        if job is not None and job.done:
-            d["job"] = None
-            if job.error is None:
-                d["result"] = job.result
-        key = dc.tobytes()
-        if d["job"] is None and (d["result"] is None or d["result"][0] != key):
-            basis, cloud = src
-
-            def work(progress):
-                if d["probe"] is None:
-                    d["probe"] = DistortionProbe(basis, cloud)
-                if rot is not None:     # exact Jacobians with the blended rotations
-                    from splatedit.deform.distortion import basis_distortion
-                    return key, basis_distortion(basis, cloud, dc)
-                return key, d["probe"].stats(dc)
-            d["job"] = Job("distortion", work, self.on_change, sync=self.fit_sync)
-            if d["job"].done:
-                return self.distortion()
-        return None if d["result"] is None else d["result"][1]
+        return self._distortion.stats(self.basis, self.cloud, dc)
 
     def cancel(self) -> None:
         self.manip = None
@@ -774,12 +576,9 @@ class Session:
         self.manip_target = None
         self.cloud = new
         self.edits = self.edits + (edit,)
-        self.basis = None
-        self.basis_key = None
-        self.basis_groups = None
-        self.pose = [np.eye(4) for _ in sel.handles]
-        self.curve_points = []
-        self.curve_moves = np.zeros((0, 3))
+        self.fit.clear()
+        self.rig.reset_pose(len(sel.handles))
+        self.rig.clear_curve()
         self.push("edit")
         return True
 
@@ -788,27 +587,16 @@ class Session:
         from splatedit.script import EditScript, SolverSettings
         return EditScript(tuple(self.edits), SolverSettings(self.method, self.tol, self.max_centers))
 
-    def stats(self) -> dict:
+    def stats(self) -> SessionStats:
         sel = self.selection
-        s = {"state": self.state, "support": sel.counts[0], "handle": sel.counts[1],
-             "edits": len(self.edits), "handles": len(sel.handles), "active_handle": sel.active,
-             "handle_sizes": [int(h.sum()) for h in sel.handles], "curve_points": len(self.curve_points),
-             "pose_pending": self.pose_pending,
-             "columns": columns_needed(len(sel.nonempty()), len(self.curve_points))}
-        if self.basis is not None:
-            st = self.basis.stats if isinstance(self.basis.stats, dict) else vars(self.basis.stats)
-            s.update(centers=st.get("n_centers"), constraints=st.get("n_constraints"),
-                     residual=st.get("residual"), method=st.get("method"),
-                     fit_seconds=st.get("fit_seconds"), basis_seconds=st.get("basis_seconds"),
-                     columns=self.basis.n_columns)
-        if self.fit_job is not None:
-            s.update(stage=self.fit_job.stage, fraction=self.fit_job.fraction,
-                     elapsed=time.perf_counter() - self.fit_job.started)
-        if self.fit_error:
-            s["error"] = self.fit_error
-        return s
+        fit = self.fit.stats()
+        return SessionStats(
+            state=self.state, support=sel.counts[0], handle=sel.counts[1], edits=len(self.edits),
+            handles=len(sel.handles), active_handle=sel.active,
+            handle_sizes=tuple(int(h.sum()) for h in sel.handles), curve_points=len(self.curve_points),
+            pose_pending=self.pose_pending,
+            columns=fit.columns if fit is not None else columns_needed(len(sel.nonempty()), len(self.curve_points)),
+            fit=fit, progress=self.fit.progress(), error=self.fit_error)
 
     def close(self) -> None:
-        if self.fit_job is not None:
-            self.fit_job.cancel.set()
-        self._pool.shutdown(wait=False, cancel_futures=True)
+        self.fit.close()

@@ -25,8 +25,11 @@ from __future__ import annotations
 
 import time
 
+from dataclasses import dataclass
+
 import numpy as np
 
+from splatedit.app import revision
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.render.camera import Camera
 
@@ -48,6 +51,16 @@ class _Slot:
         self.dc = None
 
 
+@dataclass(frozen=True)
+class FrameInfo:
+    """The last frame the viewport drew."""
+    ms: float            # GPU time of the frame (milliseconds)
+    splats: int          # splats drawn (a level of detail: fewer)
+    div: int             # resolution divisor (1: full resolution)
+    lod: bool            # a level of detail was drawn
+    interactive: bool    # drawn as a fast frame while moving
+
+
 class Viewport:
     def __init__(self, *, budget_ms: float = 100.0, renderer=None):
         from splatedit.render.renderer import Renderer
@@ -65,11 +78,14 @@ class Viewport:
         self.pyramid = None
         #: draw the distortion heat map instead of the shaded colours (Renderer.distortion_map)
         self.distortion_map = False
+        #: display options (Renderer.grey_shading, Renderer.splat_scale)
+        self.grey = False
+        self.splat_scale = 1.0
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
         self._last_key = None
-        self.last_info: dict = {}
+        self.last_info: FrameInfo | None = None
         self.full_frames_ms: list[float] = []
         self.interactive_frames_ms: list[float] = []
 
@@ -102,6 +118,8 @@ class Viewport:
     def _sync(self, slot: _Slot, level=None) -> None:
         cloud = self.cloud
         slot.r.distortion_map = self.distortion_map
+        slot.r.grey_shading = self.grey
+        slot.r.splat_scale = self.splat_scale
         if level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
@@ -113,7 +131,7 @@ class Viewport:
             slot.r.set_cloud(cloud)
             slot.cloud = cloud
             slot.sel = slot.basis = slot.dc = None
-        if slot.sel != (self.sel_version, id(cloud)):
+        if slot.sel != (self.sel_version, revision.of(cloud)):
             s, h, i = self.support, self.handle, self.inactive
             if s is not None and len(s) == cloud.n:
                 if i is None:
@@ -123,7 +141,7 @@ class Viewport:
                 slot.r.set_selection(s, h, i)
             else:
                 slot.r.set_selection(None, None)
-            slot.sel = (self.sel_version, id(cloud))
+            slot.sel = (self.sel_version, revision.of(cloud))
         basis = self.basis
         if slot.basis is not basis:
             if basis is None:
@@ -180,7 +198,7 @@ class Viewport:
         level, div = cfg
         n = self.cloud.n
         count = n if level is None else level.n
-        key = (id(level) if level is not None else None, div)
+        key = (revision.of(level) if level is not None else None, div)
         if key in self._measured:
             ms, px, _ = self._measured[key]
             return ms * pixels / max(px, 1)
@@ -220,7 +238,7 @@ class Viewport:
                 img = pad
         ms = (time.perf_counter() - t0) * 1e3
         count = self.cloud.n if level is None else level.n
-        key = (id(level) if level is not None else None, div)
+        key = (revision.of(level) if level is not None else None, div)
         old = self._measured.get(key)
         if old is not None and old[1] == w * h and ms > old[0]:
             ms_avg = 0.5 * (old[0] + ms)       # slower: average out one-off spikes
@@ -233,8 +251,7 @@ class Viewport:
             est = ms / max(count, 1)
             self.ms_per_splat = est if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + est)
         (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
-        self.last_info = {"ms": ms, "splats": count, "div": div, "lod": level is not None,
-                          "interactive": interactive}
+        self.last_info = FrameInfo(ms, count, div, level is not None, interactive)
         return np.ascontiguousarray(img)
 
     def pick(self, cam: OrbitCamera, w: int, h: int):
@@ -331,8 +348,10 @@ class BackgroundRefiner:
                     vp.set_basis(st["basis"])
                     vp.set_dc(st["dc"])
                     vp.distortion_map = bool(st.get("distortion_map", False))
+                    vp.grey = bool(st.get("grey", False))
+                    vp.splat_scale = float(st.get("splat_scale", 1.0))
                     img = vp.render(st["camera"], st["w"], st["h"])
-                    self.last_ms = vp.last_info["ms"]
+                    self.last_ms = vp.last_info.ms
                     if st.get("pick_key") is not None and st.get("dc") is None:
                         # the brush's pick map of the same view, while we are at it
                         idx, depth = vp.pick(st["camera"], st["w"], st["h"])

@@ -26,7 +26,9 @@ from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
+from splatedit.render.uniforms import FRAME_UBO
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
+                                  RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
                                   RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
                                   RENDER_VISIBILITY_EPS_RADII)
@@ -37,7 +39,7 @@ FLAG_HANDLE = 2
 FLAG_DEFORMED = 4
 FLAG_INACTIVE = 8            # an inactive handle (the editor's several handles): darker
 
-_UBO_BYTES = 272
+_UBO_BYTES = FRAME_UBO.itemsize   # splatedit/render/uniforms.py, checked against frame.glsl
 _GEOM_STRIDE = 36           # centre, u, v as float32
 _MAX_SIZE = 16384
 
@@ -236,6 +238,10 @@ class Renderer:
         #: applies, shaders_glsl/distortion.glsl; 1x neutral grey, 1.5x yellow,
         #: 2x orange, 3x red, 4x+ dark red; splats outside the support grey)
         self.distortion_map = False
+        #: multiply every splat's axes by this (display only; the editor's splat size)
+        self.splat_scale = 1.0
+        #: shade a uniform grey instead of the file's colours (RENDER_GREY_ALBEDO)
+        self.grey_shading = False
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         self._own_device = device is None
@@ -682,21 +688,21 @@ class Renderer:
         view = gpu_cam.view_matrix()
         proj = gpu_cam.projection_matrix(width / height, near, far)
         p00, p11 = proj[0, 0], proj[1, 1]
-        f = np.zeros(_UBO_BYTES // 4, dtype=np.float32)
-        f[0:16] = view.T.reshape(-1)
-        f[16:32] = proj.T.reshape(-1)
-        f[32:36] = (width, height, 1.0 / width, 1.0 / height)
-        f[36:40] = (2.0 / (width * p00), -1.0 / p00, 2.0 / (height * p11), -1.0 / p11)
-        f[40:44] = (near, far, RENDER_VISIBILITY_EPS_RADII, RENDER_LOWPASS_RADIUS_PX)
-        f[44:48] = RENDER_TINT_SUPPORT
-        f[48:52] = RENDER_TINT_HANDLE
-        f[52:56] = (*self.background[:3], 1.0)
-        f[56:60] = RENDER_LIGHT
-        f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
-                    min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
-        opts = f[64:68].view(np.uint32)
-        opts[:] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 1 if self.distortion_map else 0, 0)
-        self.ubo.write(f)
+        u = np.zeros((), FRAME_UBO)
+        u["view"] = view.T                    # GLSL mat4 is column-major
+        u["proj"] = proj.T
+        u["viewport"] = (width, height, 1.0 / width, 1.0 / height)
+        u["pix_to_ray"] = (2.0 / (width * p00), -1.0 / p00, 2.0 / (height * p11), -1.0 / p11)
+        u["depth_params"] = (near, far, RENDER_VISIBILITY_EPS_RADII, RENDER_LOWPASS_RADIUS_PX)
+        u["tint_support"] = RENDER_TINT_SUPPORT
+        u["tint_handle"] = RENDER_TINT_HANDLE
+        u["background"] = (*self.background[:3], 1.0)
+        u["light"] = RENDER_LIGHT
+        u["misc"] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
+                     min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
+        u["options"] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 1 if self.distortion_map else 0, 0)
+        u["display"] = (self.splat_scale, RENDER_GREY_ALBEDO if self.grey_shading else -1.0, 0.0, 0.0)
+        self.ubo.write(u)
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
             self._dC_dirty = False

@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, Selection, indices_in_circle, stroke_points
+from splatedit.app.brush import BrushPicker, indices_in_circle, stroke_points
 
 
 def grid_pick(h=40, w=60):
@@ -53,21 +53,3 @@ def test_picker_adds_subpixel_visible_splats_only():
     pd = np.full((20, 20), 0.9)
     bp = BrushPicker(pick, centers, depths, tol, pick_depth=pd)
     assert bp.query(10, 10, 3).tolist() == [0]     # both centres are behind the front surface
-
-
-
-def test_selection_rules():
-    sel = Selection(10)
-    assert sel.paint([1, 2, 3, 4], SUPPORT)
-    assert sel.paint([4, 5], HANDLE)          # 5 is outside the support
-    assert np.flatnonzero(sel.handle).tolist() == [4]
-    assert not sel.paint([4], HANDLE)
-    sel.paint([3, 4], SUPPORT, erase=True)     # erasing support erases the handle there
-    assert np.flatnonzero(sel.support).tolist() == [1, 2]
-    assert not sel.handle.any()
-    sel.paint([1], HANDLE)
-    sel.paint([1], HANDLE, erase=True)
-    assert not sel.handle.any() and sel.support[1]
-    k = sel.key()
-    assert sel.clear()
-    assert sel.counts == (0, 0) and sel.key() != k

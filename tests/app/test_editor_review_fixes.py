@@ -11,7 +11,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.editor import Editor, check_model_file, save_refusal
 from splatedit.app.jobs import Cancelled, Job

@@ -8,7 +8,8 @@ import numpy as np
 import pytest
 
 from splatedit.app import selection_tools as tools
-from splatedit.app.brush import HANDLE, SUPPORT, BrushPicker, Selection, picker_for_view
+from splatedit.app.brush import BrushPicker, picker_for_view
+from splatedit.select.selection import HANDLE, SUPPORT, Selection
 from splatedit.app.camera_control import OrbitCamera
 
 W, H = 640, 400

@@ -6,7 +6,7 @@ import math
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.session import GRAB, ROTATE, SCALE, Manipulation, Session, ViewInfo
 from splatedit.model import SplatCloud
 from tests.app.sessions import plane_cloud, view
@@ -69,7 +69,7 @@ def test_full_session_commit_undo_redo_and_script(tmp_path, session):
     r = paint_regions(s)
     assert s.wait_fit() and s.state == "ready"
     st = s.stats()
-    assert st["centers"] > 0 and st["support"] > st["handle"] > 0
+    assert st.fit.centers > 0 and st.support > st.handle > 0
     base = s.cloud
     assert s.begin(GRAB, view(), (100, 100))
     s.manip.set_axis(2)

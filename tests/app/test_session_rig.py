@@ -6,7 +6,7 @@ import json
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.session import Session, ViewInfo, GRAB
 from splatedit.errors import SplatEditError
 from splatedit.model import SplatCloud
@@ -60,7 +60,7 @@ def test_two_handles_follow_their_own_transforms(tmp_path, session):
     assert s.add_handle() and s.selection.active == 1 and len(s.selection.handles) == 2
     s.end_stroke(s.paint(np.union1d(a, b)))           # the other handle's splats are not taken
     assert np.array_equal(np.flatnonzero(s.selection.handles[1]), b)
-    assert s.wait_fit() and s.basis.n_columns == 8 and s.stats()["columns"] == 8
+    assert s.wait_fit() and s.basis.n_columns == 8 and s.stats().columns == 8
     assert not s.single_rig
     # move the active handle (B) down, then A up: each keeps its own transform
     assert typed_move(s, 2, "-0.1") == "pose"

@@ -27,21 +27,21 @@ def scene():
 def test_idle_full_quality_and_interactive_lod(scene):
     vp, cloud, cam = scene
     img = vp.render(cam, 160, 120)
-    assert img.shape == (120, 160, 4) and vp.last_info["splats"] == cloud.n and not vp.last_info["lod"]
+    assert img.shape == (120, 160, 4) and vp.last_info.splats == cloud.n and not vp.last_info.lod
     fg = img[..., :3].min(axis=2) < 240
     assert fg.mean() > 0.1
     # pretend the device is slow: the interactive frame falls back to a level
     vp.assume_cost(100.0 / 5000, 160 * 120)
     img2 = vp.render(cam, 160, 120, interactive=True)
     info = vp.last_info
-    assert info["lod"] and info["splats"] <= 5000
+    assert info.lod and info.splats <= 5000
     assert img2.shape == img.shape
     fg2 = img2[..., :3].min(axis=2) < 240
     # the level covers (about) the same pixels: hole-free, slightly fatter
     assert (fg & ~fg2).mean() < 0.01
     vp.assume_cost(100.0 / 500, 160 * 120)    # even the coarsest level is too slow: lower resolution
     vp.render(cam, 160, 120, interactive=True)
-    assert vp.last_info["div"] > 1 and vp.last_info["lod"]
+    assert vp.last_info.div > 1 and vp.last_info.lod
     vp.assume_cost(None, 1)
 
 
@@ -60,7 +60,7 @@ def test_handle_moves_in_lod_and_full(scene):
     assert np.abs(after.astype(int) - before).sum() > 1000
     vp.assume_cost(100.0 / 5000, 160 * 120)
     lod_img = vp.render(cam, 160, 120, interactive=True)
-    assert vp.last_info["lod"]
+    assert vp.last_info.lod
     # the deformed level looks like the deformed full cloud
     fa = after[..., :3].min(axis=2) < 240
     fl = lod_img[..., :3].min(axis=2) < 240

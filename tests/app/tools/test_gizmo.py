@@ -11,9 +11,10 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.brush import HANDLE, SUPPORT
+from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
+from splatedit.app.tools.base import DragMode
 from splatedit.app.session import GRAB, ROTATE, SCALE, Session
 from splatedit.tolerances import EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_SCALE_PX
 from tests.app.sessions import plane_cloud
@@ -27,12 +28,9 @@ class StubEditor(Editor):
     size = (W, H)
 
     def __init__(self, session, cam):            # no window, no GPU
-        self.session, self.cam, self.g = session, cam, G
-        self.mouse = self.drag_last = (0.0, 0.0)
-        self.drag = self.prompt = None
-        self.confirm_quit = self.erase_toggle = False
-        self.cursor_inside = True
-        self._centre = self._centre_key = None
+        self.path, self.window = None, None
+        self._init_state(cam, G)
+        self.session = session
         self.messages = []
 
     def motion(self):
@@ -91,55 +89,55 @@ def rotation_axis_angle(m):
 
 def test_all_parts_are_shown_and_picked_in_priority_order(editor):
     ed = editor
-    rings = dict(ed.gizmo_rings(W, H))
-    assert sorted(rings) == [0, 1, 2] and len(ed.gizmo_axes(W, H)) == 3
-    c, rad = ed.gizmo_scale_circle(W, H)
-    centre_px = ed.cam.project(ed.handle_centre(), W, H)[0][0]
+    rings = dict(ed.gizmo.rings(W, H))
+    assert sorted(rings) == [0, 1, 2] and len(ed.gizmo.axes(W, H)) == 3
+    c, rad = ed.gizmo.scale_circle(W, H)
+    centre_px = ed.cam.project(ed.gizmo.handle_centre(), W, H)[0][0]
     assert np.allclose(c, centre_px) and rad == EDITOR_GIZMO_SCALE_PX
     # every ring point lies on the projected world circle around the centroid
     for k, px in rings.items():
         assert np.isfinite(px).all() and np.allclose(px[0], px[-1])
-        assert ed.gizmo_pick(*ed.ring_grab_point(k, W, H)) == (ROTATE, k)
+        assert ed.gizmo.pick(*ed.gizmo.ring_grab_point(k, W, H)) == (ROTATE, k)
     # an arrow wins over a ring where they cross
     n_crossings = 0
-    for k, p0, p1 in ed.gizmo_axes(W, H):
+    for k, p0, p1 in ed.gizmo.axes(W, H):
         tip = p0 + 0.95 * (p1 - p0)
-        assert ed.gizmo_pick(*tip) == (GRAB, k)
+        assert ed.gizmo.pick(*tip) == (GRAB, k)
         crossing = [q for q in rings[(k + 1) % 3]
                     if abs(float(np.linalg.det(np.c_[p1 - p0, q - p0]))) / np.linalg.norm(p1 - p0) < 1.0
                     and 0.3 < (q - p0) @ (p1 - p0) / ((p1 - p0) @ (p1 - p0)) < 1.0]
         for q in crossing:
-            assert ed.gizmo_pick(*q) == (GRAB, k)
+            assert ed.gizmo.pick(*q) == (GRAB, k)
         n_crossings += len(crossing)
     # the scale grip: on its circle (away from the rest), not inside nor outside it
     for ang in np.linspace(0, 2 * math.pi, 12, endpoint=False):
         d = np.array([math.cos(ang), math.sin(ang)])
-        assert ed.gizmo_pick(*(c + d * rad)) == (SCALE, None)
-        assert ed.gizmo_pick(*(c + d * (rad + EDITOR_GIZMO_HIT_PX + 2))) is None
+        assert ed.gizmo.pick(*(c + d * rad)) == (SCALE, None)
+        assert ed.gizmo.pick(*(c + d * (rad + EDITOR_GIZMO_HIT_PX + 2))) is None
     assert n_crossings > 0
-    assert ed.gizmo_pick(5, 5) is None
+    assert ed.gizmo.pick(5, 5) is None
     # the overlay draws grip, rings and arrows
-    assert len(ed.gizmo_patches(W, H)) >= 1 + 3 + 3
+    assert len(ed.gizmo.overlay(W, H)) >= 1 + 3 + 3
 
 
 def test_edge_on_rings_are_hidden_and_nothing_shows_while_moving(editor):
     ed = editor
     ed.cam.yaw, ed.cam.pitch = 0.0, 0.0          # looking down -z: X and Y rings seen edge-on
-    assert [k for k, _ in ed.gizmo_rings(W, H)] == [2]
-    c, rad = ed.gizmo_scale_circle(W, H)
+    assert [k for k, _ in ed.gizmo.rings(W, H)] == [2]
+    c, rad = ed.gizmo.scale_circle(W, H)
     ed.session.curve_mode = True
-    assert ed.gizmo_rings(W, H) == [] and ed.gizmo_scale_circle(W, H) is None
-    assert ed.gizmo_pick(c[0] + rad, c[1]) is None
+    assert ed.gizmo.rings(W, H) == [] and ed.gizmo.scale_circle(W, H) is None
+    assert ed.gizmo.pick(c[0] + rad, c[1]) is None
 
 
 @pytest.mark.parametrize("k", [0, 1, 2])
 def test_ring_drag_rotates_about_that_axis_through_the_centroid(editor, k):
     ed, s = editor, editor.session
-    piv = ed.handle_centre().copy()
+    piv = ed.gizmo.handle_centre().copy()
     hnd = s.selection.handle.copy()
     before = s.cloud.positions[hnd].copy()
-    c = ed.gizmo_scale_circle(W, H)[0]
-    g = ed.ring_grab_point(k, W, H)
+    c = ed.gizmo.scale_circle(W, H)[0]
+    g = ed.gizmo.ring_grab_point(k, W, H)
     m = drag(ed, around(c, g, 25.0))
     axis, ang = rotation_axis_angle(m)
     assert abs(abs(axis[k]) - 1) < 1e-9 and ang == pytest.approx(25.0, abs=1e-6)
@@ -150,14 +148,14 @@ def test_ring_drag_rotates_about_that_axis_through_the_centroid(editor, k):
     signed = math.degrees(math.atan2(m[:3, :3][(k + 2) % 3, (k + 1) % 3], m[:3, :3][(k + 1) % 3, (k + 1) % 3]))
     assert np.sign(signed) == -np.sign(back[k])      # y down: the listed sweep is clockwise on screen
     # released: one handle, no curve -> applied at once, the handle moved rigidly
-    assert ed.drag is None and s.manip is None and len(s.edits) == 1 and not s.pose_pending
+    assert ed.drag is DragMode.NONE and s.manip is None and len(s.edits) == 1 and not s.pose_pending
     assert np.allclose(s.cloud.positions[hnd], before @ m[:3, :3].T + m[:3, 3], atol=1e-9)
 
 
 def test_grip_drag_scales_uniformly_about_the_centroid(editor):
     ed, s = editor, editor.session
-    piv = ed.handle_centre().copy()
-    c, rad = ed.gizmo_scale_circle(W, H)
+    piv = ed.gizmo.handle_centre().copy()
+    c, rad = ed.gizmo.scale_circle(W, H)
     d = np.array([-0.6, 0.8])
     m = drag(ed, [tuple(c + d * rad), tuple(c + d * rad * 1.2), tuple(c + d * rad * 1.5)])
     assert np.allclose(m[:3, :3], 1.5 * np.eye(3))
@@ -165,7 +163,7 @@ def test_grip_drag_scales_uniformly_about_the_centroid(editor):
     assert len(s.edits) == 1
     # inward, even through the centre: the factor stays > 0
     assert s.wait_fit() and s.active_fitted()
-    c, rad = ed.gizmo_scale_circle(W, H)
+    c, rad = ed.gizmo.scale_circle(W, H)
     m = drag(ed, [tuple(c + d * rad), tuple(c + d * 0.5 * rad), tuple(c)])
     assert m[0, 0] > 0 and np.allclose(m[:3, :3], m[0, 0] * np.eye(3)) and m[0, 0] < 0.02
 
@@ -176,17 +174,17 @@ def test_ring_drag_with_several_handles_is_kept_as_a_pending_move(editor):
     r = np.linalg.norm(s.cloud.positions[:, :2] - [-0.3, -0.3], axis=1)
     s.end_stroke(s.paint(np.flatnonzero(r < 0.15)))
     assert s.wait_fit() and s.active_fitted()
-    ed._centre_key = None
-    c = ed.gizmo_scale_circle(W, H)[0]
-    m = drag(ed, around(c, ed.ring_grab_point(2, W, H), 20.0))
+    ed.gizmo._centre_key = None
+    c = ed.gizmo.scale_circle(W, H)[0]
+    m = drag(ed, around(c, ed.gizmo.ring_grab_point(2, W, H), 20.0))
     assert abs(rotation_axis_angle(m)[0][2]) == pytest.approx(1.0)
     assert s.pose_pending and len(s.edits) == 0
     assert np.allclose(s.pose[s.selection.active], m)
 
 
 def test_gizmo_is_hidden_when_the_handle_is_far_off_screen(editor):
-    assert editor.gizmo_rings(W, H) and editor.gizmo_axes(W, H)
+    assert editor.gizmo.rings(W, H) and editor.gizmo.axes(W, H)
     # look far to the side: the handle projects thousands of pixels outside the window
     editor.cam.target = np.array([40.0, 0.0, 0.0])
-    assert not editor.gizmo_rings(W, H) and not editor.gizmo_axes(W, H)
-    assert editor.gizmo_scale_circle(W, H) is None
+    assert not editor.gizmo.rings(W, H) and not editor.gizmo.axes(W, H)
+    assert editor.gizmo.scale_circle(W, H) is None

@@ -1,0 +1,187 @@
+"""Files of the editor: checking the model before a window opens, the
+default save path, the refusal to overwrite the opened model, and the save /
+export jobs (worker threads; the editor polls them)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+
+from splatedit.app.jobs import Job
+from splatedit.errors import InputError, SplatEditError
+from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
+
+
+def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
+    """``<stem>-edited.ply`` next to the input (the current directory for the
+    bundled model or an unwritable folder), never an existing file."""
+    stem = Path(name).stem if name else (src.stem if src else "model")
+    folder = Path.cwd()
+    if src is not None and not bundled and os.access(src.parent, os.W_OK):
+        folder = src.parent
+    p = folder / f"{stem}-edited.ply"
+    k = 2
+    while p.exists():
+        p = folder / f"{stem}-edited-{k}.ply"
+        k += 1
+    return p
+
+
+def script_path_for(ply: Path) -> Path:
+    return ply.with_suffix("").with_name(ply.with_suffix("").name + ".edits.json")
+
+
+def _same_file(a, b) -> bool:
+    try:
+        return Path(a).expanduser().resolve() == Path(b).expanduser().resolve()
+    except (OSError, RuntimeError):     # e.g. a symlink loop: compare the spellings
+        return Path(a) == Path(b)
+
+
+def save_refusal(target, model) -> str | None:
+    """Why the editor refuses to save to ``target`` (None when it may): saves
+    never replace the opened model (a user's file or the bundled one), nor
+    does the edit script written beside the save."""
+    if model is None:
+        return None
+    for path in (target, script_path_for(Path(target))):
+        if _same_file(path, model):
+            return (f"not saved: {path} is the opened model, which saves never replace "
+                    "(Ctrl+Shift+S: save under another name)")
+    return None
+
+
+def check_model_file(path) -> None:
+    """Refuse a model the editor could not open, before any window exists:
+    missing, a directory, an extension :func:`splatedit.io.read` does not
+    know, or unreadable.  Raises :class:`InputError` (one line, exit 2)."""
+    from splatedit.io import READ_EXTENSIONS
+    p = Path(path)
+    if not p.exists():
+        raise InputError("no such file", path=str(path))
+    if p.is_dir():
+        raise InputError("is a directory, not a file", path=str(path))
+    ext = p.suffix.lower()
+    if ext not in READ_EXTENSIONS:
+        raise InputError(f"unsupported file extension {ext or '(none)'!r} for reading; "
+                         f"supported: {', '.join(READ_EXTENSIONS)}", path=str(path))
+    try:
+        with open(p, "rb") as f:
+            f.read(1)
+    except OSError as exc:
+        raise InputError(f"cannot read the file ({exc.strerror or exc})", path=str(path)) from None
+
+
+def load_job(path: Path, wake) -> Job:
+    def work(progress):
+        from splatedit.io import read
+        cloud = read(str(path), progress=progress)
+        if not cloud.name:
+            cloud.name = path.name
+        return cloud
+    return Job("loading", work, wake)
+
+
+def save(ed, path: Path) -> None:
+    """Start saving the session's cloud to ``path`` and its edit script beside
+    it (``ed``: the editor, or anything with ``session``, ``jobs``, ``path``,
+    ``say``, ``wake``)."""
+    s = ed.session
+    if "save" in ed.jobs:
+        ed.say("a save is already running")
+        return
+    refusal = save_refusal(path, ed.path)
+    if refusal:
+        ed.say(refusal)
+        return
+    cloud, script, pos = s.cloud, s.edit_script(), s.history.position
+    ed.save_as = path
+    spath = script_path_for(path)
+
+    def work(progress):
+        from splatedit.io import write
+        progress("saving", 0.0)
+        write(str(path), cloud, overwrite=True)
+        script.save(spath)
+        return path, spath, pos
+
+    ed.jobs["save"] = Job("saving", work, ed.wake)
+    ed.say(f"saving {path} ...")
+
+
+def export_script(ed, target: Path) -> None:
+    """Start writing only the edit script that belongs beside ``target``."""
+    script = ed.session.edit_script()
+    spath = script_path_for(target)
+
+    def work(progress):
+        script.save(spath)
+        return spath
+
+    ed.jobs["export"] = Job("exporting", work, ed.wake)
+
+
+def on_loaded(ed, cloud) -> None:
+    """A model finished loading: a new session, camera and up axis, levels of detail."""
+    ed.cloud_name = cloud.name or ed.cloud_name
+    from splatedit.app.session import Session
+    ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
+                           on_change=ed.wake)
+    ed.viewport.set_cloud(cloud)
+    if cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
+        # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
+        # that a huge model's first full-quality frame is already drawn in the background
+        w, h = ed.size
+        ed.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
+    r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
+    ed.cam.scene_radius = max(r, 1e-9)
+    ed.camera.detect_up(cloud, ed.path)
+    ed.camera.frame_all()
+    ed.window.set_title(f"splatedit - {ed.cloud_name}")
+    if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
+        def work(progress):
+            from splatedit.model.lod import LodPyramid
+            return LodPyramid(cloud, progress=progress)
+        ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
+    ed.brush.tools.prepare(cloud)
+    ed.say(f"loaded {ed.cloud_name}: {cloud.n:,} splats (up axis {ed.camera.up.label}, "
+             f"{ed.camera.up.source.value}; U changes it)")
+
+def poll_jobs(ed) -> None:
+    """Collect the editor's finished jobs (load, levels of detail, save, export, graph)."""
+    for name, job in list(ed.jobs.items()):
+        if not job.done:
+            continue
+        del ed.jobs[name]
+        if job.error is not None:
+            if name == "load":
+                # reported by run_editor's caller as any bad input: "splatedit: error: ..."
+                err = job.error
+                ed.load_error = err if isinstance(err, SplatEditError) else SplatEditError(
+                    f"{ed.path}: cannot read the model: {err}")
+                ed.exit_code = 2
+                ed.running = False
+            else:
+                ed.say(f"{job.name} failed: {job.error}")
+                if name == "graph":
+                    ed.brush.tools.poll()
+            continue
+        if name == "load":
+            ed.on_loaded(job.result)
+        elif name == "lod":
+            ed.viewport.set_pyramid(job.result)
+            counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
+            ed.say(f"levels of detail ready ({counts} splats)")
+        elif name == "save":
+            ply, script, pos = job.result
+            ed.session.history.mark_saved(pos)
+            ed.saved_path, ed.saved_script = ply, script
+            ed.say(f"saved {ply} and {script.name}")
+        elif name == "export":
+            ed.saved_script = job.result
+            ed.say(f"edit script written to {job.result}")
+        elif name == "graph":
+            if ed.brush.tools.poll() and ed.brush.tools.closure_pending and ed.session is not None:
+                ed.brush.close_pending_selection()

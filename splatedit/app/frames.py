@@ -1,0 +1,186 @@
+"""Frame scheduling of the editor: when to draw a fast interactive frame,
+when the full-quality one (here, or in the background refiner for slow
+models), compositing the overlay and presenting; the frame-time
+bookkeeping that sizes the interactive budget."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+
+import numpy as np
+
+from splatedit.app import overlay as ov
+from splatedit.app import revision
+from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.tools.base import DragMode
+from splatedit.app.viewport import FrameInfo
+from splatedit.tolerances import EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_REFINE_DELAY_S
+
+
+@dataclass(frozen=True)
+class SceneKey:
+    """Everything a drawn scene depends on (equal keys: the frame is current).
+    Clouds and bases enter by revision (:mod:`splatedit.app.revision`), never by ``id()``."""
+    camera: tuple
+    size: tuple[int, int]
+    cloud_rev: int
+    sel_version: int
+    basis_rev: int
+    dc: bytes | None
+    display: tuple          # heat map, grey shading, splat scale
+
+
+class FrameScheduler:
+    def __init__(self, ed, budget_ms: float):
+        self.ed = ed
+        self.scene = None
+        self.scene_key: SceneKey | None = None
+        self.scene_interactive = False
+        self.refiner = None
+        self._refine_failed_key = None   # view whose background frame failed (not retried)
+        self.last_motion = 0.0
+        self.frame_ms = 0.0
+        self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
+        self._rendered_interactive = False
+        self.budget_ms = float(budget_ms)
+        self.frame_overhead_ms = 10.0
+        self.frames = 0
+        self._sel_version_seen = -1
+
+    def invalidate(self) -> None:
+        self.scene_key = None
+
+    def motion(self) -> None:
+        self.last_motion = time.perf_counter()
+
+    # ------------------------------------------------------------ document
+    def sync_document(self) -> None:
+        s, vp, ed = self.ed.session, self.ed.viewport, self.ed
+        if vp.cloud is not s.cloud:
+            vp.set_cloud(s.cloud)
+            ed.brush.picker = None
+        ed.brush.tools.prepare(s.cloud)
+        if self._sel_version_seen != s.version:
+            vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
+            self._sel_version_seen = s.version
+        if vp.basis is not s.basis:
+            vp.set_basis(s.basis)
+        vp.set_dc(s.current_dc() if s.basis is not None else None)
+
+    def state(self) -> SceneKey:
+        ed, s, vp = self.ed, self.ed.session, self.ed.viewport
+        dc = None if vp.dc is None else vp.dc.tobytes()
+        return SceneKey(ed.cam.state(), ed.size, revision.of(s.cloud), s.version, revision.of(s.basis), dc,
+                        (vp.distortion_map, vp.grey, vp.splat_scale))
+
+    def async_refine(self) -> bool:
+        """True when full-quality frames are slow enough to be drawn in the background."""
+        vp = self.ed.viewport
+        return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > EDITOR_ASYNC_REFINE_MS
+
+    def pending(self) -> bool:
+        """A frame must be drawn now (the scene is stale or still interactive)."""
+        s = self.ed.session
+        return (self.scene_key is None or self.ed.drag is not DragMode.NONE
+                or (self.scene_interactive and not (s is not None and self.async_refine()))
+                or (s is not None and self.scene_key != self.state()))
+
+    def busy(self) -> bool:
+        """Waiting for a background refinement (or its start)."""
+        s = self.ed.session
+        refining = self.refiner is not None and self.refiner.busy
+        return refining or (self.scene_interactive and s is not None and self.async_refine())
+
+    # --------------------------------------------------------------- draw
+    def draw(self) -> None:
+        ed = self.ed
+        w, h = ed.size
+        if w == 0 or h == 0 or ed.window.iconified():
+            return
+        t0 = time.perf_counter()
+        if ed.session is None:
+            frame = np.full((h, w, 4), 255, np.uint8)
+        else:
+            frame = self._scene_frame(w, h)
+        for p in ed.overlay_patches(w, h):
+            ov.blend(frame, p)
+        ed.presenter.present(frame)
+        self.frames += 1
+        self.frame_ms = (time.perf_counter() - t0) * 1e3
+        if self._rendered_interactive:
+            self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
+            # the frame budget is for the whole frame: leave room for overlay + present
+            vp = ed.viewport
+            extra = max(self.frame_ms - (vp.last_info.ms if vp.last_info else 0.0), 0.0)
+            self.frame_overhead_ms = 0.8 * self.frame_overhead_ms + 0.2 * extra
+            vp.budget_ms = max(self.budget_ms - self.frame_overhead_ms, 0.3 * self.budget_ms)
+        self._rendered_interactive = False
+
+    def _scene_frame(self, w: int, h: int) -> np.ndarray:
+        ed = self.ed
+        self.sync_document()
+        key = self.state()
+        now = time.perf_counter()
+        moving = now - self.last_motion < EDITOR_REFINE_DELAY_S or ed.drag is not DragMode.NONE
+        stale = self.scene is None or key != self.scene_key
+        if stale or (self.scene_interactive and not moving):
+            if not moving and self.async_refine():
+                # a slow full-quality frame: drawn by the background refiner, once the
+                # view has been still for a while (a started frame cannot be aborted)
+                if stale:
+                    self.render_scene(key, interactive=True)
+                if (self.scene_interactive and key != self._refine_failed_key
+                        and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S):
+                    self.request_refine(key)
+            else:
+                self.render_scene(key, interactive=moving)
+        if self.refiner is not None and self.refiner.error is not None:
+            # a failed full-quality frame is reported once and not retried for this view
+            failed_key, exc = self.refiner.error
+            ed.say(f"full-quality frame failed: {exc}")
+            self.refiner.error = None
+            self._refine_failed_key = failed_key
+        if self.refiner is not None and self.scene_interactive:
+            img = self.refiner.take(key)
+            if img is not None and img.shape[:2] == (h, w):
+                self.scene, self.scene_interactive = img, False
+                ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
+        frame = self.scene.copy()
+        if frame.shape[:2] != (h, w):
+            fr = np.full((h, w, 4), 255, np.uint8)
+            hh, ww = min(h, frame.shape[0]), min(w, frame.shape[1])
+            fr[:hh, :ww] = frame[:hh, :ww]
+            frame = fr
+        return frame
+
+    def render_scene(self, key, interactive: bool) -> None:
+        ed = self.ed
+        w, h = ed.size
+        self.scene = ed.viewport.render(ed.cam, w, h, interactive=interactive)
+        self._rendered_interactive = interactive
+        self.scene_key = key
+        info = ed.viewport.last_info
+        self.scene_interactive = bool(interactive and info is not None and (info.lod or info.div > 1))
+
+    def request_refine(self, key) -> None:
+        from splatedit.app.viewport import BackgroundRefiner
+        ed = self.ed
+        vp = ed.viewport
+        if self.refiner is None:
+            self.refiner = BackgroundRefiner(ed.wake, vp.budget_ms)
+        s = ed.session
+        w, h = ed.size
+        c = ed.cam
+        cam = OrbitCamera(np.array(c.target, float), c.distance, c.yaw, c.pitch, c.fov_deg,
+                          np.array(c.up_axis, float), c.scene_radius)
+        self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
+                                       handle=s.selection.handle.copy(), sel_version=s.version,
+                                       inactive=s.selection.others(), basis=s.basis, dc=vp.dc, camera=cam,
+                                       w=w, h=h, distortion_map=vp.distortion_map, grey=vp.grey,
+                                       splat_scale=vp.splat_scale, pick_key=ed.brush.pick_key()))
+
+    def close(self) -> None:
+        if self.refiner is not None:
+            self.refiner.close()
+            self.refiner = None

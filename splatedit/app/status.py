@@ -1,0 +1,102 @@
+"""The editor's status file (test hook, ``--status-file``): a JSON snapshot
+of what the window shows, rewritten atomically whenever it changes."""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import os
+
+import numpy as np
+
+
+def _r(v, nd=1):
+    return round(float(v), nd)
+
+
+def status_dict(ed) -> dict:
+    """The editor's state as plain JSON types."""
+    s = ed.session
+    cam = ed.cam
+    vp = ed.viewport
+    help_ = ed.help
+    st = {"loaded": s is not None, "frames_presented": ed.presenter.frames_presented,
+          "running": ed.running, "jobs": sorted(ed.jobs), "validation_messages": ed.validation_count,
+          "confirm_quit": ed.confirm_quit, "prompt": ed.prompt, "help": help_.shown,
+          "help_top": help_.top, "help_rows": help_.rows, "help_total": help_.total,
+          "help_box": None if help_.box is None or not help_.shown else
+          [help_.box.x, help_.box.y, help_.box.w, help_.box.h],
+          "panel_visible": ed.panel_visible and ed.panel_box is not None,
+          "window": list(ed.size), "panel_box": list(ed.panel_box) if ed.panel_box else [0, 0, 0, 0],
+          "camera": {"distance": round(cam.distance, 6), "yaw": round(cam.yaw, 6), "pitch": round(cam.pitch, 6),
+                     "target": [round(float(x), 6) for x in cam.target],
+                     "up": [round(float(x), 6) for x in cam.up_axis]},
+          "up_axis": ed.camera.up.label, "up_source": ed.camera.up.source.value,
+          "grey": bool(vp.grey), "splat_scale": round(float(vp.splat_scale), 4),
+          "moving_frame_ms_median": (round(float(np.median(ed.moving_frame_ms)), 1)
+                                     if ed.moving_frame_ms else None),
+          "interactive_frames": len(vp.interactive_frames_ms),
+          "interactive_ms_median": (round(float(np.median(vp.interactive_frames_ms[-30:])), 1)
+                                    if vp.interactive_frames_ms else None),
+          "last_render": {} if vp.last_info is None else
+          {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
+          "saved": str(ed.saved_path) if ed.saved_path else None,
+          "script": str(ed.saved_script) if ed.saved_script else None}
+    if s is None:
+        return st
+    ss = s.stats()
+    tools = ed.brush.tools
+    st.update(n=s.cloud.n, state=ss.state, support=ss.support, handle=ss.handle,
+              edits=len(s.edits), dirty=s.dirty, undo_position=s.history.position,
+              history=len(s.history), manip=None if s.manip is None else s.manip.mode,
+              readout=ed.gizmo.readout_text(),
+              brush=s.brush_target, fit_error=ss.error, handles=ss.handles,
+              active_handle=ss.active_handle, handle_sizes=list(ss.handle_sizes),
+              curve_points=ss.curve_points, curve_mode=s.curve_mode,
+              pose_pending=ss.pose_pending, columns=ss.columns,
+              basis_columns=None if s.basis is None else s.basis.n_columns,
+              brush_mode=tools.mode, closure_added=tools.last_added,
+              closure_highlight=tools.highlighted(s.cloud) is not None)
+    st["idle"] = bool(ed.idle())
+    w, h = ed.size
+    gz = ed.gizmo
+    if not (w and h):
+        st.update(gizmo=[], gizmo_rings=[], gizmo_scale=None, gizmo_box=None, curve_dots=[],
+                  handle_px=[None] * len(s.selection.handles))
+        return st
+    st["gizmo"] = [[k, *(_r(v) for v in (*p0, *p1))] for k, p0, p1 in gz.axes(w, h)]
+    back = cam.basis()[2]
+    st["gizmo_rings"] = [[k, *(_r(v) for v in q), round(abs(float(back[k])), 3)]
+                         for k, _ in gz.rings(w, h) for q in [gz.ring_grab_point(k, w, h)] if q is not None]
+    grip = gz.scale_circle(w, h)
+    st["gizmo_scale"] = None if grip is None else [_r(grip[0][0]), _r(grip[0][1]), grip[1]]
+    box = gz.box(w, h)
+    st["gizmo_box"] = None if box is None else [_r(v) for v in box]
+    st["curve_dots"] = [[_r(v) for v in q] for q in ed.curve.dots(w, h)]
+    hc = []
+    for k, hm in enumerate(s.selection.handles):
+        if hm.any():
+            px, _ = cam.project(s.handle_centroid(k), w, h)
+            hc.append([_r(px[0, 0]), _r(px[0, 1])])
+        else:
+            hc.append(None)
+    st["handle_px"] = hc
+    return st
+
+
+class StatusWriter:
+    """Writes :func:`status_dict` to ``path`` when it changed (atomically)."""
+
+    def __init__(self, path):
+        self.path = path
+        self._last = None
+
+    def write(self, ed) -> None:
+        if self.path is None:
+            return
+        text = json.dumps(status_dict(ed), sort_keys=True)
+        if text != self._last:
+            tmp = self.path.with_suffix(".tmp")
+            tmp.write_text(text)
+            os.replace(tmp, self.path)
+            self._last = text

@@ -1,0 +1,118 @@
+"""Camera tool: orbit / pan / dolly drags, zoom to the cursor, framing and
+the numpad views about the model's up axis."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from splatedit.app.keymap import Action, Section
+from splatedit.app.tools.base import DragMode, Tool
+from splatedit.model.orientation import UpAxis, detect_up_axis, next_up
+
+
+class CameraTool(Tool):
+    section = Section.CAMERA
+
+    def __init__(self, ed):
+        super().__init__(ed)
+        self.zoom_anchor = None          # (x, y, world point) kept while the cursor stays put
+        self.up = UpAxis(1, 1)
+
+    @property
+    def cam(self):
+        return self.ed.cam
+
+    def actions(self):
+        top = math.radians(89.0)
+        return {Action.FRAME_ALL: self.frame_all, Action.FRAME_SELECTION: self.frame_selection,
+                Action.VIEW_FRONT: lambda: self.view_preset(0.0, 0.0),
+                Action.VIEW_RIGHT: lambda: self.view_preset(math.pi / 2, 0.0),
+                Action.VIEW_TOP: lambda: self.view_preset(0.0, top),
+                Action.VIEW_BACK: lambda: self.view_preset(math.pi, 0.0),
+                Action.VIEW_LEFT: lambda: self.view_preset(-math.pi / 2, 0.0),
+                Action.VIEW_BOTTOM: lambda: self.view_preset(0.0, -top),
+                Action.CYCLE_UP_AXIS: self.cycle_up_axis}
+
+    # ----------------------------------------------------------- up axis
+    def detect_up(self, cloud, path) -> None:
+        """Set the up axis from the model (and the file's format)."""
+        self.set_up(detect_up_axis(cloud.normals, cloud.positions, path))
+
+    def set_up(self, up: UpAxis) -> None:
+        self.up = up
+        self.cam.up_axis = up.vector
+        self.ed.motion()
+
+    def cycle_up_axis(self) -> None:
+        self.set_up(next_up(self.up))
+        self.view_preset(self.cam.yaw, self.cam.pitch)
+        self.ed.say(f"up axis {self.up.label} (numpad 1 / 3 / 7 views turn about it)")
+
+    # ------------------------------------------------------------ framing
+    def frame_all(self) -> None:
+        s = self.session
+        if s is None:
+            return
+        w, h = self.ed.size
+        lo, hi = s.cloud.bounds()
+        self.cam.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / max(h, 1))
+        self.ed.motion()
+
+    def frame_selection(self) -> None:
+        s = self.session
+        if s is None:
+            return
+        m = s.selection.handle if s.selection.handle.any() else s.selection.support
+        if not m.any():
+            self.frame_all()
+            return
+        w, h = self.ed.size
+        self.cam.frame_points(s.cloud.positions[m], w / max(h, 1))
+        self.ed.motion()
+
+    def view_preset(self, yaw: float, pitch: float) -> None:
+        self.cam.yaw, self.cam.pitch = yaw, pitch
+        self.ed.motion()
+
+    # -------------------------------------------------------------- mouse
+    def press(self, e):
+        g = self.ed.g
+        alt = bool(e.mods & g.MOD_ALT)
+        if e.button == g.MOUSE_BUTTON_MIDDLE or (e.button == g.MOUSE_BUTTON_LEFT and alt):
+            if e.mods & g.MOD_SHIFT:
+                return DragMode.PAN
+            return DragMode.DOLLY if (e.mods & g.MOD_CONTROL) and not alt else DragMode.ORBIT
+        return None
+
+    def drag(self, mode, x, y, dx, dy, last):
+        if mode is DragMode.ORBIT:
+            self.cam.orbit(dx, dy)
+        elif mode is DragMode.PAN:
+            self.cam.pan(dx, dy, self.ed.size[1])
+        elif mode is DragMode.DOLLY:
+            self.cam.dolly(-dy / 20.0)
+        else:
+            return
+        self.ed.motion()
+
+    def scroll(self, e) -> None:
+        """Wheel: zoom to the surface point under the cursor (picked once, when
+        this view's pick map is at hand, then kept while the cursor stays put)."""
+        ed = self.ed
+        w, h = ed.size
+        anchor = self.zoom_anchor
+        if anchor is None or abs(anchor[0] - e.x) > 2 or abs(anchor[1] - e.y) > 2:
+            point = None
+            if ed.brush.picker_current() and ed.drag is DragMode.NONE:
+                i = ed.brush.splat_under(e.x, e.y)
+                if i >= 0:
+                    point = self.session.cloud.positions[i].copy()
+            if point is None:
+                point = self.cam.point_at_depth(e.x, e.y, w, h, self.cam.distance)
+            anchor = self.zoom_anchor = (e.x, e.y, point)
+        _, d = self.cam.project(anchor[2], w, h)
+        depth = float(d[0]) if d[0] > 0 else None
+        self.cam.dolly(e.dy, e.x, e.y, w, h, depth)
+        ed.motion()

@@ -1,0 +1,127 @@
+"""Which world axis is "up" for a model (for the editor's numpad views).
+
+Scans are often Z-up (scanner and GIS formats, many photogrammetry tools)
+while meshes from graphics tools are Y-up.  :func:`detect_up_axis` decides
+from, in order:
+
+1. the file: a PLY header comment naming the up axis (``comment up_axis
+   Z``, ``comment Z-up``, ``comment up: -y`` ...: :func:`header_up_hint`),
+   else the format: LAS/LAZ and E57 are defined in a Z-up frame
+   (georeferenced / scanner coordinates) -> +Z;
+2. a ground signal in the model: when one axis carries a clear majority of
+   the axis-aligned normals (floors, terrain, a scan's flat underside) and
+   the model is not tallest along it, that axis, signed by the side most of
+   those normals face;
+3. otherwise +Y (the graphics convention of PLY / OFF / OBJ meshes: the
+   Stanford models, the bundled bunny).
+"""
+
+from __future__ import annotations
+
+import enum
+import re
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from splatedit.tolerances import UP_AXIS_ALIGNED_COS, UP_AXIS_GROUND_DOMINANCE, UP_AXIS_GROUND_MIN_FRACTION
+
+#: the formats whose coordinates are Z-up by definition
+Z_UP_SUFFIXES = (".las", ".laz", ".e57")
+
+
+class UpSource(enum.Enum):
+    FILE_HEADER = "file header"
+    FILE_FORMAT = "file format"
+    GROUND = "ground normals"
+    DEFAULT = "default"
+    USER = "set by the user"
+
+
+@dataclass(frozen=True)
+class UpAxis:
+    """A signed world axis: ``axis`` 0/1/2 (X/Y/Z), ``sign`` +1/-1."""
+    axis: int
+    sign: int
+    source: UpSource = UpSource.DEFAULT
+
+    @property
+    def vector(self) -> np.ndarray:
+        """(3,) float64 unit vector."""
+        v = np.zeros(3)
+        v[self.axis] = float(self.sign)
+        return v
+
+    @property
+    def label(self) -> str:
+        return ("+" if self.sign > 0 else "-") + "XYZ"[self.axis]
+
+
+#: the order U cycles through
+CYCLE = ((1, 1), (2, 1), (0, 1), (1, -1), (2, -1), (0, -1))
+
+
+def next_up(current: UpAxis) -> UpAxis:
+    """The up axis after ``current`` in :data:`CYCLE` (set by the user)."""
+    i = CYCLE.index((current.axis, current.sign)) if (current.axis, current.sign) in CYCLE else -1
+    a, s = CYCLE[(i + 1) % len(CYCLE)]
+    return UpAxis(a, s, UpSource.USER)
+
+
+#: "up_axis Z", "up: -y", "upaxis=+Z"  /  "Z-up", "z_up", "+Y up"
+_UP_FIRST = re.compile(r"\bup[ _-]?(?:axis|vector|direction)?\s*[:= ]\s*([+-]?)([xyz])\b", re.I)
+_AXIS_FIRST = re.compile(r"(?<![\w+-])([+-]?)([xyz])[ _-]?up\b", re.I)
+#: a PLY header is read up to this many bytes (end_header comes much earlier)
+_HEADER_BYTES = 65536
+
+
+def header_up_hint(path) -> UpAxis | None:
+    """The up axis a PLY file's header comments name, or None (not a PLY,
+    unreadable, or no such comment)."""
+    p = Path(path)
+    if p.suffix.lower() != ".ply":
+        return None
+    try:
+        with open(p, "rb") as f:
+            head = f.read(_HEADER_BYTES)
+    except OSError:
+        return None
+    text = head.split(b"end_header", 1)[0].decode("ascii", "replace")
+    for line in text.splitlines():
+        words = line.split(None, 1)
+        if len(words) < 2 or words[0] not in ("comment", "obj_info"):
+            continue
+        m = _UP_FIRST.search(words[1]) or _AXIS_FIRST.search(words[1])
+        if m:
+            return UpAxis("xyz".index(m.group(2).lower()), -1 if m.group(1) == "-" else 1, UpSource.FILE_HEADER)
+    return None
+
+
+def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpAxis:
+    """The up axis of a model.
+
+    Args:
+        normals: (n, 3) float64 unit normals (zero rows allowed).
+        positions: (n, 3) float64, model units.
+        path: the file the model came from (its suffix is a hint), or None.
+    """
+    if path is not None:
+        hint = header_up_hint(path)
+        if hint is not None:
+            return hint
+        if Path(path).suffix.lower() in Z_UP_SUFFIXES:
+            return UpAxis(2, 1, UpSource.FILE_FORMAT)
+    n = np.asarray(normals, float)
+    p = np.asarray(positions, float)
+    if len(n) and len(p):
+        aligned = np.abs(n) >= UP_AXIS_ALIGNED_COS             # (n, 3)
+        frac = aligned.mean(axis=0)
+        k = int(np.argmax(frac))
+        others = np.delete(frac, k)
+        extent = p.max(0) - p.min(0)
+        if (frac[k] >= UP_AXIS_GROUND_MIN_FRACTION and frac[k] >= UP_AXIS_GROUND_DOMINANCE * others.max()
+                and extent[k] < extent.max()):
+            sign = 1 if float(np.sign(n[aligned[:, k], k]).sum()) >= 0 else -1
+            return UpAxis(k, sign, UpSource.GROUND)
+    return UpAxis(1, 1, UpSource.DEFAULT)

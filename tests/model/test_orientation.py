@@ -1,0 +1,82 @@
+"""Up-axis detection for the editor's numpad views: file-format hints, the
+ground signal of a scan resting on a flat side, the graphics default."""
+
+from __future__ import annotations
+
+import numpy as np
+
+from splatedit.model.orientation import CYCLE, UpAxis, UpSource, detect_up_axis, next_up
+
+
+def _read(path):
+    from splatedit.io import read
+    return read(str(path))
+
+
+def test_bundled_bunny_is_y_up():
+    from splatedit.data import default_model_path
+    c = _read(default_model_path())
+    up = detect_up_axis(c.normals, c.positions, default_model_path())
+    assert (up.axis, up.sign, up.source) == (1, 1, UpSource.DEFAULT)
+
+
+def test_hippo_scan_resting_on_its_underside_is_z_up(shared_data):
+    c = _read(shared_data / "hippo1.ply")
+    up = detect_up_axis(c.normals, c.positions, shared_data / "hippo1.ply")
+    assert (up.label, up.source) == ("+Z", UpSource.GROUND)
+
+
+def test_shared_object_scans_without_a_ground_keep_y_up(shared_data):
+    for name in ("kitten.xyz", "bunny00.off"):
+        c = _read(shared_data / name)
+        assert detect_up_axis(c.normals, c.positions, shared_data / name).label == "+Y", name
+
+
+def test_scanner_formats_are_z_up_whatever_the_points():
+    rng = np.random.default_rng(0)
+    p = rng.normal(size=(500, 3))
+    n = p / np.linalg.norm(p, axis=1, keepdims=True)
+    for suffix in (".las", ".LAZ", ".e57"):
+        up = detect_up_axis(n, p, f"/scans/room{suffix}")
+        assert (up.label, up.source) == ("+Z", UpSource.FILE_FORMAT)
+    assert detect_up_axis(n, p, "/scans/room.ply").label == "+Y"
+
+
+def test_a_floor_facing_down_the_y_axis_gives_minus_y():
+    rng = np.random.default_rng(1)
+    floor = np.c_[rng.uniform(-5, 5, 3000), np.zeros(3000), rng.uniform(-5, 5, 3000)]
+    wall = np.c_[rng.uniform(-5, 5, 1000), rng.uniform(-3, 0, 1000), np.full(1000, 5.0)]
+    p = np.vstack([floor, wall])
+    n = np.vstack([np.tile([0.0, -1.0, 0.0], (3000, 1)), np.tile([0.0, 0.0, -1.0], (1000, 1))])
+    up = detect_up_axis(n, p)
+    assert (up.axis, up.sign, up.source) == (1, -1, UpSource.GROUND)
+
+
+def test_u_cycles_through_all_six_signed_axes():
+    up, seen = UpAxis(1, 1), []
+    for _ in range(len(CYCLE)):
+        up = next_up(up)
+        seen.append(up.label)
+        assert up.source is UpSource.USER and np.isclose(np.abs(up.vector).sum(), 1.0)
+    assert sorted(seen) == sorted(["+X", "+Y", "+Z", "-X", "-Y", "-Z"])
+
+
+def test_a_ply_header_comment_names_the_up_axis(tmp_path):
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    from splatedit.io.ply import write_ply
+    from splatedit.model.orientation import header_up_hint
+
+    def write(path, cloud, overwrite, comment):
+        with open(path, "wb") as fh:
+            write_ply(fh, cloud, comment=comment)
+    c = read(str(default_model_path()))
+    for comment, label in (("up_axis Z", "+Z"), ("scanned Z-up, metres", "+Z"), ("up: -y", "-Y"),
+                           ("upaxis=+X", "+X")):
+        p = tmp_path / "m.ply"
+        write(p, c, True, comment)
+        up = detect_up_axis(c.normals, c.positions, p)
+        assert (up.label, up.source) == (label, UpSource.FILE_HEADER), comment
+    write(p, c, True, "made by splatedit; backup copy")   # "backup" is no hint
+    assert header_up_hint(p) is None
+    assert detect_up_axis(c.normals, c.positions, p).source is UpSource.DEFAULT
