@@ -136,6 +136,9 @@ class GraphicsDesc:
     depth_write: bool = False
     depth_compare: str = "less"
     blend_add: tuple[bool, ...] = ()            # per colour attachment: additive (ONE, ONE)
+    #: per colour attachment: front-to-back "under" of premultiplied colour
+    #: (src ONE_MINUS_DST_ALPHA, dst ONE; Gaussian splatting)
+    blend_under: tuple[bool, ...] = ()
     color_write: bool = True
     spec: tuple[tuple[int, int], ...] = ()      # (constant_id, int32 value), both stages
 
@@ -481,11 +484,13 @@ class PipelineCache:
         blends = []
         for i in range(len(d.render_pass.colors)):
             add = d.blend_add[i] if i < len(d.blend_add) else False
+            under = d.blend_under[i] if i < len(d.blend_under) else False
+            src = vk.VK_BLEND_FACTOR_ONE_MINUS_DST_ALPHA if under else vk.VK_BLEND_FACTOR_ONE
             blends.append(vk.VkPipelineColorBlendAttachmentState(
-                blendEnable=vk.VK_TRUE if add else vk.VK_FALSE,
-                srcColorBlendFactor=vk.VK_BLEND_FACTOR_ONE, dstColorBlendFactor=vk.VK_BLEND_FACTOR_ONE,
+                blendEnable=vk.VK_TRUE if add or under else vk.VK_FALSE,
+                srcColorBlendFactor=src, dstColorBlendFactor=vk.VK_BLEND_FACTOR_ONE,
                 colorBlendOp=vk.VK_BLEND_OP_ADD,
-                srcAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE, dstAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE,
+                srcAlphaBlendFactor=src, dstAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE,
                 alphaBlendOp=vk.VK_BLEND_OP_ADD, colorWriteMask=rgba if d.color_write else 0))
         cb = vk.VkPipelineColorBlendStateCreateInfo(attachmentCount=len(blends), pAttachments=blends or None)
         dyn_states = [vk.VK_DYNAMIC_STATE_VIEWPORT, vk.VK_DYNAMIC_STATE_SCISSOR]
