@@ -11,6 +11,8 @@ layout(std140, set = 0, binding = 0) uniform GsFrame {
     vec4 params;        // alpha ceiling, pick min opacity, pick sigmas^2, near cull distance
     vec4 background;    // rgb (display values), -
     uvec4 counts;       // n, uints of SH bands 1-3 per Gaussian, sort length (power of 2), sRGB target
+    vec4 tint_support;  // rgb, strength (the splat renderer's selection tints)
+    vec4 tint_handle;   // rgb, strength
 } F;
 
 // 16 floats per Gaussian: centre (3), opacity (1), covariance xx xy xz yy yz zz (6), SH DC rgb (3), pad (3)
@@ -27,5 +29,8 @@ layout(std430, set = 0, binding = 5) buffer GsRec { vec4 rec[]; };
 layout(std430, set = 0, binding = 6) buffer GsKeys { uint keys[]; };    // view depth bits, 0xFFFFFFFF culled
 layout(std430, set = 0, binding = 7) buffer GsOrder { uint order[]; };  // draw order (front to back)
 layout(std430, set = 0, binding = 8) buffer GsDraws { uint draws[4]; }; // VkDrawIndirectCommand
+
+// selection flags per Gaussian (renderer.py FLAG_SUPPORT, FLAG_HANDLE, FLAG_INACTIVE)
+layout(std430, set = 0, binding = 11) readonly buffer GsFlags { uint gflags[]; };
 
 const uint GS_NONE = 0xFFFFFFFFu;

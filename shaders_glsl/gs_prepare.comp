@@ -132,6 +132,10 @@ void main() {
                     vec3 d = normalize(p - F.eye.xyz);
                     if (deformed) d = transpose(R) * d;
                     vec3 col = sh_color(i, dc, d, int(F.eye.w));
+                    uint fl = gflags[i];
+                    if ((fl & 1u) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
+                    if ((fl & 2u) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
+                    if ((fl & 8u) != 0u) col *= 0.35;
                     float far = F.viewport.w, near = F.viewport.z;
                     float zn = far * (z - near) / (z * (far - near));
                     rec[4u * i] = vec4(c, zn, op);

@@ -45,9 +45,9 @@ from splatedit.render.camera import Camera
 from splatedit.render.renderer import RenderTarget, _unit_scale
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
-                                  RENDER_MAX_BASIS_COLUMNS)
+                                  RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
 
-_UBO_BYTES = 176
+_UBO_BYTES = 208
 _GEOM_FLOATS = 16
 _REC_BYTES = 64
 _MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
@@ -62,7 +62,8 @@ _NONE = 0xFFFFFFFF
 _GS_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
            V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
            V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "comp"),
-           V.Binding(7, "storage", "vert|comp"), V.Binding(8, "storage", "comp"), V.Binding(9, "uniform", "comp"))
+           V.Binding(7, "storage", "vert|comp"), V.Binding(8, "storage", "comp"), V.Binding(9, "uniform", "comp"),
+           V.Binding(11, "storage", "comp"))
 _RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(10, "sampled", "frag"))
 _RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
                             depth=V.Attachment("d32f", "clear", final="transfer_src"))
@@ -180,6 +181,8 @@ class GaussianRenderer:
         self._near_far = (1.0, 2.0)
         self._n_visible = 0
         self.last_timings_ms: dict[str, float] = {}
+        #: accepted for the editor's viewport; the heat map is not drawn for Gaussians
+        self.distortion_map = False
         try:
             self.cache = V.PipelineCache(self.dev)
             self.sampler = V.Sampler(self.dev)
@@ -282,6 +285,8 @@ class GaussianRenderer:
         self._rest = self._buf(max(rest.nbytes, 4), ("storage",))
         if rest.nbytes:
             self._rest.upload(rest.view(np.uint32))
+        self._flags = self._buf(4 * n, ("storage",), host_visible=True)
+        self._flags.view(np.uint32)[:] = 0
         self._brow = self._buf(4 * n, ("storage",), host_visible=True)
         self._brow.view(np.uint32)[:] = _NONE
         self._rec = self._buf(n * _REC_BYTES)
@@ -301,7 +306,31 @@ class GaussianRenderer:
             self._bufs.append(self._dset)
         basis = self._basis_buf if self._basis_buf is not None else self._dummy_basis
         self._dset.write({0: self.ubo, 1: self._geom, 2: self._rest, 3: self._brow, 4: basis, 5: self._rec,
-                          6: self._keys, 7: self._order, 8: self._draws, 9: self.dC_ubo})
+                          6: self._keys, 7: self._order, 8: self._draws, 9: self.dC_ubo, 11: self._flags})
+
+    def set_cloud(self, cloud: GaussianCloud) -> None:
+        """:meth:`set_gaussians` under the splat renderer's name (the editor's viewport calls it)."""
+        self.set_gaussians(cloud)
+
+    def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
+        """Tint the support (blue) and handle (green) Gaussians as the splat
+        renderer does; boolean masks (n,) or index arrays; None clears."""
+        self._check()
+        flags = np.zeros(self.n, np.uint32)
+        for name, m, bit in (("support_mask", support_mask, 1), ("handle_mask", handle_mask, 2),
+                             ("inactive_mask", inactive_mask, 2 | 8)):
+            if m is None:
+                continue
+            a = np.asarray(m)
+            if a.dtype == bool:
+                if a.shape != (self.n,):
+                    raise ParameterError(name, f"boolean mask must have shape ({self.n},), got {a.shape}")
+                a = np.nonzero(a)[0]
+            a = a.astype(np.int64).reshape(-1)
+            if len(a) and (a.min() < 0 or a.max() >= self.n):
+                raise ParameterError(name, f"indices must be in 0..{self.n - 1}")
+            flags[a] |= np.uint32(bit)
+        self._flags.view(np.uint32)[:] = flags
 
     # --------------------------------------------------------- deformation
     def set_basis(self, indices, B, Bx, By, Bz) -> None:
@@ -402,6 +431,8 @@ class GaussianRenderer:
         u[36:40] = (*self.background, 1.0)
         u[40:44].view(np.uint32)[:] = (self.n, self._rest_uints, self._n2 if self.sort == "gpu" else self.n,
                                        1 if srgb_target else 0)
+        u[44:48] = RENDER_TINT_SUPPORT
+        u[48:52] = RENDER_TINT_HANDLE
         self.ubo.write(u)
         pad = np.zeros((4 * _MAX_GROUPS, 3))
         pad[:len(self._dC)] = self._dC / sc
