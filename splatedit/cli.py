@@ -324,7 +324,12 @@ def _fresh_directory(base: Path) -> Path:
 
 def cmd_bench(args) -> int:
     from splatedit.bench.runner import run_bench
-    for line in run_bench(args.what, quick=args.quick, progress=args.progress):
+    what = args.what
+    if args.gaussians:
+        if what != "render":
+            raise ParameterError("--gaussians", f"applies to 'bench render', not 'bench {what}'")
+        what = "gaussians"
+    for line in run_bench(what, quick=args.quick, progress=args.progress):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -397,6 +402,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
     s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
+    s.add_argument("--gaussians", action="store_true",
+                   help="with 'render': the Gaussian splatting renderer (100k and 1M Gaussians, both sorts)")
     s.set_defaults(func=cmd_bench)
     return p
 

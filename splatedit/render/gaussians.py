@@ -485,18 +485,24 @@ class GaussianRenderer:
             cb.reset_queries(self._query)
             cb.timestamp(self._query, 0, bottom=False)
             self._record_prepass(cb)
+            # the barrier first: lavapipe writes a timestamp without waiting for a
+            # dispatch still running (the pass measured ~0 ms without it)
+            cb.memory_barrier("compute", "shader_write", "compute|host", "shader_read|shader_write|host_read")
             cb.timestamp(self._query, 1)
             if self.sort == "gpu":
                 self._record_gpu_sort(cb)
+                cb.memory_barrier("compute", "shader_write", "compute", "shader_read")
                 cb.timestamp(self._query, 2)
-            else:
-                cb.memory_barrier("compute", "shader_write", "host", "host_read")
         self.dev.submit(rec)
         ts = self._query.results_ns(3 if self.sort == "gpu" else 2)
-        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6}
+        # lavapipe's timestamps around a lone dispatch read ~0 after the first
+        # frame: the CPU-sort path reports the pre-pass submission's wall time
+        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6 if self.sort == "gpu"
+                   else (time.perf_counter() - t0) * 1e3}
         nvis = int(dv[1])
         if self.sort == "gpu":
             timings["sort"] = float(ts[2] - ts[1]) * 1e-6
+            timings["prepass"] = max((time.perf_counter() - t0) * 1e3 - timings["sort"], 0.0)
         else:
             t1 = time.perf_counter()
             keys = self._keys.view(np.uint32)[:self.n]
