@@ -43,96 +43,13 @@ from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import RenderTarget, _unit_scale
+from splatedit.render.gs_resources import (_DEFORM_UBO_BYTES, _GS_SET, _MAX_GROUPS, _MAX_SIZE, _NONE, _PREP_WG,
+                                           _REC_BYTES, _RESOLVE_SET, _RP_PICK, _SORT_WG, _UBO_BYTES, SORTS, _rp_accum,
+                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_geometry,
+                                           selection_flags)
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
-
-_UBO_BYTES = 208
-_GEOM_FLOATS = 16
-_REC_BYTES = 64
-_MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
-_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS
-_MAX_SIZE = 16384
-_PREP_WG = 64
-_SORT_WG = 256
-_NONE = 0xFFFFFFFF
-#: set 0 of the pre-pass, the sort and the draws: frame UBO, geometry, SH
-#: bands 1-3, basis row per Gaussian, basis rows, records, keys, order,
-#: indirect draw, deformation UBO (shaders_glsl/gs_common.glsl)
-_GS_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
-           V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
-           V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "comp"),
-           V.Binding(7, "storage", "vert|comp"), V.Binding(8, "storage", "comp"), V.Binding(9, "uniform", "comp"),
-           V.Binding(11, "storage", "comp"))
-_RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(10, "sampled", "frag"))
-_RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
-                            depth=V.Attachment("d32f", "clear", final="transfer_src"))
-SORTS = ("cpu", "gpu")
-
-
-def _rp_accum(fmt: str) -> V.RenderPassDesc:
-    return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final="shader_read"),))
-
-
-def _rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
-    return V.RenderPassDesc(colors=(V.Attachment(target.format, "dont_care", final=target.final),))
-
-
-def gaussian_bounds(cloud: GaussianCloud, sigmas: float = 3.0) -> tuple[np.ndarray, np.ndarray]:
-    """Box (lo, hi), each (3,) float64, of the centres grown by ``sigmas``
-    times each Gaussian's largest standard deviation (model units)."""
-    r = sigmas * cloud.scales().max(axis=1)
-    p = cloud.positions
-    return (p - r[:, None]).min(axis=0), (p + r[:, None]).max(axis=0)
-
-
-class _Targets:
-    """Per-size images: the RGBA accumulator, pick index + depth, framebuffers."""
-
-    def __init__(self, r: "GaussianRenderer", width: int, height: int):
-        self.width, self.height = width, height
-        self.objects = []
-        self.target_fbs = {}
-        self._r = r
-        try:
-            dev = r.dev
-            self.accum = self._add(V.Image(dev, width, height, r.accum_format, ("color", "sampled")))
-            self.fb_accum = self._add(V.Framebuffer(dev, r.cache.render_pass(_rp_accum(r.accum_format)),
-                                                    [self.accum], width, height))
-            self.out = self._add(V.Image(dev, width, height, "rgba8", ("color", "transfer_src")))
-            self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
-            self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET)))
-            self.resolve_set.write({0: r.ubo, 10: (self.accum, r.sampler)})
-            self.fb_pick = None
-        except BaseException:
-            self.destroy()
-            raise
-
-    def _add(self, obj):
-        self.objects.append(obj)
-        return obj
-
-    def target_fb(self, target: RenderTarget):
-        hit = self.target_fbs.get(id(target))
-        if hit is None or hit[0] is not target:
-            rp = self._r.cache.render_pass(_rp_resolve(target))
-            fb = self._add(V.Framebuffer(self._r.dev, rp, [target.attachment], self.width, self.height))
-            hit = self.target_fbs[id(target)] = (target, fb)
-        return hit[1]
-
-    def ensure_pick(self):
-        if self.fb_pick is None:
-            dev = self._r.dev
-            self.pick_index = self._add(V.Image(dev, self.width, self.height, "r32ui", ("color", "transfer_src")))
-            self.pick_depth = self._add(V.Image(dev, self.width, self.height, "d32f", ("depth", "transfer_src")))
-            self.fb_pick = self._add(V.Framebuffer(dev, self._r.cache.render_pass(_RP_PICK),
-                                                   [self.pick_index, self.pick_depth], self.width, self.height))
-
-    def destroy(self):
-        for o in reversed(self.objects):
-            o.destroy()
-        self.objects.clear()
-        self.target_fbs.clear()
 
 
 class GaussianRenderer:
@@ -268,23 +185,15 @@ class GaussianRenderer:
         self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), 0.0)
         self.bounds = (lo, hi)
         self._sigma_max = cloud.scales().max(axis=1)
-        geom = np.zeros((n, _GEOM_FLOATS), np.float32)
-        geom[:, 0:3] = (cloud.positions - self.origin) / self.scale
-        geom[:, 3] = cloud.opacities()
-        c = cloud.covariances() / (self.scale * self.scale)
-        geom[:, 4:10] = c[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
-        geom[:, 10:13] = cloud.sh[:, 0, :]
-        rest = np.ascontiguousarray(cloud.sh[:, 1:, :], np.float32).reshape(n, -1).astype(np.float16)
-        if rest.shape[1] % 2:
-            rest = np.concatenate([rest, np.zeros((n, 1), np.float16)], axis=1)
-        self._rest_uints = rest.shape[1] // 2
+        geom, rest = pack_geometry(cloud, self.origin, self.scale)
+        self._rest_uints = rest.shape[1]
         self.degree = cloud.sh_degree
         self._n2 = n2
         self._geom = self._buf(geom.nbytes, ("storage",))
         self._geom.upload(geom)
         self._rest = self._buf(max(rest.nbytes, 4), ("storage",))
         if rest.nbytes:
-            self._rest.upload(rest.view(np.uint32))
+            self._rest.upload(rest)
         self._flags = self._buf(4 * n, ("storage",), host_visible=True)
         self._flags.view(np.uint32)[:] = 0
         self._brow = self._buf(4 * n, ("storage",), host_visible=True)
@@ -316,20 +225,7 @@ class GaussianRenderer:
         """Tint the support (blue) and handle (green) Gaussians as the splat
         renderer does; boolean masks (n,) or index arrays; None clears."""
         self._check()
-        flags = np.zeros(self.n, np.uint32)
-        for name, m, bit in (("support_mask", support_mask, 1), ("handle_mask", handle_mask, 2),
-                             ("inactive_mask", inactive_mask, 2 | 8)):
-            if m is None:
-                continue
-            a = np.asarray(m)
-            if a.dtype == bool:
-                if a.shape != (self.n,):
-                    raise ParameterError(name, f"boolean mask must have shape ({self.n},), got {a.shape}")
-                a = np.nonzero(a)[0]
-            a = a.astype(np.int64).reshape(-1)
-            if len(a) and (a.min() < 0 or a.max() >= self.n):
-                raise ParameterError(name, f"indices must be in 0..{self.n - 1}")
-            flags[a] |= np.uint32(bit)
+        flags = selection_flags(self.n, support_mask, handle_mask, inactive_mask)
         self._flags.view(np.uint32)[:] = flags
 
     # --------------------------------------------------------- deformation
@@ -352,11 +248,7 @@ class GaussianRenderer:
         if len(idx) and (idx.min() < 0 or idx.max() >= self.n or len(np.unique(idx)) != len(idx)):
             raise ParameterError("indices", f"must be distinct and in 0..{self.n - 1}")
         g = (k + 3) // 4
-        rows = np.zeros((max(len(idx), 1), g, 4, 4), np.float32)
-        for j, a in enumerate([mats[0]] + [m * self.scale for m in mats[1:]]):
-            padded = np.zeros((len(idx), 4 * g))
-            padded[:, :k] = a
-            rows[:len(idx), :, j, :] = padded.reshape(len(idx), g, 4)
+        rows = pack_basis_rows(mats, self.scale)
         if rows.nbytes > int(self.dev.limits.maxStorageBufferRange):
             raise ParameterError("indices", f"{len(idx)} deformed Gaussians with {k} columns exceed the "
                                             "device's storage-buffer range")
