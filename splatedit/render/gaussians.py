@@ -399,7 +399,9 @@ class GaussianRenderer:
             t1 = time.perf_counter()
             keys = self._keys.view(np.uint32)[:self.n]
             # positive float32 depths sort as their bit patterns; culled keys are 0xFFFFFFFF (last)
-            order = np.argsort(keys, kind="stable")[:nvis].astype(np.uint32)
+            # (numpy's default introsort: SIMD-vectorised, 6-10x faster than kind="stable"
+            # on 1M random uint32 keys, 23 vs 136-230 ms; equal depths are left in any order)
+            order = np.argsort(keys)[:nvis].astype(np.uint32)
             self._order.view(np.uint32)[:nvis] = order
             timings["sort"] = (time.perf_counter() - t1) * 1e3
         timings["prepare_wall"] = (time.perf_counter() - t0) * 1e3
