@@ -260,3 +260,18 @@ def test_2dgs_surfels_match_reference(gs):
         ref = render_reference(g, cam, W, H)
         assert coverage(ref) > 0.1
         assert_close(gs.render(cam, W, H), ref, f"2DGS, view {direction}")
+
+
+def test_close_destroys_every_vulkan_object(bunny_gaussians):
+    from splatedit.render.vk import live_handles
+    before = live_handles()
+    r = GaussianRenderer(sort="gpu")
+    r.set_gaussians(bunny_gaussians)
+    cam = view(bunny_gaussians, VIEWS[0])
+    r.render(cam, W, H)
+    r.pick(cam, W, H)
+    r.set_basis([0, 1], *(np.ones((2, 5)),) * 4)
+    r.render(cam, 40, 30)                 # a second size: targets are replaced
+    r.close()
+    r.close()                             # idempotent
+    assert live_handles() == before
