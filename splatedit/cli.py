@@ -268,7 +268,6 @@ def _camera_from_args(args, cloud):
 
 
 def cmd_render(args) -> int:
-    from splatedit.io import read
     from splatedit.io.atomic import check_writable_target
     from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
@@ -277,7 +276,10 @@ def cmd_render(args) -> int:
     for target in (args.output, args.buffers):
         if target is not None:
             check_writable_target(target, overwrite=args.force, protect=args.input)
-    cloud = read(args.input, progress=args.progress)
+    cloud = _read_model(args.input, args.progress)
+    from splatedit.model.gaussians import GaussianCloud
+    if isinstance(cloud, GaussianCloud):
+        return _render_gaussians(args, cloud)
     camera = _camera_from_args(args, cloud)
     basis_rows = d_c = None
     if args.edit is not None:
@@ -287,6 +289,38 @@ def cmd_render(args) -> int:
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
+    return 0
+
+
+def _read_model(path, progress):
+    """The model loader of ``splatedit render``: a GaussianCloud for a
+    Gaussian Splatting scene (rendered by the Gaussian renderer), else a
+    SplatCloud."""
+    from splatedit.io import is_gaussian_file, read, read_gaussians
+    if is_gaussian_file(path):
+        return read_gaussians(path, progress=progress)
+    return read(path, progress=progress)
+
+
+def _render_gaussians(args, cloud) -> int:
+    """``splatedit render`` of a GaussianCloud: camera flags as for splats, an
+    edit script's single edit fitted on the Gaussians' splat proxy and applied
+    on the GPU (centres, covariances, SH frames)."""
+    from splatedit.render.gs_headless import render_gaussians_to_png, splat_proxy
+    if args.buffers is not None:
+        raise ParameterError("--buffers", "is not available for Gaussian splatting scenes")
+    proxy = splat_proxy(cloud)
+    camera = _camera_from_args(args, proxy)
+    basis_rows = d_c = None
+    if args.edit is not None:
+        from splatedit.script import load_script
+        if len(load_script(args.edit).edits) != 1:
+            raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
+                                           "(chained edits need the Gaussian CPU deformation)")
+        _, basis_rows, d_c = _gpu_edit(args, proxy)
+    render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c)
+    print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {len(cloud)} Gaussians, SH degree "
+          f"{cloud.sh_degree}" + (", deformed on the GPU" if basis_rows is not None else "") + ")")
     return 0
 
 
@@ -362,7 +396,12 @@ def _fresh_directory(base: Path) -> Path:
 
 def cmd_bench(args) -> int:
     from splatedit.bench.runner import run_bench
-    for line in run_bench(args.what, quick=args.quick, progress=args.progress):
+    what = args.what
+    if args.gaussians:
+        if what != "render":
+            raise ParameterError("--gaussians", f"applies to 'bench render', not 'bench {what}'")
+        what = "gaussians"
+    for line in run_bench(what, quick=args.quick, progress=args.progress):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -439,6 +478,8 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
     s.add_argument("what", choices=(*BENCH_NAMES, "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
+    s.add_argument("--gaussians", action="store_true",
+                   help="with 'render': the Gaussian splatting renderer (100k and 1M Gaussians, both sorts)")
     s.set_defaults(func=cmd_bench)
     return p
 

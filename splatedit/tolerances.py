@@ -585,3 +585,50 @@ EDITOR_HELP_PAGE_OVERLAP = 2
 #: + 0.25 = 0.735), so highlights do not clip, and a grazing one (ambient
 #: only, 0.1 linear) still reads against the white background
 RENDER_GREY_ALBEDO = 0.72
+# --- Gaussian splatting rendering (issue 13, part 2) ------------------------
+#: screen-space low-pass dilation added to every projected 2D covariance
+#: (pixels^2): the 3DGS reference implementation's 0.3 (Kerbl et al. 2023),
+#: which keeps sub-pixel Gaussians at least ~0.55 px wide (anti-aliasing)
+GS_LOWPASS_PX2 = 0.3
+#: per-fragment alpha ceiling and floor of the 3DGS image formation: alpha is
+#: clamped at 0.99 (no Gaussian is fully opaque, keeps 1 - alpha > 0) and a
+#: fragment below 1/255 contributes nothing (it is skipped; it cannot change
+#: an 8-bit pixel on its own).  Both from the reference rasteriser
+GS_ALPHA_MAX = 0.99
+GS_ALPHA_MIN = 1.0 / 255.0
+#: blending stops where the transmittance would drop below this (3DGS: 1e-4);
+#: what follows changes a pixel by less than 1e-4 of full scale (0.03 of an
+#: 8-bit step)
+GS_MIN_TRANSMITTANCE = 1e-4
+#: the 3DGS Jacobian clamps the view ray's x/z and y/z at this factor times the
+#: half field of view's tangent, so Gaussians far outside the frustum do not
+#: get unbounded screen covariances
+GS_FRUSTUM_CLAMP = 1.3
+#: Gaussians whose centre is nearer than this fraction of the near plane
+#: distance are culled (3DGS culls at view depth 0.2 in its scene units; our
+#: near plane comes from the model bounds, so the cut is relative to it)
+GS_NEAR_CULL_REL = 1.0
+#: a Gaussian is pickable when its opacity is at least this: 3DGS scenes carry
+#: many near-transparent "floaters" (opacity < 0.1 is common after training)
+#: that a click should pass through to the surface behind them
+GS_PICK_MIN_OPACITY = 0.2
+#: the pick footprint is the ellipse of this Mahalanobis radius (sigmas): at 2
+#: sigma a Gaussian of opacity 1 still has alpha 0.135, so the picked pixel
+#: visibly belongs to it; the drawn footprint (alpha >= 1/255) reaches 3.33
+GS_PICK_SIGMAS = 2.0
+#: Vulkan image vs the numpy reference rasteriser (tests/render/test_gaussians.py):
+#: largest allowed mean |difference| over RGB in 8-bit steps, and the largest
+#: allowed share of pixels off by more than GS_REF_PIXEL_TOL steps.  Measured
+#: at 96x72 (1500 Gaussians on the bunny, 4 views; 400 random anisotropic ones,
+#: SH degree 0-3; the GPU-deformed bunny): mean 0.03-0.14 (0.21 on the scene
+#: pixels alone), worst pixel 2 steps (float32 vs float64 projection,
+#: half-float SH bands 1-3, RGBA16F blending); a wrong SH frame (no rotation)
+#: gives 2.9-15 on the scene pixels.  The limits leave 7x headroom on the mean
+GS_REF_MEAN_TOL = 1.0
+GS_REF_PIXEL_TOL = 16
+GS_REF_BAD_SHARE = 0.01
+#: polar decomposition on the GPU (rotation of J for the SH view direction):
+#: Newton iterations R <- (R + R^-T) / 2 from R = J; converges quadratically
+#: once the singular values are near 1, each early step halves a large one:
+#: 12 reaches float32 precision for stretches up to 100x
+GS_POLAR_ITERATIONS = 12

@@ -81,6 +81,9 @@ class Viewport:
         #: display options (Renderer.grey_shading, Renderer.splat_scale)
         self.grey = False
         self.splat_scale = 1.0
+        #: a GaussianCloud drawn and picked instead of the splats (set_gaussians)
+        self.gaussians = None
+        self.gs_slot: _Slot | None = None
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -96,6 +99,20 @@ class Viewport:
             self._last_key = None
             self.ms_per_splat = None
         self.cloud = cloud
+
+    def set_gaussians(self, gaussians) -> None:
+        """The seam for Gaussian Splatting documents (issue 13).  With a
+        GaussianCloud set, frames and picks come from a
+        :class:`~splatedit.render.gaussians.GaussianRenderer` on the same
+        Vulkan device (full quality, no LOD), while the document cloud of
+        :meth:`set_cloud` stays the Gaussians' splat proxy
+        (:func:`splatedit.render.gs_headless.splat_proxy`, same indices) for
+        the tools: selection tints, basis rows and dC apply row for row.
+        None returns to the splat renderer."""
+        self.gaussians = gaussians
+        if gaussians is not None and self.gs_slot is None:
+            from splatedit.render.gaussians import GaussianRenderer
+            self.gs_slot = _Slot(GaussianRenderer(device=self.full.r.dev))
 
     def set_pyramid(self, pyramid) -> None:
         self.pyramid = pyramid
@@ -126,6 +143,11 @@ class Viewport:
                 lc = level.cloud if cloud is src else level.deformed(cloud.positions, cloud.u, cloud.v)
                 slot.r.set_cloud(lc)
                 slot.cloud, slot.level = cloud, level
+                slot.sel = slot.basis = slot.dc = None
+        elif slot is self.gs_slot:
+            if slot.cloud is not self.gaussians:
+                slot.r.set_cloud(self.gaussians)
+                slot.cloud = self.gaussians
                 slot.sel = slot.basis = slot.dc = None
         elif slot.cloud is not cloud:
             slot.r.set_cloud(cloud)
@@ -224,6 +246,15 @@ class Viewport:
 
     def render(self, cam: OrbitCamera, w: int, h: int, interactive: bool = False) -> np.ndarray:
         """An (h, w, 4) uint8 frame."""
+        if self.gaussians is not None:
+            self._sync(self.gs_slot)
+            t0 = time.perf_counter()
+            img = self.gs_slot.r.render(render_camera(cam), w, h)
+            ms = (time.perf_counter() - t0) * 1e3
+            (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
+            self.last_info = {"ms": ms, "splats": len(self.gaussians), "div": 1, "lod": False,
+                              "interactive": interactive, "gaussians": True}
+            return img
         level, div = self.choose(interactive, w, h)
         slot = self.full if level is None else self._lod_slot()
         self._sync(slot, level)          # uploads (new cloud, selection...) are not frame cost
@@ -256,10 +287,16 @@ class Viewport:
 
     def pick(self, cam: OrbitCamera, w: int, h: int):
         """(index map (h, w) int64, -1 background; depth (h, w)) of the full cloud."""
+        if self.gaussians is not None:
+            self._sync(self.gs_slot)
+            return self.gs_slot.r.pick(render_camera(cam), w, h)
         self._sync(self.full)
         return self.full.r.pick(render_camera(cam), w, h)
 
     def close(self) -> None:
+        if self.gs_slot is not None:
+            self.gs_slot.r.close()
+            self.gs_slot = None
         if self.lod_slot is not None:
             self.lod_slot.r.close()
             self.lod_slot = None

@@ -43,6 +43,12 @@ def _render(quick: bool, progress=None) -> Iterator[dict]:
     yield from bench_render(counts=counts, size=size)
 
 
+def _gaussians(quick: bool, progress=None) -> Iterator[dict]:
+    from splatedit.bench.gs_render import bench_gaussians
+    yield from bench_gaussians(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
+                               size=(640, 360) if quick else (1280, 720))
+
+
 def _editor(quick: bool, progress=None) -> Iterator[dict]:
     try:
         from splatedit.app.bench import bench_editor_frames

@@ -50,7 +50,7 @@ def test_deform_writes_a_valid_deformed_gaussian_file(tmp_path):
     out = tmp_path / "ears.ply"
     r = run_cli("deform", gaussian_scene_path(), "--edit", script, "-o", out)
     assert r.returncode == 0, r.stderr
-    assert "edit 0: support" in r.stdout and "5000 Gaussians" in r.stdout
+    assert "edit 0: rotation deformation, support" in r.stdout and "5000 Gaussians" in r.stdout
     g0, g1 = read_gaussians(gaussian_scene_path()), read_gaussians(out)
     moved = np.linalg.norm(g1.positions - g0.positions, axis=1)
     ears = g0.positions[:, 1] > 0.38

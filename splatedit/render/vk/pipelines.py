@@ -137,6 +137,9 @@ class GraphicsDesc:
     depth_compare: str = "less"
     blend_add: tuple[bool, ...] = ()            # per colour attachment: additive (ONE, ONE)
     blend_alpha: bool = False                   # all colour attachments: "over" (SRC_ALPHA, 1-SRC_ALPHA)
+    #: per colour attachment: front-to-back "under" of premultiplied colour
+    #: (src ONE_MINUS_DST_ALPHA, dst ONE; Gaussian splatting)
+    blend_under: tuple[bool, ...] = ()
     color_write: bool = True
     spec: tuple[tuple[int, int], ...] = ()      # (constant_id, int32 value), both stages
 
@@ -484,13 +487,19 @@ class PipelineCache:
         blends = []
         for i in range(len(d.render_pass.colors)):
             add = d.blend_add[i] if i < len(d.blend_add) else False
+            under = d.blend_under[i] if i < len(d.blend_under) else False
             one, inv = vk.VK_BLEND_FACTOR_ONE, vk.VK_BLEND_FACTOR_ONE_MINUS_SRC_ALPHA
+            # three modes: additive (ONE, ONE), "over" (SRC_ALPHA, 1 - SRC_ALPHA: the GUI),
+            # "under" (1 - DST_ALPHA, ONE: front-to-back Gaussians, premultiplied colour)
+            src = vk.VK_BLEND_FACTOR_ONE_MINUS_DST_ALPHA if under else (
+                vk.VK_BLEND_FACTOR_SRC_ALPHA if d.blend_alpha else one)
             blends.append(vk.VkPipelineColorBlendAttachmentState(
-                blendEnable=vk.VK_TRUE if (add or d.blend_alpha) else vk.VK_FALSE,
-                srcColorBlendFactor=vk.VK_BLEND_FACTOR_SRC_ALPHA if d.blend_alpha else one,
-                dstColorBlendFactor=inv if d.blend_alpha else one,
+                blendEnable=vk.VK_TRUE if (add or d.blend_alpha or under) else vk.VK_FALSE,
+                srcColorBlendFactor=src,
+                dstColorBlendFactor=inv if (d.blend_alpha and not under) else one,
                 colorBlendOp=vk.VK_BLEND_OP_ADD,
-                srcAlphaBlendFactor=one, dstAlphaBlendFactor=inv if d.blend_alpha else one,
+                srcAlphaBlendFactor=vk.VK_BLEND_FACTOR_ONE_MINUS_DST_ALPHA if under else one,
+                dstAlphaBlendFactor=inv if (d.blend_alpha and not under) else one,
                 alphaBlendOp=vk.VK_BLEND_OP_ADD, colorWriteMask=rgba if d.color_write else 0))
         cb = vk.VkPipelineColorBlendStateCreateInfo(attachmentCount=len(blends), pAttachments=blends or None)
         dyn_states = [vk.VK_DYNAMIC_STATE_VIEWPORT, vk.VK_DYNAMIC_STATE_SCISSOR]

@@ -1,0 +1,84 @@
+"""Gaussian splatting renderer benchmark (``splatedit bench render --gaussians``).
+
+Per Gaussian count: Gaussians (SH degree 3) on the splats of a
+Fibonacci-sampled unit sphere (:func:`splatedit.bench.render.sphere_cloud`,
+:func:`splatedit.bench.gs_scenes.gaussians_from_splats`), framed to fill
+the view, validation off.  Both depth sorts are measured in the same run
+(CPU: numpy argsort of the read-back keys; GPU: the bitonic compute sort), and
+the deformation overhead with every Gaussian carrying a 4-column basis row.
+Times are medians over ``repeats`` frames after a warm-up: GPU timestamps
+for the passes, wall clock for the CPU sort.
+"""
+
+from __future__ import annotations
+
+import time
+from typing import Iterator
+
+import numpy as np
+
+from splatedit.bench.gs_scenes import gaussians_from_splats
+from splatedit.bench.render import _basis, _loadavg, sphere_cloud
+from splatedit.render.camera import Camera
+from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
+
+
+def _frames(r: GaussianRenderer, cam, w, h, repeats) -> dict:
+    r.render(cam, w, h)                      # warm-up (pipeline JIT, first upload)
+    runs = []
+    for _ in range(repeats):
+        t0 = time.perf_counter()
+        r.render(cam, w, h)
+        t = dict(r.last_timings_ms)
+        t["wall"] = (time.perf_counter() - t0) * 1e3
+        t["total"] = t["prepass"] + t["sort"] + t["draw"] + t["resolve"]
+        runs.append(t)
+    return {k: float(np.median([x[k] for x in runs])) for k in runs[0]}
+
+
+def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int = 3,
+                    device_name: str | None = None) -> Iterator[dict]:
+    """Yield one dict per Gaussian count, keys:
+
+    * ``bench`` = "render_gaussians", ``device``, ``gaussians``, ``visible``, ``width``, ``height``;
+    * ``cpu_ms_prepass``, ``cpu_ms_sort``, ``cpu_ms_draw``, ``cpu_ms_resolve``,
+      ``cpu_ms_frame`` (their sum), ``cpu_ms_wall`` (the whole render call,
+      readback included), ``cpu_sort_share``, ``cpu_gaussians_per_s``;
+    * the same with ``gpu_`` for the bitonic GPU sort;
+    * ``ms_prepass_deformed`` / ``deformed_prepass_over_plain`` /
+      ``ms_frame_deformed`` / ``deformed_frame_over_plain``: CPU-sort frames
+      with every Gaussian deformed (4 basis columns, ~2% displacement);
+    * ``loadavg_1min``, ``wall_s``.
+    """
+    w, h = size
+    for n in counts:
+        t0 = time.perf_counter()
+        g = gaussians_from_splats(sphere_cloud(int(n), overlap=1.0), seed=0)
+        lo, hi = gaussian_bounds(g)
+        cam = Camera.frame(lo, hi, aspect=w / h, direction=(0.3, 0.4, 1.0))
+        out = {"bench": "render_gaussians", "gaussians": int(n), "width": w, "height": h}
+        for sort in ("cpu", "gpu"):
+            with GaussianRenderer(sort=sort, device_name=device_name, validation=False) as r:
+                r.set_gaussians(g)
+                m = _frames(r, cam, w, h, repeats)
+                out["device"] = r.dev.name
+                out["visible"] = int(m["visible"])
+                for k in ("prepass", "sort", "draw", "resolve"):
+                    out[f"{sort}_ms_{k}"] = round(m[k], 2)
+                out[f"{sort}_ms_frame"] = round(m["total"], 2)
+                out[f"{sort}_ms_wall"] = round(m["wall"], 2)
+                out[f"{sort}_sort_share"] = round(m["sort"] / m["total"], 3)
+                out[f"{sort}_gaussians_per_s"] = round(n / (m["total"] * 1e-3))
+                if sort == "cpu":
+                    B = _basis(g.positions)
+                    dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]]) * 0.2
+                    r.set_basis(np.arange(n), *B)
+                    r.set_displacement(dC)
+                    d = _frames(r, cam, w, h, repeats)
+                    out["ms_prepass_deformed"] = round(d["prepass"], 2)
+                    out["deformed_prepass_over_plain"] = round(d["prepass"] / m["prepass"], 3)
+                    out["ms_frame_deformed"] = round(d["total"], 2)
+                    out["deformed_frame_over_plain"] = round(d["total"] / m["total"], 3)
+        out["loadavg_1min"] = _loadavg()
+        out["wall_s"] = round(time.perf_counter() - t0, 1)
+        yield out

@@ -1,0 +1,504 @@
+"""Vulkan renderer of 3D Gaussian Splatting scenes (issue 13), deformable on the GPU.
+
+Per frame:
+
+1. compute pre-pass (``gs_prepare.comp``), once per Gaussian: deformation
+   of the Gaussians that carry a basis row (centre p + B dC, covariance
+   J Sigma J^T with J = I + sum_k dC_k grad B_k^T, and the polar rotation R
+   of J), EWA projection to a screen conic (Jacobian of the perspective
+   projection + GS_LOWPASS_PX2), colour from the SH at the view direction
+   (R^T times it for a deformed Gaussian: its SH live in its original frame),
+   culling, and the view depth as the sort key;
+2. depth sort of the keys: ``sort="cpu"`` (default) reads the keys back and
+   sorts them with numpy; ``sort="gpu"`` runs a bitonic sort in a compute
+   shader (``gs_sort.comp``).  On lavapipe the CPU sort is the faster
+   (docs/PERFORMANCE.md, "Gaussian splatting");
+3. one screen-aligned quad per visible Gaussian in depth order, spanning the
+   ellipse where its alpha reaches GS_ALPHA_MIN, with the conic evaluated in
+   the fragment shader and blended *front to back* ("under" operator on
+   premultiplied colour into an RGBA16F target whose alpha is 1 - T).  Front
+   to back sums the same terms as the reference rasteriser in the same order
+   (C = sum T_i alpha_i c_i), and once T is used up the blend adds exactly 0
+   (1 - alpha rounds to 1 in half float below T ~ 2.4e-4): the
+   fixed-function blend cannot skip the fragment, but it stops changing the
+   pixel, the equivalent of the reference's early stop;
+4. a full-screen resolve writes C + T * background to the target.
+
+The pick pass draws the Gaussians of opacity >= GS_PICK_MIN_OPACITY as
+their GS_PICK_SIGMAS ellipses with a depth test: the same ``pick`` API as
+:class:`splatedit.render.renderer.Renderer`.
+
+Only :mod:`splatedit.render.vk` calls Vulkan.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+from splatedit.errors import ParameterError
+from splatedit.model.gaussians import GaussianCloud
+from splatedit.render import vk as V
+from splatedit.render.camera import Camera
+from splatedit.render.renderer import RenderTarget, _unit_scale
+from splatedit.render.gs_resources import (_DEFORM_UBO_BYTES, _GS_SET, _MAX_GROUPS, _MAX_SIZE, _NONE, _PREP_WG,
+                                           _REC_BYTES, _RESOLVE_SET, _RP_PICK, _SORT_WG, _UBO_BYTES, SORTS, _rp_accum,
+                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_geometry,
+                                           selection_flags)
+from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
+                                  GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
+                                  RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
+
+
+class GaussianRenderer:
+    """Offscreen (and editor) renderer of a :class:`GaussianCloud`.
+
+    Use as a context manager or call :meth:`close`::
+
+        with GaussianRenderer() as r:
+            r.set_gaussians(cloud)
+            img = r.render(camera, 256, 256)        # (256, 256, 4) uint8
+
+    Args:
+        sort: ``"cpu"`` (numpy argsort of the read-back depth keys, two
+            submissions per frame) or ``"gpu"`` (bitonic sort in a compute
+            shader, one submission).
+        background: display-referred RGB (3 floats in 0..1) behind the scene.
+        accum_format: ``"rgba16f"`` or ``"rgba32f"`` blend target.
+        device: share an existing :class:`splatedit.render.vk.Device` (the
+            editor's); otherwise one is created (``device_name``, ``validation``
+            as for :class:`~splatedit.render.renderer.Renderer`).
+    """
+
+    def __init__(self, *, sort: str = "cpu", background=RENDER_BACKGROUND, accum_format: str = "rgba16f",
+                 device: V.Device | None = None, device_name: str | None = None, validation: bool | None = None):
+        if sort not in SORTS:
+            raise ParameterError("sort", f"must be one of {SORTS}, got {sort!r}")
+        if accum_format not in ("rgba16f", "rgba32f"):
+            raise ParameterError("accum_format", f"must be 'rgba16f' or 'rgba32f', got {accum_format!r}")
+        self.sort = sort
+        self.accum_format = accum_format
+        self.background = tuple(float(x) for x in background)[:3]
+        self._own_device = device is None
+        self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
+        self._closed = False
+        self.cache = self.sampler = self.ubo = self.dC_ubo = self._query = None
+        self._targets = None
+        self._bufs = []
+        self._basis_buf = None
+        self._dset = None
+        self.cloud = None
+        self.n = 0
+        self._dC = np.zeros((4, 3))
+        self._cols = 4
+        self._basis_idx = np.zeros(0, np.int64)
+        self._reach = 0.0
+        self._near_far = (1.0, 2.0)
+        self._n_visible = 0
+        self.last_timings_ms: dict[str, float] = {}
+        #: accepted for the editor's viewport; the heat map is not drawn for Gaussians
+        self.distortion_map = False
+        try:
+            self.cache = V.PipelineCache(self.dev)
+            self.sampler = V.Sampler(self.dev)
+            self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
+            self.dC_ubo = V.Buffer(self.dev, _DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
+            self.dC_ubo.view(np.float32)[:] = 0.0
+            self._query = V.QueryPool(self.dev, 8)
+        except BaseException:
+            self.close()
+            raise
+
+    # ------------------------------------------------------------ lifecycle
+    def close(self) -> None:
+        """Destroy every Vulkan object; idempotent."""
+        if self._closed:
+            return
+        self._closed = True
+        if self.dev.device is not None:
+            self.dev.wait_idle()
+        self._free_scene()
+        if self._targets is not None:
+            self._targets.destroy()
+            self._targets = None
+        for obj in (self._query, self.dC_ubo, self.ubo, self.sampler):
+            if obj is not None:
+                obj.destroy()
+        if self.cache is not None:
+            self.cache.destroy()
+        if self._own_device:
+            self.dev.close()
+
+    def __enter__(self):
+        return self
+
+    def __exit__(self, *exc):
+        self.close()
+
+    def _check(self):
+        if self._closed:
+            raise ParameterError("renderer", "is closed")
+        if self.cloud is None:
+            raise ParameterError("cloud", "no Gaussians set (call set_gaussians first)")
+
+    # --------------------------------------------------------------- scene
+    def _free_scene(self):
+        for b in reversed(self._bufs):
+            b.destroy()
+        self._bufs = []
+        if self._basis_buf is not None:
+            self._basis_buf.destroy()
+            self._basis_buf = None
+        self._dset = None
+        self.cloud = None
+        self.n = 0
+
+    def _buf(self, size, usage=("storage",), host_visible=False):
+        b = V.Buffer(self.dev, max(int(size), 16), usage, host_visible=host_visible)
+        self._bufs.append(b)
+        return b
+
+    def set_gaussians(self, cloud: GaussianCloud) -> None:
+        """Upload a scene (float32 relative to its box centre, divided by a
+        power of two near its size); clears any deformation basis.
+
+        Raises ParameterError when a per-Gaussian buffer would exceed the
+        device's storage-buffer range (lavapipe: 128 MiB = 2,097,152 Gaussians)."""
+        if self._closed:
+            raise ParameterError("renderer", "is closed")
+        if not isinstance(cloud, GaussianCloud):
+            raise ParameterError("cloud", f"must be a GaussianCloud, got {type(cloud).__name__}")
+        n = len(cloud)
+        if n == 0:
+            raise ParameterError("cloud", "has no Gaussians")
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        n2 = 1 << max(int(math.ceil(math.log2(n))), 0)
+        if n * _REC_BYTES > limit or n2 * 4 > limit:
+            raise ParameterError("cloud", f"{n} Gaussians exceed the device's storage-buffer range "
+                                          f"({limit // _REC_BYTES} at most)")
+        self.dev.wait_idle()
+        self._free_scene()
+        lo, hi = gaussian_bounds(cloud)
+        self.origin = 0.5 * (cloud.positions.min(axis=0) + cloud.positions.max(axis=0))
+        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), 0.0)
+        self.bounds = (lo, hi)
+        self._sigma_max = cloud.scales().max(axis=1)
+        geom, rest = pack_geometry(cloud, self.origin, self.scale)
+        self._rest_uints = rest.shape[1]
+        self.degree = cloud.sh_degree
+        self._n2 = n2
+        self._geom = self._buf(geom.nbytes, ("storage",))
+        self._geom.upload(geom)
+        self._rest = self._buf(max(rest.nbytes, 4), ("storage",))
+        if rest.nbytes:
+            self._rest.upload(rest)
+        self._flags = self._buf(4 * n, ("storage",), host_visible=True)
+        self._flags.view(np.uint32)[:] = 0
+        self._brow = self._buf(4 * n, ("storage",), host_visible=True)
+        self._brow.view(np.uint32)[:] = _NONE
+        self._rec = self._buf(n * _REC_BYTES)
+        self._keys = self._buf(4 * n2, host_visible=True)
+        self._order = self._buf(4 * n2, host_visible=True)
+        self._draws = self._buf(16, ("storage", "indirect"), host_visible=True)
+        self._dummy_basis = self._buf(64, host_visible=True)
+        self._dummy_basis.view(np.float32)[:] = 0.0
+        self.cloud = cloud
+        self.n = n
+        self._cols, self._dC, self._basis_idx, self._reach = 4, np.zeros((4, 3)), np.zeros(0, np.int64), 0.0
+        self._write_dset()
+
+    def _write_dset(self):
+        if self._dset is None:
+            self._dset = V.DescriptorSet(self.dev, self.cache.set_layout(_GS_SET))
+            self._bufs.append(self._dset)
+        basis = self._basis_buf if self._basis_buf is not None else self._dummy_basis
+        self._dset.write({0: self.ubo, 1: self._geom, 2: self._rest, 3: self._brow, 4: basis, 5: self._rec,
+                          6: self._keys, 7: self._order, 8: self._draws, 9: self.dC_ubo, 11: self._flags})
+
+    def set_cloud(self, cloud: GaussianCloud) -> None:
+        """:meth:`set_gaussians` under the splat renderer's name (the editor's viewport calls it)."""
+        self.set_gaussians(cloud)
+
+    def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
+        """Tint the support (blue) and handle (green) Gaussians as the splat
+        renderer does; boolean masks (n,) or index arrays; None clears."""
+        self._check()
+        flags = selection_flags(self.n, support_mask, handle_mask, inactive_mask)
+        self._flags.view(np.uint32)[:] = flags
+
+    # --------------------------------------------------------- deformation
+    def set_basis(self, indices, B, Bx, By, Bz) -> None:
+        """Deformation basis rows for the Gaussians ``indices`` (N,): B, Bx, By,
+        Bz (N, K), K in 1..RENDER_MAX_BASIS_COLUMNS, as
+        :meth:`Renderer.set_basis`.  Other Gaussians are not deformed.  A new
+        K resets the displacement to zeros (K, 3)."""
+        self._check()
+        idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+        mats = [np.asarray(m, dtype=np.float64) for m in (B, Bx, By, Bz)]
+        for name, a in zip(("B", "Bx", "By", "Bz"), mats):
+            if a.ndim != 2 or a.shape[0] != len(idx) or a.shape[1] != mats[0].shape[1]:
+                raise ParameterError(name, f"must have shape ({len(idx)}, K) like B, got {a.shape}")
+            if not np.isfinite(a).all():
+                raise ParameterError(name, "basis rows must be finite")
+        k = mats[0].shape[1]
+        if not 1 <= k <= RENDER_MAX_BASIS_COLUMNS:
+            raise ParameterError("B", f"basis must have 1..{RENDER_MAX_BASIS_COLUMNS} columns, got {k}")
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n or len(np.unique(idx)) != len(idx)):
+            raise ParameterError("indices", f"must be distinct and in 0..{self.n - 1}")
+        g = (k + 3) // 4
+        rows = pack_basis_rows(mats, self.scale)
+        if rows.nbytes > int(self.dev.limits.maxStorageBufferRange):
+            raise ParameterError("indices", f"{len(idx)} deformed Gaussians with {k} columns exceed the "
+                                            "device's storage-buffer range")
+        self.dev.wait_idle()
+        if self._basis_buf is not None:
+            self._basis_buf.destroy()
+            self._basis_buf = None
+        self._basis_buf = V.Buffer(self.dev, rows.nbytes, ("storage",), host_visible=True)
+        self._basis_buf.write(rows)
+        brow = self._brow.view(np.uint32)
+        brow[:] = _NONE
+        brow[idx] = np.arange(len(idx), dtype=np.uint32)
+        self._groups = g
+        if k != self._cols:
+            self._cols, self._dC = k, np.zeros((k, 3))
+        self._basis_idx = idx
+        grad = np.sqrt(mats[1] ** 2 + mats[2] ** 2 + mats[3] ** 2).sum(axis=1)
+        self._reach = float((np.abs(mats[0]).sum(axis=1) + 3.0 * self._sigma_max[idx] * grad).max(initial=0.0))
+        self._write_dset()
+
+    def clear_basis(self) -> None:
+        """Every Gaussian undeformed."""
+        self._check()
+        self._brow.view(np.uint32)[:] = _NONE
+        self._basis_idx = np.zeros(0, np.int64)
+        self._reach = 0.0
+
+    def set_displacement(self, dC) -> None:
+        """Control-frame displacement dC (K, 3), K = the basis' column count (model units)."""
+        self._check()
+        a = np.asarray(dC, dtype=np.float64)
+        if a.shape != (self._cols, 3) or not np.isfinite(a).all():
+            raise ParameterError("dC", f"must be finite with shape ({self._cols}, 3), got {a.shape}")
+        self._dC = a.copy()
+
+    # -------------------------------------------------------------- frame
+    def _targets_for(self, width: int, height: int) -> _Targets:
+        for name, v in (("width", width), ("height", height)):
+            if not isinstance(v, (int, np.integer)) or not 1 <= v <= _MAX_SIZE:
+                raise ParameterError(name, f"must be an integer in 1..{_MAX_SIZE}, got {v!r}")
+        t = self._targets
+        if t is None or (t.width, t.height) != (width, height):
+            if t is not None:
+                self.dev.wait_idle()
+                t.destroy()
+                self._targets = None
+            self._targets = _Targets(self, int(width), int(height))
+        return self._targets
+
+    def _write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
+        if not isinstance(camera, Camera):
+            raise ParameterError("camera", f"must be a Camera, got {type(camera).__name__}")
+        o, sc = self.origin, self.scale
+        gpu_cam = Camera((camera.eye - o) / sc, (camera.target - o) / sc, up=camera.up, fov_deg=camera.fov_deg,
+                         near=None if camera.near is None else camera.near / sc,
+                         far=None if camera.far is None else camera.far / sc)
+        lo, hi = self.bounds
+        if len(self._basis_idx):
+            grow = self._reach * float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+            lo, hi = lo - grow, hi + grow
+        near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
+        f = 1.0 / math.tan(math.radians(camera.fov_deg) / 2.0)
+        fpx = 0.5 * f * height
+        u = np.zeros(_UBO_BYTES // 4, np.float32)
+        u[0:16] = gpu_cam.view_matrix().T.reshape(-1)
+        u[16:20] = (fpx, fpx, 0.5 * width, 0.5 * height)
+        u[20:24] = (width, height, near, far)
+        u[24:28] = (*gpu_cam.eye, self.degree)
+        u[28:32] = (GS_FRUSTUM_CLAMP * 0.5 * width / fpx, GS_FRUSTUM_CLAMP * 0.5 * height / fpx, GS_LOWPASS_PX2,
+                    GS_ALPHA_MIN)
+        u[32:36] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
+        u[36:40] = (*self.background, 1.0)
+        u[40:44].view(np.uint32)[:] = (self.n, self._rest_uints, self._n2 if self.sort == "gpu" else self.n,
+                                       1 if srgb_target else 0)
+        u[44:48] = RENDER_TINT_SUPPORT
+        u[48:52] = RENDER_TINT_HANDLE
+        self.ubo.write(u)
+        pad = np.zeros((4 * _MAX_GROUPS, 3))
+        pad[:len(self._dC)] = self._dC / sc
+        self.dC_ubo.write(np.ascontiguousarray(pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1), np.float32))
+        self._near_far = (near * sc, far * sc)
+
+    def _record_prepass(self, cb):
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        pipe = self.cache.pipeline(V.ComputeDesc("gs_prepare.comp", layout))
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, self._dset)
+        groups = self._groups if len(self._basis_idx) else 1
+        cb.push_constants(pipe, np.array([groups, GS_POLAR_ITERATIONS], np.uint32))
+        count = self._n2 if self.sort == "gpu" else self.n
+        cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
+
+    def _record_gpu_sort(self, cb):
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        pipe = self.cache.pipeline(V.ComputeDesc("gs_sort.comp", layout))
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, self._dset)
+        n2 = self._n2
+        k = 2
+        while k <= n2:
+            j = k // 2
+            while j >= 1:
+                cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
+                cb.push_constants(pipe, np.array([k, j], np.uint32))
+                cb.dispatch((n2 + _SORT_WG - 1) // _SORT_WG)
+                j //= 2
+            k *= 2
+
+    def _draw_pipeline(self):
+        layout = V.LayoutDesc(sets=(_GS_SET,))
+        return self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs.frag", _rp_accum(self.accum_format), layout,
+                                                  blend_under=(True,), spec=((0, 0),)))
+
+    def prepare_frame(self, camera: Camera, width: int, height: int, *, srgb_target: bool = False) -> None:
+        """Pre-pass and sort for this camera and image size (submits and waits).
+        Then :meth:`record_draw` records the draw into any command buffer (the
+        editor's frame); :meth:`render` does both."""
+        self._check()
+        self._targets_for(width, height)
+        self._write_ubo(camera, width, height, srgb_target)
+        dv = self._draws.view(np.uint32)
+        dv[:] = (4, 0, 0, 0)
+        t0 = time.perf_counter()
+
+        def rec(cb):
+            cb.reset_queries(self._query)
+            cb.timestamp(self._query, 0, bottom=False)
+            self._record_prepass(cb)
+            # the barrier first: lavapipe writes a timestamp without waiting for a
+            # dispatch still running (the pass measured ~0 ms without it)
+            cb.memory_barrier("compute", "shader_write", "compute|host", "shader_read|shader_write|host_read")
+            cb.timestamp(self._query, 1)
+            if self.sort == "gpu":
+                self._record_gpu_sort(cb)
+                cb.memory_barrier("compute", "shader_write", "compute", "shader_read")
+                cb.timestamp(self._query, 2)
+        self.dev.submit(rec)
+        ts = self._query.results_ns(3 if self.sort == "gpu" else 2)
+        # lavapipe's timestamps around a lone dispatch read ~0 after the first
+        # frame: the CPU-sort path reports the pre-pass submission's wall time
+        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6 if self.sort == "gpu"
+                   else (time.perf_counter() - t0) * 1e3}
+        nvis = int(dv[1])
+        if self.sort == "gpu":
+            timings["sort"] = float(ts[2] - ts[1]) * 1e-6
+            timings["prepass"] = max((time.perf_counter() - t0) * 1e3 - timings["sort"], 0.0)
+        else:
+            t1 = time.perf_counter()
+            keys = self._keys.view(np.uint32)[:self.n]
+            # positive float32 depths sort as their bit patterns; culled keys are 0xFFFFFFFF (last)
+            # (numpy's default introsort: SIMD-vectorised, 6-10x faster than kind="stable"
+            # on 1M random uint32 keys, 23 vs 136-230 ms; equal depths are left in any order)
+            order = np.argsort(keys)[:nvis].astype(np.uint32)
+            self._order.view(np.uint32)[:nvis] = order
+            timings["sort"] = (time.perf_counter() - t1) * 1e3
+        timings["prepare_wall"] = (time.perf_counter() - t0) * 1e3
+        self._n_visible = nvis
+        self.last_timings_ms = timings
+
+    def record_draw(self, cb, target: RenderTarget) -> None:
+        """Record the Gaussians' draw and the resolve into ``target`` (after
+        :meth:`prepare_frame` for the same size)."""
+        t = self._targets_for(target.width, target.height)
+        cb.memory_barrier("host", "host_write", "draw_indirect|vertex", "indirect_read|shader_read")
+        pipe = self._draw_pipeline()
+        cb.begin_render_pass(self.cache.render_pass(_rp_accum(self.accum_format)), t.fb_accum,
+                             [(0.0, 0.0, 0.0, 0.0)])
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, self._dset)
+        cb.draw_indirect(self._draws, 0)
+        cb.end_render_pass()
+        cb.timestamp(self._query, 3)
+        layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
+        rpipe = self.cache.pipeline(V.GraphicsDesc("fullscreen.vert", "gs_resolve.frag", _rp_resolve(target),
+                                                   layout, topology="triangle_list"))
+        cb.begin_render_pass(self.cache.render_pass(_rp_resolve(target)), t.target_fb(target), [None])
+        cb.bind_pipeline(rpipe)
+        cb.bind_descriptor_set(rpipe, t.resolve_set)
+        cb.draw(3)
+        cb.end_render_pass()
+        cb.timestamp(self._query, 4)
+
+    def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
+        """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
+        self.prepare_frame(camera, width, height)
+        t = self._targets
+        rb = V.Buffer(self.dev, width * height * 4, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                cb.reset_queries(self._query, 2, 3)
+                cb.timestamp(self._query, 2, bottom=False)
+                self.record_draw(cb, t.offscreen)
+                cb.copy_image_to_buffer(t.out, rb)
+                cb.host_read_barrier()
+            self.dev.submit(rec)
+            out = rb.read().reshape(height, width, 4)
+        finally:
+            rb.destroy()
+        ts = self._query.results_ns(5)
+        self.last_timings_ms["draw"] = float(ts[3] - ts[2]) * 1e-6
+        self.last_timings_ms["resolve"] = float(ts[4] - ts[3]) * 1e-6
+        self.last_timings_ms["visible"] = float(self._n_visible)
+        return out
+
+    def pick(self, camera: Camera, width: int, height: int, rect=None):
+        """Gaussian index per pixel (-1 background) and view-axis depth of its
+        centre (model units, NaN background) of the nearest pickable Gaussian
+        (opacity >= GS_PICK_MIN_OPACITY, within GS_PICK_SIGMAS), for the image
+        or ``rect`` = (x, y, w, h) (clipped): the API of Renderer.pick."""
+        self._check()
+        t = self._targets_for(width, height)
+        t.ensure_pick()
+        if rect is None:
+            x, y, w, h = 0, 0, width, height
+        else:
+            x, y, w, h = (int(v) for v in rect)
+            x0, y0, x1, y1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
+            if x1 <= x0 or y1 <= y0:
+                raise ParameterError("rect", f"{tuple(rect)} does not overlap the {width}x{height} image")
+            x, y, w, h = x0, y0, x1 - x0, y1 - y0
+        self._write_ubo(camera, width, height)
+        self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
+        nbytes = w * h * 4
+        rb = V.Buffer(self.dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
+        layout = V.LayoutDesc(sets=(_GS_SET,))
+        pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", _RP_PICK, layout, depth_test=True,
+                                                  depth_write=True, depth_compare="less", spec=((0, 1),)))
+        try:
+            def rec(cb):
+                # records of culled Gaussians are stale: draw in index order those the
+                # pre-pass wrote this frame (order = identity, count = all; the
+                # vertex shader drops the culled through their zeroed opacity)
+                self._record_prepass(cb)
+                cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
+                cb.begin_render_pass(self.cache.render_pass(_RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
+                cb.bind_pipeline(pipe)
+                cb.bind_descriptor_set(pipe, self._dset)
+                cb.draw(4, self.n)
+                cb.end_render_pass()
+                cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
+                cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
+                cb.host_read_barrier()
+            self.dev.submit(rec)
+            raw = rb.read()
+        finally:
+            rb.destroy()
+        idx = raw[:nbytes].view(np.uint32).reshape(h, w).astype(np.int64) - 1
+        d = raw[nbytes:].view(np.float32).reshape(h, w).astype(np.float64)
+        near, far = self._near_far
+        with np.errstate(divide="ignore", invalid="ignore"):
+            depth = near / (1.0 - d * (far - near) / far)
+        depth[idx < 0] = np.nan
+        return idx, depth
