@@ -28,7 +28,7 @@ from splatedit.render.camera import Camera
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
                                   RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
-                                  RENDER_VISIBILITY_EPS_RADII)
+                                  RENDER_UPLOAD_CHUNK_SPLATS, RENDER_VISIBILITY_EPS_RADII)
 
 #: per-splat flag bits (shaders_glsl/frame.glsl)
 FLAG_SUPPORT = 1
@@ -360,18 +360,11 @@ class Renderer:
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
         self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), float(r.max()))
-        geom = np.empty((n, 9), dtype=np.float32)
-        geom[:, 0:3] = (cloud.positions - self.origin) / self.scale
-        geom[:, 3:6] = cloud.u / self.scale
-        geom[:, 6:9] = cloud.v / self.scale
-        colors = cloud.colors if cloud.colors is not None else np.tile(
-            np.asarray(RENDER_DEFAULT_COLOR, np.uint8), (n, 1))
-        self._geom = V.Buffer(self.dev, geom.nbytes, ("vertex", "storage"))
+        self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self._geom)
-        self._geom.upload(geom)
         self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
         self._cloud_bufs.append(self._color)
-        self._color.upload(np.ascontiguousarray(colors, dtype=np.uint8))
+        self._upload_cloud(cloud)
         self._flags = V.Buffer(self.dev, 4 * n, ("vertex", "storage"), host_visible=True)
         self._cloud_bufs.append(self._flags)
         self._flags.view(np.uint32)[:] = 0
@@ -382,6 +375,32 @@ class Renderer:
         self._basis_cols = 4
         self._dC = np.zeros((4, 3))
         self._dC_dirty = True
+
+    def _upload_cloud(self, cloud: SplatCloud) -> None:
+        """Geometry (float32 centre - origin, u, v in GPU units) and colours
+        through one staging buffer of ``RENDER_UPLOAD_CHUNK_SPLATS`` splats:
+        no whole-cloud float32 copy and no whole-cloud staging buffer (at 10M
+        splats they were 360 MB each on top of the 360 MB device buffer)."""
+        n = cloud.n
+        chunk = min(n, RENDER_UPLOAD_CHUNK_SPLATS)
+        staging = V.Buffer(self.dev, chunk * _GEOM_STRIDE, ("transfer_src",), host_visible=True)
+        try:
+            inv = 1.0 / self.scale                   # an exact power of two
+            default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
+            for lo in range(0, n, chunk):
+                m = min(chunk, n - lo)
+                geom = staging.view(np.float32)[:9 * m].reshape(m, 9)
+                np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom[:, 0:3],
+                            casting="same_kind")
+                np.multiply(cloud.u[lo:lo + m], inv, out=geom[:, 3:6], casting="same_kind")
+                np.multiply(cloud.v[lo:lo + m], inv, out=geom[:, 6:9], casting="same_kind")
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
+                                                          lo * _GEOM_STRIDE))
+                col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
+                col[:] = default if cloud.colors is None else cloud.colors[lo:lo + m]
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
+        finally:
+            staging.destroy()
 
     @property
     def _basis_groups(self) -> int:
