@@ -64,6 +64,16 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
     return tuple(parts)  # type: ignore[return-value]
 
 
+def _positive_count(text: str) -> int:
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive whole number, got {text!r}")
+    return value
+
+
 # ------------------------------------------------------------------ commands
 def _sig(x, digits: int = 7) -> float | None:
     """``x`` rounded to ``digits`` significant digits (not decimals: a model
@@ -291,7 +301,7 @@ def _fresh_directory(base: Path) -> Path:
 
 def cmd_bench(args) -> int:
     from splatedit.bench.runner import run_bench
-    for line in run_bench(args.what, quick=args.quick, progress=args.progress):
+    for line in run_bench(args.what, quick=args.quick, progress=args.progress, counts=args.splats):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -362,8 +372,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_edit)
 
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
-    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "all"))
+    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor",
+                                     "estimate", "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
+    s.add_argument("--splats", type=_positive_count, nargs="+", metavar="N",
+                   help="point/splat counts of estimate, render and editor (e.g. --splats 1000000 10000000)")
     s.set_defaults(func=cmd_bench)
     return p
 

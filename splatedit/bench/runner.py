@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Iterator
 
 
-def _solve(quick: bool, progress=None) -> Iterator[dict]:
+def _solve(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.solve import bench_solve, standard_cases
     for name, cloud, support, handles in standard_cases(large=not quick):
         if quick and cloud.n > 300_000:
@@ -21,7 +21,7 @@ def _solve(quick: bool, progress=None) -> Iterator[dict]:
         yield out
 
 
-def _groups(quick: bool, progress=None) -> Iterator[dict]:
+def _groups(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
         from splatedit.bench.solve import bench_groups
     except ImportError:
@@ -30,36 +30,43 @@ def _groups(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "groups", **line}
 
 
-def _qr(quick: bool, progress=None) -> Iterator[dict]:
+def _qr(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.qr import bench_qr
     for m in ((500, 1000) if quick else (1000, 3000, 5000)):
         yield {"bench": "qr", **bench_qr(m, repeat=1 if quick else 3)}
 
 
-def _render(quick: bool, progress=None) -> Iterator[dict]:
+def _render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.render import bench_render
-    counts = (20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000)
+    counts = counts or ((20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000))
     size = (640, 360) if quick else (1280, 720)
-    yield from bench_render(counts=counts, size=size)
+    # the per-pass/point-floor/deformation cases hold a full basis: up to 2M
+    yield from bench_render(counts=[n for n in counts if n <= 2_000_000], size=size)
+    from splatedit.bench.scale import bench_upload_lod
+    for n in counts:
+        yield {"bench": "render", **bench_upload_lod(int(n), size=size)}
 
 
-def _editor(quick: bool, progress=None) -> Iterator[dict]:
+def _editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
         from splatedit.app.bench import bench_editor_frames
     except ImportError:
         return
-    counts = (100_000,) if quick else (100_000, 1_000_000, 2_000_000)
-    for line in bench_editor_frames(counts=counts):
+    counts = counts or ((100_000,) if quick else (100_000, 1_000_000, 2_000_000))
+    for line in bench_editor_frames(counts=[n for n in counts if n <= 2_000_000]):
         yield {"bench": "editor", **line}
+    from splatedit.app.bench import bench_editor_first_image
+    for n in counts:
+        yield {"bench": "editor", **bench_editor_first_image(int(n))}
 
 
-def _closure(quick: bool, progress=None) -> Iterator[dict]:
+def _closure(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.closure import bench_closure
     yield from bench_closure(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
                              repeats=2 if quick else 3)
 
 
-def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
+def _accuracy(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.accuracy import accuracy_cases, bench_accuracy
     for name, cloud, support, handles in accuracy_cases(large=False):
         if quick and cloud.n > 100_000:
@@ -67,12 +74,20 @@ def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
 
 
+def _estimate(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.estimate import bench_estimate
+    for line in bench_estimate(counts or ((100_000,) if quick else (1_000_000,))):
+        yield {"bench": "estimate", **line}
+
+
 BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
-           "render": _render, "editor": _editor}
+           "render": _render, "editor": _editor, "estimate": _estimate}
 
 
-def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
-    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all")."""
+def run_bench(what: str, *, quick: bool = False, progress=None, counts=None) -> Iterator[dict]:
+    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
+    ``counts``: splat/point counts for ``estimate``, ``render`` and ``editor``
+    (default: each benchmark's own)."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
-        yield from BENCHES[name](quick, progress)
+        yield from BENCHES[name](quick, progress, counts)
