@@ -188,7 +188,9 @@ def _camera_from_args(args, cloud):
     from splatedit.render.camera import Camera
     w, h = args.size
     lo, hi = cloud.bounds()
-    rmax = float(cloud.radii.max())       # frames a single point by its splat
+    # frames a single point by its splat (the largest semi-axis; einsum: no (n,) norms)
+    rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
+                             np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
     # all centres in one point: look at the splat face-on (from +z it may be edge-on)
     direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
     base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)

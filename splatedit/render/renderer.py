@@ -352,14 +352,16 @@ class Renderer:
         n = cloud.n
         lo, hi = cloud.bounds()
         self.origin = 0.5 * (lo + hi)
-        r = cloud.radii
-        self._radii = r
+        # the largest semi-axis without the (n,) radii array (per-splat radii
+        # are computed for the basis rows only, in _basis_radii)
+        rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
+                                 np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
         #: undeformed bounds padded by the largest splat radius; near/far come
         #: from these grown by the deformation's reach (:meth:`_clip_bounds`)
-        self.bounds = (lo - r.max(), hi + r.max())
+        self.bounds = (lo - rmax, hi + rmax)
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
-        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), float(r.max()))
+        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), rmax)
         self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self._geom)
         self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
@@ -401,6 +403,11 @@ class Renderer:
                 self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
         finally:
             staging.destroy()
+
+    def _basis_radii(self, idx: np.ndarray) -> np.ndarray:
+        """(N,) float64 larger semi-axis of the splats ``idx`` (model units)."""
+        u, v = self.cloud.u[idx], self.cloud.v[idx]
+        return np.sqrt(np.maximum(np.einsum("ij,ij->i", u, u), np.einsum("ij,ij->i", v, v)))
 
     @property
     def _basis_groups(self) -> int:
@@ -515,7 +522,7 @@ class Renderer:
         if not len(idx):
             return 0.0
         grad = np.sqrt(Bx * Bx + By * By + Bz * Bz).sum(axis=1)
-        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._radii[idx] * grad
+        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._basis_radii(idx) * grad
         return float(per_row.max())
 
     def _clip_bounds(self):
