@@ -39,7 +39,8 @@ from splatedit.progress import report
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
                                   FALLBACK_SPLAT_RADIUS, MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
                                   ORIENT_NEIGHBOURS, ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
-                                  SIZE_NEIGHBOURS, SPACING_NEIGHBOUR, SPLAT_RADIUS_FACTOR)
+                                  OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS, SPACING_NEIGHBOUR,
+                                  SPLAT_RADIUS_FACTOR)
 
 
 def _points(points) -> np.ndarray:
@@ -49,28 +50,34 @@ def _points(points) -> np.ndarray:
     return pts
 
 
-def knn(points, k: int, *, tree: cKDTree | None = None, query=None,
-        progress=None) -> tuple[np.ndarray, np.ndarray]:
+def knn(points, k: int, *, tree: cKDTree | None = None, query=None, progress=None,
+        compact: bool = False, dist_columns: int | None = None) -> tuple[np.ndarray, np.ndarray]:
     """k nearest neighbours (the point itself included), chunked.
 
     Args:
         points: (n, 3) float64 positions.
         k: neighbours per point including itself, clamped to n.
         query: optional (m,) indices of the points to query (default all).
+        compact: int32 indices (when n < 2^31) and float32 distances: half
+            the memory (10M points, k = 16: 1.0 GB instead of 2.6 GB).
+        dist_columns: keep only this many leading distance columns.
     Returns:
-        dist (m, k) float64 sorted distances (model units) and idx (m, k)
-        int64 indices into ``points``.
+        dist (m, min(k, dist_columns)) float64 (float32 if ``compact``) sorted
+        distances (model units) and idx (m, k) int64 (int32 if ``compact``)
+        indices into ``points``.
     """
     pts = _points(points)
     k = int(min(max(k, 1), len(pts)))
+    kd = k if dist_columns is None else int(min(max(dist_columns, 1), k))
     idx_q = np.arange(len(pts)) if query is None else np.asarray(query, dtype=np.int64)
     tree = cKDTree(pts) if tree is None else tree
-    dist = np.empty((len(idx_q), k))
-    idx = np.empty((len(idx_q), k), dtype=np.int64)
+    small = compact and len(pts) < 2 ** 31
+    dist = np.empty((len(idx_q), kd), dtype=np.float32 if compact else np.float64)
+    idx = np.empty((len(idx_q), k), dtype=np.int32 if small else np.int64)
     step = 8 * ESTIMATE_CHUNK_POINTS
     for lo in range(0, len(idx_q), step):
         d, i = tree.query(pts[idx_q[lo:lo + step]], k=k, workers=-1)
-        dist[lo:lo + step] = d.reshape(-1, k)
+        dist[lo:lo + step] = d.reshape(-1, k)[:, :kd]
         idx[lo:lo + step] = i.reshape(-1, k)
         report(progress, "finding neighbours", (lo + step) / max(len(idx_q), 1))
     return dist, idx
@@ -161,7 +168,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree
     if neighbours is None or neighbours.shape[1] < k + 1:
         _, neighbours = knn(pts, k + 1, tree=tree)
     nb = neighbour_indices(pts, k + 1, neighbours=neighbours)      # (n, k), self left out
-    w = np.empty(nb.shape)
+    w = np.empty(nb.shape, dtype=np.float32)      # 1 - |cos|: float32 resolves 1e-7
     neg = np.empty(nb.shape, dtype=bool)
     step = 8 * ESTIMATE_CHUNK_POINTS
     for lo in range(0, n, step):
@@ -196,7 +203,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree
     hr, hc = hi // k, nb.ravel()[hi]
     a, b = lab[hr], lab[hc]
     keep = a != b
-    a, b, hw = a[keep], b[keep], w.ravel()[hi][keep]
+    a, b, hw = a[keep], b[keep], w.ravel()[hi][keep].astype(np.float64)
     g = neg.ravel()[hi][keep] ^ rel[hr[keep]] ^ rel[hc[keep]]   # flip between the two roots
     del w, neg, low, hi, hr, hc
     a, b = np.minimum(a, b), np.maximum(a, b)
@@ -319,7 +326,7 @@ def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS
     k = int(min(k, n - 1))
     if distances is None or distances.shape[1] < k + 1:
         distances, _ = knn(pts, k + 1, tree=tree, query=idx_q)
-    r = distances[:, k] * factor
+    r = distances[:, k].astype(np.float64) * factor
     ok = r[np.isfinite(r) & (r > 0)]
     if len(ok) == 0:
         allr = nearest_neighbour_distances(pts, k, tree or cKDTree(pts)) * factor
@@ -461,7 +468,8 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
         if normals is None:
             kmax = max(NORMAL_NEIGHBOURS, ORIENT_NEIGHBOURS + 1, kmax)
         if radius is None or normals is None:
-            dist, nb = knn(sp, kmax, tree=tree, progress=progress)
+            dist, nb = knn(sp, kmax, tree=tree, progress=progress, compact=True,
+                           dist_columns=max(SPACING_NEIGHBOUR, OUTLIER_NEIGHBOURS) + 1)
     if normals is None:
         nrm = estimate_normals(sp, tree=tree, neighbours=nb, progress=progress)
         nrm = orient_normals(sp, nrm, tree=tree, neighbours=nb, progress=progress)
