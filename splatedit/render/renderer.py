@@ -234,6 +234,12 @@ class Renderer:
         self.distortion_map = False
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
+        #: alpha of background pixels in the output (0: uncovered pixels are
+        #: told apart, as :mod:`splatedit.render.progressive` does)
+        self.background_alpha = 1.0
+        #: frames recorded so far (a progressive frame restarts when another
+        #: frame has used the shared targets in between)
+        self.frames_recorded = 0
         self._own_device = device is None
         self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
         self._closed = False
@@ -652,7 +658,7 @@ class Renderer:
         f[40:44] = (near, far, RENDER_VISIBILITY_EPS_RADII, RENDER_LOWPASS_RADIUS_PX)
         f[44:48] = RENDER_TINT_SUPPORT
         f[48:52] = RENDER_TINT_HANDLE
-        f[52:56] = (*self.background[:3], 1.0)
+        f[52:56] = (*self.background[:3], self.background_alpha)
         f[56:60] = RENDER_LIGHT
         f[60:64] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
                     min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
@@ -781,6 +787,7 @@ class Renderer:
                 cb.draw(1, self.n)
 
     def _record_passes_12(self, cb, t: _Targets, attr_final: str):
+        self.frames_recorded += 1
         cb.timestamp(self._query, 0, bottom=False)
         prepared = self._use_prepass()
         if prepared:
