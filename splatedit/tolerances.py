@@ -504,3 +504,8 @@ ORIENT_SAFE_ANGLE_DEG = 10.0
 #: splats; chunks of 1M keep the per-submit overhead (one fence wait, ~1 ms)
 #: negligible next to the 36 MB copy
 RENDER_UPLOAD_CHUNK_SPLATS = 1 << 20
+#: LodPyramid(background=True): the preview level is clustered from an evenly
+#: strided sample of this many splats.  A 1M-splat pyramid takes 0.6-1.3 s
+#: here (load 5-7), 10M 7-9 s; the preview of a 10M cloud is one 1M-sample
+#: level, so the editor's first image comes after ~1 s instead of ~9 s
+LOD_PREVIEW_SAMPLE_SPLATS = 1_000_000

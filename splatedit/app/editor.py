@@ -235,7 +235,7 @@ class Editor:
         if self.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
             def work(progress):
                 from splatedit.model.lod import LodPyramid
-                return LodPyramid(cloud, progress=progress)
+                return LodPyramid(cloud, progress=progress, background=True)   # preview first
             self.jobs["lod"] = Job("levels of detail", work, self.wake)
         self.tools.prepare(cloud)
         self.say(f"loaded {self.cloud_name}: {cloud.n:,} splats")

@@ -21,13 +21,14 @@ number of splats the device can draw within a frame-time budget.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
-from splatedit.tolerances import EDITOR_LOD_CELL_FACTOR, EDITOR_LOD_MIN_CELL_REL
+from splatedit.tolerances import EDITOR_LOD_CELL_FACTOR, EDITOR_LOD_MIN_CELL_REL, LOD_PREVIEW_SAMPLE_SPLATS
 
 PROGRESS_STAGE = "building levels of detail"
 #: default splat budgets of the coarser levels (levels with more than half of
@@ -44,13 +45,14 @@ class LodLevel:
     Attributes:
         cloud: the level's splats (representatives with enlarged axes).
         rep: (m,) int64, full-cloud index of each level splat's representative.
-        cluster: (n,) int64, level splat index of every full-cloud splat.
+        cluster: (n,) int64, level splat index of every full-cloud splat
+            (None for a preview level, see :class:`LodPyramid`).
         cell: voxel size used.
         scale: (m,) enlargement factors of the axes.
     """
     cloud: SplatCloud
     rep: np.ndarray
-    cluster: np.ndarray
+    cluster: np.ndarray | None
     cell: float
     scale: np.ndarray
 
@@ -213,28 +215,55 @@ def _compose(fine: LodLevel, coarse: LodLevel, source: SplatCloud) -> LodLevel:
 
 
 class LodPyramid:
-    """Coarser levels of a cloud, finest first (the full cloud is not a level)."""
+    """Coarser levels of a cloud, finest first (the full cloud is not a level).
 
-    def __init__(self, cloud: SplatCloud, budgets=DEFAULT_BUDGETS, progress=None):
+    With ``background=True`` and a cloud of more than
+    ``LOD_PREVIEW_SAMPLE_SPLATS`` splats the constructor returns after a
+    *preview*: one coarse level clustered from an evenly strided sample of
+    that many splats (about 1 s instead of ~1 s per million splats), and the
+    real levels are built in a daemon thread that replaces :attr:`levels`
+    when done (:attr:`ready` is set then; :meth:`wait` joins it).  The
+    preview's representatives are splats of the cloud and its enlargement
+    covers the sampled members (``cluster`` is None: the other splats are not
+    assigned), so it may leave pinholes where the full levels do not (with
+    ~20 sampled members per cluster, as for 10M splats and the 40k budget,
+    every centre of the cloud is covered in the test).
+    """
+
+    def __init__(self, cloud: SplatCloud, budgets=DEFAULT_BUDGETS, progress=None,
+                 background: bool = False):
         """Each level is clustered from the next finer level's splats (whose
         enlarged axes already cover their members), so a coarse level costs
         a fraction of clustering the full cloud; the cell size of the next
         level is predicted from the previous one (count ~ 1 / cell^2)."""
         self.source = cloud
         self.levels: list[LodLevel] = []
+        self.ready = threading.Event()
+        self._thread = None
+        #: the preview level (background builds only; kept after it is replaced)
+        self.preview: LodLevel | None = None
         budgets = sorted((b for b in budgets if b <= cloud.n // 2), reverse=True)
-        prev, cell = None, None
-        for i, b in enumerate(budgets):
-            report(progress, PROGRESS_STAGE, i / max(len(budgets), 1))
-            if prev is not None:
-                cell = prev.cell * math.sqrt(prev.n / b) * 1.02
-            base = cloud if prev is None else prev.cloud
-            lvl = level_for_budget(base, b, cell=cell)
-            if prev is not None:
-                lvl = _compose(prev, lvl, cloud)
-            self.levels.append(lvl)
-            prev = lvl
-        report(progress, PROGRESS_STAGE, 1.0)
+        if background and budgets and cloud.n > LOD_PREVIEW_SAMPLE_SPLATS:
+            report(progress, PROGRESS_STAGE, 0.0)
+            self.preview = _preview_level(cloud, budgets[-1])
+            self.levels = [self.preview]
+            self._thread = threading.Thread(target=self._build_background, args=(budgets,),
+                                            name="splatedit-lod", daemon=True)
+            self._thread.start()
+            report(progress, PROGRESS_STAGE, 1.0)
+            return
+        self.levels = _build_levels(cloud, budgets, progress)
+        self.ready.set()
+
+    def _build_background(self, budgets) -> None:
+        try:
+            self.levels = _build_levels(self.source, budgets, None)   # one atomic swap
+        finally:
+            self.ready.set()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait for the background levels; True when they are in :attr:`levels`."""
+        return self.ready.wait(timeout)
 
     def level_for(self, max_splats: int) -> LodLevel | None:
         """The finest level with at most ``max_splats`` splats; None when the
@@ -245,3 +274,31 @@ class LodPyramid:
             if lvl.n <= max_splats:
                 return lvl
         return self.levels[-1]
+
+
+def _build_levels(cloud: SplatCloud, budgets, progress) -> list[LodLevel]:
+    levels: list[LodLevel] = []
+    prev, cell = None, None
+    for i, b in enumerate(budgets):
+        report(progress, PROGRESS_STAGE, i / max(len(budgets), 1))
+        if prev is not None:
+            cell = prev.cell * math.sqrt(prev.n / b) * 1.02
+        base = cloud if prev is None else prev.cloud
+        lvl = level_for_budget(base, b, cell=cell)
+        if prev is not None:
+            lvl = _compose(prev, lvl, cloud)
+        levels.append(lvl)
+        prev = lvl
+    report(progress, PROGRESS_STAGE, 1.0)
+    return levels
+
+
+def _preview_level(cloud: SplatCloud, budget: int) -> LodLevel:
+    """A level of at most ``budget`` splats clustered from every k-th splat
+    (about ``LOD_PREVIEW_SAMPLE_SPLATS`` of them); ``cluster`` is None."""
+    stride = max(1, cloud.n // LOD_PREVIEW_SAMPLE_SPLATS)
+    idx = np.arange(0, cloud.n, stride)
+    sample = _derived_cloud(cloud.positions[idx], cloud.u[idx], cloud.v[idx],
+                            None if cloud.colors is None else cloud.colors[idx], cloud.name)
+    lvl = level_for_budget(sample, budget)
+    return LodLevel(lvl.cloud, idx[lvl.rep], None, lvl.cell, lvl.scale)
