@@ -13,7 +13,7 @@ from splatedit.render.camera import Camera
 def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monkeypatch):
     """The bundled bunny (with colours) uploaded in chunks of 1000 splats, the
     last one partial: the device buffers hold exactly the float32 geometry and
-    the colours of a one-chunk upload, and the frames are identical."""
+    the colours of a one-chunk upload, and the frames agree."""
     import splatedit.render.renderer as rmod
     bunny = read(default_model_path())
     rng = np.random.default_rng(4)
@@ -32,4 +32,7 @@ def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monke
     assert np.array_equal(out[1][1], colors)
     expect = ((cloud.positions - renderer.origin) / renderer.scale).astype(np.float32)
     assert np.array_equal(out[1][0][:, :3], expect)
-    assert np.array_equal(out[0][2], out[1][2])
+    # the same buffers give the same frame up to the blending order of the
+    # pre-pass (its slots come from atomics): a rounding step of the fp16 sums
+    diff = np.abs(out[0][2].astype(int) - out[1][2].astype(int))
+    assert diff.max() <= 3 and diff.mean() < 0.05
