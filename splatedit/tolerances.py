@@ -509,3 +509,8 @@ RENDER_UPLOAD_CHUNK_SPLATS = 1 << 20
 #: here (load 5-7), 10M 7-9 s; the preview of a 10M cloud is one 1M-sample
 #: level, so the editor's first image comes after ~1 s instead of ~9 s
 LOD_PREVIEW_SAMPLE_SPLATS = 1_000_000
+#: orientation: only the safe edges to this many nearest neighbours form the
+#: BFS forest (the others join the MST phase, where most fall inside one
+#: piece and are dropped); halves the graph that connected_components and
+#: the BFS copy and transpose (measured below in docs/PERFORMANCE.md)
+ORIENT_FOREST_NEIGHBOURS = 4

@@ -38,7 +38,7 @@ from splatedit.model.spacing import nearest_neighbour_distances
 from splatedit.progress import report
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
                                   FALLBACK_SPLAT_RADIUS, MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
-                                  ORIENT_NEIGHBOURS, ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
+                                  ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS, ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
                                   OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS, SPACING_NEIGHBOUR,
                                   SPLAT_RADIUS_FACTOR)
 
@@ -179,6 +179,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree
     # 1. "safe" edges (normals within ORIENT_SAFE_ANGLE_DEG): any spanning
     #    forest of them orients its components; a BFS forest costs O(n).
     low = w < 1.0 - np.cos(np.radians(ORIENT_SAFE_ANGLE_DEG))
+    low[:, ORIENT_FOREST_NEIGHBOURS:] = False    # the farther safe edges go to the MST phase
     # the safe graph as CSR straight from the row-major k-NN table, with a
     # virtual root row n appended later (no COO sort)
     indptr = np.zeros(n + 2, dtype=np.int64)
