@@ -8,7 +8,13 @@
 * :func:`orient_normals` makes the signs consistent by propagating along the
   minimum spanning tree of the k-nearest-neighbour "Riemannian graph" with edge
   weight ``1 - |n_i . n_j|`` (Hoppe et al.): nearly parallel normals are
-  traversed first.  Each connected component is seeded at its highest point
+  traversed first.  In two levels, which Kruskal's order makes nearly the
+  same tree: edges to the ``ORIENT_FOREST_NEIGHBOURS`` nearest neighbours
+  whose normals are within ``ORIENT_SAFE_ANGLE_DEG`` (whose relative sign is
+  unambiguous) are joined first by a BFS forest, O(n), and the MST runs only
+  over the pieces that forest leaves, on the remaining edges between them
+  (the MST over all n k edges was 2 of the 3 seconds at 1M points).  Each
+  connected component is seeded at its highest point
   (largest z) whose normal is turned towards +z; on a closed surface the
   outward normal at the highest point *is* +z, so closed shapes come out
   outward-facing.  When that seed normal is nearly horizontal
@@ -138,14 +144,15 @@ def _seed_flips(pts, nrm, labels, ncomp):
 
 def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree | None = None,
                    neighbours=None, progress=None) -> np.ndarray:
-    """Consistently orient normals by MST propagation (Hoppe et al. 1992).
+    """Consistently orient normals by MST propagation (Hoppe et al. 1992),
+    after a BFS forest over the safe edges (see the module docstring).
 
     Args:
         points: (n, 3) float64 positions (model units).
         normals: (n, 3) float64 unit normals with arbitrary signs.
         k: neighbours per point in the Riemannian graph.
         tree: optional prebuilt ``cKDTree(points)``.
-        neighbours: optional (n, >= k + 1) int64 indices from :func:`knn`.
+        neighbours: optional (n, >= k + 1) integer indices from :func:`knn`.
     Returns:
         (n, 3) float64 normals, each equal to ``+-normals[i]``; every
         connected component of the k-NN graph is seeded at its highest point
