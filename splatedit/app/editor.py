@@ -263,7 +263,8 @@ class Editor:
             elif name == "lod":
                 self.viewport.set_pyramid(job.result)
                 counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
-                self.say(f"levels of detail ready ({counts} splats)")
+                more = "" if job.result.ready.is_set() else "; the finer ones are being built"
+                self.say(f"levels of detail ready ({counts} splats{more})")
             elif name == "save":
                 ply, script, pos = job.result
                 self.session.history.mark_saved(pos)
