@@ -68,6 +68,16 @@ def _parse_vec3(text: str, name: str) -> tuple[float, float, float]:
     return tuple(parts)  # type: ignore[return-value]
 
 
+def _positive_count(text: str) -> int:
+    try:
+        value = int(text.replace("_", ""))
+    except ValueError:
+        value = 0
+    if value < 1:
+        raise argparse.ArgumentTypeError(f"must be a positive whole number, got {text!r}")
+    return value
+
+
 # ------------------------------------------------------------------ commands
 def _sig(x, digits: int = 7) -> float | None:
     """``x`` rounded to ``digits`` significant digits (not decimals: a model
@@ -247,7 +257,9 @@ def _camera_from_args(args, cloud):
     from splatedit.render.camera import Camera
     w, h = args.size
     lo, hi = cloud.bounds()
-    rmax = float(cloud.radii.max())       # frames a single point by its splat
+    # frames a single point by its splat (the largest semi-axis; einsum: no (n,) norms)
+    rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
+                             np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
     # all centres in one point: look at the splat face-on (from +z it may be edge-on)
     direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
     base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)
@@ -400,8 +412,8 @@ def cmd_bench(args) -> int:
     if args.gaussians:
         if what != "render":
             raise ParameterError("--gaussians", f"applies to 'bench render', not 'bench {what}'")
-        what = "gaussians"
-    for line in run_bench(what, quick=args.quick, progress=args.progress):
+        what = "gaussian-render"
+    for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -480,6 +492,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
     s.add_argument("--gaussians", action="store_true",
                    help="with 'render': the Gaussian splatting renderer (100k and 1M Gaussians, both sorts)")
+    s.add_argument("--splats", type=_positive_count, nargs="+", metavar="N",
+                   help="point/splat counts of estimate, render, editor and the Gaussian benches "
+                        "(e.g. --splats 1000000 10000000)")
     s.set_defaults(func=cmd_bench)
     return p
 

@@ -632,3 +632,38 @@ GS_REF_BAD_SHARE = 0.01
 #: once the singular values are near 1, each early step halves a large one:
 #: 12 reaches float32 precision for stretches up to 100x
 GS_POLAR_ITERATIONS = 12
+# ---------------------------------------------------------------------------
+# Scan scale: estimation speed, levels of detail, rendering at 10M (issue 11, parts 4-6)
+# ---------------------------------------------------------------------------
+#: closed-form 3x3 eigenvectors (splatedit.model.pca): a row falls back to
+#: np.linalg.eigh when the largest cross product of two rows of A - lambda I
+#: is below this fraction of p^2 (p^2 ~ the squared eigenvalue spread; the
+#: cross product ~ (l1 - l3)(l2 - l3)), i.e. when l2 - l3 < ~3e-4 p and the
+#: closed form's smallest eigenvalue (error ~ sqrt(eps) p there) could tilt
+#: the vector by more than ~1e-5 rad.  Measured on the bunny sampled with 1M
+#: points: 0 of 1M rows fall back and the largest angle to eigh's vector is
+#: (see tests/model/test_pca.py) below 1e-6 rad
+EIGEN_CROSS_MIN_REL = 1e-3
+#: orientation (splatedit.model.estimate.orient_normals): k-NN edges whose two
+#: normals are within this angle are "safe" and oriented along any spanning
+#: forest of them (BFS, O(n)); Hoppe's MST then runs only over the pieces
+#: they form.  Kruskal over every k-NN edge took 2.0 of the 3.1 s of
+#: orientation at 1M points; with 10 degrees 95% of the bunny's k-NN edges
+#: are safe and the MST shrinks to (see the measurement in docs/PERFORMANCE.md)
+ORIENT_SAFE_ANGLE_DEG = 10.0
+#: Renderer.set_cloud uploads geometry and colours through one staging
+#: buffer of this many splats (36 MB of float32 geometry).  The whole-cloud
+#: float32 array + whole-cloud staging buffer it replaces cost 720 MB at 10M
+#: splats; chunks of 1M keep the per-submit overhead (one fence wait, ~1 ms)
+#: negligible next to the 36 MB copy
+RENDER_UPLOAD_CHUNK_SPLATS = 1 << 20
+#: LodPyramid(background=True): the preview level is clustered from an evenly
+#: strided sample of this many splats.  A 1M-splat pyramid takes 0.6-1.3 s
+#: here (load 5-7), 10M 7-9 s; the preview of a 10M cloud is one 1M-sample
+#: level, so the editor's first image comes after ~1 s instead of ~9 s
+LOD_PREVIEW_SAMPLE_SPLATS = 1_000_000
+#: orientation: only the safe edges to this many nearest neighbours form the
+#: BFS forest (the others join the MST phase, where most fall inside one
+#: piece and are dropped); halves the graph that connected_components and
+#: the BFS copy and transpose (measured below in docs/PERFORMANCE.md)
+ORIENT_FOREST_NEIGHBOURS = 4

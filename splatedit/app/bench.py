@@ -203,3 +203,65 @@ def main() -> None:  # pragma: no cover - manual runs
 
 if __name__ == "__main__":  # pragma: no cover
     main()
+
+
+def bench_editor_first_image(n: int, size=(1280, 720), frames: int = 4, budget_ms: float = 100.0,
+                             full_frame_max: int = 2_000_000) -> dict:
+    """What opening an ``n``-splat model costs before the first image, and the
+    frame rate while moving, through the editor's :class:`Viewport`.
+
+    ``first_image_s``: level-of-detail preview (``LodPyramid(background=True)``,
+    as the editor builds it) + upload of the level + its first frame (the
+    editor shows the level while the full-quality frame is drawn in the
+    background), after the cloud is in memory (reading the file is ``bench
+    io``'s); ``lod_all_levels_s``: until the real levels replaced the preview
+    (about, as the orbit frames share the CPU); ``moving_fps``: orbiting
+    frames (interactive: the level that fits ``budget_ms``, possibly still the
+    preview); ``full_frame_s``: one full-quality frame (the background
+    refinement; measured up to ``full_frame_max`` splats).
+    """
+    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.viewport import Viewport
+    from splatedit.model.lod import LodPyramid
+    from splatedit.render.renderer import Renderer
+    from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT
+
+    w, h = size
+    cloud = bunny_surface_cloud(int(n))
+    vp = Viewport(budget_ms=budget_ms, renderer=Renderer(validation=False))
+    try:
+        t0 = time.perf_counter()
+        vp.set_cloud(cloud)
+        vp.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, w * h)      # as the editor does on opening
+        pyr = LodPyramid(cloud, background=True)             # as the editor: preview first
+        lod_s = time.perf_counter() - t0
+        vp.set_pyramid(pyr)
+        cam = OrbitCamera(scene_radius=cloud.diagonal / 2, yaw=0.3, pitch=0.2)
+        lo, hi = cloud.bounds()
+        cam.frame((lo + hi) / 2, cloud.diagonal / 2, w / h)
+        vp.render(cam, w, h, interactive=True)
+        first = time.perf_counter() - t0
+        first_splats = vp.last_info["splats"]
+        ms = []
+        for _ in range(frames):
+            cam.orbit(15, 0)
+            t1 = time.perf_counter()
+            vp.render(cam, w, h, interactive=True)
+            ms.append((time.perf_counter() - t1) * 1e3)
+        t1 = time.perf_counter()
+        pyr.wait()
+        levels_s = lod_s + time.perf_counter() - t1 + sum(ms) / 1e3
+        out = {"case": "editor_first_image", "splats": cloud.n, "width": w, "height": h,
+               "first_image_s": round(first, 2), "lod_preview_s": round(lod_s, 2),
+               "lod_all_levels_s": round(levels_s, 2),
+               "first_image_splats": int(first_splats),
+               "moving_fps": round(1000.0 / float(np.median(ms)), 1),
+               "moving_splats": int(vp.last_info["splats"]),
+               "moving_resolution_divisor": int(vp.last_info["div"])}
+        if cloud.n <= full_frame_max:
+            t1 = time.perf_counter()
+            vp.render(cam, w, h)
+            out["full_frame_s"] = round(time.perf_counter() - t1, 2)
+        return out
+    finally:
+        vp.close()

@@ -143,7 +143,7 @@ def on_loaded(ed, cloud) -> None:
     if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
             from splatedit.model.lod import LodPyramid
-            return LodPyramid(cloud, progress=progress)
+            return LodPyramid(cloud, progress=progress, background=True)   # preview first
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
     ed.brush.tools.prepare(cloud)
     ed.say(f"loaded {ed.cloud_name}: {cloud.n:,} splats (up axis {ed.camera.up.label}, "
@@ -173,7 +173,8 @@ def poll_jobs(ed) -> None:
         elif name == "lod":
             ed.viewport.set_pyramid(job.result)
             counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
-            ed.say(f"levels of detail ready ({counts} splats)")
+            more = "" if job.result.ready.is_set() else "; the finer ones are being built"
+            ed.say(f"levels of detail ready ({counts} splats{more})")
         elif name == "save":
             ply, script, pos = job.result
             ed.session.history.mark_saved(pos)

@@ -11,7 +11,7 @@ from __future__ import annotations
 from typing import Iterator
 
 
-def _solve(quick: bool, progress=None) -> Iterator[dict]:
+def _solve(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.solve import bench_solve, standard_cases
     for name, cloud, support, handles in standard_cases(large=not quick):
         if quick and cloud.n > 300_000:
@@ -21,7 +21,7 @@ def _solve(quick: bool, progress=None) -> Iterator[dict]:
         yield out
 
 
-def _groups(quick: bool, progress=None) -> Iterator[dict]:
+def _groups(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
         from splatedit.bench.solve import bench_groups
     except ImportError:
@@ -30,42 +30,49 @@ def _groups(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "groups", **line}
 
 
-def _qr(quick: bool, progress=None) -> Iterator[dict]:
+def _qr(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.qr import bench_qr
     for m in ((500, 1000) if quick else (1000, 3000, 5000)):
         yield {"bench": "qr", **bench_qr(m, repeat=1 if quick else 3)}
 
 
-def _render(quick: bool, progress=None) -> Iterator[dict]:
+def _render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.render import bench_render
-    counts = (20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000)
+    counts = counts or ((20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000))
     size = (640, 360) if quick else (1280, 720)
-    yield from bench_render(counts=counts, size=size)
+    # the per-pass/point-floor/deformation cases hold a full basis: up to 2M
+    yield from bench_render(counts=[n for n in counts if n <= 2_000_000], size=size)
+    from splatedit.bench.scale import bench_upload_lod
+    for n in counts:
+        yield {"bench": "render", **bench_upload_lod(int(n), size=size)}
 
 
-def _gaussians(quick: bool, progress=None) -> Iterator[dict]:
+def _gaussian_render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.gs_render import bench_gaussians
-    yield from bench_gaussians(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
+    yield from bench_gaussians(counts=counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)),
                                size=(640, 360) if quick else (1280, 720))
 
 
-def _editor(quick: bool, progress=None) -> Iterator[dict]:
+def _editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
         from splatedit.app.bench import bench_editor_frames
     except ImportError:
         return
-    counts = (100_000,) if quick else (100_000, 1_000_000, 2_000_000)
-    for line in bench_editor_frames(counts=counts):
+    counts = counts or ((100_000,) if quick else (100_000, 1_000_000, 2_000_000))
+    for line in bench_editor_frames(counts=[n for n in counts if n <= 2_000_000]):
         yield {"bench": "editor", **line}
+    from splatedit.app.bench import bench_editor_first_image
+    for n in counts:
+        yield {"bench": "editor", **bench_editor_first_image(int(n))}
 
 
-def _closure(quick: bool, progress=None) -> Iterator[dict]:
+def _closure(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.closure import bench_closure
     yield from bench_closure(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
                              repeats=2 if quick else 3)
 
 
-def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
+def _accuracy(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.accuracy import accuracy_cases, bench_accuracy
     for name, cloud, support, handles in accuracy_cases(large=False):
         if quick and cloud.n > 100_000:
@@ -73,20 +80,26 @@ def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
 
 
-def _detail(quick: bool, progress=None) -> Iterator[dict]:
+def _detail(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.detail import bench_detail
     yield from bench_detail(sizes=((200, 200), (500, 500)) if quick else ((300, 300), (1000, 1000)))
 
 
-def _gui(quick: bool, progress=None) -> Iterator[dict]:
+def _gui(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.gui import bench_gui
     yield from bench_gui(size=(640, 360) if quick else (1280, 720), repeats=10 if quick else 30)
 
 
-def _gaussians(quick: bool, progress=None) -> Iterator[dict]:
+def _gaussians(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.gaussians import bench_gaussian_deform
-    for n in ((20_000, 100_000) if quick else (100_000, 1_000_000)):
+    for n in counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)):
         yield bench_gaussian_deform(n, repeat=1 if quick else 3)
+
+
+def _estimate(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.estimate import bench_estimate
+    for line in bench_estimate(counts or ((100_000,) if quick else (1_000_000,))):
+        yield {"bench": "estimate", **line}
 
 
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
@@ -98,14 +111,18 @@ BENCHES = {
     "closure": _closure,
     "render": _render,
     "editor": _editor,
+    "estimate": _estimate,
     "detail": _detail,
     "gui": _gui,
     "gaussians": _gaussians,
+    "gaussian-render": _gaussian_render,
 }
 
 
-def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
-    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all")."""
+def run_bench(what: str, *, quick: bool = False, progress=None, counts=None) -> Iterator[dict]:
+    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
+    ``counts``: splat/point counts for ``estimate``, ``render`` and ``editor``
+    (default: each benchmark's own)."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
-        yield from BENCHES[name](quick, progress)
+        yield from BENCHES[name](quick, progress, counts)

@@ -21,13 +21,14 @@ number of splats the device can draw within a frame-time budget.
 from __future__ import annotations
 
 import math
+import threading
 from dataclasses import dataclass
 
 import numpy as np
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
-from splatedit.tolerances import EDITOR_LOD_CELL_FACTOR, EDITOR_LOD_MIN_CELL_REL
+from splatedit.tolerances import EDITOR_LOD_CELL_FACTOR, EDITOR_LOD_MIN_CELL_REL, LOD_PREVIEW_SAMPLE_SPLATS
 
 PROGRESS_STAGE = "building levels of detail"
 #: default splat budgets of the coarser levels (levels with more than half of
@@ -44,13 +45,14 @@ class LodLevel:
     Attributes:
         cloud: the level's splats (representatives with enlarged axes).
         rep: (m,) int64, full-cloud index of each level splat's representative.
-        cluster: (n,) int64, level splat index of every full-cloud splat.
+        cluster: (n,) int64, level splat index of every full-cloud splat
+            (None for a preview level, see :class:`LodPyramid`).
         cell: voxel size used.
         scale: (m,) enlargement factors of the axes.
     """
     cloud: SplatCloud
     rep: np.ndarray
-    cluster: np.ndarray
+    cluster: np.ndarray | None
     cell: float
     scale: np.ndarray
 
@@ -82,50 +84,98 @@ class LodLevel:
                           self.cloud.colors, None, name=self.cloud.name)
 
 
-def _cluster(positions: np.ndarray, cell: float) -> tuple[np.ndarray, int]:
-    lo = positions.min(axis=0)
-    q = np.floor((positions - lo) / cell).astype(np.int64)
-    dims = q.max(axis=0) + 1
-    key = (q[:, 0] * dims[1] + q[:, 1]) * dims[2] + q[:, 2]
-    _, inv = np.unique(key, return_inverse=True)
-    return inv.ravel(), int(inv.max()) + 1
+def _voxel_keys(positions: np.ndarray, cell: float, lo: np.ndarray | None = None,
+                hi: np.ndarray | None = None) -> np.ndarray:
+    """(n,) int64 voxel index of every (n, 3) position on a grid of ``cell``
+    anchored at ``lo`` (the bounding box ``lo``, ``hi``; computed when not given)."""
+    if lo is None or hi is None:
+        lo, hi = positions.min(axis=0), positions.max(axis=0)
+    dims = np.floor((hi - lo) / cell).astype(np.int64) + 1
+    key = np.zeros(len(positions), dtype=np.int64)
+    for j in range(3):
+        q = np.floor((positions[:, j] - lo[j]) / cell).astype(np.int64)
+        np.clip(q, 0, dims[j] - 1, out=q)
+        key *= dims[j]
+        key += q
+    return key
 
 
-def build_level(cloud: SplatCloud, cell: float) -> LodLevel:
-    """Cluster ``cloud`` on a grid of ``cell`` and build the covering level."""
+def _count_cells(positions: np.ndarray, cell: float, lo=None, hi=None) -> int:
+    """Number of occupied voxels (= level splats) for grid ``cell``."""
+    key = np.sort(_voxel_keys(positions, cell, lo, hi))
+    return int(np.count_nonzero(key[1:] != key[:-1])) + 1 if len(key) else 0
+
+
+def _derived_cloud(positions, u, v, colors, name: str) -> SplatCloud:
+    """A level's SplatCloud without re-running :meth:`SplatCloud.validate`
+    (0.6 s of a 1M-splat pyramid build).  Safe by construction: every level
+    splat is a splat of a validated cloud (finite, non-degenerate, axes not
+    parallel) with both axes scaled by the same k in [1, MAX_ENLARGE], and
+    the level's bounding box lies inside the source's, so the axis-length
+    floor relative to the diagonal still holds."""
+    out = object.__new__(SplatCloud)
+    out.positions, out.u, out.v, out.colors = positions, u, v, colors
+    out.faces, out.name, out.source = None, name, None
+    return out
+
+
+def _rows_dot(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    return np.einsum("ij,ij->i", a, b)
+
+
+def build_level(cloud: SplatCloud, cell: float, bounds=None) -> LodLevel:
+    """Cluster ``cloud`` on a grid of ``cell`` and build the covering level.
+
+    The splats are sorted by voxel once; every cluster is then a contiguous
+    run, so the per-member work is sequential (``np.repeat`` of per-cluster
+    values, ``reduceat`` over runs) instead of random gathers: 1M splats in
+    about a third of the time of the gather version.
+    """
     p, u, v = cloud.positions, cloud.u, cloud.v
     n = len(p)
-    inv, m = _cluster(p, cell)
-    counts = np.bincount(inv, minlength=m).astype(np.float64)
-    cen = np.stack([np.bincount(inv, weights=p[:, k], minlength=m) for k in range(3)], 1) / counts[:, None]
-    d2 = ((p - cen[inv]) ** 2).sum(1)
-    order = np.lexsort((d2, inv))
+    key = _voxel_keys(p, cell, *(bounds or (None, None)))
+    order = np.argsort(key)
+    ks = key[order]
+    del key
     first = np.ones(n, bool)
-    first[1:] = inv[order][1:] != inv[order][:-1]
-    rep = order[first]                      # sorted by cluster id
+    first[1:] = ks[1:] != ks[:-1]
+    del ks
+    starts = np.flatnonzero(first)
+    counts = np.diff(np.append(starts, n))
+    group = np.cumsum(first) - 1                          # cluster of every sorted member
+    ps = p[order]
+    cen = np.add.reduceat(ps, starts, axis=0) / counts[:, None]
+    d = ps - np.repeat(cen, counts, axis=0)
+    d2 = _rows_dot(d, d)
+    near = d2 == np.repeat(np.minimum.reduceat(d2, starts), counts)
+    cand = np.flatnonzero(near)                           # closest members (ties: first)
+    keep = np.ones(len(cand), bool)
+    keep[1:] = group[cand[1:]] != group[cand[:-1]]
+    rep = order[cand[keep]]                               # (m,) in cluster order
     # enlargement: member centres in the representative's (u, v) frame
-    ru, rv = u[rep][inv], v[rep][inv]
-    d = p - p[rep][inv]
-    uu = (ru * ru).sum(1)
-    vv = (rv * rv).sum(1)
-    uv = (ru * rv).sum(1)
-    du = (d * ru).sum(1)
-    dv = (d * rv).sum(1)
+    ru, rv = u[rep], v[rep]
+    uu, vv, uv = _rows_dot(ru, ru), _rows_dot(rv, rv), _rows_dot(ru, rv)
     det = uu * vv - uv * uv
-    s = (du * vv - dv * uv) / det
-    t = (dv * uu - du * uv) / det
+    d = ps - np.repeat(p[rep], counts, axis=0)
+    del ps
+    du = _rows_dot(d, np.repeat(ru, counts, axis=0))
+    dv = _rows_dot(d, np.repeat(rv, counts, axis=0))
+    del d
+    c = np.repeat(det, counts)
+    s = (du * np.repeat(vv, counts) - dv * np.repeat(uv, counts)) / c
+    t = (dv * np.repeat(uu, counts) - du * np.repeat(uv, counts)) / c
     ell = np.sqrt(s * s + t * t)
-    rmem = np.maximum(np.linalg.norm(u, axis=1), np.linalg.norm(v, axis=1))
-    rmin = np.minimum(np.sqrt(uu), np.sqrt(vv))
-    need = ell + rmem / rmin
-    starts = np.flatnonzero(first)             # group starts in ``order`` (sorted by cluster)
-    k = np.maximum.reduceat(need[order], starts)
+    rmem = np.sqrt(np.maximum(_rows_dot(u, u), _rows_dot(v, v)))[order]
+    rmin = np.sqrt(np.minimum(uu, vv))
+    need = ell + rmem / np.repeat(rmin, counts)
+    k = np.maximum.reduceat(need, starts)
     k = np.clip(k, 1.0, MAX_ENLARGE)
     k[counts == 1] = 1.0
+    inv = np.empty(n, dtype=np.int64)
+    inv[order] = group
     colors = None if cloud.colors is None else cloud.colors[rep]
-    lvl_cloud = SplatCloud(p[rep], u[rep] * k[:, None], v[rep] * k[:, None], colors, None,
-                           name=cloud.name)
-    return LodLevel(lvl_cloud, rep.astype(np.int64), inv.astype(np.int64), float(cell), k)
+    lvl_cloud = _derived_cloud(p[rep], ru * k[:, None], rv * k[:, None], colors, cloud.name)
+    return LodLevel(lvl_cloud, rep.astype(np.int64), inv, float(cell), k)
 
 
 def level_for_budget(cloud: SplatCloud, budget: int, max_iter: int = 12,
@@ -146,13 +196,14 @@ def level_for_budget(cloud: SplatCloud, budget: int, max_iter: int = 12,
         area = float(np.median(disc)) * cloud.n / 2.0
         cell = EDITOR_LOD_CELL_FACTOR * math.sqrt(max(area, 1e-30) / max(budget, 1))
     cell = max(cell, float(np.linalg.norm(ext)) * EDITOR_LOD_MIN_CELL_REL)
-    level = build_level(cloud, cell)
+    # retries only count occupied voxels (one sort); the level is built once
+    count = _count_cells(cloud.positions, cell, lo, hi)
     it = 0
-    while level.n > budget and it < max_iter:
-        cell *= max(math.sqrt(level.n / budget) * 1.02, 1.05)
-        level = build_level(cloud, cell)
+    while count > budget and it < max_iter:
+        cell *= max(math.sqrt(count / budget) * 1.02, 1.05)
+        count = _count_cells(cloud.positions, cell, lo, hi)
         it += 1
-    return level
+    return build_level(cloud, cell, (lo, hi))
 
 
 def _compose(fine: LodLevel, coarse: LodLevel, source: SplatCloud) -> LodLevel:
@@ -164,28 +215,55 @@ def _compose(fine: LodLevel, coarse: LodLevel, source: SplatCloud) -> LodLevel:
 
 
 class LodPyramid:
-    """Coarser levels of a cloud, finest first (the full cloud is not a level)."""
+    """Coarser levels of a cloud, finest first (the full cloud is not a level).
 
-    def __init__(self, cloud: SplatCloud, budgets=DEFAULT_BUDGETS, progress=None):
+    With ``background=True`` and a cloud of more than
+    ``LOD_PREVIEW_SAMPLE_SPLATS`` splats the constructor returns after a
+    *preview*: one coarse level clustered from an evenly strided sample of
+    that many splats (about 1 s instead of ~1 s per million splats), and the
+    real levels are built in a daemon thread that replaces :attr:`levels`
+    when done (:attr:`ready` is set then; :meth:`wait` joins it).  The
+    preview's representatives are splats of the cloud and its enlargement
+    covers the sampled members (``cluster`` is None: the other splats are not
+    assigned), so it may leave pinholes where the full levels do not (with
+    ~20 sampled members per cluster, as for 10M splats and the 40k budget,
+    every centre of the cloud is covered in the test).
+    """
+
+    def __init__(self, cloud: SplatCloud, budgets=DEFAULT_BUDGETS, progress=None,
+                 background: bool = False):
         """Each level is clustered from the next finer level's splats (whose
         enlarged axes already cover their members), so a coarse level costs
         a fraction of clustering the full cloud; the cell size of the next
         level is predicted from the previous one (count ~ 1 / cell^2)."""
         self.source = cloud
         self.levels: list[LodLevel] = []
+        self.ready = threading.Event()
+        self._thread = None
+        #: the preview level (background builds only; kept after it is replaced)
+        self.preview: LodLevel | None = None
         budgets = sorted((b for b in budgets if b <= cloud.n // 2), reverse=True)
-        prev, cell = None, None
-        for i, b in enumerate(budgets):
-            report(progress, PROGRESS_STAGE, i / max(len(budgets), 1))
-            if prev is not None:
-                cell = prev.cell * math.sqrt(prev.n / b) * 1.02
-            base = cloud if prev is None else prev.cloud
-            lvl = level_for_budget(base, b, cell=cell)
-            if prev is not None:
-                lvl = _compose(prev, lvl, cloud)
-            self.levels.append(lvl)
-            prev = lvl
-        report(progress, PROGRESS_STAGE, 1.0)
+        if background and budgets and cloud.n > LOD_PREVIEW_SAMPLE_SPLATS:
+            report(progress, PROGRESS_STAGE, 0.0)
+            self.preview = _preview_level(cloud, budgets[-1])
+            self.levels = [self.preview]
+            self._thread = threading.Thread(target=self._build_background, args=(budgets,),
+                                            name="splatedit-lod", daemon=True)
+            self._thread.start()
+            report(progress, PROGRESS_STAGE, 1.0)
+            return
+        self.levels = _build_levels(cloud, budgets, progress)
+        self.ready.set()
+
+    def _build_background(self, budgets) -> None:
+        try:
+            self.levels = _build_levels(self.source, budgets, None)   # one atomic swap
+        finally:
+            self.ready.set()
+
+    def wait(self, timeout: float | None = None) -> bool:
+        """Wait for the background levels; True when they are in :attr:`levels`."""
+        return self.ready.wait(timeout)
 
     def level_for(self, max_splats: int) -> LodLevel | None:
         """The finest level with at most ``max_splats`` splats; None when the
@@ -196,3 +274,31 @@ class LodPyramid:
             if lvl.n <= max_splats:
                 return lvl
         return self.levels[-1]
+
+
+def _build_levels(cloud: SplatCloud, budgets, progress) -> list[LodLevel]:
+    levels: list[LodLevel] = []
+    prev, cell = None, None
+    for i, b in enumerate(budgets):
+        report(progress, PROGRESS_STAGE, i / max(len(budgets), 1))
+        if prev is not None:
+            cell = prev.cell * math.sqrt(prev.n / b) * 1.02
+        base = cloud if prev is None else prev.cloud
+        lvl = level_for_budget(base, b, cell=cell)
+        if prev is not None:
+            lvl = _compose(prev, lvl, cloud)
+        levels.append(lvl)
+        prev = lvl
+    report(progress, PROGRESS_STAGE, 1.0)
+    return levels
+
+
+def _preview_level(cloud: SplatCloud, budget: int) -> LodLevel:
+    """A level of at most ``budget`` splats clustered from every k-th splat
+    (about ``LOD_PREVIEW_SAMPLE_SPLATS`` of them); ``cluster`` is None."""
+    stride = max(1, cloud.n // LOD_PREVIEW_SAMPLE_SPLATS)
+    idx = np.arange(0, cloud.n, stride)
+    sample = _derived_cloud(cloud.positions[idx], cloud.u[idx], cloud.v[idx],
+                            None if cloud.colors is None else cloud.colors[idx], cloud.name)
+    lvl = level_for_budget(sample, budget)
+    return LodLevel(lvl.cloud, idx[lvl.rep], None, lvl.cell, lvl.scale)

@@ -45,8 +45,9 @@ def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None 
         neighbours: optional (n, >= k) int64 indices of a k-NN query that
             includes the point itself (:func:`splatedit.model.estimate.knn`).
     Returns:
-        (n, k - 1) int64 indices; the point itself is left out even when
-        duplicates of it came first.
+        (n, k - 1) integer indices (int64, or the dtype of ``neighbours``:
+        int32 from a compact :func:`knn`); the point itself is left out even
+        when duplicates of it came first.
     """
     pts = np.asarray(points, dtype=np.float64)
     n = len(pts)
@@ -57,7 +58,9 @@ def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None 
         step = 8 * ESTIMATE_CHUNK_POINTS
         for lo in range(0, n, step):
             neighbours[lo:lo + step] = tree.query(pts[lo:lo + step], k=k, workers=-1)[1]
-    idx = np.asarray(neighbours[:, :k], dtype=np.int64)
+    idx = np.asarray(neighbours[:, :k])
+    if idx.dtype.kind not in "iu":
+        idx = idx.astype(np.int64)
     out = idx[:, 1:].copy()                      # the usual case: the point itself comes first
     odd = np.flatnonzero(idx[:, 0] != np.arange(n))
     if len(odd):                                 # a duplicate came first: drop the point's own entry

@@ -31,7 +31,7 @@ from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDE
                                   RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
                                   RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
-                                  RENDER_VISIBILITY_EPS_RADII)
+                                  RENDER_UPLOAD_CHUNK_SPLATS, RENDER_VISIBILITY_EPS_RADII)
 
 #: per-splat flag bits (shaders_glsl/frame.glsl)
 FLAG_SUPPORT = 1
@@ -244,6 +244,12 @@ class Renderer:
         self.grey_shading = False
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
+        #: alpha of background pixels in the output (0: uncovered pixels are
+        #: told apart, as :mod:`splatedit.render.progressive` does)
+        self.background_alpha = 1.0
+        #: frames recorded so far (a progressive frame restarts when another
+        #: frame has used the shared targets in between)
+        self.frames_recorded = 0
         self._own_device = device is None
         self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
         self._closed = False
@@ -366,26 +372,21 @@ class Renderer:
         n = cloud.n
         lo, hi = cloud.bounds()
         self.origin = 0.5 * (lo + hi)
-        r = cloud.radii
-        self._radii = r
+        # the largest semi-axis without the (n,) radii array (per-splat radii
+        # are computed for the basis rows only, in _basis_radii)
+        rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
+                                 np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
         #: undeformed bounds padded by the largest splat radius; near/far come
         #: from these grown by the deformation's reach (:meth:`_clip_bounds`)
-        self.bounds = (lo - r.max(), hi + r.max())
+        self.bounds = (lo - rmax, hi + rmax)
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
-        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), float(r.max()))
-        geom = np.empty((n, 9), dtype=np.float32)
-        geom[:, 0:3] = (cloud.positions - self.origin) / self.scale
-        geom[:, 3:6] = cloud.u / self.scale
-        geom[:, 6:9] = cloud.v / self.scale
-        colors = cloud.colors if cloud.colors is not None else np.tile(
-            np.asarray(RENDER_DEFAULT_COLOR, np.uint8), (n, 1))
-        self._geom = V.Buffer(self.dev, geom.nbytes, ("vertex", "storage"))
+        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), rmax)
+        self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self._geom)
-        self._geom.upload(geom)
         self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
         self._cloud_bufs.append(self._color)
-        self._color.upload(np.ascontiguousarray(colors, dtype=np.uint8))
+        self._upload_cloud(cloud)
         self._flags = V.Buffer(self.dev, 4 * n, ("vertex", "storage"), host_visible=True)
         self._cloud_bufs.append(self._flags)
         self._flags.view(np.uint32)[:] = 0
@@ -397,6 +398,37 @@ class Renderer:
         self._dC = np.zeros((4, 3))
         self._rot = None
         self._dC_dirty = True
+
+    def _upload_cloud(self, cloud: SplatCloud) -> None:
+        """Geometry (float32 centre - origin, u, v in GPU units) and colours
+        through one staging buffer of ``RENDER_UPLOAD_CHUNK_SPLATS`` splats:
+        no whole-cloud float32 copy and no whole-cloud staging buffer (at 10M
+        splats they were 360 MB each on top of the 360 MB device buffer)."""
+        n = cloud.n
+        chunk = min(n, RENDER_UPLOAD_CHUNK_SPLATS)
+        staging = V.Buffer(self.dev, chunk * _GEOM_STRIDE, ("transfer_src",), host_visible=True)
+        try:
+            inv = 1.0 / self.scale                   # an exact power of two
+            default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
+            for lo in range(0, n, chunk):
+                m = min(chunk, n - lo)
+                geom = staging.view(np.float32)[:9 * m].reshape(m, 9)
+                np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom[:, 0:3],
+                            casting="same_kind")
+                np.multiply(cloud.u[lo:lo + m], inv, out=geom[:, 3:6], casting="same_kind")
+                np.multiply(cloud.v[lo:lo + m], inv, out=geom[:, 6:9], casting="same_kind")
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
+                                                          lo * _GEOM_STRIDE))
+                col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
+                col[:] = default if cloud.colors is None else cloud.colors[lo:lo + m]
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
+        finally:
+            staging.destroy()
+
+    def _basis_radii(self, idx: np.ndarray) -> np.ndarray:
+        """(N,) float64 larger semi-axis of the splats ``idx`` (model units)."""
+        u, v = self.cloud.u[idx], self.cloud.v[idx]
+        return np.sqrt(np.maximum(np.einsum("ij,ij->i", u, u), np.einsum("ij,ij->i", v, v)))
 
     @property
     def _basis_groups(self) -> int:
@@ -513,7 +545,7 @@ class Renderer:
         if not len(idx):
             return 0.0
         grad = np.sqrt(Bx * Bx + By * By + Bz * Bz).sum(axis=1)
-        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._radii[idx] * grad
+        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._basis_radii(idx) * grad
         return float(per_row.max())
 
     def _clip_bounds(self):
@@ -696,7 +728,7 @@ class Renderer:
         u["depth_params"] = (near, far, RENDER_VISIBILITY_EPS_RADII, RENDER_LOWPASS_RADIUS_PX)
         u["tint_support"] = RENDER_TINT_SUPPORT
         u["tint_handle"] = RENDER_TINT_HANDLE
-        u["background"] = (*self.background[:3], 1.0)
+        u["background"] = (*self.background[:3], self.background_alpha)
         u["light"] = RENDER_LIGHT
         u["misc"] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
                      min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
@@ -839,6 +871,7 @@ class Renderer:
                 cb.draw(1, self.n)
 
     def _record_passes_12(self, cb, t: _Targets, attr_final: str):
+        self.frames_recorded += 1
         cb.timestamp(self._query, 0, bottom=False)
         prepared = self._use_prepass()
         if prepared:

@@ -88,3 +88,29 @@ def test_pyramid_levels_cover_the_full_cloud():
         assert np.allclose(lvl.cloud.u, c.u[lvl.rep] * lvl.scale[:, None])
         e = ellipse_norm(lvl.cloud, lvl.cluster, c.positions)
         assert np.percentile(e, 99) <= 1.0 and e.max() <= 1.3
+
+
+def test_background_pyramid_shows_a_covering_preview_then_the_real_levels(monkeypatch):
+    """background=True on a cloud above the preview sample size: the
+    constructor returns at once with a preview level (within the coarsest
+    budget, its splats are splats of the cloud, scaled), 99.9% of all splat
+    centres lie in one of the 16 nearest preview ellipses, and after wait()
+    the levels are those of a foreground build."""
+    import splatedit.model.lod as lod
+    from scipy.spatial import cKDTree
+    monkeypatch.setattr(lod, "LOD_PREVIEW_SAMPLE_SPLATS", 6000)
+    c = sphere_cloud(60000)
+    budgets = (20000, 6000, 300)              # ~20 sampled members per preview cluster
+    pyr = LodPyramid(c, budgets=budgets, background=True)
+    pre = pyr.preview
+    assert pre is not None and pre.cluster is None and 0 < pre.n <= 300
+    assert np.allclose(pre.cloud.positions, c.positions[pre.rep])
+    assert np.allclose(pre.cloud.u, c.u[pre.rep] * pre.scale[:, None])
+    _, near = cKDTree(pre.cloud.positions).query(c.positions, k=16)
+    inside = np.zeros(c.n, bool)
+    for j in range(16):
+        inside |= ellipse_norm(pre.cloud, near[:, j], c.positions) <= 1.0
+    assert inside.mean() >= 0.999
+    assert pyr.wait(60)
+    ref = LodPyramid(c, budgets=budgets)
+    assert [lvl.n for lvl in pyr.levels] == [lvl.n for lvl in ref.levels]

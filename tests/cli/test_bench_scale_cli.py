@@ -1,0 +1,42 @@
+"""``splatedit bench estimate|render|editor --splats N``: one JSON line per case."""
+
+from __future__ import annotations
+
+import json
+
+import pytest
+
+from splatedit.cli import main
+
+
+def _lines(capsys):
+    return [json.loads(x) for x in capsys.readouterr().out.splitlines() if x.strip()]
+
+
+def test_bench_estimate_reports_stages_and_full_orientation(capsys):
+    code = main(["bench", "estimate", "--splats", "30000"])
+    assert code == 0
+    (line,) = _lines(capsys)
+    assert line["bench"] == "estimate" and line["points"] == 30000
+    assert line["oriented"] == 1.0
+    stages = [line[k] for k in ("finding_s", "estimating_s", "orienting_s", "sizing_s")]
+    assert all(s >= 0 for s in stages) and sum(stages) <= line["total_s"] + 0.05
+    assert "open3d_normals_k16_s" in line or "not installed" in line.get("open3d", "")
+
+
+def test_bench_render_scale_line_has_upload_frame_and_lod(capsys):
+    from splatedit.bench.scale import bench_upload_lod
+    line = bench_upload_lod(120_000, size=(160, 90))
+    assert line["splats"] == 120_000
+    assert line["upload_s"] >= 0 and line["frame_gpu_ms"]["total"] > 0
+    assert line["lod_levels"] and max(line["lod_levels"]) <= 60_000
+    assert line["lod_frame_splats"] == line["lod_levels"][0]
+
+
+@pytest.mark.parametrize("bad", ["0", "-5", "ten"])
+def test_bench_splats_must_be_positive_counts(capsys, bad):
+    with pytest.raises(SystemExit) as exc:
+        main(["bench", "estimate", "--splats", bad])
+    assert exc.value.code == 2
+    err = capsys.readouterr().err
+    assert err.startswith("splatedit: error: bench: argument --splats") and "\n" == err[-1]
