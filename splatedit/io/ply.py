@@ -20,16 +20,19 @@ Written file layout (binary little endian by default)::
 
 from __future__ import annotations
 
+import os
+
 import numpy as np
 import plyfile
 
 from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
 from splatedit.io._plycheck import TYPES as _TYPES
-from splatedit.io._plycheck import check_declared_sizes, check_trailing, warn_trailing
+from splatedit.io._plycheck import binary_layout, check_declared_sizes, check_trailing, warn_trailing
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
+from splatedit.tolerances import PLY_READ_CHUNK_BYTES
 
 _NORMALS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
 _COLORS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
@@ -234,6 +237,103 @@ def _read_ascii_fast(path, progress):
     return vert, (flat, k, fprop)
 
 
+# --------------------------------------------------- fast binary reading
+
+def _shift_row(exc: InputError, lo: int) -> InputError:
+    """``exc`` (raised on a chunk) with its row made absolute."""
+    if exc.row is None:
+        return exc
+    return InputError(exc.reason, path=exc.path, element=exc.element, row=exc.row + lo,
+                      prop=exc.prop)
+
+
+def _read_binary_chunked(path, layout, progress) -> SplatCloud:
+    """Read a binary PLY holding only a vertex element of scalars (any
+    types, either byte order) through a ``PLY_READ_CHUNK_BYTES`` buffer:
+    each chunk is viewed as a structured array (``np.frombuffer`` with the
+    header's dtype), checked and converted into the arrays kept.  No
+    per-splat Python, no full-size temporary copy."""
+    body, n, dtype = layout
+    src = str(path)
+    names = set(dtype.names)
+    for p in ("x", "y", "z"):
+        if p not in names:
+            raise InputError(f"missing property {p!r} (need x, y and z)", path=src,
+                             element="vertex", prop=p)
+    if n == 0:
+        raise InputError("zero vertices: the file holds no points", path=src, element="vertex")
+    nn = next((t for t in _NORMALS if set(t) <= names), None)
+    have_axes = set(_AXES) <= names
+    cn = next((t for t in _COLORS if set(t[:3]) <= names), None)
+    use_c = [p for p in cn if p in names] if cn else []
+    int_colours = all(dtype[p].kind in "iu" for p in use_c)
+    checked = ["x", "y", "z"] + list(nn or ()) + (["radius"] if "radius" in names else []) \
+        + (list(_AXES) if have_axes else [])
+    out = {"positions": (np.empty((n, 3)), ("x", "y", "z"))}
+    if nn:
+        out["normals"] = (np.empty((n, 3)), nn)
+    if have_axes:
+        out["u"] = (np.empty((n, 3)), _AXES[:3])
+        out["v"] = (np.empty((n, 3)), _AXES[3:])
+    radius = np.empty(n) if "radius" in names else None
+    colors = raw_c = None
+    if use_c and int_colours:
+        colors = np.full((n, 4), 255, dtype=np.uint8)
+    elif use_c:
+        raw_c = np.empty((n, len(use_c)), dtype=np.result_type(*[dtype[p] for p in use_c]))
+    size = dtype.itemsize
+    rows = max(1, PLY_READ_CHUNK_BYTES // size)
+    buf = bytearray(min(rows, n) * size)
+    try:
+        fh = open(path, "rb")
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    with fh:
+        total = os.fstat(fh.fileno()).st_size
+        fh.seek(body)
+        for lo in range(0, n, rows):
+            hi = min(n, lo + rows)
+            want = (hi - lo) * size
+            view = memoryview(buf)[:want]
+            got = 0
+            while got < want:
+                k = fh.readinto(view[got:])
+                if not k:
+                    break
+                got += k
+            if got < want:
+                raise InputError("early end-of-file (the file is truncated or the header's "
+                                 "element count is wrong)", path=src, element="vertex",
+                                 row=lo + got // size)
+            rec = np.frombuffer(buf, dtype=dtype, count=hi - lo)
+            try:
+                check_finite({p: rec[p] for p in checked}, src)
+                if colors is not None:
+                    colors[lo:hi] = colors_from_columns([rec[p] for p in use_c], use_c, src)
+            except InputError as exc:
+                raise _shift_row(exc, lo) from None
+            for arr, cols in out.values():
+                for j, p in enumerate(cols):
+                    arr[lo:hi, j] = rec[p]
+            if radius is not None:
+                radius[lo:hi] = rec["radius"]
+            if raw_c is not None:
+                for j, p in enumerate(use_c):
+                    raw_c[lo:hi, j] = rec[p]
+            report(progress, "reading", 0.5 * hi / n)
+        del rec, view
+    extra = total - body - n * size
+    if extra > 0:
+        warn_trailing(path, f"{extra} byte(s)", n, None)
+    if raw_c is not None:
+        colors = colors_from_columns(list(raw_c.T), use_c, src)
+        del raw_c
+    report(progress, "reading", 1.0)
+    get = {k: a for k, (a, _) in out.items()}
+    return build_cloud(path, get["positions"], normals=get.get("normals"), radius=radius,
+                       u=get.get("u"), v=get.get("v"), colors=colors, progress=progress)
+
+
 def read_ply(path, *, progress=None) -> SplatCloud:
     """Read a PLY point cloud, splat cloud or mesh.
 
@@ -245,6 +345,9 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     """
     report(progress, "reading", 0.0)
     check_declared_sizes(path)
+    layout = binary_layout(path)
+    if layout is not None:
+        return _read_binary_chunked(path, layout, progress)
     fast = _read_ascii_fast(path, progress)
     if fast is not None:
         data, face_lists = fast
@@ -305,7 +408,7 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
         fields += [(p, "u1") for p in ("red", "green", "blue", "alpha")]
     arr = np.empty(cloud.n, dtype=fields)
     for j, p in enumerate("xyz"):
-        arr[p] = cloud.positions[:, j]
+        arr[p] = cloud.positions[:, j] + cloud.origin[j]
     if axes:
         nrm = cloud.normals
         for j, p in enumerate(("nx", "ny", "nz")):
