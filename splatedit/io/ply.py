@@ -407,8 +407,9 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
     if cloud.colors is not None:
         fields += [(p, "u1") for p in ("red", "green", "blue", "alpha")]
     arr = np.empty(cloud.n, dtype=fields)
+    world = cloud.world_positions()
     for j, p in enumerate("xyz"):
-        arr[p] = cloud.positions[:, j] + cloud.origin[j]
+        arr[p] = world[:, j]
     if axes:
         nrm = cloud.normals
         for j, p in enumerate(("nx", "ny", "nz")):

@@ -203,7 +203,10 @@ class SplatCloud:
         return float(np.linalg.norm(hi - lo))
 
     def world_positions(self, rows=slice(None)) -> np.ndarray:
-        """(m, 3) float64 centres in the file's frame (``positions + origin``)."""
+        """(m, 3) float64 centres in the file's frame (``positions + origin``;
+        the positions themselves when the origin is 0, so -0.0 stays -0.0)."""
+        if not self.origin.any():
+            return self.positions[rows]
         return self.positions[rows] + self.origin
 
     def _scan_fields(self, index=None) -> dict:
