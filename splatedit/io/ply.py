@@ -32,7 +32,7 @@ from splatedit.io._plycheck import binary_layout, check_declared_sizes, check_tr
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
-from splatedit.tolerances import PLY_READ_CHUNK_BYTES
+from splatedit.tolerances import MAX_COORDINATE_ABS, PLY_READ_CHUNK_BYTES
 
 _NORMALS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
 _COLORS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
@@ -247,12 +247,27 @@ def _shift_row(exc: InputError, lo: int) -> InputError:
                       prop=exc.prop)
 
 
+def _columns_view(buf, dtype, names, rows: int):
+    """(rows, k) view of ``k`` consecutive fields of one type in the record
+    buffer (one strided copy instead of k), or None when they are not
+    laid out that way."""
+    first = dtype.fields[names[0]]
+    t, off = first[0], first[1]
+    for j, nm in enumerate(names):
+        f = dtype.fields[nm]
+        if f[0] != t or f[1] != off + j * t.itemsize:
+            return None
+    return np.ndarray((rows, len(names)), dtype=t, buffer=buf, offset=off,
+                      strides=(dtype.itemsize, t.itemsize))
+
+
 def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     """Read a binary PLY holding only a vertex element of scalars (any
     types, either byte order) through a ``PLY_READ_CHUNK_BYTES`` buffer:
     each chunk is viewed as a structured array (``np.frombuffer`` with the
     header's dtype), checked and converted into the arrays kept.  No
-    per-splat Python, no full-size temporary copy."""
+    per-splat Python, no full-size temporary copy; the normals are not kept
+    when the file has our splat axes (they are ``u x v``)."""
     body, n, dtype = layout
     src = str(path)
     names = set(dtype.names)
@@ -270,12 +285,13 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     checked = ["x", "y", "z"] + list(nn or ()) + (["radius"] if "radius" in names else []) \
         + (list(_AXES) if have_axes else [])
     out = {"positions": (np.empty((n, 3)), ("x", "y", "z"))}
-    if nn:
-        out["normals"] = (np.empty((n, 3)), nn)
     if have_axes:
         out["u"] = (np.empty((n, 3)), _AXES[:3])
         out["v"] = (np.empty((n, 3)), _AXES[3:])
-    radius = np.empty(n) if "radius" in names else None
+    elif nn:
+        out["normals"] = (np.empty((n, 3)), nn)
+    if "radius" in names and not have_axes:
+        out["radius"] = (np.empty((n, 1)), ("radius",))
     colors = raw_c = None
     if use_c and int_colours:
         colors = np.full((n, 4), 255, dtype=np.uint8)
@@ -294,34 +310,45 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
         for lo in range(0, n, rows):
             hi = min(n, lo + rows)
             want = (hi - lo) * size
-            view = memoryview(buf)[:want]
             got = 0
-            while got < want:
-                k = fh.readinto(view[got:])
-                if not k:
-                    break
-                got += k
+            with memoryview(buf) as mv:
+                while got < want:
+                    k = fh.readinto(mv[got:want])
+                    if not k:
+                        break
+                    got += k
             if got < want:
                 raise InputError("early end-of-file (the file is truncated or the header's "
                                  "element count is wrong)", path=src, element="vertex",
                                  row=lo + got // size)
             rec = np.frombuffer(buf, dtype=dtype, count=hi - lo)
+            ok = True
+            for arr, cols in out.values():
+                view = _columns_view(buf, dtype, cols, hi - lo)
+                blk = arr[lo:hi]
+                if view is not None:
+                    blk[...] = view
+                else:
+                    for j, p in enumerate(cols):
+                        blk[:, j] = rec[p]
+                # NaN propagates through max/min: one test per block, the
+                # per-column search only when it fails
+                ok = ok and bool(blk.max() <= MAX_COORDINATE_ABS and blk.min() >= -MAX_COORDINATE_ABS)
+            if have_axes and nn:        # normals not kept, still checked
+                for p in nn:
+                    ok = ok and bool(np.abs(rec[p]).max() <= MAX_COORDINATE_ABS)
             try:
-                check_finite({p: rec[p] for p in checked}, src)
+                if not ok:
+                    check_finite({p: rec[p] for p in checked}, src)
                 if colors is not None:
                     colors[lo:hi] = colors_from_columns([rec[p] for p in use_c], use_c, src)
             except InputError as exc:
                 raise _shift_row(exc, lo) from None
-            for arr, cols in out.values():
-                for j, p in enumerate(cols):
-                    arr[lo:hi, j] = rec[p]
-            if radius is not None:
-                radius[lo:hi] = rec["radius"]
             if raw_c is not None:
                 for j, p in enumerate(use_c):
                     raw_c[lo:hi, j] = rec[p]
+            del rec
             report(progress, "reading", 0.5 * hi / n)
-        del rec, view
     extra = total - body - n * size
     if extra > 0:
         warn_trailing(path, f"{extra} byte(s)", n, None)
@@ -330,6 +357,7 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
         del raw_c
     report(progress, "reading", 1.0)
     get = {k: a for k, (a, _) in out.items()}
+    radius = get["radius"][:, 0] if "radius" in get else None
     return build_cloud(path, get["positions"], normals=get.get("normals"), radius=radius,
                        u=get.get("u"), v=get.get("v"), colors=colors, progress=progress)
 

@@ -126,10 +126,15 @@ class SplatCloud:
             raise InputError(f"origin {self.origin.tolist()} is not 3 finite numbers of at most "
                              f"{MAX_COORDINATE_ABS:g}", path=src, prop="origin")
         step = VALIDATE_CHUNK_ROWS
+        lo_c = np.full(3, np.inf)
+        hi_c = np.full(3, -np.inf)
         for nm, arr in (("positions", self.positions), ("u", self.u), ("v", self.v)):
             first_nan = first_big = None
             for lo in range(0, n, step):
                 blk = arr[lo:lo + step]
+                # NaN propagates through max/min: the row search runs only on failure
+                if blk.max() <= MAX_COORDINATE_ABS and blk.min() >= -MAX_COORDINATE_ABS:
+                    continue
                 fin = np.isfinite(blk).all(axis=1)
                 if first_nan is None and not fin.all():
                     first_nan = lo + int(np.flatnonzero(~fin)[0])
@@ -144,19 +149,28 @@ class SplatCloud:
                 raise InputError(f"value {arr[first_big].tolist()} beyond the supported magnitude "
                                  f"{MAX_COORDINATE_ABS:g} (rescale the model)", path=src,
                                  element="vertex", row=first_big, prop=nm)
-        diag = float(np.linalg.norm(self.positions.max(0) - self.positions.min(0)))
+        for lo in range(0, n, step):
+            blk = self.positions[lo:lo + step]
+            np.minimum(lo_c, blk.min(axis=0), out=lo_c)
+            np.maximum(hi_c, blk.max(axis=0), out=hi_c)
+        diag = float(np.linalg.norm(hi_c - lo_c))
         min_len = MIN_AXIS_LENGTH_REL * max(diag, 1e-300)
         for lo in range(0, n, step):
             bu, bv = self.u[lo:lo + step], self.v[lo:lo + step]
-            lu = np.linalg.norm(bu, axis=1)
-            lv = np.linalg.norm(bv, axis=1)
+            uu = np.einsum("ij,ij->i", bu, bu)
+            vv = np.einsum("ij,ij->i", bv, bv)
+            lu, lv = np.sqrt(uu), np.sqrt(vv)
             for nm, ln in (("u", lu), ("v", lv)):
                 bad = ~(ln > min_len)
                 if bad.any():
                     row = int(np.flatnonzero(bad)[0])
                     raise InputError(f"degenerate splat axis (length {ln[row]:.3g})", path=src,
                                      element="vertex", row=lo + row, prop=nm)
-            sine = np.linalg.norm(np.cross(bu, bv), axis=1) / (lu * lv)
+            # |u x v|^2 = |u|^2 |v|^2 - (u.v)^2 (Lagrange): no (n, 3) cross
+            # product; at the 1e-6 threshold sine^2 = 1e-12 is far above the
+            # 1e-16 rounding of the difference
+            uv = np.einsum("ij,ij->i", bu, bv)
+            sine = np.sqrt(np.maximum(1.0 - uv * uv / (uu * vv), 0.0))
             bad = ~(sine >= MIN_AXIS_SINE)     # NaN-safe: a NaN sine is degenerate too
             if bad.any():
                 row = int(np.flatnonzero(bad)[0])
