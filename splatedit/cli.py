@@ -80,32 +80,60 @@ def _sig(x, digits: int = 7) -> float | None:
 
 
 def cmd_info(args) -> int:
+    """Counts, bounds and cleanliness figures.  Up to INFO_EXACT_MAX_POINTS
+    splats everything is exact; above, spacing, boundary splats and outliers
+    are estimated from spatial patches (listed under ``estimated``) and
+    stray clusters (a global graph property) are not computed (null)."""
     import numpy as np
     from splatedit.io import read
-    from splatedit.model.quality import assess
+    from splatedit.model.quality import assess, estimate_quality
     from splatedit.model.spacing import point_spacing
+    from splatedit.tolerances import INFO_EXACT_MAX_POINTS
     cloud = read(args.file, progress=args.progress)
     lo, hi = cloud.bounds()
     radii = cloud.radii
-    quality = assess(cloud)
+    est = estimate_quality(cloud) if cloud.n > INFO_EXACT_MAX_POINTS else None
     info = {
         "file": str(args.file),
         "splats": cloud.n,
         "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
         "colors": cloud.colors is not None,
+        "intensity": cloud.intensity is not None,
+        "classification": cloud.classification is not None,
+        "origin": [_sig(x, 15) for x in cloud.origin],
         "bounds_min": [_sig(x) for x in lo],
         "bounds_max": [_sig(x) for x in hi],
         "diagonal": _sig(cloud.diagonal),
-        "spacing": _sig(point_spacing(cloud.positions)),
-        "splat_radius_median": _sig(np.median(radii)),
-        "splat_radius_max": _sig(radii.max()),
-        "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
-        "boundary_splats": quality.boundary_count,
-        "outliers": quality.outliers.count,
-        "outliers_statistical": int(quality.outliers.statistical.sum()),
-        "outliers_isolated": int(quality.outliers.isolated.sum()),
-        "stray_cluster_points": int(quality.stray_clusters.sum()),
     }
+    med = np.median(radii)
+    if est is None:
+        quality = assess(cloud)
+        info.update({
+            "spacing": _sig(point_spacing(cloud.positions)),
+            "splat_radius_median": _sig(med),
+            "splat_radius_max": _sig(radii.max()),
+            "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
+            "boundary_splats": quality.boundary_count,
+            "outliers": quality.outliers.count,
+            "outliers_statistical": int(quality.outliers.statistical.sum()),
+            "outliers_isolated": int(quality.outliers.isolated.sum()),
+            "stray_cluster_points": int(quality.stray_clusters.sum()),
+        })
+    else:
+        info.update({
+            "spacing": _sig(est.spacing),
+            "splat_radius_median": _sig(med),
+            "splat_radius_max": _sig(radii.max()),
+            "splat_radius_max_rel_median": _sig(radii.max() / med, 4),
+            "boundary_splats": est.boundary,
+            "outliers": est.outliers,
+            "outliers_statistical": est.statistical,
+            "outliers_isolated": est.isolated,
+            "stray_cluster_points": None,
+            "estimated": ["spacing", "outliers", "outliers_statistical", "outliers_isolated"]
+                         + ([] if cloud.faces is not None else ["boundary_splats"]),
+            "sample_points": est.sample_points,
+        })
     if args.json:
         print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
     else:

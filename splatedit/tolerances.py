@@ -499,9 +499,8 @@ REBASE_MIN_ABS = 1e4
 #: all-points kNN took 36 s of the issue's 47 s
 INFO_EXACT_MAX_POINTS = 1_000_000
 INFO_SAMPLE_POINTS = 200_000
-#: patch cells are this many (estimated) spacings wide; figures are taken at
-#: points at least a quarter cell from the cell's faces, whose 16 nearest
-#: neighbours (2-3 spacings on a surface) all lie in the patch.  On the
-#: bunny (35k) and kitten scans the patch spacing is within 2 % of the
-#: all-points value (tests/model/test_sample.py)
+#: patch cells are this many (estimated) spacings wide: ~1000 points of a
+#: surface per cell, so a point's 16 nearest neighbours (2-3 spacings) lie in
+#: its cell unless it is within 3 spacings of a face (~20 % of the points,
+#: left out).  Patch figures against all-points ones: tests/model/test_sample.py
 INFO_PATCH_SPACINGS = 32.0

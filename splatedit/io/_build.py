@@ -8,7 +8,7 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.model.cloud import SplatCloud
+from splatedit.model.cloud import SplatCloud, column_bounds
 from splatedit.model.estimate import estimate_splats
 from splatedit.model.mesh import cloud_from_mesh
 from splatedit.tolerances import MAX_COORDINATE_ABS, REBASE_MIN_ABS
@@ -133,7 +133,7 @@ def local_origin(positions) -> np.ndarray:
     units.  An integer origin makes ``x - origin`` and back exact for every
     float64 ``x`` of the file (ulp(x) divides 1 below 2^53, and the local
     value needs fewer bits than ``x``)."""
-    lo, hi = positions.min(axis=0), positions.max(axis=0)
+    lo, hi = column_bounds(positions)
     if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
         return np.zeros(3)
     return np.round(0.5 * (lo + hi))
