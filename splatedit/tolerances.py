@@ -504,3 +504,6 @@ INFO_SAMPLE_POINTS = 200_000
 #: its cell unless it is within 3 spacings of a face (~20 % of the points,
 #: left out).  Patch figures against all-points ones: tests/model/test_sample.py
 INFO_PATCH_SPACINGS = 32.0
+#: LAS/LAZ written from a cloud not read from LAS: coordinate resolution
+#: (model units; millimetres for metre scans, the usual LiDAR grid)
+LAS_DEFAULT_SCALE = 0.001

@@ -51,10 +51,12 @@ class Quantization:
     Attributes:
         scale: (3,) float64, the resolution per axis (world units).
         offset: (3,) float64, the file's offset (world units).
+        point_format: the LAS point format id read (None if unknown).
     """
 
     scale: tuple
     offset: tuple
+    point_format: Optional[int] = None
 
 
 @dataclass(eq=False)
