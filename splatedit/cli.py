@@ -325,7 +325,7 @@ def _fresh_directory(base: Path) -> Path:
 
 def cmd_bench(args) -> int:
     from splatedit.bench.runner import run_bench
-    for line in run_bench(args.what, quick=args.quick, progress=args.progress):
+    for line in run_bench(args.what, quick=args.quick, progress=args.progress, large=args.large):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -359,7 +359,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print one JSON object")
     s.set_defaults(func=cmd_info)
 
-    s = sub.add_parser("convert", help="convert PLY/XYZ/OFF to a splat PLY (estimates normals and sizes when missing)")
+    s = sub.add_parser("convert", help="convert between PLY, XYZ, OFF, LAS/LAZ, E57, PCD and PTS by extension "
+                                       "(estimates normals and sizes when missing)")
     s.add_argument("input")
     s.add_argument("output")
     s.add_argument("--remove-outliers", action="store_true",
@@ -396,8 +397,11 @@ def build_parser() -> argparse.ArgumentParser:
     s.set_defaults(func=cmd_edit)
 
     s = sub.add_parser("bench", help="benchmarks; print one JSON line per case")
-    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "all"))
+    s.add_argument("what", choices=("solve", "groups", "qr", "accuracy", "closure", "render", "editor", "io",
+                                    "all"))
     s.add_argument("--quick", action="store_true", help="small sizes only (a smoke run)")
+    s.add_argument("--large", action="store_true",
+                   help="io: also the 10M-splat PLY read (writes an 840 MB file to the temp folder)")
     s.set_defaults(func=cmd_bench)
     return p
 

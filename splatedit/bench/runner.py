@@ -67,12 +67,21 @@ def _accuracy(quick: bool, progress=None) -> Iterator[dict]:
         yield {"bench": "accuracy", **bench_accuracy(cloud, support, handles, name=name)}
 
 
+def _io(quick: bool, progress=None, large: bool = False) -> Iterator[dict]:
+    from splatedit.bench.io import bench_io
+    yield from bench_io(quick=quick, large=large)
+
+
 BENCHES = {"solve": _solve, "groups": _groups, "qr": _qr, "accuracy": _accuracy, "closure": _closure,
-           "render": _render, "editor": _editor}
+           "render": _render, "editor": _editor, "io": _io}
 
 
-def run_bench(what: str, *, quick: bool = False, progress=None) -> Iterator[dict]:
-    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all")."""
+def run_bench(what: str, *, quick: bool = False, progress=None, large: bool = False) -> Iterator[dict]:
+    """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or
+    "all"); ``large`` adds the 10M-splat cases of ``io``."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
-        yield from BENCHES[name](quick, progress)
+        if name == "io":
+            yield from _io(quick, progress, large=large)
+        else:
+            yield from BENCHES[name](quick, progress)

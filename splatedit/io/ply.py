@@ -298,7 +298,8 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     elif use_c:
         raw_c = np.empty((n, len(use_c)), dtype=np.result_type(*[dtype[p] for p in use_c]))
     size = dtype.itemsize
-    rows = max(1, PLY_READ_CHUNK_BYTES // size)
+    # at most an eighth of the file: the buffer is small next to the arrays kept at any size
+    rows = max(1, min(PLY_READ_CHUNK_BYTES // size, max(4096, -(-n // 8))))
     buf = bytearray(min(rows, n) * size)
     try:
         fh = open(path, "rb")

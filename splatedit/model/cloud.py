@@ -134,7 +134,7 @@ class SplatCloud:
         if self.origin.shape != (3,) or not (np.abs(self.origin) <= MAX_COORDINATE_ABS).all():
             raise InputError(f"origin {self.origin.tolist()} is not 3 finite numbers of at most "
                              f"{MAX_COORDINATE_ABS:g}", path=src, prop="origin")
-        step = VALIDATE_CHUNK_ROWS
+        step = min(VALIDATE_CHUNK_ROWS, max(4096, -(-n // 8)))     # temporaries << the arrays
         for nm, arr in (("positions", self.positions), ("u", self.u), ("v", self.v)):
             # NaN propagates through max/min: the row search runs only on failure
             if arr.max() <= MAX_COORDINATE_ABS and arr.min() >= -MAX_COORDINATE_ABS:

@@ -5,9 +5,8 @@ A random subsample is not enough: thinning a surface changes its spacing
 (by sqrt of the thinning factor) and so every neighbour distance.  Instead
 whole cells of a grid are kept (a Kronecker sequence over the integer cell
 coordinates picks about ``target`` points' worth of cells), so the points of a picked cell keep
-all their neighbours; a figure is taken at the patch points whose
-neighbourhood ball (to the k-th neighbour found) lies inside their cell, so
-every neighbour is found (:meth:`PatchSample.exact`).  Cells are ``INFO_PATCH_SPACINGS`` spacings wide, the spacing
+all their neighbours; figures are taken at the patch points far enough
+from their cell's faces (:meth:`PatchSample.knn`).  Cells are ``INFO_PATCH_SPACINGS`` spacings wide, the spacing
 being first estimated from a random subsample (surface scaling).
 """
 
@@ -43,13 +42,18 @@ class PatchSample:
         """k-NN of the patch points within the patch (the point itself first).
 
         Returns:
-            (dist (m, k), idx (m, k) into the patch, exact (m,) bool): rows
-            whose k-th distance is at most the distance to the cell's faces
-            are the true k-NN in the whole cloud.
+            (dist (m, k), idx (m, k) into the patch, used (m,) bool): the
+            points at least R from their cell's faces, R the 99th
+            percentile of the k-th distances found.  Their neighbours within
+            R are all found, so every figure is exact except for the ~1 %
+            with k-th distance beyond R, whose distances found are upper
+            bounds (and beyond R either way).  The choice does not depend on
+            a point's own neighbourhood, so it does not favour dense parts.
         """
         k = min(k, len(self.index))
         d, j = self.tree.query(self.tree.data, k=k, workers=-1)
-        return d, j, d[:, -1] <= self.face_distance
+        reach = float(np.quantile(d[:, -1], 0.99))
+        return d, j, self.face_distance >= reach
 
 
 def _rough_spacing(points, rng, m: int) -> float:
