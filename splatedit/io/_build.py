@@ -127,13 +127,13 @@ def triangulate(flat, lengths, n_vertices: int, path, element: str = "face",
     return np.stack([flat[base], flat[base + j + 1], flat[base + j + 2]], axis=1)
 
 
-def local_origin(positions) -> np.ndarray:
+def local_origin(positions, bounds=None) -> np.ndarray:
     """(3,) float64 origin for the positions: zeros when the bounding box lies
     within ``REBASE_MIN_ABS`` of 0, else its centre rounded to whole model
     units.  An integer origin makes ``x - origin`` and back exact for every
     float64 ``x`` of the file (ulp(x) divides 1 below 2^53, and the local
-    value needs fewer bits than ``x``)."""
-    lo, hi = column_bounds(positions)
+    value needs fewer bits than ``x``).  ``bounds``: (min, max) if known."""
+    lo, hi = column_bounds(positions) if bounds is None else bounds
     if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
         return np.zeros(3)
     return np.round(0.5 * (lo + hi))
@@ -151,8 +151,8 @@ def rebase(positions, origin) -> np.ndarray:
 
 
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
-                faces=None, progress=None, origin=None, intensity=None, classification=None,
-                quantization=None) -> SplatCloud:
+                faces=None, progress=None, origin=None, already_local=False, intensity=None,
+                classification=None, quantization=None) -> SplatCloud:
     """Apply the axes rule (first match wins):
 
     1. ``u`` and ``v`` given (our ``ux..vz`` properties): used as they are;
@@ -163,9 +163,9 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     5. nothing: normals estimated, oriented and sized
        (:func:`estimate_splats`).
 
-    Faces are kept in every case.  Positions far from 0 are first rebased
-    to :func:`local_origin` (in place), unless the reader gives ``origin``
-    (positions already local); ``intensity``, ``classification`` and
+    Faces are kept in every case.  Positions are first rebased (in place) to
+    ``origin``, by default :func:`local_origin` (``already_local``: the
+    reader did that, as the LAS reader does on the file's integer grid); ``intensity``, ``classification`` and
     ``quantization`` are stored with the cloud.
     """
     name, source = Path(path).name, str(path)
@@ -173,6 +173,7 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
         raise InputError("zero vertices: the file holds no points", path=source, element="vertex")
     if origin is None:
         origin = local_origin(positions)
+    if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,
                 quantization=quantization)

@@ -91,7 +91,8 @@ def read_las(path, *, progress=None) -> SplatCloud:
                          int(las.header.point_format.id))
     report(progress, "reading", 1.0)
     return build_cloud(path, positions, colors=colors, progress=progress, origin=origin,
-                       intensity=intensity, classification=classification, quantization=quant)
+                       already_local=True, intensity=intensity, classification=classification,
+                       quantization=quant)
 
 
 def quantize(cloud: SplatCloud, scale, offset, path) -> np.ndarray:

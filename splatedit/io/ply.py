@@ -26,11 +26,11 @@ import numpy as np
 import plyfile
 
 from splatedit.errors import InputError
-from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
+from splatedit.io._build import build_cloud, check_finite, colors_from_columns, local_origin, triangulate
 from splatedit.io._plycheck import TYPES as _TYPES
 from splatedit.io._plycheck import binary_layout, check_declared_sizes, check_trailing, warn_trailing
 from splatedit.io._text import scan_numbers
-from splatedit.model.cloud import SplatCloud
+from splatedit.model.cloud import SplatCloud, column_bounds
 from splatedit.progress import report
 from splatedit.tolerances import MAX_COORDINATE_ABS, PLY_READ_CHUNK_BYTES
 
@@ -298,6 +298,7 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     elif use_c:
         raw_c = np.empty((n, len(use_c)), dtype=np.result_type(*[dtype[p] for p in use_c]))
     size = dtype.itemsize
+    lo_b, hi_b = np.full(3, np.inf), np.full(3, -np.inf)
     # at most an eighth of the file: the buffer is small next to the arrays kept at any size
     rows = max(1, min(PLY_READ_CHUNK_BYTES // size, max(4096, -(-n // 8))))
     buf = bytearray(min(rows, n) * size)
@@ -324,7 +325,7 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
                                  row=lo + got // size)
             rec = np.frombuffer(buf, dtype=dtype, count=hi - lo)
             ok = True
-            for arr, cols in out.values():
+            for key, (arr, cols) in out.items():
                 view = _columns_view(buf, dtype, cols, hi - lo)
                 blk = arr[lo:hi]
                 if view is not None:
@@ -334,10 +335,17 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
                         blk[:, j] = rec[p]
                 # NaN propagates through max/min: one test per block, the
                 # per-column search only when it fails
-                ok = ok and bool(blk.max() <= MAX_COORDINATE_ABS and blk.min() >= -MAX_COORDINATE_ABS)
+                if key == "positions":        # per column: the bounds come with the test
+                    bmin, bmax = column_bounds(blk)
+                    np.minimum(lo_b, bmin, out=lo_b)
+                    np.maximum(hi_b, bmax, out=hi_b)
+                    ok = ok and bool(bmax.max() <= MAX_COORDINATE_ABS and bmin.min() >= -MAX_COORDINATE_ABS)
+                else:
+                    ok = ok and bool(blk.max() <= MAX_COORDINATE_ABS and blk.min() >= -MAX_COORDINATE_ABS)
             if have_axes and nn:        # normals not kept, still checked
                 for p in nn:
-                    ok = ok and bool(np.abs(rec[p]).max() <= MAX_COORDINATE_ABS)
+                    c = rec[p]
+                    ok = ok and bool(c.max() <= MAX_COORDINATE_ABS and c.min() >= -MAX_COORDINATE_ABS)
             try:
                 if not ok:
                     check_finite({p: rec[p] for p in checked}, src)
@@ -360,7 +368,8 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     get = {k: a for k, (a, _) in out.items()}
     radius = get["radius"][:, 0] if "radius" in get else None
     return build_cloud(path, get["positions"], normals=get.get("normals"), radius=radius,
-                       u=get.get("u"), v=get.get("v"), colors=colors, progress=progress)
+                       u=get.get("u"), v=get.get("v"), colors=colors, progress=progress,
+                       origin=local_origin(get["positions"], bounds=(lo_b, hi_b)))
 
 
 def read_ply(path, *, progress=None) -> SplatCloud:
