@@ -17,7 +17,9 @@ Cases (one dict each, printed as a JSON line by the CLI):
 * ``las_write`` / ``las_read`` / ``laz_write`` / ``laz_read``: a 1M-point
   georeferenced scan (UTM-like coordinates, scale 0.001, RGB, intensity,
   classification) through :func:`splatedit.io.write` and :func:`read`, with
-  laspy's own read (``laspy.read``) in the same run.
+  laspy's own read (``laspy.read``) in the same run.  LAS has no normals:
+  our read includes normal estimation, orientation and sizing of the raw
+  points (``splatedit.model.estimate``), which is most of its time.
 
 Sizes: 1M by default (``--quick``: 200k); 10M only with ``--large``.
 """
@@ -38,7 +40,7 @@ import numpy as np
 _CHUNK = 1_000_000
 
 _CHILD = r"""
-import json, resource, sys, time
+import json, sys, time
 kind, path = sys.argv[1], sys.argv[2]
 import numpy as np
 if kind == "splatedit":
@@ -47,10 +49,11 @@ elif kind == "plyfile":
     import plyfile
 else:
     import open3d as o3d
-def rss_mb():
+def rss_mb(key="VmRSS:"):
+    # /proc, not getrusage: ru_maxrss survives exec and starts at the parent's size
     with open("/proc/self/status") as fh:
         for line in fh:
-            if line.startswith("VmRSS:"):
+            if line.startswith(key):
                 return int(line.split()[1]) / 1024
 base = rss_mb()
 t0 = time.perf_counter()
@@ -66,7 +69,7 @@ else:
     n = len(pc.points)
     kept = n * 24 * (1 + pc.has_normals() + pc.has_colors())
 dt = time.perf_counter() - t0
-peak = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+peak = rss_mb("VmHWM:")
 print(json.dumps({"seconds": round(dt, 3), "n": n, "peak_rss_mb": round(peak), "base_rss_mb": round(base),
                   "kept_mb": round(kept / 2**20), "peak_over_kept": round((peak - base) / (kept / 2**20), 3)}))
 """
