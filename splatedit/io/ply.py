@@ -3,7 +3,9 @@
 Read: ascii, binary little/big endian; any numeric property type.  Vertex
 properties used: ``x y z`` (required), ``nx ny nz`` (or ``normal_x ...``),
 ``red green blue [alpha]`` (or ``r g b a`` / ``diffuse_red ...``; uchar or
-float), ``radius``, and our ``ux uy uz vx vy vz``.  Other properties and
+float), ``radius``, our ``ux uy uz vx vy vz``, and the scan attributes
+``intensity`` and ``classification`` (kept, not turned into colours: a PLY
+without colours keeps the default material).  Other properties and
 elements are ignored.  A ``face`` element (``vertex_indices`` or
 ``vertex_index`` list) makes the file a mesh: polygons are fan-triangulated.
 
@@ -14,6 +16,7 @@ Written file layout (binary little endian by default)::
       float  nx ny nz         unit normals, for other tools
       double ux uy uz vx vy vz  splat semi-axes, bit-exact   (axes=True)
       uchar  red green blue alpha                           (if colours)
+      ushort intensity, uchar classification                (if the cloud has them)
     element face f
       list uchar int vertex_indices                         (if faces)
 """
@@ -237,6 +240,25 @@ def _read_ascii_fast(path, progress):
     return vert, (flat, k, fprop)
 
 
+# --------------------------------------------------- scan attributes
+
+def _scan_columns(get, names, src):
+    """(intensity uint16 or None, classification uint8 or None) from the
+    ``intensity`` and ``classification`` vertex properties (rounded, clipped
+    to their types' ranges; NaN is an error naming the row)."""
+    out = []
+    for nm, top, dt in (("intensity", 65535, np.uint16), ("classification", 255, np.uint8)):
+        if nm not in names:
+            out.append(None)
+            continue
+        col = get(nm)
+        if col.dtype.kind == "f":
+            check_finite({nm: col}, src)
+            col = np.rint(col)
+        out.append(np.clip(col, 0, top).astype(dt))
+    return out
+
+
 # --------------------------------------------------- fast binary reading
 
 def _shift_row(exc: InputError, lo: int) -> InputError:
@@ -292,6 +314,8 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
         out["normals"] = (np.empty((n, 3)), nn)
     if "radius" in names and not have_axes:
         out["radius"] = (np.empty((n, 1)), ("radius",))
+    scan_cols = [p for p in ("intensity", "classification") if p in names]
+    raw_s = {p: np.empty(n, dtype=dtype[p]) for p in scan_cols}
     colors = raw_c = None
     if use_c and int_colours:
         colors = np.full((n, 4), 255, dtype=np.uint8)
@@ -356,6 +380,8 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
             if raw_c is not None:
                 for j, p in enumerate(use_c):
                     raw_c[lo:hi, j] = rec[p]
+            for p, arr in raw_s.items():
+                arr[lo:hi] = rec[p]
             del rec
             report(progress, "reading", 0.5 * hi / n)
     extra = total - body - n * size
@@ -367,9 +393,12 @@ def _read_binary_chunked(path, layout, progress) -> SplatCloud:
     report(progress, "reading", 1.0)
     get = {k: a for k, (a, _) in out.items()}
     radius = get["radius"][:, 0] if "radius" in get else None
+    intensity, classification = _scan_columns(raw_s.__getitem__, raw_s, src)
+    del raw_s
     return build_cloud(path, get["positions"], normals=get.get("normals"), radius=radius,
                        u=get.get("u"), v=get.get("v"), colors=colors, progress=progress,
-                       origin=local_origin(get["positions"], bounds=(lo_b, hi_b)))
+                       origin=local_origin(get["positions"], bounds=(lo_b, hi_b)),
+                       intensity=intensity, classification=classification)
 
 
 def read_ply(path, *, progress=None) -> SplatCloud:
@@ -430,9 +459,11 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         use = [p for p in cn if p in names]
         colors = colors_from_columns([_column(data, p, path) for p in use], use, str(path))
     faces = _faces(face_lists, len(positions), path)
+    intensity, classification = _scan_columns(lambda nm: _column(data, nm, path), names, str(path))
     report(progress, "reading", 1.0)
     return build_cloud(path, positions, normals=normals, radius=radius, u=u, v=v,
-                       colors=colors, faces=faces, progress=progress)
+                       colors=colors, faces=faces, progress=progress, intensity=intensity,
+                       classification=classification)
 
 
 # ----------------------------------------------------------------- writing
@@ -444,7 +475,15 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
         fields += [(p, e + "f8") for p in _AXES]
     if cloud.colors is not None:
         fields += [(p, "u1") for p in ("red", "green", "blue", "alpha")]
+    if cloud.intensity is not None:
+        fields.append(("intensity", e + "u2"))
+    if cloud.classification is not None:
+        fields.append(("classification", "u1"))
     arr = np.empty(cloud.n, dtype=fields)
+    if cloud.intensity is not None:
+        arr["intensity"] = cloud.intensity
+    if cloud.classification is not None:
+        arr["classification"] = cloud.classification
     world = cloud.world_positions()
     for j, p in enumerate("xyz"):
         arr[p] = world[:, j]
@@ -462,7 +501,7 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
     return arr
 
 
-_PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "i4": "int"}
+_PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "u2": "ushort", "i4": "int"}
 
 
 def _header(vert: np.ndarray, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
@@ -504,7 +543,7 @@ def write_ply(fh, cloud: SplatCloud, *, binary: bool = True, axes: bool = True,
             fa["i"] = faces
             fh.write(fa.tobytes())
         return
-    fmt = {"f8": "%.17g", "f4": "%.9g", "u1": "%d"}
+    fmt = {"f8": "%.17g", "f4": "%.9g", "u1": "%d", "u2": "%d"}
     np.savetxt(fh, vert, fmt=[fmt[vert.dtype[nm].str[1:]] for nm in vert.dtype.names])
     if faces is not None:
         np.savetxt(fh, faces, fmt="3 %d %d %d")

@@ -101,3 +101,16 @@ def test_subset_and_replace_keep_the_origin_and_scan_attributes(tmp_path):
     assert np.array_equal(s.origin, c.origin) and np.array_equal(s.intensity, c.intensity[::2])
     r = c.replace(positions=c.positions + 1.0)
     assert np.array_equal(r.origin, c.origin) and r.intensity is c.intensity
+
+
+@pytest.mark.parametrize("binary", [True, False])
+def test_ply_keeps_intensity_and_classification(tmp_path, binary):
+    p, axes = _sphere_splats(300)
+    c = read(make_ply(tmp_path / "i.ply", p, fdtype="f8", axes=axes))
+    c.intensity = (np.arange(300) * 200).astype(np.uint16)
+    c.classification = (np.arange(300) % 19).astype(np.uint8)
+    write(tmp_path / "o.ply", c, binary=binary)
+    back = read(tmp_path / "o.ply")
+    assert np.array_equal(back.intensity, c.intensity)
+    assert np.array_equal(back.classification, c.classification)
+    assert back.colors is None
