@@ -467,7 +467,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
 
 
 # ----------------------------------------------------------------- writing
-def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
+def _vertex_dtype(cloud: SplatCloud, axes: bool, byte_order: str) -> np.dtype:
     e = byte_order
     fields = [(p, e + "f8") for p in ("x", "y", "z")]
     if axes:
@@ -479,40 +479,48 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
         fields.append(("intensity", e + "u2"))
     if cloud.classification is not None:
         fields.append(("classification", "u1"))
-    arr = np.empty(cloud.n, dtype=fields)
+    return np.dtype(fields)
+
+
+def _vertex_array(cloud: SplatCloud, dtype: np.dtype, rows: slice = slice(None)) -> np.ndarray:
+    """The vertex records of ``rows`` (a chunk: the writer never holds a
+    full copy of a large cloud)."""
+    world = cloud.world_positions(rows)
+    arr = np.empty(len(world), dtype=dtype)
     if cloud.intensity is not None:
-        arr["intensity"] = cloud.intensity
+        arr["intensity"] = cloud.intensity[rows]
     if cloud.classification is not None:
-        arr["classification"] = cloud.classification
-    world = cloud.world_positions()
+        arr["classification"] = cloud.classification[rows]
     for j, p in enumerate("xyz"):
         arr[p] = world[:, j]
-    if axes:
-        nrm = cloud.normals
+    if "ux" in dtype.names:
+        u, v = cloud.u[rows], cloud.v[rows]
+        nrm = np.cross(u, v)
+        nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
         for j, p in enumerate(("nx", "ny", "nz")):
             arr[p] = nrm[:, j]
         for j, p in enumerate(_AXES[:3]):
-            arr[p] = cloud.u[:, j]
+            arr[p] = u[:, j]
         for j, p in enumerate(_AXES[3:]):
-            arr[p] = cloud.v[:, j]
+            arr[p] = v[:, j]
     if cloud.colors is not None:
         for j, p in enumerate(("red", "green", "blue", "alpha")):
-            arr[p] = cloud.colors[:, j]
+            arr[p] = cloud.colors[rows, j]
     return arr
 
 
 _PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "u2": "ushort", "i4": "int"}
 
 
-def _header(vert: np.ndarray, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
+def _header(dtype: np.dtype, n: int, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
     lines = ["ply", f"format {fmt} 1.0"]
     if comment:
         # PLY headers are ASCII: escape anything else (e.g. a file name like été.ply)
         safe = comment.encode("ascii", "backslashreplace").decode("ascii")
         lines += [f"comment {c}" for c in safe.splitlines()]
-    lines.append(f"element vertex {len(vert)}")
-    for name in vert.dtype.names:
-        lines.append(f"property {_PLY_TYPE[vert.dtype[name].str[1:]]} {name}")
+    lines.append(f"element vertex {n}")
+    for name in dtype.names:
+        lines.append(f"property {_PLY_TYPE[dtype[name].str[1:]]} {name}")
     if n_faces is not None:
         lines += [f"element face {n_faces}", "property list uchar int vertex_indices"]
     lines.append("end_header")
@@ -531,12 +539,14 @@ def write_ply(fh, cloud: SplatCloud, *, binary: bool = True, axes: bool = True,
             reader then derives the splats again (from the mesh if there are
             faces).
     """
-    vert = _vertex_array(cloud, axes, "<")
+    dtype = _vertex_dtype(cloud, axes, "<")
     faces = cloud.faces
-    fh.write(_header(vert, None if faces is None else len(faces),
+    fh.write(_header(dtype, cloud.n, None if faces is None else len(faces),
                      "binary_little_endian" if binary else "ascii", comment))
     if binary:
-        fh.write(vert.tobytes())
+        step = max(1, PLY_READ_CHUNK_BYTES // dtype.itemsize)
+        for lo in range(0, cloud.n, step):
+            fh.write(_vertex_array(cloud, dtype, slice(lo, lo + step)).tobytes())
         if faces is not None:
             fa = np.empty(len(faces), dtype=[("n", "u1"), ("i", "<i4", (3,))])
             fa["n"] = 3
@@ -544,6 +554,6 @@ def write_ply(fh, cloud: SplatCloud, *, binary: bool = True, axes: bool = True,
             fh.write(fa.tobytes())
         return
     fmt = {"f8": "%.17g", "f4": "%.9g", "u1": "%d", "u2": "%d"}
-    np.savetxt(fh, vert, fmt=[fmt[vert.dtype[nm].str[1:]] for nm in vert.dtype.names])
+    np.savetxt(fh, _vertex_array(cloud, dtype), fmt=[fmt[dtype[nm].str[1:]] for nm in dtype.names])
     if faces is not None:
         np.savetxt(fh, faces, fmt="3 %d %d %d")
