@@ -21,7 +21,7 @@ Cases (one dict each, printed as a JSON line by the CLI):
   our read includes normal estimation, orientation and sizing of the raw
   points (``splatedit.model.estimate``), which is most of its time.
 
-Sizes: 1M by default (``--quick``: 200k); 10M only with ``--large``.
+Sizes: 1M by default (``--quick``: 200k PLY, 20k LAS); 10M only with ``--large``.
 """
 
 from __future__ import annotations
@@ -189,4 +189,4 @@ def bench_io(*, quick: bool = False, large: bool = False) -> Iterator[dict]:
     counts = (200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,))
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-io-") as tmp:
         yield from bench_ply_read(counts, Path(tmp))
-        yield from bench_las(200_000 if quick else 1_000_000, Path(tmp))
+        yield from bench_las(20_000 if quick else 1_000_000, Path(tmp))

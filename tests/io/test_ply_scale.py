@@ -114,3 +114,15 @@ def test_ply_keeps_intensity_and_classification(tmp_path, binary):
     assert np.array_equal(back.intensity, c.intensity)
     assert np.array_equal(back.classification, c.classification)
     assert back.colors is None
+
+
+def test_bench_io_quick_compares_readers_in_one_run_and_las_is_exact():
+    from splatedit.bench.io import bench_io
+    lines = list(bench_io(quick=True))
+    reads = {ln["reader"]: ln for ln in lines if ln["case"] == "ply_read"}
+    assert set(reads) == {"splatedit", "plyfile", "open3d"}
+    ours = reads["splatedit"]
+    assert ours["n"] == ours["splats"] == 200_000 and ours["seconds"] > 0
+    assert ours["peak_over_kept"] <= 1.5        # the memory bound, measured in a fresh process
+    las = [ln for ln in lines if ln["case"] in ("las_read", "laz_read")]
+    assert len(las) == 2 and all(ln["mm_exact"] for ln in las)
