@@ -92,7 +92,7 @@ def cmd_info(args) -> int:
     cloud = read(args.file, progress=args.progress)
     lo, hi = cloud.bounds()
     radii = cloud.radii
-    est = estimate_quality(cloud) if cloud.n > INFO_EXACT_MAX_POINTS else None
+    est = estimate_quality(cloud, lower=lo) if cloud.n > INFO_EXACT_MAX_POINTS else None
     info = {
         "file": str(args.file),
         "splats": cloud.n,
@@ -103,7 +103,7 @@ def cmd_info(args) -> int:
         "origin": [_sig(x, 15) for x in cloud.origin],
         "bounds_min": [_sig(x) for x in lo],
         "bounds_max": [_sig(x) for x in hi],
-        "diagonal": _sig(cloud.diagonal),
+        "diagonal": _sig(np.linalg.norm(hi - lo)),
     }
     med = np.median(radii)
     if est is None:

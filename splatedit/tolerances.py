@@ -498,12 +498,18 @@ REBASE_MIN_ABS = 1e4
 #: (splatedit.model.sample) of about INFO_SAMPLE_POINTS points.  At 10M the
 #: all-points kNN took 36 s of the issue's 47 s
 INFO_EXACT_MAX_POINTS = 1_000_000
-INFO_SAMPLE_POINTS = 200_000
-#: patch cells are this many (estimated) spacings wide: ~1000 points of a
-#: surface per cell, so a point's 16 nearest neighbours (2-3 spacings) lie in
-#: its cell unless it is within 3 spacings of a face (~20 % of the points,
-#: left out).  Patch figures against all-points ones: tests/model/test_sample.py
-INFO_PATCH_SPACINGS = 32.0
+INFO_SAMPLE_POINTS = 100_000
+#: patch cells are this many rough spacings wide.  The rough spacing is the
+#: median nearest-neighbour distance of a random subsample scaled to the full
+#: density as for random points on a surface; a regular scan's spacing is up
+#: to 2.3x that (a 10M Fibonacci sphere: 0.00053 against 1.08e-3), so cells
+#: are 28-64 true spacings wide.  At 32 only 6 % of the patch points of that
+#: sphere were far enough from the faces; at 64, 40-60 %
+INFO_PATCH_SPACINGS = 64.0
+#: figures are taken at patch points at least this quantile of the k-th
+#: neighbour distances found from their cell's faces (0.99 let the few
+#: corner points, whose one-sided neighbourhoods are wide, set the margin)
+INFO_PATCH_REACH_QUANTILE = 0.95
 #: LAS/LAZ written from a cloud not read from LAS: coordinate resolution
 #: (model units; millimetres for metre scans, the usual LiDAR grid)
 LAS_DEFAULT_SCALE = 0.001

@@ -78,12 +78,14 @@ class QualityEstimate:
     sample_points: int
 
 
-def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS) -> QualityEstimate | None:
+def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
+                     lower=None) -> QualityEstimate | None:
     """:class:`QualityEstimate` of ``cloud`` without an all-points k-NN, or
-    None when the patches give no usable points (then use :func:`assess`)."""
+    None when the patches give no usable points (then use :func:`assess`).
+    ``lower``: the bounding box's lower corner, if known."""
     from splatedit.model.sample import patch_sample
     n = cloud.n
-    ps = patch_sample(cloud.positions, target)
+    ps = patch_sample(cloud.positions, target, lower=lower)
     if ps is None or len(ps.index) < 100:
         return None
     k = max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1)

@@ -4,10 +4,11 @@ all-points k-NN (``splatedit info`` above ``INFO_EXACT_MAX_POINTS``).
 A random subsample is not enough: thinning a surface changes its spacing
 (by sqrt of the thinning factor) and so every neighbour distance.  Instead
 whole cells of a grid are kept (a Kronecker sequence over the integer cell
-coordinates picks about ``target`` points' worth of cells), so the points of a picked cell keep
-all their neighbours; figures are taken at the patch points far enough
-from their cell's faces (:meth:`PatchSample.knn`).  Cells are ``INFO_PATCH_SPACINGS`` spacings wide, the spacing
-being first estimated from a random subsample (surface scaling).
+coordinates picks about ``target`` points' worth of cells), so the points of
+a picked cell keep all their neighbours; figures are taken at the patch
+points far enough from their cell's faces (:meth:`PatchSample.knn`).  Cells
+are ``INFO_PATCH_SPACINGS`` rough spacings wide, the rough spacing estimated
+from a random subsample (surface scaling).
 """
 
 from __future__ import annotations
@@ -18,7 +19,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from splatedit.model.cloud import column_bounds
-from splatedit.tolerances import INFO_PATCH_SPACINGS, INFO_SAMPLE_POINTS
+from splatedit.tolerances import INFO_PATCH_REACH_QUANTILE, INFO_PATCH_SPACINGS, INFO_SAMPLE_POINTS
 
 _CHUNK = 1 << 20
 
@@ -43,16 +44,16 @@ class PatchSample:
 
         Returns:
             (dist (m, k), idx (m, k) into the patch, used (m,) bool): the
-            points at least R from their cell's faces, R the 99th
-            percentile of the k-th distances found.  Their neighbours within
-            R are all found, so every figure is exact except for the ~1 %
-            with k-th distance beyond R, whose distances found are upper
-            bounds (and beyond R either way).  The choice does not depend on
+            points at least R from their cell's faces, R the
+            ``INFO_PATCH_REACH_QUANTILE`` quantile of the k-th distances
+            found.  Their neighbours within R are all found, so every figure
+            is exact except for the few with k-th distance beyond R, whose
+            distances found are upper bounds (and beyond R either way).  The choice does not depend on
             a point's own neighbourhood, so it does not favour dense parts.
         """
         k = min(k, len(self.index))
         d, j = self.tree.query(self.tree.data, k=k, workers=-1)
-        reach = float(np.quantile(d[:, -1], 0.99))
+        reach = float(np.quantile(d[:, -1], INFO_PATCH_REACH_QUANTILE))
         return d, j, self.face_distance >= reach
 
 
@@ -66,11 +67,13 @@ def _rough_spacing(points, rng, m: int) -> float:
     return float(np.median(d)) * np.sqrt(m / n)     # surface: spacing ~ 1/sqrt(density)
 
 
-def patch_sample(points, target: int = INFO_SAMPLE_POINTS, seed: int = 0) -> PatchSample | None:
+def patch_sample(points, target: int = INFO_SAMPLE_POINTS, seed: int = 0,
+                 lower=None) -> PatchSample | None:
     """Pick grid cells holding about ``target`` points in all.
 
     Args:
         points: (n, 3) float64 positions (model units).
+        lower: (3,) lower corner of their bounding box, if known.
     Returns:
         :class:`PatchSample`, or None when no spacing can be estimated
         (all points coincide).
@@ -81,7 +84,7 @@ def patch_sample(points, target: int = INFO_SAMPLE_POINTS, seed: int = 0) -> Pat
     if not h0 > 0:
         return None
     cell = INFO_PATCH_SPACINGS * h0
-    lo = column_bounds(points)[0]
+    lo = column_bounds(points)[0] if lower is None else np.asarray(lower, dtype=np.float64)
     keep_frac = min(1.0, target / n)
     # a cell (i, j, k) is picked when frac(i a + j b + k c) < keep_frac, with
     # a, b, c irrational (a Kronecker sequence): cells spread evenly over
