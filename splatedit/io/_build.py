@@ -180,7 +180,9 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     if faces is not None and len(faces) == 0:
         faces = None
     if u is not None and v is not None:
-        return SplatCloud(positions, u, v, colors, faces, name=name, source=source, **scan)
+        # every reader checks its columns (check_finite) before calling here
+        return SplatCloud(positions, u, v, colors, faces, name=name, source=source,
+                          values_checked=True, **scan)
     if radius is not None:
         bad = ~(radius > 0)
         if bad.any():

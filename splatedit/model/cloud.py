@@ -17,7 +17,7 @@ keeps sub-millimetre steps, and writers add ``origin`` back.
 
 from __future__ import annotations
 
-from dataclasses import dataclass, field
+from dataclasses import InitVar, dataclass, field
 from typing import Optional
 
 import numpy as np
@@ -92,8 +92,11 @@ class SplatCloud:
     intensity: Optional[np.ndarray] = field(default=None, repr=False)
     classification: Optional[np.ndarray] = field(default=None, repr=False)
     quantization: Optional[Quantization] = field(default=None, repr=False)
+    #: the caller (a reader) has already checked every position and axis
+    #: value for NaN / magnitude: the constructor's validate skips that scan
+    values_checked: InitVar[bool] = False
 
-    def __post_init__(self):
+    def __post_init__(self, values_checked: bool = False):
         src = self.source
         self.origin = np.array(self.origin, dtype=np.float64).reshape(-1)
         if self.intensity is not None:
@@ -114,10 +117,10 @@ class SplatCloud:
                                  path=src, prop="colors")
         if self.faces is not None:
             self.faces = _as_array("faces", self.faces, (3,), np.int64, src)
-        self.validate()
+        self.validate(values_checked=values_checked)
 
     # ------------------------------------------------------------------ checks
-    def validate(self) -> None:
+    def validate(self, *, values_checked: bool = False) -> None:
         """Check the invariants; raise :class:`InputError` naming the first bad row.
 
         Invariants: at least one splat; finite positions and axes, at most
@@ -125,7 +128,8 @@ class SplatCloud:
         ``origin`` is taken off); axes longer than ``MIN_AXIS_LENGTH_REL`` of
         the bounding-box diagonal and not parallel; faces index existing
         splats.  Runs over ``VALIDATE_CHUNK_ROWS`` rows at a time, so its
-        temporaries stay small for 10M splats.
+        temporaries stay small for 10M splats.  ``values_checked``: skip
+        the NaN / magnitude scan (a reader did it column by column).
         """
         src = self.source
         n = len(self.positions)
@@ -135,7 +139,8 @@ class SplatCloud:
             raise InputError(f"origin {self.origin.tolist()} is not 3 finite numbers of at most "
                              f"{MAX_COORDINATE_ABS:g}", path=src, prop="origin")
         step = min(VALIDATE_CHUNK_ROWS, max(4096, -(-n // 8)))     # temporaries << the arrays
-        for nm, arr in (("positions", self.positions), ("u", self.u), ("v", self.v)):
+        for nm, arr in () if values_checked else (("positions", self.positions), ("u", self.u),
+                                                  ("v", self.v)):
             # NaN propagates through max/min: the row search runs only on failure
             if arr.max() <= MAX_COORDINATE_ABS and arr.min() >= -MAX_COORDINATE_ABS:
                 continue

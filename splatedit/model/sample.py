@@ -92,10 +92,19 @@ def patch_sample(points, target: int = INFO_SAMPLE_POINTS, seed: int = 0,
     w = np.array([0.6180339887498949, 0.7548776662466927, 0.5698402909980532])
     inv = 1.0 / cell
     picked = []
+    cbuf = np.empty((min(n, _CHUNK), 3))
+    kbuf = np.empty(min(n, _CHUNK))
+    fbuf = np.empty(min(n, _CHUNK))
     for a in range(0, n, _CHUNK):
-        c = np.floor((points[a:a + _CHUNK] - lo) * inv)
-        key = c @ w
-        key -= np.floor(key)
+        blk = points[a:a + _CHUNK]
+        m = len(blk)
+        c, key, fl = cbuf[:m], kbuf[:m], fbuf[:m]
+        np.subtract(blk, lo, out=c)          # reused buffers: no allocation per chunk
+        c *= inv
+        np.floor(c, out=c)
+        np.matmul(c, w, out=key)
+        np.floor(key, out=fl)
+        key -= fl
         picked.append(a + np.flatnonzero(key < keep_frac))
     index = np.concatenate(picked)
     pts = points[index]
