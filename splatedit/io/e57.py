@@ -66,8 +66,8 @@ def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
         if "intensity" in d:
             raw = np.asarray(d["intensity"], dtype=np.float64)[keep]
             try:
-                lo, hi = header.intensity_limits
-            except Exception:
+                lo, hi = float(header.intensityMinimum), float(header.intensityMaximum)
+            except Exception:          # no intensityLimits node
                 lo, hi = (float(raw.min()), float(raw.max())) if raw.size else (0.0, 1.0)
             inten = np.clip(np.rint((raw - lo) / max(hi - lo, 1e-300) * 65535), 0, 65535)
         parts.append((xyz, rgb, inten))
@@ -110,8 +110,16 @@ def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
             data[c] = cloud.colors[:, j].astype(np.uint8)
     if cloud.intensity is not None:
         data["intensity"] = cloud.intensity.astype(np.float64)
+    # the limits 0..65535 make a reader map our intensities back unchanged
+    # (pye57 would otherwise store the data's own min/max as the limits)
+    from types import SimpleNamespace
+    lo, hi = world.min(axis=0), world.max(axis=0)
+    header = SimpleNamespace(name=cloud.name or "splatedit", rotation=np.array([1.0, 0, 0, 0]),
+                             translation=np.zeros(3), intensityMinimum=0.0,
+                             intensityMaximum=65535.0, xMinimum=lo[0], yMinimum=lo[1],
+                             zMinimum=lo[2], xMaximum=hi[0], yMaximum=hi[1], zMaximum=hi[2])
     e57 = pye57.E57(tmp_path, mode="w")
     try:
-        e57.write_scan_raw(data, name=cloud.name or "splatedit")
+        e57.write_scan_raw(data, scan_header=header)
     finally:
         e57.close()

@@ -5,7 +5,8 @@ Read: fields ``x y z`` (required), ``normal_x normal_y normal_z``, ``rgb`` /
 ``intensity``; other fields are skipped.  ``DATA binary_compressed`` (LZF)
 is refused with a clear message (convert with ``pcl_convert_pcd_ascii_binary``).
 Points with a NaN coordinate (PCL's "invalid" points of organised clouds)
-are an error naming the row, like every reader here.
+are dropped with a warning giving their number; any other NaN or infinity
+is an error naming the row.
 
 Write: ``DATA binary``, ``x y z`` as F8 (world coordinates, exact),
 ``normal_x..z`` F4, ``rgb`` packed U4 when the cloud has colours,
@@ -14,9 +15,11 @@ Write: ``DATA binary``, ``x y z`` as F8 (world coordinates, exact),
 
 from __future__ import annotations
 
+import warnings
+
 import numpy as np
 
-from splatedit.errors import InputError
+from splatedit.errors import InputError, InputWarning
 from splatedit.io._build import build_cloud, check_finite
 from splatedit.io._text import scan_numbers
 from splatedit.io.las import grey_from_intensity
@@ -121,8 +124,15 @@ def read_pcd(path, *, progress=None) -> SplatCloud:
             col += w
     else:
         raise InputError(f"header: DATA {kind!r} (expected ascii or binary)", path=src)
+    invalid = np.isnan(rec["x"]) | np.isnan(rec["y"]) | np.isnan(rec["z"])
+    if invalid.any():                   # PCL's organised clouds mark missing returns so
+        warnings.warn(InputWarning(f"{src}: {int(invalid.sum())} of {n} points have NaN "
+                                   f"coordinates (PCL's invalid points) and were dropped"),
+                      stacklevel=3)
+        rec = rec[~invalid]
+        n = len(rec)
     if n == 0:
-        raise InputError("zero points: the file holds no points", path=src)
+        raise InputError("zero points: the file holds no (valid) points", path=src)
     cols = {p: rec[p] for p in ("x", "y", "z")}
     has_n = {"normal_x", "normal_y", "normal_z"} <= set(names)
     if has_n:

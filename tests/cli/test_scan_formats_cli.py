@@ -8,7 +8,6 @@ import subprocess
 import sys
 
 import numpy as np
-import pytest
 
 from splatedit.io import read, write
 from splatedit.model.cloud import SplatCloud

@@ -126,6 +126,7 @@ def test_e57_scans_merged_with_poses_or_picked_by_index(tmp_path):
     again = read(tmp_path / "out.e57")
     assert np.allclose(again.world_positions(), second.world_positions(), atol=1e-9)
     assert np.array_equal(again.colors, second.colors)
+    assert np.array_equal(again.intensity, second.intensity)
 
 
 def _pcd_text(rows, binary=False, fields="x y z rgb"):
@@ -184,3 +185,16 @@ def test_pts_with_intensity_and_colour_and_bad_row(tmp_path):
     with pytest.raises(InputError) as info:
         read(path)
     assert "line 8" in str(info.value) and "row 6" in str(info.value)
+
+
+def test_pcd_invalid_nan_points_are_dropped_with_a_warning(tmp_path):
+    from splatedit.errors import InputWarning
+    rng = np.random.default_rng(6)
+    p = rng.normal(size=(300, 3))
+    p /= np.linalg.norm(p, axis=1, keepdims=True)
+    rows = [(*map(float, r), 0) for r in p] + [(float("nan"),) * 3 + (0,)] * 7
+    path = tmp_path / "org.pcd"
+    path.write_bytes(_pcd_text(rows, binary=True))
+    with pytest.warns(InputWarning, match="7 of 307 points"):
+        c = read(path)
+    assert c.n == 300
