@@ -12,8 +12,9 @@ Far coordinates are rebased to an origin on the file's own integer grid:
 the local coordinates are ``(X - X0) * scale``, so writing back with the same
 scale and offset gives back the same integers.
 
-Write: point format 3 (RGB) when the cloud has colours of its own, else 1;
-LAS 1.2; the scale and offset of the file the cloud was read from, else
+Write: point format 3 (RGB) when the cloud has colours of its own, else 1,
+LAS 1.2; formats 7 / 6 and LAS 1.4 when the source file was LAS 1.4-style
+(format 6 or above) or a class is above 31 (1.2 holds 5-bit classes); the scale and offset of the file the cloud was read from, else
 0.001 and the origin.  Colours are written as 16-bit ``c * 257``.
 """
 
@@ -123,8 +124,11 @@ def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
     q = cloud.quantization
     own_rgb = cloud.colors is not None and (q is None or q.point_format in _RGB_FORMATS
                                             or q.point_format is None)
-    fmt = 3 if own_rgb else 1
-    header = laspy.LasHeader(point_format=fmt, version="1.2")
+    # LAS 1.4 formats (6+) hold 8-bit classes; 1.2's formats 1/3 only 0..31
+    wide = (q is not None and (q.point_format or 0) >= 6) or (
+        cloud.classification is not None and int(cloud.classification.max()) > 31)
+    fmt = (7 if own_rgb else 6) if wide else (3 if own_rgb else 1)
+    header = laspy.LasHeader(point_format=fmt, version="1.4" if wide else "1.2")
     if q is not None:
         scale, offset = np.array(q.scale), np.array(q.offset)
     else:

@@ -198,3 +198,21 @@ def test_pcd_invalid_nan_points_are_dropped_with_a_warning(tmp_path):
     with pytest.warns(InputWarning, match="7 of 307 points"):
         c = read(path)
     assert c.n == 300
+
+
+def test_las14_format_and_wide_classes_are_kept(tmp_path):
+    import laspy
+    world = _terrain(500)
+    header = laspy.LasHeader(point_format=7, version="1.4")
+    header.scales = np.array([0.001, 0.001, 0.001])
+    header.offsets = np.array([512_000.0, 5_123_000.0, 0.0])
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = world[:, 0], world[:, 1], world[:, 2]
+    las.classification = (np.arange(500) % 200).astype(np.uint8)   # 8-bit classes (1.4 only)
+    las.red = las.green = las.blue = np.full(500, 65535, dtype=np.uint16)
+    las.write(str(tmp_path / "a.las"))
+    write(tmp_path / "b.las", read(tmp_path / "a.las"))
+    back = laspy.read(str(tmp_path / "b.las"))
+    assert back.point_format.id == 7
+    assert np.array_equal(back.classification, las.classification)
+    assert np.array_equal(np.asarray(back.X), np.asarray(laspy.read(str(tmp_path / "a.las")).X))
