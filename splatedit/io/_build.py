@@ -152,7 +152,7 @@ def rebase(positions, origin) -> np.ndarray:
 
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
                 faces=None, progress=None, origin=None, already_local=False, intensity=None,
-                classification=None, quantization=None) -> SplatCloud:
+                classification=None, quantization=None, point_fields=None) -> SplatCloud:
     """Apply the axes rule (first match wins):
 
     1. ``u`` and ``v`` given (our ``ux..vz`` properties): used as they are;
@@ -176,7 +176,7 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,
-                quantization=quantization)
+                quantization=quantization, point_fields=point_fields)
     if faces is not None and len(faces) == 0:
         faces = None
     if u is not None and v is not None:
@@ -195,7 +195,8 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     else:
         cloud = estimate_splats(positions, normals, colors, progress, radius=radius, faces=faces,
                                 name=name, source=source)
-    if origin.any() or intensity is not None or classification is not None:
+    if origin.any() or any(v is not None for v in (intensity, classification, quantization,
+                                                   point_fields)):
         for k, val in scan.items():
             setattr(cloud, k, val)
         cloud.validate()

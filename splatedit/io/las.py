@@ -3,9 +3,11 @@
 Read: x y z (the file's 32-bit integers times ``scale`` plus ``offset``),
 16-bit RGB (point formats 2, 3, 5, 7, 8, 10) as 8-bit colours (the high
 byte), ``intensity`` (uint16) and ``classification``.  Files without RGB get
-grey colours from the intensity (linear, the 99.5th percentile white).  Other
-dimensions (GPS time, return numbers, scan angle, extra bytes) are not kept.
-Normals and splat sizes are estimated (LAS has none).
+grey colours from the intensity (linear, the 99.5th percentile white).  The
+other dimensions (GPS time, return numbers, scan angle, user data, point
+source, extra bytes, ...) are kept in ``SplatCloud.point_fields`` and
+written back by the LAS writer (same point format; extra bytes with their
+types).  Normals and splat sizes are estimated (LAS has none).
 
 Far coordinates are rebased to an origin on the file's own integer grid:
 ``origin = offset + X0 * scale`` for an integer ``X0`` near the centre, and
@@ -90,10 +92,12 @@ def read_las(path, *, progress=None) -> SplatCloud:
         colors = grey_from_intensity(intensity)
     quant = Quantization(tuple(scale.tolist()), tuple(offset.tolist()),
                          int(las.header.point_format.id))
+    handled = {"X", "Y", "Z", "intensity", "classification", "red", "green", "blue"}
+    fields = {nm: np.array(las[nm]) for nm in las.point_format.dimension_names if nm not in handled}
     report(progress, "reading", 1.0)
     return build_cloud(path, positions, colors=colors, progress=progress, origin=origin,
                        already_local=True, intensity=intensity, classification=classification,
-                       quantization=quant)
+                       quantization=quant, point_fields=fields or None)
 
 
 def quantize(cloud: SplatCloud, scale, offset, path) -> np.ndarray:
@@ -128,7 +132,18 @@ def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
     wide = (q is not None and (q.point_format or 0) >= 6) or (
         cloud.classification is not None and int(cloud.classification.max()) > 31)
     fmt = (7 if own_rgb else 6) if wide else (3 if own_rgb else 1)
-    header = laspy.LasHeader(point_format=fmt, version="1.4" if wide else "1.2")
+    fields = cloud.point_fields or {}
+    if fields and q is not None and q.point_format is not None:
+        # fields read from a LAS file: its own point format keeps them all
+        fmt = q.point_format
+        if own_rgb and fmt not in _RGB_FORMATS:
+            fmt = {0: 2, 1: 3, 4: 5, 6: 7, 9: 10}.get(fmt, fmt)
+    header = laspy.LasHeader(point_format=fmt, version="1.4" if fmt >= 6 or wide else "1.2")
+    standard = set(header.point_format.dimension_names)
+    extra = [laspy.ExtraBytesParams(nm, a.dtype) for nm, a in fields.items()
+             if nm not in standard and a.ndim == 1]
+    if extra:
+        header.add_extra_dims(extra)
     if q is not None:
         scale, offset = np.array(q.scale), np.array(q.offset)
     else:
@@ -144,6 +159,9 @@ def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
         las.intensity = cloud.intensity
     if cloud.classification is not None:
         las.classification = cloud.classification
+    for nm, arr in fields.items():
+        if nm in set(las.point_format.dimension_names):
+            las[nm] = arr
     if own_rgb:
         c = cloud.colors.astype(np.uint16) * 257
         las.red, las.green, las.blue = c[:, 0], c[:, 1], c[:, 2]

@@ -79,6 +79,10 @@ class SplatCloud:
         classification: (n,) uint8 (ASPRS LAS classes), or None.
         quantization: the source file's integer coordinate grid
             (:class:`Quantization`), or None.
+        point_fields: other per-splat fields of the source file, kept so a
+            writer of the same format can put them back (LAS: GPS time,
+            return numbers, scan angle, extra bytes, ...): name -> (n,) array,
+            or None.
     """
 
     positions: np.ndarray
@@ -92,6 +96,7 @@ class SplatCloud:
     intensity: Optional[np.ndarray] = field(default=None, repr=False)
     classification: Optional[np.ndarray] = field(default=None, repr=False)
     quantization: Optional[Quantization] = field(default=None, repr=False)
+    point_fields: Optional[dict] = field(default=None, repr=False)
     #: the caller (a reader) has already checked every position and axis
     #: value for NaN / magnitude: the constructor's validate skips that scan
     values_checked: InitVar[bool] = False
@@ -184,7 +189,8 @@ class SplatCloud:
                 row = int(np.flatnonzero(bad)[0])
                 raise InputError("degenerate splat: axes u and v are parallel", path=src,
                                  element="vertex", row=lo + row, prop="u")
-        for nm, arr in (("intensity", self.intensity), ("classification", self.classification)):
+        extra = [(f"point_fields[{k!r}]", a) for k, a in (self.point_fields or {}).items()]
+        for nm, arr in [("intensity", self.intensity), ("classification", self.classification)] + extra:
             if arr is not None and len(arr) != n:
                 raise InputError(f"has {len(arr)} rows but positions has {n}", path=src, prop=nm)
         if self.faces is not None and len(self.faces):
@@ -235,8 +241,11 @@ class SplatCloud:
     def _scan_fields(self, index=None) -> dict:
         def pick(a):
             return None if a is None else (a.copy() if index is None else a[index])
+        fields = (None if self.point_fields is None else
+                  {k: pick(a) for k, a in self.point_fields.items()})
         return dict(origin=self.origin.copy(), intensity=pick(self.intensity),
-                    classification=pick(self.classification), quantization=self.quantization)
+                    classification=pick(self.classification), quantization=self.quantization,
+                    point_fields=fields)
 
     def with_scan_fields(self, other: "SplatCloud") -> "SplatCloud":
         """This cloud with ``other``'s origin, per-splat scan attributes and
@@ -261,7 +270,8 @@ class SplatCloud:
                           self.v if v is None else v,
                           self.colors, self.faces, name=self.name, source=self.source,
                           origin=self.origin, intensity=self.intensity,
-                          classification=self.classification, quantization=self.quantization)
+                          classification=self.classification, quantization=self.quantization,
+                          point_fields=self.point_fields)
 
     def subset(self, index) -> "SplatCloud":
         """A new cloud with only the splats selected by ``index`` (mask or

@@ -216,3 +216,28 @@ def test_las14_format_and_wide_classes_are_kept(tmp_path):
     assert back.point_format.id == 7
     assert np.array_equal(back.classification, las.classification)
     assert np.array_equal(np.asarray(back.X), np.asarray(laspy.read(str(tmp_path / "a.las")).X))
+
+
+def test_las_other_dimensions_and_extra_bytes_survive_read_deform_subset_write(tmp_path):
+    import laspy
+    world = _terrain(800)
+    header = laspy.LasHeader(point_format=1, version="1.2")
+    header.add_extra_dims([laspy.ExtraBytesParams("amplitude", np.float32)])
+    header.scales = np.array([0.001, 0.001, 0.001])
+    header.offsets = np.array([512_000.0, 5_123_000.0, 0.0])
+    las = laspy.LasData(header)
+    las.x, las.y, las.z = world[:, 0], world[:, 1], world[:, 2]
+    las.gps_time = np.linspace(1e5, 2e5, 800)
+    las.return_number = (np.arange(800) % 3 + 1).astype(np.uint8)
+    las.number_of_returns = np.full(800, 3, dtype=np.uint8)
+    las.amplitude = np.linspace(0, 1, 800).astype(np.float32)
+    las.write(str(tmp_path / "a.las"))
+    cloud = read(tmp_path / "a.las")
+    keep = np.arange(0, 800, 2)
+    part = cloud.subset(keep)
+    write(tmp_path / "b.las", part.replace(positions=part.positions + [0, 0, 0.5]))
+    back = laspy.read(str(tmp_path / "b.las"))
+    assert back.point_format.id == 1
+    for nm in ("gps_time", "return_number", "number_of_returns", "amplitude"):
+        assert np.array_equal(np.asarray(back[nm]), np.asarray(las[nm])[keep]), nm
+    assert np.array_equal(np.asarray(back.Z), np.asarray(las.Z)[keep] + 500)
