@@ -11,7 +11,7 @@ import pytest
 
 from splatedit.errors import InputError
 from splatedit.io import read, write
-from splatedit.io import ply as plymod
+from splatedit.io import _plybinary as plymod
 from tests.io._plyutil import make_ply
 
 
