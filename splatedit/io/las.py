@@ -33,10 +33,14 @@ from splatedit.tolerances import LAS_DEFAULT_SCALE, REBASE_MIN_ABS
 _RGB_FORMATS = (2, 3, 5, 7, 8, 10)
 
 
-def grey_from_intensity(intensity: np.ndarray) -> np.ndarray:
+def grey_from_intensity(intensity: np.ndarray) -> np.ndarray | None:
     """(n, 4) uint8 grey RGBA from (n,) intensities: linear, 0 black, the
     99.5th percentile and above white (a few bright returns would otherwise
-    leave everything else dark)."""
+    leave everything else dark).  None when every intensity is 0 (LAS
+    always has the field; a writer without intensities leaves it 0): the
+    default material then, not a black cloud."""
+    if not intensity.any():
+        return None
     hi = float(np.percentile(intensity, 99.5)) if len(intensity) else 0.0
     g = np.clip(intensity.astype(np.float32) * (255.0 / max(hi, 1.0)), 0, 255)
     out = np.empty((len(intensity), 4), dtype=np.uint8)

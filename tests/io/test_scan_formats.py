@@ -241,3 +241,14 @@ def test_las_other_dimensions_and_extra_bytes_survive_read_deform_subset_write(t
     for nm in ("gps_time", "return_number", "number_of_returns", "amplitude"):
         assert np.array_equal(np.asarray(back[nm]), np.asarray(las[nm])[keep]), nm
     assert np.array_equal(np.asarray(back.Z), np.asarray(las.Z)[keep] + 500)
+
+
+def test_all_zero_intensity_gives_the_default_material_not_black(tmp_path):
+    import laspy
+    world = _terrain(400)
+    las = laspy.LasData(laspy.LasHeader(point_format=1, version="1.2"))
+    las.header.scales = np.array([0.001, 0.001, 0.001])
+    las.header.offsets = np.array([512_000.0, 5_123_000.0, 0.0])
+    las.x, las.y, las.z = world[:, 0], world[:, 1], world[:, 2]
+    las.write(str(tmp_path / "z.las"))
+    assert read(tmp_path / "z.las").colors is None
