@@ -480,13 +480,17 @@ RENDER_BUFFERS_BYTES_PER_PIXEL = 150
 PLY_DECLARED_EXCESS_BYTES = 2**20
 
 # --- scan-scale I/O (issue 11, parts 1-3) -------------------------------------
-#: SplatCloud.validate checks this many rows at a time: its temporaries (abs,
-#: cross products, norms) are then ~25 MB instead of 3 x 240 MB at 10M splats
-#: (which pushed the read's peak memory past 1.5x the arrays kept)
+#: SplatCloud.validate tests axes this many rows at a time (at most an
+#: eighth of the cloud): its temporaries (lengths, dot products) stay ~50 MB
+#: instead of several 240 MB arrays at 10M splats.  With whole-array
+#: temporaries and the normals kept, a 10M read peaked at 1.57x the arrays
+#: kept; now 1.15x (splatedit bench io --large)
 VALIDATE_CHUNK_ROWS = 1 << 20
-#: binary PLY bodies are read through a buffer of this many bytes and
-#: converted chunk by chunk: 10M splats (840 MB) then need the arrays kept plus
-#: 32 MB, not a second full copy; 8-64 MB chunks all read at the same speed
+#: binary PLY bodies are read through a buffer of this many bytes (at most
+#: an eighth of the file) and converted chunk by chunk: 10M splats (840 MB)
+#: then need the arrays kept plus 32 MB, not a second full copy; the PLY
+#: writer converts the same amount at a time.  Reading the 10M body's
+#: copies through this buffer or through mmap took the same 0.7-0.9 s
 PLY_READ_CHUNK_BYTES = 32 * 2**20
 #: a file whose bounding box reaches farther from 0 than this (model units)
 #: is rebased to a local origin on load.  float32 (GPU) has a step of
@@ -494,7 +498,8 @@ PLY_READ_CHUNK_BYTES = 32 * 2**20
 #: y = 5,000,000.  Below 1e4 nothing changes (all our sample models)
 REBASE_MIN_ABS = 1e4
 #: `splatedit info` computes spacing, outliers and boundary splats exactly up
-#: to this many splats (1M: about 4 s here); above it, from spatial patches
+#: to this many splats (the issue's 36 s of k-NN at 10M scale to about 4 s at
+#: 1M, not measured again here); above it, from spatial patches
 #: (splatedit.model.sample) of about INFO_SAMPLE_POINTS points.  At 10M the
 #: all-points kNN took 36 s of the issue's 47 s
 INFO_EXACT_MAX_POINTS = 1_000_000
