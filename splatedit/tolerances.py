@@ -667,3 +667,42 @@ LOD_PREVIEW_SAMPLE_SPLATS = 1_000_000
 #: piece and are dropped); halves the graph that connected_components and
 #: the BFS copy and transpose (measured below in docs/PERFORMANCE.md)
 ORIENT_FOREST_NEIGHBOURS = 4
+# --- scan-scale I/O (issue 11, parts 1-3) -------------------------------------
+#: SplatCloud.validate tests axes this many rows at a time (at most an
+#: eighth of the cloud): its temporaries (lengths, dot products) stay ~50 MB
+#: instead of several 240 MB arrays at 10M splats.  With whole-array
+#: temporaries and the normals kept, a 10M read peaked at 1.57x the arrays
+#: kept; now 1.15x (splatedit bench io --large)
+VALIDATE_CHUNK_ROWS = 1 << 20
+#: binary PLY bodies are read through a buffer of this many bytes (at most
+#: an eighth of the file) and converted chunk by chunk: 10M splats (840 MB)
+#: then need the arrays kept plus 32 MB, not a second full copy; the PLY
+#: writer converts the same amount at a time.  Reading the 10M body's
+#: copies through this buffer or through mmap took the same 0.7-0.9 s
+PLY_READ_CHUNK_BYTES = 32 * 2**20
+#: a file whose bounding box reaches farther from 0 than this (model units)
+#: is rebased to a local origin on load.  float32 (GPU) has a step of
+#: |x| * 2^-24: 0.6 mm at 1e4 m, 0.03 m at UTM x = 500,000, 0.5 m at
+#: y = 5,000,000.  Below 1e4 nothing changes (all our sample models)
+REBASE_MIN_ABS = 1e4
+#: `splatedit info` computes spacing, outliers and boundary splats exactly up
+#: to this many splats (the issue's 36 s of k-NN at 10M scale to about 4 s at
+#: 1M, not measured again here); above it, from spatial patches
+#: (splatedit.model.sample) of about INFO_SAMPLE_POINTS points.  At 10M the
+#: all-points kNN took 36 s of the issue's 47 s
+INFO_EXACT_MAX_POINTS = 1_000_000
+INFO_SAMPLE_POINTS = 100_000
+#: patch cells are this many rough spacings wide.  The rough spacing is the
+#: median nearest-neighbour distance of a random subsample scaled to the full
+#: density as for random points on a surface; a regular scan's spacing is up
+#: to 2.3x that (a 10M Fibonacci sphere: 0.00053 against 1.08e-3), so cells
+#: are 28-64 true spacings wide.  At 32 only 6 % of the patch points of that
+#: sphere were far enough from the faces; at 64, 40-60 %
+INFO_PATCH_SPACINGS = 64.0
+#: figures are taken at patch points at least this quantile of the k-th
+#: neighbour distances found from their cell's faces (0.99 let the few
+#: corner points, whose one-sided neighbourhoods are wide, set the margin)
+INFO_PATCH_REACH_QUANTILE = 0.95
+#: LAS/LAZ written from a cloud not read from LAS: coordinate resolution
+#: (model units; millimetres for metre scans, the usual LiDAR grid)
+LAS_DEFAULT_SCALE = 0.001

@@ -57,8 +57,8 @@ def check_model_file(path) -> None:
     """Refuse a model the editor could not open, before any window exists:
     missing, a directory, an extension :func:`splatedit.io.read` does not
     know, or unreadable.  Raises :class:`InputError` (one line, exit 2)."""
-    from splatedit.io import READ_EXTENSIONS
-    p = Path(path)
+    from splatedit.io import READ_EXTENSIONS, split_scan_index
+    p = Path(split_scan_index(path)[0])
     if not p.exists():
         raise InputError("no such file", path=str(path))
     if p.is_dir():

@@ -102,6 +102,11 @@ def _estimate(quick: bool, progress=None, counts=None) -> Iterator[dict]:
         yield {"bench": "estimate", **line}
 
 
+def _io(quick: bool, progress=None, counts=None, large: bool = False) -> Iterator[dict]:
+    from splatedit.bench.io import bench_io
+    yield from bench_io(quick=quick, large=large)
+
+
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
@@ -112,6 +117,7 @@ BENCHES = {
     "render": _render,
     "editor": _editor,
     "estimate": _estimate,
+    "io": _io,
     "detail": _detail,
     "gui": _gui,
     "gaussians": _gaussians,
@@ -119,10 +125,14 @@ BENCHES = {
 }
 
 
-def run_bench(what: str, *, quick: bool = False, progress=None, counts=None) -> Iterator[dict]:
+def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
+              large: bool = False) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
     ``counts``: splat/point counts for ``estimate``, ``render`` and ``editor``
-    (default: each benchmark's own)."""
+    (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
-        yield from BENCHES[name](quick, progress, counts)
+        if name == "io":
+            yield from _io(quick, progress, counts, large=large)
+        else:
+            yield from BENCHES[name](quick, progress, counts)

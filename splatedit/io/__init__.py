@@ -1,4 +1,5 @@
-"""Reading and writing splat clouds: PLY, XYZ text, OFF meshes.
+"""Reading and writing splat clouds: PLY, XYZ text, OFF meshes, and the
+scanner formats LAS/LAZ, E57, PCD and PTS.
 
 Public API::
 
@@ -10,7 +11,8 @@ Public API::
     write_gaussians(path, scene, *, overwrite=False, progress=None) -> Path
 
 The format follows the file extension (case-insensitive): ``.ply``;
-``.xyz``, ``.txt``, ``.pts`` (XYZ text); ``.off``.  Splats come from the file
+``.xyz``, ``.txt`` (XYZ text); ``.off``; ``.las``, ``.laz``; ``.e57`` (one
+scan by index: ``file.e57#2``); ``.pcd``; ``.pts`` (Leica).  Splats come from the file
 (our ``ux..vz`` PLY properties) or are derived: see
 :func:`splatedit.io._build.build_cloud`.  Every problem with an input file is
 an :class:`~splatedit.errors.InputError` naming the file.
@@ -33,24 +35,31 @@ from pathlib import Path
 
 from splatedit.errors import InputError
 from splatedit.io.atomic import atomic_open, check_writable_target
+from splatedit.io.e57 import read_e57, split_scan_index, write_e57
+from splatedit.io.las import read_las, write_las
 from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply, write_gaussian_ply
 from splatedit.io.off import read_off, write_off
+from splatedit.io.pcd import read_pcd, write_pcd
 from splatedit.io.ply import read_ply, write_ply
+from splatedit.io.pts import read_pts, write_pts
 from splatedit.io.xyz import read_xyz, write_xyz
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.progress import report
 
-__all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "READ_EXTENSIONS",
-           "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians"]
+__all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "split_scan_index",
+           "READ_EXTENSIONS", "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians"]
 
-_READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_xyz,
-            ".off": read_off}
+_READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_pts,
+            ".off": read_off, ".las": read_las, ".laz": read_las, ".e57": read_e57,
+            ".pcd": read_pcd}
 #: extensions :func:`read` understands
 READ_EXTENSIONS = tuple(_READERS)
 #: extensions :func:`write` understands (.ply is the lossless splat format;
-#: .xyz keeps positions and normals, .off positions and faces)
-WRITE_EXTENSIONS = (".ply", ".xyz", ".off")
+#: .xyz keeps positions and normals, .off positions and faces; the scanner
+#: formats keep positions, colours, intensity (and LAS classification), .pcd
+#: normals too)
+WRITE_EXTENSIONS = (".ply", ".xyz", ".off", ".las", ".laz", ".e57", ".pcd", ".pts")
 
 
 def _ext(path, allowed, what) -> str:
@@ -65,16 +74,20 @@ def read(path, *, progress=None) -> SplatCloud:
     """Read a splat cloud, point cloud or mesh.
 
     Args:
-        path: a ``.ply``, ``.xyz``/``.txt``/``.pts`` or ``.off`` file.
+        path: a file of one of ``READ_EXTENSIONS``; ``file.e57#N`` reads
+            scan N (0-based) of an E57 file, ``file.e57`` all scans merged.
         progress: optional ``progress(stage, fraction)`` callback.
     Returns:
         SplatCloud with ``name`` = file name and ``source`` = path.
     Raises:
         InputError: unknown extension, unreadable or malformed file.
     """
+    path, scan = split_scan_index(path)
     ext = _ext(path, READ_EXTENSIONS, "reading")
     reader = _READERS[ext]
     check_readable_file(path)
+    if scan is not None:
+        return read_e57(path, scan=scan, progress=progress)
     if ext == ".ply" and is_gaussian_ply(path):
         return read_gaussian_ply(path, progress=progress).proxy_splats()
     return reader(path, progress=progress)
@@ -158,7 +171,9 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
     """Save ``cloud`` atomically (:func:`splatedit.io.atomic.atomic_open`).
 
     Args:
-        path: target ``.ply`` (lossless), ``.xyz`` or ``.off``.
+        path: target ``.ply`` (lossless), ``.xyz``, ``.off``, ``.las``,
+            ``.laz``, ``.e57``, ``.pcd`` or ``.pts`` (world coordinates:
+            the cloud's ``origin`` is added back).
         overwrite: replace an existing file (by default that is refused).
         binary: PLY only: binary little endian (default) or ascii.
         axes: PLY only: store normals and splat axes (default); False
@@ -185,6 +200,14 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
                           comment=f"written by splatedit from {cloud.name or 'a splat cloud'}")
             elif ext == ".xyz":
                 write_xyz(fh, cloud)
+            elif ext in (".las", ".laz"):
+                write_las(fh, cloud, path, compress=ext == ".laz")
+            elif ext == ".pcd":
+                write_pcd(fh, cloud)
+            elif ext == ".pts":
+                write_pts(fh, cloud)
+            elif ext == ".e57":
+                write_e57(fh, cloud, path.parent)
             else:
                 write_off(fh, cloud)
     except OSError as exc:

@@ -8,10 +8,10 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.model.cloud import SplatCloud
+from splatedit.model.cloud import SplatCloud, column_bounds
 from splatedit.model.estimate import estimate_splats
 from splatedit.model.mesh import cloud_from_mesh
-from splatedit.tolerances import MAX_COORDINATE_ABS
+from splatedit.tolerances import MAX_COORDINATE_ABS, REBASE_MIN_ABS
 
 
 def _located(message, path, element, row, prop, lines=None) -> InputError:
@@ -127,8 +127,32 @@ def triangulate(flat, lengths, n_vertices: int, path, element: str = "face",
     return np.stack([flat[base], flat[base + j + 1], flat[base + j + 2]], axis=1)
 
 
+def local_origin(positions, bounds=None) -> np.ndarray:
+    """(3,) float64 origin for the positions: zeros when the bounding box lies
+    within ``REBASE_MIN_ABS`` of 0, else its centre rounded to whole model
+    units.  An integer origin makes ``x - origin`` and back exact for every
+    float64 ``x`` of the file (ulp(x) divides 1 below 2^53, and the local
+    value needs fewer bits than ``x``).  ``bounds``: (min, max) if known."""
+    lo, hi = column_bounds(positions) if bounds is None else bounds
+    if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
+        return np.zeros(3)
+    return np.round(0.5 * (lo + hi))
+
+
+def rebase(positions, origin) -> np.ndarray:
+    """``positions - origin``, in place when ``positions`` is a writeable
+    float64 array (the readers' own), to keep the peak memory down."""
+    if not origin.any():
+        return positions
+    if isinstance(positions, np.ndarray) and positions.dtype == np.float64 and positions.flags.writeable:
+        positions -= origin
+        return positions
+    return np.asarray(positions, dtype=np.float64) - origin
+
+
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
-                faces=None, progress=None) -> SplatCloud:
+                faces=None, progress=None, origin=None, already_local=False, intensity=None,
+                classification=None, quantization=None, point_fields=None) -> SplatCloud:
     """Apply the axes rule (first match wins):
 
     1. ``u`` and ``v`` given (our ``ux..vz`` properties): used as they are;
@@ -139,15 +163,26 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     5. nothing: normals estimated, oriented and sized
        (:func:`estimate_splats`).
 
-    Faces are kept in every case.
+    Faces are kept in every case.  Positions are first rebased (in place) to
+    ``origin``, by default :func:`local_origin` (``already_local``: the
+    reader did that, as the LAS reader does on the file's integer grid); ``intensity``, ``classification`` and
+    ``quantization`` are stored with the cloud.
     """
     name, source = Path(path).name, str(path)
     if len(positions) == 0:
         raise InputError("zero vertices: the file holds no points", path=source, element="vertex")
+    if origin is None:
+        origin = local_origin(positions)
+    if not already_local:
+        positions = rebase(positions, origin)
+    scan = dict(origin=origin, intensity=intensity, classification=classification,
+                quantization=quantization, point_fields=point_fields)
     if faces is not None and len(faces) == 0:
         faces = None
     if u is not None and v is not None:
-        return SplatCloud(positions, u, v, colors, faces, name=name, source=source)
+        # every reader checks its columns (check_finite) before calling here
+        return SplatCloud(positions, u, v, colors, faces, name=name, source=source,
+                          values_checked=True, **scan)
     if radius is not None:
         bad = ~(radius > 0)
         if bad.any():
@@ -155,7 +190,14 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
             raise InputError(f"radius must be > 0, got {radius[row]}", path=source,
                              element="vertex", row=row, prop="radius")
     if faces is not None and not (normals is not None and radius is not None):
-        return cloud_from_mesh(positions, faces, normals=normals, colors=colors, name=name,
-                               source=source, progress=progress)
-    return estimate_splats(positions, normals, colors, progress, radius=radius, faces=faces,
-                           name=name, source=source)
+        cloud = cloud_from_mesh(positions, faces, normals=normals, colors=colors, name=name,
+                                source=source, progress=progress)
+    else:
+        cloud = estimate_splats(positions, normals, colors, progress, radius=radius, faces=faces,
+                                name=name, source=source)
+    if origin.any() or any(v is not None for v in (intensity, classification, quantization,
+                                                   point_fields)):
+        for k, val in scan.items():
+            setattr(cloud, k, val)
+        cloud.validate()
+    return cloud

@@ -104,3 +104,49 @@ def check_declared_sizes(path) -> None:
             raise InputError(f"header declares {count} rows of element {name!r}, at least "
                              f"{need} bytes of data, but the file has {body} bytes after its "
                              f"header (truncated, or a wrong count)", path=str(path), element=name)
+
+
+def binary_layout(path):
+    """Header of a binary PLY whose first element is ``vertex`` with scalar
+    properties only and that has no other element, for the chunked reader.
+
+    Returns (body offset, vertex count, numpy structured dtype with the file's
+    byte order) or None for anything else (ascii, lists, faces, more
+    elements, a header this cannot parse: plyfile then reads the file and
+    reports problems in its own words).  A property declared twice raises
+    :class:`InputError`.
+    """
+    try:
+        with open(path, "rb") as fh:
+            head = fh.read(1 << 16)
+    except OSError:
+        return None
+    end = head.find(b"end_header")
+    nl = head.find(b"\n", end)
+    if not head.startswith(b"ply") or end < 0 or nl < 0 or head[end:nl].strip() != b"end_header":
+        return None
+    try:
+        lines = head[:end].decode("ascii").splitlines()
+    except UnicodeDecodeError:
+        return None
+    fmt, elements = None, []
+    for line in lines[1:]:
+        w = line.split()
+        if not w or w[0] in ("comment", "obj_info"):
+            continue
+        if w[0] == "format" and len(w) == 3 and w[2] == "1.0":
+            fmt = w[1]
+        elif w[0] == "element" and len(w) == 3 and w[2].isdigit():
+            elements.append((w[1], int(w[2]), []))
+        elif w[0] == "property" and elements and len(w) == 3 and w[1] in TYPES:
+            if any(nm == w[2] for nm, _ in elements[-1][2]):
+                raise InputError(f"header: property {w[2]!r} is declared twice", path=str(path),
+                                 element=elements[-1][0])
+            elements[-1][2].append((w[2], TYPES[w[1]]))
+        else:
+            return None
+    order = {"binary_little_endian": "<", "binary_big_endian": ">"}.get(fmt)
+    if order is None or len(elements) != 1 or elements[0][0] != "vertex" or not elements[0][2]:
+        return None
+    dtype = np.dtype([(nm, order + code) for nm, code in elements[0][2]])
+    return nl + 1, elements[0][1], dtype

@@ -15,7 +15,7 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.io._build import check_finite, colors_from_columns, triangulate
+from splatedit.io._build import check_finite, colors_from_columns, local_origin, rebase, triangulate
 from splatedit.io._text import read_bytes, scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.mesh import cloud_from_mesh
@@ -140,8 +140,11 @@ def read_off(path, *, progress=None) -> SplatCloud:
         raise _error("face vertex index is not an integer", src, int(fline[row]),
                      element="face", row=row)
     faces = triangulate(flat, k, nv, src, "face", "vertex_indices", fline)
-    return cloud_from_mesh(positions, faces, normals=normals, colors=colors,
-                           name=Path(path).name, source=src, progress=progress)
+    origin = local_origin(positions)
+    cloud = cloud_from_mesh(rebase(positions, origin), faces, normals=normals, colors=colors,
+                            name=Path(path).name, source=src, progress=progress)
+    cloud.origin = origin
+    return cloud
 
 
 def write_off(fh, cloud: SplatCloud) -> None:
@@ -149,5 +152,5 @@ def write_off(fh, cloud: SplatCloud) -> None:
     OFF with zero faces) to the open binary file ``fh``."""
     faces = cloud.faces if cloud.faces is not None else np.zeros((0, 3), dtype=np.int64)
     fh.write(f"OFF\n{cloud.n} {len(faces)} 0\n".encode("ascii"))
-    np.savetxt(fh, cloud.positions, fmt="%.17g")
+    np.savetxt(fh, cloud.world_positions(), fmt="%.17g")
     np.savetxt(fh, faces, fmt="3 %d %d %d")

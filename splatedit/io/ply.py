@@ -1,9 +1,13 @@
-"""PLY reading (via plyfile) and writing (our own vectorised binary writer).
+"""PLY reading (binary files of vertex scalars: our chunked reader in
+:mod:`splatedit.io._plybinary`; ascii: a vectorised parser; anything else:
+plyfile) and writing (our own vectorised binary writer, 32 MB at a time).
 
 Read: ascii, binary little/big endian; any numeric property type.  Vertex
 properties used: ``x y z`` (required), ``nx ny nz`` (or ``normal_x ...``),
 ``red green blue [alpha]`` (or ``r g b a`` / ``diffuse_red ...``; uchar or
-float), ``radius``, and our ``ux uy uz vx vy vz``.  Other properties and
+float), ``radius``, our ``ux uy uz vx vy vz``, and the scan attributes
+``intensity`` and ``classification`` (kept, not turned into colours: a PLY
+without colours keeps the default material).  Other properties and
 elements are ignored.  A ``face`` element (``vertex_indices`` or
 ``vertex_index`` list) makes the file a mesh: polygons are fan-triangulated.
 
@@ -14,6 +18,7 @@ Written file layout (binary little endian by default)::
       float  nx ny nz         unit normals, for other tools
       double ux uy uz vx vy vz  splat semi-axes, bit-exact   (axes=True)
       uchar  red green blue alpha                           (if colours)
+      ushort intensity, uchar classification                (if the cloud has them)
     element face f
       list uchar int vertex_indices                         (if faces)
 """
@@ -25,16 +30,14 @@ import plyfile
 
 from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
+from splatedit.io._plybinary import _AXES, _COLORS, _NORMALS, read_binary_chunked, scan_columns
 from splatedit.io._plycheck import TYPES as _TYPES
-from splatedit.io._plycheck import check_declared_sizes, check_trailing, warn_trailing
+from splatedit.io._plycheck import binary_layout, check_declared_sizes, check_trailing, warn_trailing
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
+from splatedit.tolerances import PLY_READ_CHUNK_BYTES
 
-_NORMALS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
-_COLORS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
-                                               "diffuse_alpha"), ("r", "g", "b", "a"))
-_AXES = ("ux", "uy", "uz", "vx", "vy", "vz")
 _FACE_LISTS = ("vertex_indices", "vertex_index")
 
 
@@ -245,6 +248,9 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     """
     report(progress, "reading", 0.0)
     check_declared_sizes(path)
+    layout = binary_layout(path)
+    if layout is not None:
+        return read_binary_chunked(path, layout, progress)
     fast = _read_ascii_fast(path, progress)
     if fast is not None:
         data, face_lists = fast
@@ -289,13 +295,15 @@ def read_ply(path, *, progress=None) -> SplatCloud:
         use = [p for p in cn if p in names]
         colors = colors_from_columns([_column(data, p, path) for p in use], use, str(path))
     faces = _faces(face_lists, len(positions), path)
+    intensity, classification = scan_columns(lambda nm: _column(data, nm, path), names, str(path))
     report(progress, "reading", 1.0)
     return build_cloud(path, positions, normals=normals, radius=radius, u=u, v=v,
-                       colors=colors, faces=faces, progress=progress)
+                       colors=colors, faces=faces, progress=progress, intensity=intensity,
+                       classification=classification)
 
 
 # ----------------------------------------------------------------- writing
-def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
+def _vertex_dtype(cloud: SplatCloud, axes: bool, byte_order: str) -> np.dtype:
     e = byte_order
     fields = [(p, e + "f8") for p in ("x", "y", "z")]
     if axes:
@@ -303,35 +311,52 @@ def _vertex_array(cloud: SplatCloud, axes: bool, byte_order: str) -> np.ndarray:
         fields += [(p, e + "f8") for p in _AXES]
     if cloud.colors is not None:
         fields += [(p, "u1") for p in ("red", "green", "blue", "alpha")]
-    arr = np.empty(cloud.n, dtype=fields)
+    if cloud.intensity is not None:
+        fields.append(("intensity", e + "u2"))
+    if cloud.classification is not None:
+        fields.append(("classification", "u1"))
+    return np.dtype(fields)
+
+
+def _vertex_array(cloud: SplatCloud, dtype: np.dtype, rows: slice = slice(None)) -> np.ndarray:
+    """The vertex records of ``rows`` (a chunk: the writer never holds a
+    full copy of a large cloud)."""
+    world = cloud.world_positions(rows)
+    arr = np.empty(len(world), dtype=dtype)
+    if cloud.intensity is not None:
+        arr["intensity"] = cloud.intensity[rows]
+    if cloud.classification is not None:
+        arr["classification"] = cloud.classification[rows]
     for j, p in enumerate("xyz"):
-        arr[p] = cloud.positions[:, j]
-    if axes:
-        nrm = cloud.normals
+        arr[p] = world[:, j]
+    if "ux" in dtype.names:
+        u, v = cloud.u[rows], cloud.v[rows]
+        nrm = np.cross(u, v)
+        nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
         for j, p in enumerate(("nx", "ny", "nz")):
             arr[p] = nrm[:, j]
         for j, p in enumerate(_AXES[:3]):
-            arr[p] = cloud.u[:, j]
+            arr[p] = u[:, j]
         for j, p in enumerate(_AXES[3:]):
-            arr[p] = cloud.v[:, j]
+            arr[p] = v[:, j]
     if cloud.colors is not None:
         for j, p in enumerate(("red", "green", "blue", "alpha")):
-            arr[p] = cloud.colors[:, j]
+            arr[p] = cloud.colors[rows, j]
     return arr
 
 
-_PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "i4": "int"}
+_PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "u2": "ushort", "i4": "int"}
 
 
-def _header(vert: np.ndarray, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
+def _header(dtype: np.dtype, n: int, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
     lines = ["ply", f"format {fmt} 1.0"]
     if comment:
         # PLY headers are ASCII: escape anything else (e.g. a file name like été.ply)
         safe = comment.encode("ascii", "backslashreplace").decode("ascii")
         lines += [f"comment {c}" for c in safe.splitlines()]
-    lines.append(f"element vertex {len(vert)}")
-    for name in vert.dtype.names:
-        lines.append(f"property {_PLY_TYPE[vert.dtype[name].str[1:]]} {name}")
+    lines.append(f"element vertex {n}")
+    for name in dtype.names:
+        lines.append(f"property {_PLY_TYPE[dtype[name].str[1:]]} {name}")
     if n_faces is not None:
         lines += [f"element face {n_faces}", "property list uchar int vertex_indices"]
     lines.append("end_header")
@@ -350,19 +375,21 @@ def write_ply(fh, cloud: SplatCloud, *, binary: bool = True, axes: bool = True,
             reader then derives the splats again (from the mesh if there are
             faces).
     """
-    vert = _vertex_array(cloud, axes, "<")
+    dtype = _vertex_dtype(cloud, axes, "<")
     faces = cloud.faces
-    fh.write(_header(vert, None if faces is None else len(faces),
+    fh.write(_header(dtype, cloud.n, None if faces is None else len(faces),
                      "binary_little_endian" if binary else "ascii", comment))
     if binary:
-        fh.write(vert.tobytes())
+        step = max(1, PLY_READ_CHUNK_BYTES // dtype.itemsize)
+        for lo in range(0, cloud.n, step):
+            fh.write(_vertex_array(cloud, dtype, slice(lo, lo + step)).tobytes())
         if faces is not None:
             fa = np.empty(len(faces), dtype=[("n", "u1"), ("i", "<i4", (3,))])
             fa["n"] = 3
             fa["i"] = faces
             fh.write(fa.tobytes())
         return
-    fmt = {"f8": "%.17g", "f4": "%.9g", "u1": "%d"}
-    np.savetxt(fh, vert, fmt=[fmt[vert.dtype[nm].str[1:]] for nm in vert.dtype.names])
+    fmt = {"f8": "%.17g", "f4": "%.9g", "u1": "%d", "u2": "%d"}
+    np.savetxt(fh, _vertex_array(cloud, dtype), fmt=[fmt[dtype[nm].str[1:]] for nm in dtype.names])
     if faces is not None:
         np.savetxt(fh, faces, fmt="3 %d %d %d")

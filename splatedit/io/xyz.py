@@ -59,4 +59,4 @@ def read_xyz(path, *, progress=None) -> SplatCloud:
 
 def write_xyz(fh, cloud: SplatCloud) -> None:
     """Write ``x y z nx ny nz`` lines to the open binary file ``fh``."""
-    np.savetxt(fh, np.hstack([cloud.positions, cloud.normals]), fmt="%.17g")
+    np.savetxt(fh, np.hstack([cloud.world_positions(), cloud.normals]), fmt="%.17g")

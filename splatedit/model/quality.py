@@ -10,7 +10,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import knn
 from splatedit.model.outliers import OutlierFlags, detect_outliers, stray_clusters
 from splatedit.model.sizing import boundary_points, mesh_boundary_vertices, neighbour_indices
-from splatedit.tolerances import OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
+from splatedit.tolerances import INFO_SAMPLE_POINTS, OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
 
 
 @dataclass(frozen=True)
@@ -55,3 +55,60 @@ def assess(cloud: SplatCloud) -> CloudQuality:
         boundary = boundary_points(pts, cloud.normals, nb)
     strays = stray_clusters(pts, flags.isolation_radius) & ~flags.mask
     return CloudQuality(flags, boundary, spread, strays)
+
+
+@dataclass(frozen=True)
+class QualityEstimate:
+    """Figures of a large cloud estimated from spatial patches
+    (:func:`splatedit.model.sample.patch_sample`): counts are the fraction
+    among the exactly-known patch points times the cloud's size.
+
+    Attributes:
+        spacing: median nearest-neighbour distance at distinct positions (model units).
+        boundary: estimated boundary splats (meshes: exact, from the faces).
+        statistical, isolated, outliers: estimated outlier counts.
+        sample_points: patch points whose neighbourhoods were known exactly.
+    """
+
+    spacing: float
+    boundary: int
+    statistical: int
+    isolated: int
+    outliers: int
+    sample_points: int
+
+
+def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
+                     lower=None) -> QualityEstimate | None:
+    """:class:`QualityEstimate` of ``cloud`` without an all-points k-NN, or
+    None when the patches give no usable points (then use :func:`assess`).
+    ``lower``: the bounding box's lower corner, if known."""
+    from splatedit.model.sample import patch_sample
+    n = cloud.n
+    ps = patch_sample(cloud.positions, target, lower=lower)
+    if ps is None or len(ps.index) < 100:
+        return None
+    k = max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1)
+    dist, idx, exact = ps.knn(k)
+    if exact.sum() < 100:
+        return None
+    pts = ps.tree.data
+    d1 = dist[:, 1]
+    use = exact & (d1 > 0)
+    spacing = float(np.median(d1[use])) if use.any() else 0.0
+    flags = detect_outliers(pts, distances=dist)
+    m = int(exact.sum())
+    scale = n / m
+    stat = int(round(flags.statistical[exact].sum() * scale))
+    iso = int(round(flags.isolated[exact].sum() * scale))
+    both = int(round(flags.mask[exact].sum() * scale))
+    if cloud.faces is not None and len(cloud.faces):
+        boundary = int(mesh_boundary_vertices(n, cloud.faces).sum())
+    else:
+        sel = ps.index
+        nrm = np.cross(cloud.u[sel], cloud.v[sel])
+        nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+        nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, len(pts)), neighbours=idx)
+        bnd = boundary_points(pts, nrm, nb)
+        boundary = int(round(bnd[exact].sum() * scale))
+    return QualityEstimate(spacing, boundary, stat, iso, both, m)

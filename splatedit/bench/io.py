@@ -1,0 +1,192 @@
+"""``splatedit bench io``: reading and writing scan-sized files.
+
+Cases (one dict each, printed as a JSON line by the CLI):
+
+* ``ply_read``: a binary little-endian splat PLY as our writer lays it out
+  (x y z double, nx ny nz float, ux..vz double: 84 bytes per splat, 840 MB at
+  10M) on a Fibonacci sphere, generated once per size in a temporary folder
+  (in chunks: the generator never holds the whole cloud).  Each reader runs
+  in a fresh Python process so its peak memory is its own: ``splatedit``
+  (:func:`splatedit.io.read`, the whole SplatCloud), ``plyfile`` (its plain
+  ``PlyData.read``, the structured vertex array only) and ``open3d``
+  (``read_point_cloud``; skipped with a note when Open3D is not installed).
+  Keys: ``seconds`` (the read alone), ``peak_rss_mb`` (the child's peak
+  resident memory), ``base_rss_mb`` (the child's memory after its imports,
+  before reading), ``kept_mb`` (bytes of the arrays the reader returns) and
+  ``peak_over_kept`` = (peak - base) / kept.
+* ``las_write`` / ``las_read`` / ``laz_write`` / ``laz_read``: a 1M-point
+  georeferenced scan (UTM-like coordinates, scale 0.001, RGB, intensity,
+  classification) through :func:`splatedit.io.write` and :func:`read`, with
+  laspy's own read (``laspy.read``) in the same run.  LAS has no normals:
+  our read includes normal estimation, orientation and sizing of the raw
+  points (``splatedit.model.estimate``), which is most of its time.
+
+Sizes: 1M by default (``--quick``: 200k PLY, 20k LAS); 10M only with ``--large``.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+from typing import Iterator
+
+import numpy as np
+
+_CHUNK = 1_000_000
+
+_CHILD = r"""
+import json, sys, time
+kind, path = sys.argv[1], sys.argv[2]
+import numpy as np
+if kind == "splatedit":
+    from splatedit.io import read
+elif kind == "plyfile":
+    import plyfile
+else:
+    import open3d as o3d
+def rss_mb(key="VmRSS:"):
+    # /proc, not getrusage: ru_maxrss survives exec and starts at the parent's size
+    with open("/proc/self/status") as fh:
+        for line in fh:
+            if line.startswith(key):
+                return int(line.split()[1]) / 1024
+base = rss_mb()
+t0 = time.perf_counter()
+if kind == "splatedit":
+    c = read(path)
+    kept = sum(a.nbytes for a in (c.positions, c.u, c.v, c.colors) if a is not None)
+    n = c.n
+elif kind == "plyfile":
+    d = np.array(plyfile.PlyData.read(path)["vertex"].data)   # mapped, then copied: the plain read
+    kept, n = d.nbytes, len(d)
+else:
+    pc = o3d.io.read_point_cloud(path)
+    n = len(pc.points)
+    kept = n * 24 * (1 + pc.has_normals() + pc.has_colors())
+dt = time.perf_counter() - t0
+peak = rss_mb("VmHWM:")
+print(json.dumps({"seconds": round(dt, 3), "n": n, "peak_rss_mb": round(peak), "base_rss_mb": round(base),
+                  "kept_mb": round(kept / 2**20), "peak_over_kept": round((peak - base) / (kept / 2**20), 3)}))
+"""
+
+
+def write_sphere_ply(path: Path, n: int) -> int:
+    """Write ``n`` splats of a unit Fibonacci sphere as our binary PLY layout,
+    ``_CHUNK`` splats at a time.  Returns the file size in bytes."""
+    fields = ([(p, "<f8") for p in "xyz"] + [(p, "<f4") for p in ("nx", "ny", "nz")]
+              + [(p, "<f8") for p in ("ux", "uy", "uz", "vx", "vy", "vz")])
+    names = {"<f8": "double", "<f4": "float"}
+    head = ["ply", "format binary_little_endian 1.0", f"element vertex {n}"]
+    head += [f"property {names[t]} {p}" for p, t in fields] + ["end_header", ""]
+    s = np.sqrt(4 * np.pi / n)
+    with open(path, "wb") as fh:
+        fh.write("\n".join(head).encode("ascii"))
+        for lo in range(0, n, _CHUNK):
+            i = np.arange(lo, min(n, lo + _CHUNK)) + 0.5
+            z = 1.0 - 2.0 * i / n
+            phi = np.pi * (1.0 + 5 ** 0.5) * i
+            r = np.sqrt(1.0 - z * z)
+            nrm = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
+            a = np.where(np.abs(nrm[:, [0]]) < 0.9, np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]))
+            t1 = np.cross(nrm, a)
+            t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
+            t2 = np.cross(nrm, t1)
+            arr = np.empty(len(i), dtype=fields)
+            for j, p in enumerate("xyz"):
+                arr[p] = nrm[:, j]
+                arr["n" + p] = nrm[:, j]
+                arr["u" + p] = s * t1[:, j]
+                arr["v" + p] = s * t2[:, j]
+            fh.write(arr.tobytes())
+    return path.stat().st_size
+
+
+def _child(kind: str, path: Path) -> dict:
+    env = dict(os.environ)
+    env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")     # as the CLI runs (see splatedit.cli)
+    proc = subprocess.run([sys.executable, "-c", _CHILD, kind, str(path)], capture_output=True,
+                          text=True, env=env)
+    if proc.returncode != 0:
+        last = (proc.stderr.strip().splitlines() or ["failed"])[-1]
+        return {"skipped": last[:200]}
+    return json.loads(proc.stdout.strip().splitlines()[-1])
+
+
+def _has_open3d() -> bool:
+    import importlib.util
+    return importlib.util.find_spec("open3d") is not None
+
+
+def bench_ply_read(counts, tmp: Path) -> Iterator[dict]:
+    for n in counts:
+        path = tmp / f"sphere{n}.ply"
+        t0 = time.perf_counter()
+        size = write_sphere_ply(path, n)
+        gen = time.perf_counter() - t0
+        for kind in ("splatedit", "plyfile", "open3d"):
+            out = {"bench": "io", "case": "ply_read", "reader": kind, "splats": n,
+                   "file_mb": round(size / 2**20)}
+            if kind == "open3d" and not _has_open3d():
+                out["skipped"] = "open3d not installed (pip install splatedit[bench])"
+            else:
+                out.update(_child(kind, path))
+            if kind == "splatedit":
+                out["generate_s"] = round(gen, 2)
+            yield out
+        path.unlink()
+
+
+def scan_cloud(n: int, seed: int = 0):
+    """A synthetic georeferenced terrain tile: ``n`` points on a 1 km
+    rolling surface at UTM-like coordinates (x ~ 500,000, y ~ 5,000,000 m)
+    quantised to millimetres, with RGB, intensity and classification; splats
+    sized from the grid spacing (no estimation)."""
+    from splatedit.model.cloud import SplatCloud
+    rng = np.random.default_rng(seed)
+    xy = rng.uniform(0, 1000, size=(n, 2))
+    z = 200 + 5 * np.sin(xy[:, 0] / 50) * np.cos(xy[:, 1] / 70)
+    world = np.round(np.column_stack([xy[:, 0] + 500_000, xy[:, 1] + 5_000_000, z]), 3)
+    origin = np.array([500_500.0, 5_000_500.0, 200.0])
+    h = 1000 / np.sqrt(n)
+    u = np.zeros((n, 3))
+    v = np.zeros((n, 3))
+    u[:, 0] = h
+    v[:, 1] = h
+    colors = np.column_stack([rng.integers(0, 256, (n, 3)), np.full(n, 255)]).astype(np.uint8)
+    return SplatCloud(world - origin, u, v, colors, name=f"tile{n}", origin=origin,
+                      intensity=rng.integers(0, 65536, n), classification=rng.integers(1, 7, n))
+
+
+def bench_las(n: int, tmp: Path) -> Iterator[dict]:
+    import laspy
+    from splatedit.io import read, write
+    cloud = scan_cloud(n)
+    for ext in (".las", ".laz"):
+        path = tmp / f"tile{ext}"
+        t0 = time.perf_counter()
+        write(path, cloud, overwrite=True)
+        tw = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        back = read(path)
+        tr = time.perf_counter() - t0
+        t0 = time.perf_counter()
+        laspy.read(path)
+        tl = time.perf_counter() - t0
+        same = bool(np.array_equal(np.round(back.world_positions() * 1000),
+                                   np.round(cloud.world_positions() * 1000)))
+        yield {"bench": "io", "case": ext[1:] + "_write", "points": n, "seconds": round(tw, 3),
+               "file_mb": round(path.stat().st_size / 2**20, 1)}
+        yield {"bench": "io", "case": ext[1:] + "_read", "points": n, "seconds": round(tr, 3),
+               "laspy_read_s": round(tl, 3), "mm_exact": same}
+
+
+def bench_io(*, quick: bool = False, large: bool = False) -> Iterator[dict]:
+    counts = (200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,))
+    with tempfile.TemporaryDirectory(prefix="splatedit-bench-io-") as tmp:
+        yield from bench_ply_read(counts, Path(tmp))
+        yield from bench_las(20_000 if quick else 1_000_000, Path(tmp))

@@ -1,0 +1,173 @@
+"""LAS and LAZ airborne/terrestrial LiDAR files (laspy, LAZ through lazrs).
+
+Read: x y z (the file's 32-bit integers times ``scale`` plus ``offset``),
+16-bit RGB (point formats 2, 3, 5, 7, 8, 10) as 8-bit colours (the high
+byte), ``intensity`` (uint16) and ``classification``.  Files without RGB get
+grey colours from the intensity (linear, the 99.5th percentile white).  The
+other dimensions (GPS time, return numbers, scan angle, user data, point
+source, extra bytes, ...) are kept in ``SplatCloud.point_fields`` and
+written back by the LAS writer (same point format; extra bytes with their
+types).  Normals and splat sizes are estimated (LAS has none).
+
+Far coordinates are rebased to an origin on the file's own integer grid:
+``origin = offset + X0 * scale`` for an integer ``X0`` near the centre, and
+the local coordinates are ``(X - X0) * scale``, so writing back with the same
+scale and offset gives back the same integers.
+
+Write: point format 3 (RGB) when the cloud has colours of its own, else 1,
+LAS 1.2; formats 7 / 6 and LAS 1.4 when the source file was LAS 1.4-style
+(format 6 or above) or a class is above 31 (1.2 holds 5-bit classes); the scale and offset of the file the cloud was read from, else
+0.001 and the origin.  Colours are written as 16-bit ``c * 257``.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from splatedit.errors import InputError
+from splatedit.io._build import build_cloud
+from splatedit.model.cloud import Quantization, SplatCloud, column_bounds
+from splatedit.progress import report
+from splatedit.tolerances import LAS_DEFAULT_SCALE, REBASE_MIN_ABS
+
+_RGB_FORMATS = (2, 3, 5, 7, 8, 10)
+
+
+def grey_from_intensity(intensity: np.ndarray) -> np.ndarray | None:
+    """(n, 4) uint8 grey RGBA from (n,) intensities: linear, 0 black, the
+    99.5th percentile and above white (a few bright returns would otherwise
+    leave everything else dark).  None when every intensity is 0 (LAS
+    always has the field; a writer without intensities leaves it 0): the
+    default material then, not a black cloud."""
+    if not intensity.any():
+        return None
+    hi = float(np.percentile(intensity, 99.5)) if len(intensity) else 0.0
+    g = np.clip(intensity.astype(np.float32) * (255.0 / max(hi, 1.0)), 0, 255)
+    out = np.empty((len(intensity), 4), dtype=np.uint8)
+    out[:, :3] = np.rint(g)[:, None]
+    out[:, 3] = 255
+    return out
+
+
+def read_las(path, *, progress=None) -> SplatCloud:
+    """Read a ``.las`` or ``.laz`` file (see the module docstring)."""
+    import laspy
+    src = str(path)
+    report(progress, "reading", 0.0)
+    try:
+        las = laspy.read(src)
+    except Exception as exc:        # laspy raises many kinds on corrupt data
+        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
+        raise InputError(f"not a readable LAS/LAZ file: {msg}", path=src) from None
+    n = len(las.points)
+    if n == 0:
+        raise InputError("zero points: the file holds no points", path=src)
+    scale = np.asarray(las.header.scales, dtype=np.float64)
+    offset = np.asarray(las.header.offsets, dtype=np.float64)
+    ints = np.empty((n, 3), dtype=np.int64)
+    for j, d in enumerate("XYZ"):
+        ints[:, j] = las[d]
+    lo_i, hi_i = column_bounds(ints)
+    world_lo, world_hi = lo_i * scale + offset, hi_i * scale + offset
+    if max(np.abs(world_lo).max(), np.abs(world_hi).max()) > REBASE_MIN_ABS:
+        ref = (lo_i + hi_i) // 2
+        origin = offset + ref * scale
+        ints -= ref
+        positions = ints.astype(np.float64)
+        positions *= scale
+    else:
+        origin = np.zeros(3)
+        positions = ints.astype(np.float64)
+        positions *= scale
+        positions += offset
+    del ints
+    names = set(las.point_format.dimension_names)
+    intensity = np.asarray(las.intensity, dtype=np.uint16) if "intensity" in names else None
+    classification = (np.asarray(las.classification, dtype=np.uint8)
+                      if "classification" in names else None)
+    colors = None
+    if {"red", "green", "blue"} <= names:
+        rgb = np.column_stack([np.asarray(las[c]) for c in ("red", "green", "blue")])
+        # 16-bit per the standard; some writers store 8-bit values
+        shift = 8 if rgb.max() > 255 else 0
+        colors = np.full((n, 4), 255, dtype=np.uint8)
+        colors[:, :3] = rgb >> shift
+    elif intensity is not None:
+        colors = grey_from_intensity(intensity)
+    quant = Quantization(tuple(scale.tolist()), tuple(offset.tolist()),
+                         int(las.header.point_format.id))
+    handled = {"X", "Y", "Z", "intensity", "classification", "red", "green", "blue"}
+    fields = {nm: np.array(las[nm]) for nm in las.point_format.dimension_names if nm not in handled}
+    report(progress, "reading", 1.0)
+    return build_cloud(path, positions, colors=colors, progress=progress, origin=origin,
+                       already_local=True, intensity=intensity, classification=classification,
+                       quantization=quant, point_fields=fields or None)
+
+
+def quantize(cloud: SplatCloud, scale, offset, path) -> np.ndarray:
+    """(n, 3) int64 ``round((positions + origin - offset) / scale)``, computed
+    as ``round(positions / scale) + round((origin - offset) / scale)`` so
+    that coordinates read from the same grid come back exactly.
+
+    Raises:
+        InputError when a value does not fit LAS's signed 32-bit integers.
+    """
+    scale = np.asarray(scale, dtype=np.float64)
+    base = np.asarray(cloud.origin, dtype=np.float64) - np.asarray(offset, dtype=np.float64)
+    ref = np.round(base / scale)
+    ints = np.rint(cloud.positions / scale).astype(np.int64) + ref.astype(np.int64)
+    frac = base / scale - ref        # an origin off the grid (a cloud not read from LAS)
+    if np.any(frac != 0):
+        ints = np.rint((cloud.positions + base) / scale).astype(np.int64)
+    lo, hi = column_bounds(ints)
+    if lo.min() < -2**31 or hi.max() > 2**31 - 1:
+        raise InputError(f"coordinates do not fit LAS's 32-bit integers at scale "
+                         f"{scale.tolist()} (extent too large)", path=str(path))
+    return ints
+
+
+def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
+    """Write ``cloud`` as LAS (or LAZ with ``compress``) to the open binary file ``fh``."""
+    import laspy
+    q = cloud.quantization
+    own_rgb = cloud.colors is not None and (q is None or q.point_format in _RGB_FORMATS
+                                            or q.point_format is None)
+    # LAS 1.4 formats (6+) hold 8-bit classes; 1.2's formats 1/3 only 0..31
+    wide = (q is not None and (q.point_format or 0) >= 6) or (
+        cloud.classification is not None and int(cloud.classification.max()) > 31)
+    fmt = (7 if own_rgb else 6) if wide else (3 if own_rgb else 1)
+    fields = cloud.point_fields or {}
+    if fields and q is not None and q.point_format is not None:
+        # fields read from a LAS file: its own point format keeps them all
+        fmt = q.point_format
+        if own_rgb and fmt not in _RGB_FORMATS:
+            fmt = {0: 2, 1: 3, 4: 5, 6: 7, 9: 10}.get(fmt, fmt)
+    header = laspy.LasHeader(point_format=fmt, version="1.4" if fmt >= 6 or wide else "1.2")
+    standard = set(header.point_format.dimension_names)
+    extra = [laspy.ExtraBytesParams(nm, a.dtype) for nm, a in fields.items()
+             if nm not in standard and a.ndim == 1]
+    if extra:
+        header.add_extra_dims(extra)
+    if q is not None:
+        scale, offset = np.array(q.scale), np.array(q.offset)
+    else:
+        scale = np.full(3, LAS_DEFAULT_SCALE)
+        offset = np.array(cloud.origin, dtype=np.float64)
+    header.scales = scale
+    header.offsets = offset
+    ints = quantize(cloud, scale, offset, path)
+    las = laspy.LasData(header)
+    las.X, las.Y, las.Z = ints[:, 0], ints[:, 1], ints[:, 2]
+    del ints
+    if cloud.intensity is not None:
+        las.intensity = cloud.intensity
+    if cloud.classification is not None:
+        las.classification = cloud.classification
+    for nm, arr in fields.items():
+        if nm in set(las.point_format.dimension_names):
+            las[nm] = arr
+    if own_rgb:
+        c = cloud.colors.astype(np.uint16) * 257
+        las.red, las.green, las.blue = c[:, 0], c[:, 1], c[:, 2]
+    las.write(fh, do_compress=compress,
+              laz_backend=laspy.LazBackend.Lazrs if compress else None)
