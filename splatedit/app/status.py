@@ -51,7 +51,7 @@ def status_dict(ed) -> dict:
           {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
-          "error_box": ed.error_box, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
+          "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
           "browser": _browser(ed.browser),
           "script": str(ed.saved_script) if ed.saved_script else None}
     if s is None:
