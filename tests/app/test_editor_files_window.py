@@ -1,9 +1,9 @@
 """Opening another model in the real window (Xvfb + xdotool): Ctrl+O shows
 the file browser, a model picked by typing its name and Enter asks first
 while there are unsaved changes (N keeps the edit, Y opens), the new model
-is shown, the recent files come first in the next browser, and a file that
-cannot be read shows an error box in the window (Esc closes it) while the
-open model stays.  Drag-and-drop cannot be produced under Xvfb (xdotool
+is shown, the recent files come first in the next browser (and are offered
+when the editor starts without a file), and a file that cannot be read shows
+an error box in the window (Esc closes it) while the open model stays.  Drag-and-drop cannot be produced under Xvfb (xdotool
 sends no XDND drops): its event path is tested in test_editor_files.py."""
 
 from __future__ import annotations
@@ -105,5 +105,16 @@ def test_open_another_model_through_the_browser(xvfb, tmp_path):
         ed.xdo("key", "Escape")
         s = ed.idle(lambda s: s["error_box"] is None, "Esc closes the error box")
         assert s["running"] and s["n"] == 1600 and s["validation_messages"] == 0
+    finally:
+        ed.close()
+    # --- `splatedit edit` without a file offers the recent files over the bunny
+    (tmp_path / "status.json").unlink()
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.wait(lambda s: s["browser"] is not None and s["loaded"], "recent files offered", 90)
+        assert s["browser"]["entries"][0] == ["recent", "plane.ply"] and s["browser"]["index"] == 0
+        ed.xdo("key", "Return")
+        s = ed.idle(lambda s: s["n"] == 1600 and s["browser"] is None, "recent file opened", 60)
+        assert s["path"] == str(scans / "plane.ply")
     finally:
         ed.close()
