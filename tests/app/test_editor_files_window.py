@@ -3,11 +3,14 @@ the file browser, a model picked by typing its name and Enter asks first
 while there are unsaved changes (N keeps the edit, Y opens), the new model
 is shown, the recent files come first in the next browser (and are offered
 when the editor starts without a file), and a file that cannot be read shows
-an error box in the window (Esc closes it) while the open model stays.  Drag-and-drop cannot be produced under Xvfb (xdotool
-sends no XDND drops): its event path is tested in test_editor_files.py."""
+an error box in the window (Esc closes it) while the open model stays.  A
+file dropped on the window opens too: xdotool cannot drop, so
+:mod:`tests.app.xdnd` plays the XDND source (the drop reaches glfw's drop
+callback through the X server, as a file manager's would)."""
 
 from __future__ import annotations
 
+import subprocess
 import time
 
 import numpy as np
@@ -15,6 +18,7 @@ import pytest
 
 from tests.app.sessions import plane_cloud
 from tests.app.window_harness import WINDOW, EditorProcess, _foreground_centre
+from tests.app.xdnd import drop_files
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 
@@ -116,5 +120,13 @@ def test_open_another_model_through_the_browser(xvfb, tmp_path):
         ed.xdo("key", "Return")
         s = ed.idle(lambda s: s["n"] == 1600 and s["browser"] is None, "recent file opened", 60)
         assert s["path"] == str(scans / "plane.ply")
+        # --- a file dropped on the window (a real XDND drop) opens like Ctrl+O
+        write(str(tmp_path / "dropped.ply"), plane_cloud(30))
+        win = subprocess.run(["xdotool", "search", "--onlyvisible", "--name", "^splatedit"], env=ed.env,
+                             capture_output=True, text=True, timeout=30).stdout.split()
+        assert win, "the editor's window is not found"
+        drop_files(ed.env["DISPLAY"], int(win[0]), [tmp_path / "dropped.ply"], w // 2, h // 2)
+        s = ed.idle(lambda s: s["n"] == 900, "dropped file opened", 60)
+        assert s["path"] == str(tmp_path / "dropped.ply") and s["validation_messages"] == 0
     finally:
         ed.close()
