@@ -193,7 +193,10 @@ class Editor:
 
     # ------------------------------------------- opening (also the GUI's File menu)
     def open_dialog(self, folder=None) -> None:
-        """Show the file browser (Ctrl+O) in ``folder`` (default: the model's)."""
+        """Show the file browser (Ctrl+O) in ``folder`` (default: the model's);
+        a G/R/S move in progress is cancelled first."""
+        if self.session is not None and self.session.manip is not None:
+            self.gizmo.cancel_manip()
         self.confirm_quit = False
         self.prompt = None
         self.browser.open(folder)

@@ -164,7 +164,7 @@ def save(ed, path: Path) -> None:
         progress("saving", 0.0)
         write(str(path), cloud, overwrite=True)
         script.save(spath)
-        return path, spath, pos
+        return path, spath, pos, s
 
     ed.jobs["save"] = Job("saving", work, ed.wake)
     ed.say(f"saving {path} ...")
@@ -250,7 +250,10 @@ def poll_jobs(ed) -> None:
             counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
             ed.say(f"levels of detail ready ({counts} splats)")
         elif name == "save":
-            ply, script, pos = job.result
+            ply, script, pos, saved_session = job.result
+            if ed.session is not saved_session:     # another model was opened meanwhile
+                ed.say(f"saved {ply} and {script.name} (the model opened since is not saved)")
+                continue
             ed.session.history.mark_saved(pos)
             ed.saved_path, ed.saved_script = ply, script
             ed.say(f"saved {ply} and {script.name}")

@@ -188,3 +188,26 @@ def test_recent_files_come_first_in_the_browser(ed, models):
     key(ed, glfw.KEY_ENTER)              # the recent file is selected first
     assert ed.jobs["load"].key == models / "b_plane.ply"
     ed.settle()
+
+
+def test_a_failed_save_shows_an_error_box(ed, tmp_path, capsys):
+    ed.save(tmp_path / "no-such-folder" / "out.ply")
+    ed.settle()
+    assert ed.error_box is not None and "saving failed" in ed.error_box and "no-such-folder" in ed.error_box
+    assert "splatedit: error: saving failed" in capsys.readouterr().err
+    assert ed.error_rect is None
+    from splatedit.app.panel import error_box
+    (patch,) = error_box(ed, W, H, 8)          # drawn: a click inside it closes it
+    assert ed.error_rect == patch.box
+    x, y, bw, bh = ed.error_rect
+    ed.on_button(types.SimpleNamespace(x=x + bw / 2, y=y + bh / 2, button=glfw.MOUSE_BUTTON_LEFT, mods=0,
+                                       action=glfw.PRESS))
+    assert ed.error_box is None
+
+
+def test_ctrl_o_during_a_move_cancels_the_move(ed):
+    s = ed.session
+    paint_regions(s)
+    assert s.wait_fit() and s.begin(GRAB, view(), (100, 100))
+    key(ed, glfw.KEY_O, glfw.MOD_CONTROL)
+    assert ed.browser.shown and s.manip is None and not s.dirty
