@@ -235,21 +235,7 @@ class Editor:
         self.request_quit()
 
     def on_drop(self, e) -> None:
-        """Files dropped on the window: open the first model (a folder: browse it)."""
-        paths = [Path(p) for p in e.paths]
-        if not paths:
-            return
-        if self.prompt is not None or self.confirm_quit or self.confirm_open is not None:
-            self.say("answer the open question first, then drop the file again")
-            return
-        self.browser.close()
-        first = paths[0]
-        if len(paths) > 1:
-            self.say(f"{len(paths)} files dropped: opening only {first.name}")
-        if first.is_dir():
-            self.open_dialog(first)
-        else:
-            self.open_path(first)
+        files.on_drop(self, [Path(p) for p in e.paths])
 
     def on_char(self, e) -> None:
         if self.browser.shown and self.prompt is None and self.confirm_open is None:
@@ -340,11 +326,7 @@ class Editor:
                 self.say("quit cancelled")
             return
         if self.confirm_open is not None:
-            path, self.confirm_open = self.confirm_open, None
-            if k == g.KEY_Y:
-                self.open_path(path, confirmed=True)
-            else:                      # N, Esc or anything else: keep the model
-                self.say(f"not opened: {path.name} (the current model stays)")
+            files.answer_open(self, k == g.KEY_Y)
             return
         if self.browser.shown:
             action = lookup(k, ctrl, shift, [Context.BROWSER])

@@ -115,6 +115,32 @@ def open_path(ed, path, *, confirmed: bool = False) -> bool:
     return True
 
 
+def answer_open(ed, yes: bool) -> None:
+    """The answer to "open without saving?": Y opens, anything else keeps the model."""
+    path, ed.confirm_open = ed.confirm_open, None
+    if yes:
+        open_path(ed, path, confirmed=True)
+    else:
+        ed.say(f"not opened: {path.name} (the current model stays)")
+
+
+def on_drop(ed, paths: list[Path]) -> None:
+    """Files dropped on the window: open the first model (a folder: browse it)."""
+    if not paths:
+        return
+    if ed.prompt is not None or ed.confirm_quit or ed.confirm_open is not None:
+        ed.say("answer the open question first, then drop the file again")
+        return
+    ed.browser.close()
+    first = paths[0]
+    if len(paths) > 1:
+        ed.say(f"{len(paths)} files dropped: opening only {first.name}")
+    if first.is_dir():
+        ed.open_dialog(first)
+    else:
+        open_path(ed, first)
+
+
 def _replace_session(ed, path: Path) -> None:
     """Before a newly loaded model takes over: close the old session, drop its
     levels of detail and per-model state (the camera is framed anew)."""
