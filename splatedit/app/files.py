@@ -93,7 +93,7 @@ def open_path(ed, path, *, confirmed: bool = False) -> bool:
     the GUI's File menu).  A file that cannot be opened shows an error box;
     with unsaved changes the editor asks first (``ed.confirm_open``) unless
     ``confirmed``.  Returns True when the load started."""
-    p = Path(path).expanduser()
+    p = Path(os.path.abspath(Path(path).expanduser()))
     try:
         check_model_file(p)
     except InputError as exc:

@@ -62,7 +62,7 @@ def panel_lines(ed) -> list:
     """The status panel's lines (str or (str, rgb))."""
     s = ed.session
     if s is None:
-        return [f"splatedit - opening {ed.path}", "F1: help"]
+        return [f"splatedit - opening {ed.path}", "F1: help   Ctrl+O: open another model"]
     st = s.stats()
     brush = ed.brush
     lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats"]
@@ -109,7 +109,7 @@ def panel_lines(ed) -> list:
                  f"/{len(s.history) - 1}")
     if ed.message and time.perf_counter() - ed.message_time < 8:
         lines.append((ed.message[:100], (255, 220, 140)))
-    lines.append("F1: help   P: hide this panel")
+    lines.append("F1: help   Ctrl+O: open a model   P: hide this panel")
     return lines
 
 

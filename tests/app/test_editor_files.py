@@ -211,3 +211,18 @@ def test_ctrl_o_during_a_move_cancels_the_move(ed):
     assert s.wait_fit() and s.begin(GRAB, view(), (100, 100))
     key(ed, glfw.KEY_O, glfw.MOD_CONTROL)
     assert ed.browser.shown and s.manip is None and not s.dirty
+
+
+def test_a_typed_path_that_matches_no_entry_is_opened_as_typed(ed, models):
+    ed.open_dialog(models / "sub")
+    for ch in "../b_plane.ply":
+        ed.on_char(types.SimpleNamespace(char=ch))
+    key(ed, glfw.KEY_ENTER)
+    assert not ed.browser.shown and ed.jobs["load"].key == models / "b_plane.ply"
+    ed.settle()
+    assert ed.session.cloud.n == 144
+    ed.open_dialog(models / "sub")
+    for ch in "../nothing.ply":
+        ed.on_char(types.SimpleNamespace(char=ch))
+    key(ed, glfw.KEY_KP_ENTER)
+    assert "load" not in ed.jobs and "no such file" in ed.error_box
