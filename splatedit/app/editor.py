@@ -11,7 +11,12 @@ The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve), keys are looked
 up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
 help and README's controls list) and run the bound action; each tool draws
-its overlay.  Entry point: :func:`run_editor`.
+its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
+browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
+dropped on the window opens the same way, and :meth:`Editor.open_dialog`,
+:meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
+File menu calls; load / save errors stay in an error box until dismissed.
+Entry point: :func:`run_editor`.
 """
 
 from __future__ import annotations
