@@ -11,7 +11,12 @@ The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve), keys are looked
 up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
 help and README's controls list) and run the bound action; each tool draws
-its overlay.  Entry point: :func:`run_editor`.
+its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
+browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
+dropped on the window opens the same way, and :meth:`Editor.open_dialog`,
+:meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
+File menu calls; load / save errors stay in an error box until dismissed.
+Entry point: :func:`run_editor`.
 """
 
 from __future__ import annotations
@@ -32,7 +37,9 @@ from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # 
 from splatedit.app.panel import HelpView, compose_overlay
 from splatedit.app.session import Session
 from splatedit.app.status import StatusWriter
+from splatedit.app.recent import RecentFiles
 from splatedit.app.tools.base import DragMode
+from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
 from splatedit.app.tools.curve import CurveTool
@@ -48,7 +55,7 @@ HELP_WHEEL_LINES = 3
 class Editor:
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
-                 budget_ms=100.0, lod=True, bundled=False, max_seconds=None):
+                 budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
         import glfw
         from splatedit.render.vk.swapchain import SwapchainPresenter
         from splatedit.render.vk.window import Window
@@ -60,6 +67,7 @@ class Editor:
         self.status = StatusWriter(Path(status_file) if status_file else None)
         self.use_lod = lod
         self.max_seconds = max_seconds
+        self.offer_recent = offer_recent
         self.window = self.presenter = self.viewport = None
         self.frames = FrameScheduler(self, budget_ms)
         self._init_state(OrbitCamera(), glfw)
@@ -82,8 +90,13 @@ class Editor:
         self.running = True
         self.exit_code = 0
         self.load_error: SplatEditError | None = None
+        self.error_box: str | None = None    # a load / save error shown until dismissed
+        self.error_rect: tuple | None = None  # its x, y, w, h on screen (clicks dismiss it)
+        if not hasattr(self, "recent"):
+            self.recent = RecentFiles()
         # modal questions
         self.confirm_quit = False
+        self.confirm_open: Path | None = None   # open this model without saving?
         self.prompt: str | None = None      # save-as path being typed
         self.prompt_fresh = False            # the first key replaces the proposed path
         # pointer
@@ -111,6 +124,7 @@ class Editor:
         self.gizmo = GizmoTool(self)
         self.curve = CurveTool(self)
         self.tools = (self.camera, self.curve, self.gizmo, self.brush)
+        self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()
 
@@ -126,6 +140,16 @@ class Editor:
         self.message_time = time.perf_counter()
         print(f"splatedit: {text}", file=sys.stderr)
 
+    def show_error(self, text: str) -> None:
+        """An error box in the window (until Esc / Enter / a click on it) and on stderr."""
+        self.error_box = text
+        self.message = ""
+        print(f"splatedit: error: {text}", file=sys.stderr, flush=True)
+        self.wake()
+
+    def dismiss_error(self) -> None:
+        self.error_box = self.error_rect = None
+
     def debug(self, text: str) -> None:
         if self.debug_enabled:
             print(f"splatedit: debug: {text}", file=sys.stderr, flush=True)
@@ -138,8 +162,8 @@ class Editor:
         self.frames.motion()
 
     def modal(self) -> bool:
-        """A question is open (save-as path, quit with unsaved changes)."""
-        return self.prompt is not None or self.confirm_quit
+        """A question is open (save-as path, quit / open with unsaved changes, the file browser)."""
+        return self.prompt is not None or self.confirm_quit or self.confirm_open is not None or self.browser.shown
 
     @property
     def refiner(self):
@@ -169,8 +193,27 @@ class Editor:
     def start_load(self) -> None:
         self.jobs["load"] = files.load_job(self.path, self.wake)
 
-    def on_loaded(self, cloud) -> None:
-        files.on_loaded(self, cloud)
+    def on_loaded(self, cloud, path=None) -> None:
+        files.on_loaded(self, cloud, path)
+
+    # ------------------------------------------- opening (also the GUI's File menu)
+    def open_dialog(self, folder=None) -> None:
+        """Show the file browser (Ctrl+O) in ``folder`` (default: the model's);
+        a G/R/S move in progress is cancelled first."""
+        if self.session is not None and self.session.manip is not None:
+            self.gizmo.cancel_manip()
+        self.confirm_quit = False
+        self.prompt = None
+        self.browser.open(folder)
+
+    def open_path(self, path, confirmed: bool = False) -> bool:
+        """Open the model at ``path`` in place of the current one (asks first
+        with unsaved changes unless ``confirmed``); True when loading started."""
+        return files.open_path(self, path, confirmed=confirmed)
+
+    def recent_files(self) -> list[Path]:
+        """The recent models, most recent first (missing files dropped)."""
+        return [] if self.recent is None else self.recent.files()
 
     def poll_jobs(self) -> None:
         files.poll_jobs(self)
@@ -196,12 +239,21 @@ class Editor:
     def on_close(self, e) -> None:
         self.request_quit()
 
+    def on_drop(self, e) -> None:
+        files.on_drop(self, [Path(p) for p in e.paths])
+
     def on_char(self, e) -> None:
+        if self.browser.shown and self.prompt is None and self.confirm_open is None:
+            self.browser.type_char(e.char)
+            return
         if self.prompt is not None and e.char.isprintable():
             self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
             self.prompt_fresh = False
 
     def on_scroll(self, e) -> None:
+        if self.browser.shown:
+            self.browser.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
+            return
         b = self.help.box
         if self.help.shown and b is not None and b.x <= e.x < b.right and b.y <= e.y < b.bottom:
             self.help.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
@@ -235,7 +287,17 @@ class Editor:
             if tool is not None and s is not None:
                 tool.release(mode)
             return
-        if e.action != g.PRESS or s is None or self.modal():
+        if e.action != g.PRESS:
+            return
+        if self.browser.shown and self.confirm_open is None:
+            if e.button == g.MOUSE_BUTTON_LEFT:
+                self.browser.click(e.x, e.y)
+            return
+        r = self.error_rect
+        if r is not None and r[0] <= e.x < r[0] + r[2] and r[1] <= e.y < r[1] + r[3]:
+            self.dismiss_error()
+            return
+        if s is None or self.modal():
             return
         self.drag_last = (e.x, e.y)
         for tool in self.tools:
@@ -268,10 +330,20 @@ class Editor:
                 self.confirm_quit = False
                 self.say("quit cancelled")
             return
+        if self.confirm_open is not None:
+            files.answer_open(self, k == g.KEY_Y)
+            return
+        if self.browser.shown:
+            action = lookup(k, ctrl, shift, [Context.BROWSER])
+            if action is not None:
+                self.actions[action]()
+            return
         s = self.session
         manip = s is not None and s.manip is not None
         # a running move keeps its keys (Esc cancels it, digits type) even under the help
         helping = [Context.HELP] if self.help.shown else []
+        if self.error_box is not None:
+            helping.insert(0, Context.ERROR)
         if s is None:
             contexts = helping + [Context.ANY]
         elif manip:
@@ -309,7 +381,9 @@ class Editor:
         for tool in self.tools:
             t.update(tool.actions())
         s = lambda: self.session  # noqa: E731
+        t.update(self.browser.actions())
         t.update({
+            Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
             Action.DEFORMATION_MODE: lambda: self.say(f"deformation: {s().cycle_deformation().value}"),
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
@@ -399,6 +473,8 @@ class Editor:
         if self.path is None:
             raise SplatEditError("no model to open")
         self.start_load()
+        if self.offer_recent and self.recent_files():
+            self.open_dialog(Path.cwd())
         fr = self.frames
         try:
             while self.running:
@@ -476,7 +552,7 @@ def run_editor(path=None, **options) -> int:
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
                              "saves never replace it: choose another path")
-    editor = Editor(path, bundled=bundled, **options)
+    editor = Editor(path, bundled=bundled, offer_recent=bundled, **options)
     try:
         return editor.run()
     finally:

@@ -1,6 +1,9 @@
 """Files of the editor: checking the model before a window opens, the
-default save path, the refusal to overwrite the opened model, and the save /
-export jobs (worker threads; the editor polls them)."""
+default save path, the refusal to overwrite the opened model, the load /
+save / export jobs (worker threads; the editor polls them), and opening
+another model in the same window (:func:`open_path`: asks about unsaved
+changes, loads in the background, keeps the old model when the new one
+cannot be read, remembers the file in the recent files)."""
 
 from __future__ import annotations
 
@@ -9,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from splatedit.app.jobs import Job
+from splatedit.app.jobs import Cancelled, Job
 from splatedit.errors import InputError, SplatEditError
 from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
 
@@ -75,13 +78,95 @@ def check_model_file(path) -> None:
 
 
 def load_job(path: Path, wake) -> Job:
+    """Read ``path`` in the background (the job's ``key`` is the path)."""
     def work(progress):
         from splatedit.io import read
         cloud = read(str(path), progress=progress)
         if not cloud.name:
             cloud.name = path.name
         return cloud
-    return Job("loading", work, wake)
+    return Job(f"loading {path.name}", work, wake, key=Path(path))
+
+
+def open_path(ed, path, *, confirmed: bool = False) -> bool:
+    """Open ``path`` in place of the current model (Ctrl+O, a dropped file,
+    the GUI's File menu).  A file that cannot be opened shows an error box;
+    with unsaved changes the editor asks first (``ed.confirm_open``) unless
+    ``confirmed``.  Returns True when the load started."""
+    p = Path(os.path.abspath(Path(path).expanduser()))
+    try:
+        check_model_file(p)
+    except InputError as exc:
+        ed.show_error(f"cannot open: {exc}")
+        return False
+    if "save" in ed.jobs:
+        ed.show_error(f"cannot open {p.name} while a save is running: wait for it, then open again")
+        return False
+    if "load" in ed.jobs:              # the newest request wins
+        ed.jobs.pop("load").cancel.set()
+    s = ed.session
+    if s is not None and s.dirty and not confirmed:
+        ed.confirm_open = p
+        ed.say(f"unsaved changes: press Y to open {p.name} without saving, N or Esc to stay")
+        return False
+    ed.confirm_open = None
+    ed.jobs["load"] = load_job(p, ed.wake)
+    ed.say(f"opening {p} ...")
+    return True
+
+
+def answer_open(ed, yes: bool) -> None:
+    """The answer to "open without saving?": Y opens, anything else keeps the model."""
+    path, ed.confirm_open = ed.confirm_open, None
+    if yes:
+        open_path(ed, path, confirmed=True)
+    else:
+        ed.say(f"not opened: {path.name} (the current model stays)")
+
+
+def on_drop(ed, paths: list[Path]) -> None:
+    """Files dropped on the window: open the first model (a folder: browse it)."""
+    if not paths:
+        return
+    if ed.prompt is not None or ed.confirm_quit or ed.confirm_open is not None:
+        ed.say("answer the open question first, then drop the file again")
+        return
+    ed.browser.close()
+    first = paths[0]
+    if len(paths) > 1:
+        ed.say(f"{len(paths)} files dropped: opening only {first.name}")
+    if first.is_dir():
+        ed.open_dialog(first)
+    else:
+        open_path(ed, first)
+
+
+def _replace_session(ed, path: Path) -> None:
+    """Before a newly loaded model takes over: close the old session, drop its
+    levels of detail and per-model state (the camera is framed anew)."""
+    old = ed.session
+    lod = ed.jobs.pop("lod", None)
+    if lod is not None:
+        lod.cancel.set()
+    ed.session = None
+    if old is not None:
+        old.close()
+    ed.drag, ed.drag_tool = type(ed.drag).NONE, None
+    ed.confirm_quit, ed.prompt = False, None
+    ed.viewport.set_pyramid(None)
+    ed.frames.invalidate()
+    ed.path, ed.bundled = path, False
+    ed.save_as = ed.saved_path = ed.saved_script = None
+
+
+def remember(ed, path: Path) -> None:
+    """Put a user's model first in the recent files (not the bundled one)."""
+    if ed.bundled or ed.recent is None:
+        return
+    try:
+        ed.recent.add(path)
+    except SplatEditError as exc:
+        ed.say(f"recent files not kept: {exc}")
 
 
 def save(ed, path: Path) -> None:
@@ -105,7 +190,7 @@ def save(ed, path: Path) -> None:
         progress("saving", 0.0)
         write(str(path), cloud, overwrite=True)
         script.save(spath)
-        return path, spath, pos
+        return path, spath, pos, s
 
     ed.jobs["save"] = Job("saving", work, ed.wake)
     ed.say(f"saving {path} ...")
@@ -123,8 +208,12 @@ def export_script(ed, target: Path) -> None:
     ed.jobs["export"] = Job("exporting", work, ed.wake)
 
 
-def on_loaded(ed, cloud) -> None:
-    """A model finished loading: a new session, camera and up axis, levels of detail."""
+def on_loaded(ed, cloud, path: Path | None = None) -> None:
+    """A model finished loading (from ``path``; None: ``ed.path``): it
+    replaces the open one; a new session, camera and up axis, levels of detail."""
+    if path is not None and (ed.session is not None or path != ed.path):
+        _replace_session(ed, path)
+        ed.cloud_name = path.name
     ed.cloud_name = cloud.name or ed.cloud_name
     from splatedit.app.session import Session
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
@@ -146,8 +235,10 @@ def on_loaded(ed, cloud) -> None:
             return LodPyramid(cloud, progress=progress, background=True)   # preview first
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
     ed.brush.tools.prepare(cloud)
+    remember(ed, ed.path)
     ed.say(f"loaded {ed.cloud_name}: {cloud.n:,} splats (up axis {ed.camera.up.label}, "
              f"{ed.camera.up.source.value}; U changes it)")
+
 
 def poll_jobs(ed) -> None:
     """Collect the editor's finished jobs (load, levels of detail, save, export, graph)."""
@@ -156,27 +247,40 @@ def poll_jobs(ed) -> None:
             continue
         del ed.jobs[name]
         if job.error is not None:
-            if name == "load":
-                # reported by run_editor's caller as any bad input: "splatedit: error: ..."
-                err = job.error
+            err = job.error
+            if name == "graph":
+                if not isinstance(err, Cancelled):
+                    ed.say(f"{job.name} failed: {err}")
+                ed.brush.tools.poll()
+                continue
+            if isinstance(err, Cancelled):
+                continue
+            if name == "load" and ed.session is None and job.key == ed.path:
+                # the first model: reported by run_editor's caller as any bad input
                 ed.load_error = err if isinstance(err, SplatEditError) else SplatEditError(
                     f"{ed.path}: cannot read the model: {err}")
                 ed.exit_code = 2
                 ed.running = False
+            elif name == "load":       # another model: the open one stays
+                text = str(err) if isinstance(err, SplatEditError) else f"{job.key}: cannot read the model: {err}"
+                ed.show_error(f"not opened: {text}")
+            elif name in ("save", "export"):
+                ed.show_error(f"{job.name} failed: {err}")
             else:
-                ed.say(f"{job.name} failed: {job.error}")
-                if name == "graph":
-                    ed.brush.tools.poll()
+                ed.say(f"{job.name} failed: {err}")
             continue
         if name == "load":
-            ed.on_loaded(job.result)
+            ed.on_loaded(job.result, job.key)
         elif name == "lod":
             ed.viewport.set_pyramid(job.result)
             counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)
             more = "" if job.result.ready.is_set() else "; the finer ones are being built"
             ed.say(f"levels of detail ready ({counts} splats{more})")
         elif name == "save":
-            ply, script, pos = job.result
+            ply, script, pos, saved_session = job.result
+            if ed.session is not saved_session:     # another model was opened meanwhile
+                ed.say(f"saved {ply} and {script.name} (the model opened since is not saved)")
+                continue
             ed.session.history.mark_saved(pos)
             ed.saved_path, ed.saved_script = ply, script
             ed.say(f"saved {ply} and {script.name}")

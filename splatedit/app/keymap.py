@@ -35,6 +35,7 @@ class Section(enum.Enum):
     CURVE = "Control curve (paper Sect. 3 end, Fig. 3 and 7)"
     DISPLAY = "Display"
     FILE = "File and history"
+    BROWSER = "File browser (Ctrl+O; recent files first, then the folder's models)"
 
 
 class Context(enum.Enum):
@@ -43,6 +44,8 @@ class Context(enum.Enum):
     IDLE = "idle"        # a model is open and nothing is being moved
     MANIP = "manip"      # during a G/R/S move (or a curve point drag)
     HELP = "help"        # while the help window is shown (before the others)
+    BROWSER = "browser"  # while the file browser is shown (only these keys)
+    ERROR = "error"      # while an error box is shown (before the others)
 
 
 class Action(enum.Enum):
@@ -109,7 +112,19 @@ class Action(enum.Enum):
     SAVE = "save"
     SAVE_AS = "save_as"
     EXPORT_SCRIPT = "export_script"
+    OPEN = "open"
+    DISMISS_ERROR = "dismiss_error"
     QUIT = "quit"
+    # file browser
+    BROWSE_UP = "browse_up"
+    BROWSE_DOWN = "browse_down"
+    BROWSE_PAGE_UP = "browse_page_up"
+    BROWSE_PAGE_DOWN = "browse_page_down"
+    BROWSE_FIRST = "browse_first"
+    BROWSE_LAST = "browse_last"
+    BROWSE_PICK = "browse_pick"
+    BROWSE_PARENT = "browse_parent"
+    BROWSE_CANCEL = "browse_cancel"
 
 
 #: modifier names of a chord ("ctrl+shift+z")
@@ -283,8 +298,30 @@ KEYMAP: tuple[Binding, ...] = (
             ("ctrl+s",)),
     Binding(S.FILE, "Ctrl+Shift+S", "save as: type a path, Enter", Action.SAVE_AS, ("ctrl+shift+s",)),
     Binding(S.FILE, "Ctrl+E", "export only the edit script", Action.EXPORT_SCRIPT, ("ctrl+e",)),
+    Binding(S.FILE, "Ctrl+O", "open another model in this window: the file browser (below); asks first when\n"
+            "there are unsaved changes (Y opens without saving, N or Esc stays)", Action.OPEN, ("ctrl+o",), C.ANY),
+    Binding(S.FILE, "Drop a file", "on the window: open it the same way (a dropped folder: browse it)", mouse=True,
+            context=C.ANY),
+    Binding(S.FILE, "Esc or Enter", "close an error box (load and save errors stay until closed; also on stderr)",
+            Action.DISMISS_ERROR, ("escape", "enter", "kp_enter"), C.ERROR),
     Binding(S.FILE, "Q", "quit (asks first when there are unsaved changes: Y or Q again quits, N or Esc stays;\n"
             "Esc never quits)", Action.QUIT, ("q",), C.ANY),
+    # ---- file browser
+    Binding(S.BROWSER, "Up / Down", "select the previous / next entry (PageUp / PageDown, Home / End, wheel)",
+            Action.BROWSE_UP, ("up",), C.BROWSER),
+    Binding(S.BROWSER, "", "", Action.BROWSE_DOWN, ("down",), C.BROWSER),
+    Binding(S.BROWSER, "", "", Action.BROWSE_PAGE_UP, ("page_up",), C.BROWSER),
+    Binding(S.BROWSER, "", "", Action.BROWSE_PAGE_DOWN, ("page_down",), C.BROWSER),
+    Binding(S.BROWSER, "", "", Action.BROWSE_FIRST, ("home",), C.BROWSER),
+    Binding(S.BROWSER, "", "", Action.BROWSE_LAST, ("end",), C.BROWSER),
+    Binding(S.BROWSER, "Typing", "jump to the first entry whose name starts with the typed text\n"
+            "(a typed path that matches no entry is opened as typed)", mouse=True, context=C.BROWSER),
+    Binding(S.BROWSER, "Enter or left click", "open the model / enter the folder", Action.BROWSE_PICK,
+            ("enter", "kp_enter"), C.BROWSER),
+    Binding(S.BROWSER, "Backspace", "delete a typed character, else go up one folder", Action.BROWSE_PARENT,
+            ("backspace",), C.BROWSER),
+    Binding(S.BROWSER, "Esc", "close the browser (the current model stays)", Action.BROWSE_CANCEL, ("escape",),
+            C.BROWSER),
 )
 del S, C
 

@@ -62,7 +62,7 @@ def panel_lines(ed) -> list:
     """The status panel's lines (str or (str, rgb))."""
     s = ed.session
     if s is None:
-        return [f"splatedit - opening {ed.path}", "F1: help"]
+        return [f"splatedit - opening {ed.path}", "F1: help   Ctrl+O: open another model"]
     st = s.stats()
     brush = ed.brush
     lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats"]
@@ -109,7 +109,7 @@ def panel_lines(ed) -> list:
                  f"/{len(s.history) - 1}")
     if ed.message and time.perf_counter() - ed.message_time < 8:
         lines.append((ed.message[:100], (255, 220, 140)))
-    lines.append("F1: help   P: hide this panel")
+    lines.append("F1: help   Ctrl+O: open a model   P: hide this panel")
     return lines
 
 
@@ -192,6 +192,29 @@ class HelpView:
         return self._cache[1]
 
 
+ERROR_BOX_RGB = (255, 150, 140)
+#: the error box's widest line in characters (longer messages wrap)
+ERROR_BOX_CHARS = 100
+
+
+def error_box(ed, w: int, h: int, y: int) -> list:
+    """The error box (a load / save error) at the top centre below ``y``,
+    shown until dismissed; records its rectangle in ``ed.error_rect``."""
+    if ed.error_box is None:
+        ed.error_rect = None
+        return []
+    import textwrap
+    lines = [("Error", ERROR_BOX_RGB)]
+    lines += [(t, (245, 235, 235)) for t in textwrap.wrap(ed.error_box, ERROR_BOX_CHARS)[:8]]
+    lines.append(("Esc, Enter or a click here: close", (200, 200, 200)))
+    img = ov.text_panel(tuple(lines), size=14, bg=(70, 18, 18, 240))
+    img = img[:max(h, 1), :max(w, 1)]
+    x = max((w - img.shape[1]) // 2, 0)
+    y = min(max(y, PANEL_MARGIN), max(h - img.shape[0], 0))
+    ed.error_rect = (x, y, img.shape[1], img.shape[0])
+    return [ov.Patch(x, y, img)]
+
+
 def compose_overlay(ed, w: int, h: int) -> list:
     """Every overlay patch of a frame, back to front: the tools' drawings,
     the panel (off the gizmo), progress bars, the help, a centred question."""
@@ -224,8 +247,13 @@ def compose_overlay(ed, w: int, h: int) -> list:
         y += bar.shape[0] + 4
     if help_patch is not None:
         patches.append(help_patch)
+    patches += ed.browser.overlay(w, h)
+    patches += error_box(ed, w, h, y)
     center_msg = None
-    if ed.confirm_quit:
+    if ed.confirm_open is not None:
+        center_msg = ("Unsaved changes.", f"Y: open {ed.confirm_open.name} without saving     N / Esc: keep editing",
+                      "(Ctrl+S saves)")
+    elif ed.confirm_quit:
         center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
                       "(Ctrl+S saves)")
     elif ed.prompt is not None:

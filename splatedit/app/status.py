@@ -14,6 +14,15 @@ def _r(v, nd=1):
     return round(float(v), nd)
 
 
+def _browser(b) -> dict | None:
+    """The file browser's state (None when closed): folder, entry names and kinds, selection."""
+    if not b.shown:
+        return None
+    return {"folder": str(b.folder), "index": b.index, "top": b.top, "rows": b.rows, "typed": b.typed,
+            "entries": [[e.kind.value, e.name] for e in b.entries],
+            "box": list(b.box) if b.box else None, "row0": b.row0, "line_h": b.line_h}
+
+
 def status_dict(ed) -> dict:
     """The editor's state as plain JSON types."""
     s = ed.session
@@ -41,6 +50,9 @@ def status_dict(ed) -> dict:
           "last_render": {} if vp.last_info is None else
           {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
           "saved": str(ed.saved_path) if ed.saved_path else None,
+          "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
+          "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
+          "browser": _browser(ed.browser),
           "script": str(ed.saved_script) if ed.saved_script else None}
     if s is None:
         return st

@@ -43,3 +43,12 @@ def xvfb(tmp_path_factory):
             proc.kill()
 
 
+
+
+@pytest.fixture(autouse=True)
+def private_config(tmp_path, monkeypatch):
+    """Every editor test (and the editor processes it starts) keeps its
+    recent files in its own config folder, never the user's."""
+    cfg = tmp_path / "config"
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(cfg))
+    return cfg

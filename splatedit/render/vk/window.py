@@ -52,7 +52,8 @@ class InputEvent:
     kind: "key" (key, action, mods), "char" (char), "button" (button, action,
     mods, x, y), "move" (x, y), "scroll" (dx, dy, x, y, mods), "resize"
     (w, h: framebuffer size), "close", "iconify" (action 1 = minimized),
-    "enter" (action 1 = the cursor entered the window, 0 = left it).
+    "enter" (action 1 = the cursor entered the window, 0 = left it), "drop"
+    (paths: the files / folders dropped on the window, in the order given).
     Coordinates are framebuffer pixels, origin top-left.
     """
     kind: str
@@ -67,6 +68,7 @@ class InputEvent:
     char: str = ""
     w: int = 0
     h: int = 0
+    paths: tuple[str, ...] = ()
 
 
 class Window:
@@ -103,6 +105,7 @@ class Window:
         glfw.set_window_close_callback(self.handle, self._on_close)
         glfw.set_window_iconify_callback(self.handle, self._on_iconify)
         glfw.set_cursor_enter_callback(self.handle, self._on_enter)
+        glfw.set_drop_callback(self.handle, self._on_drop)
 
     # ----------------------------------------------------------- callbacks
     def _update_scale(self) -> None:
@@ -140,6 +143,11 @@ class Window:
 
     def _on_enter(self, win, entered):
         self.events.append(InputEvent("enter", action=int(entered)))
+
+    def _on_drop(self, win, paths):
+        x, y = self._last_pos
+        names = tuple(p.decode("utf-8", "surrogateescape") if isinstance(p, bytes) else str(p) for p in paths)
+        self.events.append(InputEvent("drop", paths=names, x=x, y=y))
 
     def _on_iconify(self, win, iconified):
         self.events.append(InputEvent("iconify", action=int(iconified)))
