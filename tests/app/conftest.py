@@ -2,6 +2,7 @@
 
 from __future__ import annotations
 
+import os
 import shutil
 import subprocess
 import time
@@ -10,11 +11,27 @@ from pathlib import Path
 import pytest
 
 
-def _free_display() -> int:
-    for n in range(91, 200):
-        if not Path(f"/tmp/.X{n}-lock").exists() and not Path(f"/tmp/.X11-unix/X{n}").exists():
-            return n
-    raise RuntimeError("no free X display number")
+def _start_xvfb(fbdir: Path) -> tuple[subprocess.Popen, int]:
+    """Start a private Xvfb that picks a free display number itself
+    (``-displayfd``: no race with other X servers started at the same time,
+    e.g. by parallel test runs) and return it with its number once it accepts
+    connections."""
+    read_fd, write_fd = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(write_fd), "-screen", "0", "1280x800x24",
+                             "-fbdir", str(fbdir), "-nolisten", "tcp", "-noreset"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, pass_fds=(write_fd,))
+    os.close(write_fd)
+    text = b""
+    with os.fdopen(read_fd, "rb") as pipe:       # Xvfb writes "N\n" when it is ready
+        while not text.endswith(b"\n"):
+            chunk = pipe.read(1)
+            if not chunk:
+                break
+            text += chunk
+    if proc.poll() is not None or not text.strip().isdigit():
+        proc.kill()
+        pytest.fail(f"Xvfb did not start (exit code {proc.poll()}, said {text!r})")
+    return proc, int(text)
 
 
 @pytest.fixture(scope="module")
@@ -24,15 +41,7 @@ def xvfb(tmp_path_factory):
     if shutil.which("xdotool") is None:
         pytest.skip("xdotool is not installed (apt-get install xdotool)")
     fbdir = tmp_path_factory.mktemp("xvfb")
-    n = _free_display()
-    proc = subprocess.Popen(["Xvfb", f":{n}", "-screen", "0", "1280x800x24", "-fbdir", str(fbdir),
-                             "-nolisten", "tcp", "-noreset"], stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
-    sock = Path(f"/tmp/.X11-unix/X{n}")
-    t0 = time.time()
-    while not sock.exists() and time.time() - t0 < 10:
-        if proc.poll() is not None:
-            pytest.fail(f"Xvfb :{n} exited with code {proc.returncode}")
-        time.sleep(0.05)
+    proc, n = _start_xvfb(fbdir)
     try:
         yield {"display": f":{n}", "screen": fbdir / "Xvfb_screen0"}
     finally:
