@@ -41,7 +41,7 @@ from __future__ import annotations
 
 import copy
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
@@ -85,6 +85,13 @@ class DetailLayer:
         scale: smoothing scale sigma (model units): bumps much narrower than
             ~2.5 sigma are detail, broader shapes are base.
         iterations: umbrella iterations used.
+        outer_index: (M,) sorted int64 cloud indices of the smoothed splats
+            around the support (the rings the smoothing grew into).
+        outer_base: (M, 3) float64 their smoothed positions: the fit puts the
+            fixed band's constraints there, on the same base surface as the
+            support's base points (else a band on the original surface next
+            to base points inside it bends the weight fields: -0.4 instead of
+            0 next to the band of a bumpy bar, splats there jumping away).
     """
 
     index: np.ndarray
@@ -93,6 +100,8 @@ class DetailLayer:
     normals: np.ndarray
     scale: float
     iterations: int
+    outer_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    outer_base: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 def _splat_normals(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -169,7 +178,9 @@ def decompose(cloud, index, *, graph: NeighbourGraph | None = None,
     nb_[flip] *= -1.0
     lam = np.einsum("ij,ij->i", pos[idx] - x[rows], nb_)
     base = pos[idx] - lam[:, None] * nb_
-    return DetailLayer(idx, base, lam, nb_, sigma, iters)
+    outer = np.ones(len(region), bool)
+    outer[rows] = False
+    return DetailLayer(idx, base, lam, nb_, sigma, iters, region[outer], x[outer])
 
 
 def _cross(a, b, out):
@@ -279,6 +290,7 @@ class DetailBasis:
         t2 = time.perf_counter()
         base_cloud = copy.copy(cloud)
         bpos = cloud.positions.copy()
+        bpos[layer.outer_index] = layer.outer_base   # the fixed band on the base surface too
         bpos[layer.index] = layer.base
         base_cloud.positions = bpos
         bb = DeformationBasis.fit(base_cloud, sup_mask, h_masks, curves=curves, method=method,
