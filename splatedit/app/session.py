@@ -33,6 +33,12 @@ recorded as script edits (``indices`` support + ``indices`` handles +
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
 
+The deformation mode of new edits (:attr:`Session.deformation`, the B key:
+rotation -> detail -> linear) picks the basis: rotation and linear share a
+:class:`~splatedit.deform.basis.DeformationBasis`, detail fits a
+:class:`~splatedit.deform.detail.DetailBasis` (the kind is part of the fit's
+key, so switching to or from detail refits); each committed edit records it.
+
 Parts kept in their own modules: the rig's pose and curve
 (:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
 a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
