@@ -54,7 +54,8 @@ class FitScheduler:
     thread, tests) and keeps the last result.
 
     ``basis`` is the fitted :class:`~splatedit.deform.basis.DeformationBasis`
-    (or :class:`~splatedit.deform.detail.DetailBasis`, :func:`fitted_kind`) of ``key`` (the selection key it was fitted for) and ``groups`` its
+    (or :class:`~splatedit.deform.detail.DetailBasis`, :func:`fitted_kind`) of
+    ``key`` (the selection key it was fitted for) and ``groups`` its
     ``(fitted handle indices, ControlCurve or None)``."""
 
     def __init__(self, *, sync: bool = False, on_change=None):
