@@ -46,7 +46,10 @@ the JSON path of the bad value, e.g. ``$.edits[0].transform.rotate.axis`` or
 default) blends each handle's rotation over the support, so bends and twists
 of 90 degrees and more keep their cross-sections; ``"linear"`` is the paper's
 deformation (exact for translations, large rotations shrink the middle);
-``"detail"`` is not supported yet.  Curves move the same way in both modes.
+``"detail"`` splits the support into a smooth base surface plus normal
+offsets, deforms the base rotation-aware and re-attaches the offsets along
+the deformed normals (relief keeps its height and stays upright; see
+:mod:`splatedit.deform.detail`).  Curves are displacements in every mode.
 """
 
 from __future__ import annotations
@@ -528,7 +531,7 @@ class EditReport:
     #: distortion of the support splats (splatedit.deform.distortion): per-splat
     #: stretch max(s1, 1/s2) and area change s1 s2 of the committed axes
     distortion: DistortionStats | None = None
-    #: the edit's deformation mode ("rotation", "linear")
+    #: the edit's deformation mode ("rotation", "linear", "detail")
     mode: str = DeformationMode.ROTATION.value
 
     def distortion_line(self) -> str:

@@ -497,9 +497,13 @@ DETAIL_MAX_ITERATIONS = 400
 #: neighbours of the PCA base normals on the smoothed points (as
 #: NORMAL_NEIGHBOURS: the smoothed surface is smooth at this radius)
 DETAIL_NORMAL_NEIGHBOURS = 16
-#: support rows per chunk of the detail mode's CPU apply (5 (c, 3) float64
-#: temporaries + three (c, K + 3) GEMM inputs: ~10 MB at K = 4)
-DETAIL_APPLY_CHUNK = 65536
+#: support splats per sub-chunk of the detail mode's CPU apply
+#: (splatedit.deform.detail_apply: three (3 + 6 r, c) GEMM outputs and ~10
+#: (c,) rows of temporaries, ~1 MB at c = 8192: they stay in L2).  Measured on
+#: the loaded 2-core machine, (9, 7) @ (7, c) products over 200k splats:
+#: c = 2048-8192 0.9-1.2 ms in all, c >= 16384 68-85 ms (OpenBLAS starts its
+#: threads, which only contend here)
+DETAIL_APPLY_CHUNK = 8192
 # ---------------------------------------------------------------- GUI (Dear ImGui on Vulkan)
 #: largest difference (8-bit levels, any channel) between a flat GUI area drawn
 #: by the GUI pipeline on lavapipe and the same colour alpha-blended in float

@@ -41,6 +41,8 @@ class DistortionFeed:
             d0, rot = split_displacement(dc)
 
             def work(progress):
+                if hasattr(basis, "detail_for_gpu"):   # a DetailBasis: its own exact figures
+                    return key, basis.distortion(cloud, dc)
                 if rot is not None:     # exact Jacobians with the blended rotations
                     return key, basis_distortion(basis, cloud, dc)
                 if self._probe is None:

@@ -10,7 +10,17 @@ from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 from splatedit.app.jobs import Cancelled, Job
+from splatedit.deform.modes import DeformationMode
 from splatedit.errors import SplatEditError
+
+
+def fitted_kind(mode: DeformationMode) -> str:
+    """The basis a deformation mode draws with: ``"detail"`` (a
+    :class:`~splatedit.deform.detail.DetailBasis`: base surface + offsets) for
+    DETAIL, ``"plain"`` (a :class:`~splatedit.deform.basis.DeformationBasis`)
+    for LINEAR and ROTATION, which share one fit (switching between them
+    needs no refit)."""
+    return "detail" if DeformationMode(mode) is DeformationMode.DETAIL else "plain"
 
 
 @dataclass(frozen=True)
@@ -44,7 +54,8 @@ class FitScheduler:
     thread, tests) and keeps the last result.
 
     ``basis`` is the fitted :class:`~splatedit.deform.basis.DeformationBasis`
-    of ``key`` (the selection key it was fitted for) and ``groups`` its
+    (or :class:`~splatedit.deform.detail.DetailBasis`, :func:`fitted_kind`) of
+    ``key`` (the selection key it was fitted for) and ``groups`` its
     ``(fitted handle indices, ControlCurve or None)``."""
 
     def __init__(self, *, sync: bool = False, on_change=None):
@@ -56,6 +67,7 @@ class FitScheduler:
         self.key = None
         self.groups = None
         self.error: str | None = None
+        self._graph = None    # (positions, NeighbourGraph) of the last detail fit's cloud
 
     def current(self, key) -> bool:
         """The basis (or the running fit) is for ``key``."""
@@ -68,6 +80,36 @@ class FitScheduler:
             self.job = None
         self.basis = self.key = self.groups = None
         self.error = None
+
+    def neighbour_graph(self, cloud):
+        """The :class:`~splatedit.select.graph.NeighbourGraph` of ``cloud`` for
+        the detail mode's smoothing, built on the fit worker and kept for the
+        next fits of the same base cloud (called only from the worker: fits
+        run one at a time).  ``NeighbourGraph.build`` of the positions, as the
+        script replay builds it, so a replay reproduces the edit bitwise."""
+        from splatedit.select.graph import NeighbourGraph
+        got = self._graph
+        if got is None or got[0] is not cloud.positions:
+            got = self._graph = (cloud.positions, NeighbourGraph.build(cloud.positions))
+        return got[1]
+
+    def work(self, cloud, support, handles, curves, mode: DeformationMode, *, method: str,
+             tol: float, max_centers: int | None):
+        """``work(progress) -> basis`` for :meth:`start`: the basis of
+        :func:`fitted_kind` (``mode``) on ``cloud`` for the (n,) bool
+        ``support``, the handle masks and the ControlCurves, without closing
+        the selection (the editor closes it visibly after each stroke)."""
+        detail = fitted_kind(mode) == "detail"
+
+        def work(progress):
+            from splatedit.deform.basis import DeformationBasis
+            kw = dict(curves=curves, method=method, tol=tol, max_centers=max_centers,
+                      progress=progress, fill_holes=False)
+            if not detail:
+                return DeformationBasis.fit(cloud, support, handles, **kw)
+            from splatedit.deform.detail import DetailBasis
+            return DetailBasis.fit(cloud, support, handles, graph=self.neighbour_graph(cloud), **kw)
+        return work
 
     def start(self, key, groups, work) -> None:
         """Start fitting ``work(progress) -> basis`` for selection ``key``."""

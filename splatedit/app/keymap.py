@@ -239,7 +239,9 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.DEFORMATION, "Left drag outer circle", "scale the active handle about its centre (outward: larger)",
             mouse=True),
     Binding(S.DEFORMATION, "B", "deformation of new edits: ROTATION (default: the handles' rotations are blended,\n"
-            "bends and twists keep their thickness) / LINEAR (the paper's)", Action.DEFORMATION_MODE, ("b",)),
+            "bends and twists keep their thickness) / DETAIL (as ROTATION on a smoothed base\n"
+            "surface, the relief re-attached along its normals; refits) / LINEAR (the paper's)",
+            Action.DEFORMATION_MODE, ("b",)),
     Binding(S.DEFORMATION, "G / R / S", "grab / rotate / scale the active handle with the mouse\n"
             "(the overlay shows the distance / angle / factor while moving)", Action.GRAB, ("g",)),
     Binding(S.DEFORMATION, "", "", Action.ROTATE, ("r",)),

@@ -33,6 +33,12 @@ recorded as script edits (``indices`` support + ``indices`` handles +
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
 
+The deformation mode of new edits (:attr:`Session.deformation`, the B key:
+rotation -> detail -> linear) picks the basis: rotation and linear share a
+:class:`~splatedit.deform.basis.DeformationBasis`, detail fits a
+:class:`~splatedit.deform.detail.DetailBasis` (the kind is part of the fit's
+key, so switching to or from detail refits); each committed edit records it.
+
 Parts kept in their own modules: the rig's pose and curve
 (:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
 a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
@@ -49,7 +55,7 @@ import numpy as np
 
 from splatedit.app import revision
 from splatedit.app.distortion_feed import DistortionFeed
-from splatedit.app.fitting import FitProgress, FitScheduler, FitStats
+from splatedit.app.fitting import FitProgress, FitScheduler, FitStats, fitted_kind
 from splatedit.app.history import History, Snapshot
 from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.rig import Rig, _matrix_tuple
@@ -325,7 +331,10 @@ class Session:
 
     # --------------------------------------------------------------- fitting
     def selection_key(self):
-        return (revision.of(self.cloud),) + self.selection.key() + (self.rig.curve_key(),)
+        """What a fit depends on: the cloud, the selection, the curve and the
+        kind of basis the deformation mode draws with (:func:`fitted_kind`)."""
+        return ((revision.of(self.cloud),) + self.selection.key() + (self.rig.curve_key(),)
+                + (fitted_kind(self.deformation),))
 
     def request_fit(self) -> None:
         """Start (or restart) a background fit of all non-empty handles and
@@ -346,16 +355,11 @@ class Session:
             self.fit_error = (f"{k} basis columns needed (4 per handle + 1 per curve point), at most "
                               f"{RENDER_MAX_BASIS_COLUMNS}: remove a handle or curve points")
             return
-        cloud = self.cloud
         support = self.selection.support.copy()
         handles = [self.selection.handles[k].copy() for k in hidx]
-        curves = [curve] if curve is not None else []
-        def work(progress):
-            from splatedit.deform.basis import DeformationBasis
-            return DeformationBasis.fit(cloud, support, handles, curves=curves, method=self.method,
-                                        tol=self.tol, max_centers=self.max_centers, progress=progress,
-                                        fill_holes=False)  # closed visibly after each stroke
-
+        work = self.fit.work(self.cloud, support, handles, [curve] if curve is not None else [],
+                             self.deformation, method=self.method, tol=self.tol,
+                             max_centers=self.max_centers)
         # fits run one at a time on the scheduler's worker (a cancelled one ends at its
         # next progress report); fit_sync runs it here
         self.fit.start(key, (tuple(hidx), curve), work)
@@ -478,11 +482,25 @@ class Session:
             return None
         return self.basis.displacement(self.inputs(), mode=self.deformation)
 
+    #: the B key's cycle of deformation modes
+    DEFORMATION_CYCLE = (DeformationMode.ROTATION, DeformationMode.DETAIL, DeformationMode.LINEAR)
+
     def cycle_deformation(self) -> DeformationMode:
-        """Switch the mode of new edits: rotation <-> linear ("detail" is not
-        available yet); the live pose is shown in the new mode at once."""
-        self.deformation = (DeformationMode.LINEAR if self.deformation is DeformationMode.ROTATION
-                            else DeformationMode.ROTATION)
+        """Switch the mode of new edits: rotation -> detail -> linear -> rotation.
+        Rotation and linear share the fitted basis (the live pose is shown in
+        the new mode at once); switching to or from detail refits (a
+        :class:`~splatedit.deform.detail.DetailBasis`: base surface plus normal
+        offsets), the pose is kept and drawn again when the fit is done.  Not
+        an undo step (a setting, like the brush mode); each committed edit
+        records its mode."""
+        cyc = self.DEFORMATION_CYCLE
+        return self.set_deformation(cyc[(cyc.index(self.deformation) + 1) % len(cyc)])
+
+    def set_deformation(self, mode) -> DeformationMode:
+        """Make ``mode`` (a DeformationMode or its name) the mode of new edits
+        (refits when the kind of basis changes, see :meth:`cycle_deformation`)."""
+        self.deformation = DeformationMode(mode)
+        self.request_fit()          # a no-op unless the basis kind changed
         self.on_change()
         return self.deformation
 

@@ -67,6 +67,8 @@ def status_dict(ed) -> dict:
               curve_points=ss.curve_points, curve_mode=s.curve_mode,
               pose_pending=ss.pose_pending, columns=ss.columns,
               basis_columns=None if s.basis is None else s.basis.n_columns,
+              deformation=s.deformation.value,
+              basis_kind=None if s.basis is None else type(s.basis).__name__,
               brush_mode=tools.mode, closure_added=tools.last_added,
               closure_highlight=tools.highlighted(s.cloud) is not None)
     st["idle"] = bool(ed.idle())

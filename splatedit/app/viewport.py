@@ -174,9 +174,14 @@ class Viewport:
                 # fit: each frame only dC (K x 3) changes, so all pending transforms
                 # are drawn together and switching the active handle costs nothing
                 rows = basis.rows_for_gpu()
-                if level is not None:
+                detail = getattr(basis, "detail_for_gpu", None)   # a DetailBasis (the detail mode)
+                if detail is not None and slot is not self.gs_slot:
+                    rows = rows + (detail(),)   # (n_b, lambda) rows: a level's splat keeps its
+                if level is not None:           # representative's position, so b = p - lambda n_b holds
                     rows = level.rows(*rows)
-                slot.r.set_basis(*rows)
+                slot.r.set_basis(*rows[:5])
+                if len(rows) > 5:
+                    slot.r.set_detail(rows[0], rows[5])
                 slot.basis = basis
             slot.dc = None
         if basis is not None:

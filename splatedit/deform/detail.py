@@ -31,7 +31,8 @@ docs/PERFORMANCE.md), so it is offered for measurements only.
 
 Per frame the CPU needs, like the linear mode, three chunked GEMMs
 (``b' = [B | b] [dC; I]``, ``J t1 = [W1 | t1] [dC; I]``, ``J t2`` likewise,
-``Wk = tk_x Bx + tk_y By + tk_z Bz``) and a few element-wise products; the GPU
+``Wk = tk_x Bx + tk_y By + tk_z Bz``; the rotation terms come out of the same
+GEMMs, :mod:`splatedit.deform.detail_apply`) and element-wise products; the GPU
 pre-pass (shaders_glsl/prepare_detail*.comp) reads the same basis rows at b
 and one vec4 (n_b, lambda) per splat.
 """
@@ -40,7 +41,7 @@ from __future__ import annotations
 
 import copy
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 from enum import Enum
 
 import numpy as np
@@ -51,13 +52,13 @@ from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import as_mask
 from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.modes import DeformationMode
-from splatedit.deform.rotation import blend_terms, handle_blocks, split_displacement
+from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.estimate import estimate_normals, tangent_frame
 from splatedit.progress import report
 from splatedit.select.closure import close_selection
 from splatedit.select.graph import NeighbourGraph
-from splatedit.tolerances import (BAND_RINGS, DETAIL_APPLY_CHUNK, DETAIL_MAX_ITERATIONS,
+from splatedit.tolerances import (BAND_RINGS, DETAIL_MAX_ITERATIONS,
                                   DETAIL_NORMAL_NEIGHBOURS, DETAIL_SCALE_SPACINGS, DETAIL_STEP,
                                   IQR_DEFAULT_TOL)
 
@@ -84,6 +85,13 @@ class DetailLayer:
         scale: smoothing scale sigma (model units): bumps much narrower than
             ~2.5 sigma are detail, broader shapes are base.
         iterations: umbrella iterations used.
+        outer_index: (M,) sorted int64 cloud indices of the smoothed splats
+            around the support (the rings the smoothing grew into).
+        outer_base: (M, 3) float64 their smoothed positions: the fit puts the
+            fixed band's constraints there, on the same base surface as the
+            support's base points (else a band on the original surface next
+            to base points inside it bends the weight fields: -0.4 instead of
+            0 next to the band of a bumpy bar, splats there jumping away).
     """
 
     index: np.ndarray
@@ -92,6 +100,8 @@ class DetailLayer:
     normals: np.ndarray
     scale: float
     iterations: int
+    outer_index: np.ndarray = field(default_factory=lambda: np.zeros(0, np.int64))
+    outer_base: np.ndarray = field(default_factory=lambda: np.zeros((0, 3)))
 
 
 def _splat_normals(u: np.ndarray, v: np.ndarray) -> np.ndarray:
@@ -168,7 +178,9 @@ def decompose(cloud, index, *, graph: NeighbourGraph | None = None,
     nb_[flip] *= -1.0
     lam = np.einsum("ij,ij->i", pos[idx] - x[rows], nb_)
     base = pos[idx] - lam[:, None] * nb_
-    return DetailLayer(idx, base, lam, nb_, sigma, iters)
+    outer = np.ones(len(region), bool)
+    outer[rows] = False
+    return DetailLayer(idx, base, lam, nb_, sigma, iters, region[outer], x[outer])
 
 
 def _cross(a, b, out):
@@ -278,6 +290,7 @@ class DetailBasis:
         t2 = time.perf_counter()
         base_cloud = copy.copy(cloud)
         bpos = cloud.positions.copy()
+        bpos[layer.outer_index] = layer.outer_base   # the fixed band on the base surface too
         bpos[layer.index] = layer.base
         base_cloud.positions = bpos
         bb = DeformationBasis.fit(base_cloud, sup_mask, h_masks, curves=curves, method=method,
@@ -348,49 +361,30 @@ class DetailBasis:
         return np.concatenate([self.layer.normals, self.layer.offset[:, None]], axis=1)
 
     # ----------------------------------------------------------- per frame
-    def _cpu_arrays(self):
+    def _hot_path(self, n_points: int):
         if self._cpu is None:
-            pk = self.base_basis._pack          # (N, 4, K) rows at b
-            lay = self.layer
-            arrs = [np.concatenate([pk[:, 0, :], lay.base], axis=1)]
-            for t in self._t:
-                w = np.einsum("nj,njk->nk", t, pk[:, 1:, :])
-                arrs.append(np.concatenate([w, t], axis=1))
-            self._cpu = arrs
+            from splatedit.deform.detail_apply import DetailHotPath
+            self._cpu = DetailHotPath(self, n_points)
         return self._cpu
 
     def release_cpu_cache(self) -> None:
-        """Drop the hot-path arrays (about 24 (K + 3) bytes per support splat)."""
+        """Drop the hot-path arrays (about 24 (K + 3) + 80 bytes per support splat)."""
         self._cpu = None
 
     def apply_arrays(self, cloud, dC):
         """Deformed ``(positions, u, v)`` (n, 3) float64 of ``cloud`` (the
         original cloud of :meth:`fit`); splats outside the support are copied
-        bitwise, ``dC == 0`` returns bitwise copies.  Memory: chunks of
-        ``DETAIL_APPLY_CHUNK`` rows beyond the cached hot-path arrays."""
+        bitwise, ``dC == 0`` returns bitwise copies.  Three GEMMs per frame in
+        the run-plan layout of the linear basis plus element-wise work on
+        cache-sized chunks (:mod:`splatedit.deform.detail_apply`)."""
         bb = self.base_basis
         bb._check_cloud(cloud)
         d, rot = split_displacement(dC)
         d = bb._check_dc(d)
-        outs = (cloud.positions.copy(), cloud.u.copy(), cloud.v.copy())
+        srcs = (cloud.positions, cloud.u, cloud.v)
         if not d.any() and rot is None:
-            return outs
-        blocks = handle_blocks(bb) if rot is not None else None
-        arrs = self._cpu_arrays()
-        mx = np.vstack([d, np.eye(3)])
-        idx, lay = self.indices, self.layer
-        for s in range(0, len(idx), DETAIL_APPLY_CHUNK):
-            e = min(len(idx), s + DETAIL_APPLY_CHUNK)
-            mb, jt1, jt2 = (a[s:e] @ mx for a in arrs)
-            if rot is not None:     # the rotation-aware base: arc terms at the base points
-                dp, (d1, d2) = blend_terms(rot, bb._pack[s:e], blocks, (self._t[0][s:e], self._t[1][s:e]))
-                mb += dp
-                jt1 += d1
-                jt2 += d2
-            p, u, v = _attach(mb, jt1, jt2, lay.offset[s:e], self._cu[s:e], self._cv[s:e], self.frames)
-            rows = idx[s:e]
-            outs[0][rows], outs[1][rows], outs[2][rows] = p, u, v
-        return outs
+            return tuple(x.copy() for x in srcs)
+        return self._hot_path(len(cloud.positions)).apply(srcs, d, rot, self.frames is FrameMode.RIGID)
 
     def distortion(self, cloud, dC, **kw):
         """:class:`DistortionStats` of the support splats' axes under ``dC``

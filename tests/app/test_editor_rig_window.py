@@ -1,6 +1,7 @@
 """The real editor window (Xvfb + xdotool): two simultaneous handles and a
-control curve, each committed as one edit, saved, and reproduced by
-replaying the exported edit script with ``splatedit deform``."""
+control curve, each committed as one edit (the first in the detail mode, B),
+saved, and reproduced by replaying the exported edit script with
+``splatedit deform``."""
 
 from __future__ import annotations
 
@@ -38,6 +39,11 @@ def test_two_handles_and_a_curve(xvfb, tmp_path):
         ed.xdo("mousemove", cx + 28, cy, "click", "1")
         s = ed.idle(lambda s: min(s["handle_sizes"]) > 0 and s["state"] == "ready"
                     and s["basis_columns"] == 8, "handle 2 painted, both fitted")
+        # --- B: the detail mode (a refit of the detail basis); this edit is replayed in it
+        assert s["deformation"] == "rotation" and s["basis_kind"] == "DeformationBasis"
+        ed.xdo("key", "b")
+        s = ed.idle(lambda s: s["deformation"] == "detail" and s["state"] == "ready"
+                    and s["basis_kind"] == "DetailBasis", "detail mode fitted", 90)
         # --- move handle 2 (active) up, then drag handle 1 (becomes active) down: kept as a pose
         ed.xdo("mousemove", cx + 28, cy, "mousedown", "1", "mousemove", cx + 30, cy - 8,
                "mousemove", cx + 32, cy - 18, "sleep", "0.2", "mouseup", "1")
@@ -79,7 +85,7 @@ def test_two_handles_and_a_curve(xvfb, tmp_path):
 
     doc = json.loads(script_path.read_text())
     e1, e2 = doc["edits"]
-    assert len(e1["handles"]) == 2 and len(e1["transforms"]) == 2
+    assert len(e1["handles"]) == 2 and len(e1["transforms"]) == 2 and e1["deformation"] == "detail"
     assert "curves" in e2 and len(e2["curves"][0]["points"]) == 3 and "handle" not in e2
     assert np.abs(np.asarray(e2["curves"][0]["move"][1])).max() > 0
     src, saved = read(default_model_path()), read(out)

@@ -142,8 +142,8 @@ def test_background_fit_stale_results_are_dropped():
 
 def test_rotation_mode_is_the_default_cycles_and_is_exported(tmp_path, session):
     """A 150-degree rotation in the session's default (rotation) mode keeps the
-    handle's neighbourhood wide where the linear mode pulls it in; M's cycle
-    switches the mode and the exported script carries it per edit."""
+    handle's neighbourhood wide where the linear mode pulls it in; switching
+    to linear and back keeps the fitted basis and the exported script carries it per edit."""
     from splatedit.deform.modes import DeformationMode
     from splatedit.deform.rotation import RotationDisplacement
     s = session
@@ -155,9 +155,11 @@ def test_rotation_mode_is_the_default_cycles_and_is_exported(tmp_path, session):
     for ch in "150":
         s.manip.type_char(ch)
     assert isinstance(s.current_dc(), RotationDisplacement)
-    assert s.cycle_deformation() is DeformationMode.LINEAR
-    assert isinstance(s.current_dc(), np.ndarray)
+    plain = s.basis
+    assert s.set_deformation(DeformationMode.LINEAR) is DeformationMode.LINEAR
+    assert s.basis is plain and isinstance(s.current_dc(), np.ndarray)   # no refit
     assert s.cycle_deformation() is DeformationMode.ROTATION
+    assert s.basis is plain
     base = s.cloud
     assert s.commit()
     ring = (r > 0.35) & (r < 0.45)

@@ -71,6 +71,46 @@ def test_handle_moves_in_lod_and_full(scene):
     vp.set_selection(None, None, 2)
 
 
+def test_detail_mode_draws_the_cpu_commit_in_full_and_lod(scene):
+    """A DetailBasis in the viewport (basis rows at the base points plus the
+    (n_b, lambda) rows; a level takes its representatives' rows) draws what
+    the CPU commit gives: the same foreground as the committed cloud drawn
+    without a basis."""
+    from splatedit.app.viewport import Viewport
+    from splatedit.deform import transform as tf
+    from splatedit.deform.detail import DetailBasis
+    vp, cloud, cam = scene
+    sup, hnd = _support_and_handle(cloud, 3000)
+    basis = DetailBasis.fit(cloud, sup, [hnd])
+    c = cloud.positions[hnd].mean(axis=0)
+    dc = basis.displacement([tf.rotate((0.0, 0.0, 1.0), 60.0, c)])
+    vp.set_basis(basis)
+    vp.set_dc(dc)
+    full = vp.render(cam, 160, 120)
+    vp.assume_cost(100.0 / 5000, 160 * 120)
+    level, div = vp.choose(True, 160, 120)
+    lod = vp.render(cam, 160, 120, interactive=True)
+    assert vp.last_info.lod and level is not None and div == 1
+    vp.assume_cost(None, 1)
+    vp.set_dc(None)
+    vp.set_basis(None)
+    new = basis.commit(cloud, dc)
+    ref_vp = Viewport()
+    try:
+        ref_vp.set_cloud(new)
+        ref = ref_vp.render(cam, 160, 120)
+        ref_vp.set_cloud(level.deformed(new.positions, new.u, new.v))   # the level of the commit
+        ref_lod = ref_vp.render(cam, 160, 120)
+    finally:
+        ref_vp.close()
+    before = vp.render(cam, 160, 120)
+    diff = lambda a, b: np.abs(a[..., :3].astype(int) - b[..., :3]).max(axis=2).mean()  # noqa: E731
+    moved = diff(before, ref)
+    assert moved > 0.5                   # the edit changes the picture (measured 0.8 levels/pixel)
+    assert diff(full, ref) < 0.05 * moved    # measured 0.007
+    assert diff(lod, ref_lod) < 0.05 * moved
+
+
 def test_pick_matches_projection(scene):
     vp, cloud, cam = scene
     idx, depth = vp.pick(cam, 160, 120)
