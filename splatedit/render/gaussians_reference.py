@@ -28,42 +28,10 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.model.gaussians import GaussianCloud
+from splatedit.model.spherical_harmonics import sh_colors   # the 3DGS convention, one numpy copy
 from splatedit.render.camera import Camera
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2,
                                   GS_MIN_TRANSMITTANCE, GS_NEAR_CULL_REL, RENDER_BACKGROUND)
-
-SH_C0 = 0.28209479177387814
-SH_C1 = 0.4886025119029199
-SH_C2 = (1.0925484305920792, -1.0925484305920792, 0.31539156525252005, -1.0925484305920792,
-         0.5462742152960396)
-SH_C3 = (-0.5900435899266435, 2.890611442640554, -0.4570457994644658, 0.3731763325901154,
-         -0.4570457994644658, 1.445305721320277, -0.5900435899266435)
-
-
-def sh_basis(dirs: np.ndarray, degree: int) -> np.ndarray:
-    """Real SH basis values of the 3DGS convention: dirs (n, 3) unit vectors
-    -> (n, (degree + 1)^2) float64 (coefficient order of GaussianCloud.sh)."""
-    x, y, z = np.asarray(dirs, np.float64).T
-    out = [np.full_like(x, SH_C0)]
-    if degree >= 1:
-        out += [-SH_C1 * y, SH_C1 * z, -SH_C1 * x]
-    if degree >= 2:
-        xx, yy, zz, xy, yz, xz = x * x, y * y, z * z, x * y, y * z, x * z
-        out += [SH_C2[0] * xy, SH_C2[1] * yz, SH_C2[2] * (2 * zz - xx - yy), SH_C2[3] * xz,
-                SH_C2[4] * (xx - yy)]
-    if degree >= 3:
-        out += [SH_C3[0] * y * (3 * xx - yy), SH_C3[1] * xy * z, SH_C3[2] * y * (4 * zz - xx - yy),
-                SH_C3[3] * z * (2 * zz - 3 * xx - 3 * yy), SH_C3[4] * x * (4 * zz - xx - yy),
-                SH_C3[5] * z * (xx - yy), SH_C3[6] * x * (xx - 3 * yy)]
-    return np.stack(out, axis=1)
-
-
-def sh_colors(sh: np.ndarray, dirs: np.ndarray) -> np.ndarray:
-    """Colours max(0.5 + SH(dirs), 0): sh (n, (d+1)^2, 3), dirs (n, 3) unit -> (n, 3) float64."""
-    sh = np.asarray(sh, np.float64)
-    d = int(round(math.sqrt(sh.shape[1]))) - 1
-    return np.maximum(np.einsum("nk,nkc->nc", sh_basis(dirs, d), sh) + 0.5, 0.0)
-
 
 @dataclass
 class Projected:
