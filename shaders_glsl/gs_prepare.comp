@@ -7,14 +7,19 @@
 #include "gs_common.glsl"
 #define DEFORM_BINDING 9
 #include "deform.glsl"
+#include "rotation.glsl"
 
-// the group g of 4 basis columns: dp += B dC, Jm += dC^T grad B (J = I + Jm), as splat_math.glsl
+// the group g of 4 basis columns: dp += B dC, Jm += dC^T grad B (J = I + Jm), as splat_math.glsl;
+// a rotating handle (rotation-aware mode) adds its blended arc and that arc's Jacobian
 void deform_group(uint g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inout mat3 Jm) {
     vec4 dx = D.dC[3u * g], dy = D.dC[3u * g + 1u], dz = D.dC[3u * g + 2u];
     dp += vec3(dot(B, dx), dot(B, dy), dot(B, dz));
     Jm[0] += vec3(dot(dx, Bx), dot(dy, Bx), dot(dz, Bx));
     Jm[1] += vec3(dot(dx, By), dot(dy, By), dot(dz, By));
     Jm[2] += vec3(dot(dx, Bz), dot(dy, Bz), dot(dz, Bz));
+    if (D.rot[4u * g].w != 0.0)
+        rotation_blend(D.rot[4u * g], D.rot[4u * g + 1u], D.rot[4u * g + 2u], D.rot[4u * g + 3u],
+                       B, Bx, By, Bz, dp, Jm);
 }
 
 layout(local_size_x = 64) in;

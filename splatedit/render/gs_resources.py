@@ -17,7 +17,8 @@ _UBO_BYTES = 208
 _GEOM_FLOATS = 16
 _REC_BYTES = 64
 _MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
-_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS
+#: deform.glsl's block: dC (3 vec4 per group) and the handle rotations (4 vec4 per group)
+_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS + 64 * _MAX_GROUPS
 _MAX_SIZE = 16384
 _PREP_WG = 64
 _SORT_WG = 256

@@ -39,7 +39,7 @@ def test_gaussians_draw_pick_tint_and_deform_through_the_viewport(scene):
     splats = vp.render(cam, 160, 120)
     vp.set_gaussians(g)
     img = vp.render(cam, 160, 120)
-    assert vp.last_info["gaussians"] and vp.last_info["splats"] == len(g)
+    assert vp.last_info.gaussians and vp.last_info.splats == len(g)
     fg = img[..., :3].min(axis=2) < 240
     assert fg.mean() > 0.1
     assert np.abs(img.astype(int) - splats).mean() > 3          # not the splat renderer's image
