@@ -105,6 +105,7 @@ void main() {
             S = J * S * transpose(J);
             R = polar_rotation(J);
         }
+        S *= F.display.x * F.display.x;       // the editor's splat size (display only)
         vec3 t = (F.view * vec4(p, 1.0)).xyz;
         float z = -t.z;
         if (z > F.params.w && op >= F.limits.w) {
@@ -137,6 +138,7 @@ void main() {
                     vec3 d = normalize(p - F.eye.xyz);
                     if (deformed) d = transpose(R) * d;
                     vec3 col = sh_color(i, dc, d, int(F.eye.w));
+                    if (F.display.y != 0.0) col = vec3(dot(col, vec3(0.2126, 0.7152, 0.0722)));
                     uint fl = gflags[i];
                     if ((fl & 1u) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
                     if ((fl & 2u) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);

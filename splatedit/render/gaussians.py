@@ -103,6 +103,10 @@ class GaussianRenderer:
         self.last_timings_ms: dict[str, float] = {}
         #: accepted for the editor's viewport; the heat map is not drawn for Gaussians
         self.distortion_map = False
+        #: display options of the editor (as Renderer's): every standard deviation
+        #: drawn this many times larger, and colours as their luminance (grey)
+        self.splat_scale = 1.0
+        self.grey_shading = False
         try:
             self.cache = V.PipelineCache(self.dev)
             self.sampler = V.Sampler(self.dev)
@@ -317,6 +321,8 @@ class GaussianRenderer:
                          near=None if camera.near is None else camera.near / sc,
                          far=None if camera.far is None else camera.far / sc)
         lo, hi = self.bounds
+        grown = 3.0 * max(float(self.splat_scale) - 1.0, 0.0) * float(self._sigma_max.max())
+        lo, hi = lo - grown, hi + grown
         if len(self._basis_idx):
             move = float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
             if self._rot is not None:   # an arc moves a point by at most 2 angle |offset| (Renderer._clip_bounds)
@@ -340,6 +346,7 @@ class GaussianRenderer:
                                        1 if srgb_target else 0)
         u[44:48] = RENDER_TINT_SUPPORT
         u[48:52] = RENDER_TINT_HANDLE
+        u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 0.0, 0.0)
         self.ubo.write(u)
         pad = np.zeros((4 * _MAX_GROUPS, 3))
         pad[:len(self._dC)] = self._dC / sc

@@ -13,7 +13,7 @@ from splatedit.render import vk as V
 from splatedit.render.renderer import RenderTarget
 from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
 
-_UBO_BYTES = 208
+_UBO_BYTES = 224
 _GEOM_FLOATS = 16
 _REC_BYTES = 64
 _MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4

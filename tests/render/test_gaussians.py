@@ -325,3 +325,24 @@ def test_rigid_90_degrees_as_a_deformation_shows_no_colour_bleed(gs, mode):
                 f"{name} ({mode}), view {direction}: mean {foreground_diff(imgs[name], ref):.3f}, worst {diff.max()}"
         bleed = foreground_diff(imgs["unrotated"], ref)
         assert bleed >= GS_BLEED_MIN_MEAN, f"unrotated SH should bleed visibly, mean {bleed:.2f}"
+
+
+def test_display_options_scale_the_gaussians_and_grey_their_colours(gs, bunny_gaussians):
+    """The editor's display options on Gaussians: splat size 2 draws every
+    standard deviation twice as long (more pixels covered, the same scene
+    centre), grey draws each colour's luminance (R = G = B); back to the
+    defaults gives the same image as before."""
+    cam = view(bunny_gaussians, VIEWS[0])
+    gs.set_gaussians(bunny_gaussians)
+    plain = gs.render(cam, W, H)
+    try:
+        gs.splat_scale = 2.0
+        big = gs.render(cam, W, H)
+        assert coverage(big) > 1.15 * coverage(plain)
+        gs.splat_scale, gs.grey_shading = 1.0, True
+        grey = gs.render(cam, W, H).astype(int)
+        fg = np.abs(grey[..., :3] - 255).max(axis=2) > 8
+        assert np.ptp(grey[..., :3], axis=2)[fg].max() <= 1 and np.ptp(plain[..., :3].astype(int), axis=2)[fg].mean() > 10
+    finally:
+        gs.splat_scale, gs.grey_shading = 1.0, False
+    assert np.array_equal(gs.render(cam, W, H), plain)
