@@ -162,3 +162,56 @@ def test_save_writes_a_3dgs_file_and_the_script_replays_it(scene, tmp_path):
     del ed.jobs["save"]                                    # (the editor's poll_jobs collects it)
     files.save(ed, tmp_path / "ears.xyz")                 # not a .ply: refused with a message
     assert "save" not in ed.jobs and ".ply" in ed.said[-1]
+
+
+@pytest.mark.gpu
+def test_two_handles_and_a_curve_draw_live_and_commit_as_one_edit(scene):
+    """Both ears as handles (one turned 60 degrees, one moved) and a control
+    curve across the back, all pending together: the live GPU frame and the
+    frame of the committed Gaussians agree, and the commit is the CPU
+    deformation of the same basis and pose."""
+    from splatedit.app.viewport import Viewport
+    from splatedit.tolerances import GS_REF_MEAN_TOL
+    doc = gaussian_document(scene)
+    s = Session(doc, fit_sync=True)
+    p = doc.positions
+    y, x = p[:, 1], p[:, 0]
+    top = y > np.percentile(y, 80)
+    tips = y > np.percentile(y, 95)
+    split = np.median(x[tips])
+    s.set_selection(top | (y > np.percentile(y, 60)), [tips & (x < split), tips & (x >= split)])
+    back = p[(y > np.percentile(y, 62)) & (y < np.percentile(y, 70))]
+    order = np.argsort(back[:, 0])
+    for q in back[order[[len(order) // 5, len(order) // 2, 4 * len(order) // 5]]]:
+        s.add_curve_point(q)
+    assert s.wait_fit() and s.basis.n_columns == 4 + 4 + 3
+    s.select_handle(0)
+    a = _turn(s, 60.0)
+    m = np.eye(4)
+    m[:3, 3] = [0.0, 0.05, 0.04]
+    s.pose[1] = m
+    s.curve_moves = np.array([[0.0, 0.0, 0.0], [0.0, 0.04, 0.0], [0.0, 0.0, 0.0]])
+    dc = s.current_dc()
+    want = deform_with_evaluator(scene, s.basis, dc)
+    vp = Viewport()
+    try:
+        vp.set_cloud(s.cloud)
+        cam = OrbitCamera(scene_radius=doc.diagonal / 2)
+        lo, hi = doc.bounds()
+        cam.frame((lo + hi) / 2, doc.diagonal / 2, 4 / 3)
+        before = vp.render(cam, 200, 150)
+        vp.set_basis(s.basis)
+        vp.set_dc(dc)
+        live = vp.render(cam, 200, 150)
+        assert s.commit() and len(s.edits) == 1 and len(s.edits[0].handles) == 2 and s.edits[0].curves
+        got = gaussians_of(s.cloud)
+        assert np.array_equal(got.positions, want.positions) and np.array_equal(got.sh, want.sh)
+        vp.set_cloud(s.cloud)
+        vp.set_basis(None)
+        vp.set_dc(None)
+        committed = vp.render(cam, 200, 150)
+    finally:
+        vp.close()
+    assert (np.abs(live.astype(int) - before)[..., :3].max(axis=2) > 16).mean() > 0.01
+    assert np.abs(live.astype(int) - committed)[..., :3].mean() < GS_REF_MEAN_TOL
+    assert not np.array_equal(a, np.eye(4))
