@@ -101,7 +101,8 @@ class GaussianRenderer:
         self._near_far = (1.0, 2.0)
         self._n_visible = 0
         self.last_timings_ms: dict[str, float] = {}
-        #: accepted for the editor's viewport; the heat map is not drawn for Gaussians
+        #: the editor's distortion heat map: support Gaussians coloured by the principal
+        #: stretch of J on their own plane (the splat renderer's ramp), the others dark grey
         self.distortion_map = False
         #: display options of the editor (as Renderer's): every standard deviation
         #: drawn this many times larger, and colours as their luminance (grey)
@@ -346,7 +347,8 @@ class GaussianRenderer:
                                        1 if srgb_target else 0)
         u[44:48] = RENDER_TINT_SUPPORT
         u[48:52] = RENDER_TINT_HANDLE
-        u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 0.0, 0.0)
+        u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 1.0 if self.distortion_map else 0.0,
+                    0.0)
         self.ubo.write(u)
         pad = np.zeros((4 * _MAX_GROUPS, 3))
         pad[:len(self._dC)] = self._dC / sc

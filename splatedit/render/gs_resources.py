@@ -105,7 +105,7 @@ class _Targets:
 def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     """GPU arrays of a scene: ((n, 16) float32 geometry: centre relative to
     ``origin`` / ``scale``, opacity, covariance xx xy xz yy yz zz / scale^2, SH DC
-    rgb; (n, m) uint32 SH bands 1-3 as pairs of half floats (m = 0 for degree 0))."""
+    rgb, unit shortest axis; (n, m) uint32 SH bands 1-3 as pairs of half floats (m = 0 for degree 0))."""
     n = len(cloud)
     geom = np.zeros((n, _GEOM_FLOATS), np.float32)
     geom[:, 0:3] = (cloud.positions - origin) / scale
@@ -113,6 +113,8 @@ def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     c = cloud.covariances() / (scale * scale)
     geom[:, 4:10] = c[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
     geom[:, 10:13] = cloud.sh[:, 0, :]
+    shortest = np.argmin(cloud.scales(), axis=1)          # the heat map's normal (2DGS: the third axis)
+    geom[:, 13:16] = cloud.rotation_matrices()[np.arange(n), :, shortest]
     rest = np.ascontiguousarray(cloud.sh[:, 1:, :], np.float32).reshape(n, -1).astype(np.float16)
     if rest.shape[1] % 2:
         rest = np.concatenate([rest, np.zeros((n, 1), np.float16)], axis=1)

@@ -346,3 +346,36 @@ def test_display_options_scale_the_gaussians_and_grey_their_colours(gs, bunny_ga
     finally:
         gs.splat_scale, gs.grey_shading = 1.0, False
     assert np.array_equal(gs.render(cam, W, H), plain)
+
+
+def test_heat_map_colours_gaussians_by_their_stretch(gs, bunny_gaussians):
+    """The editor's D on Gaussians: an affine map stretching x by 2 (support =
+    every Gaussian) draws the support in the ramp's 2x orange, a rigid 90-degree
+    turn in its 1x light grey, and undeformed Gaussians outside the support
+    in dark grey."""
+    g = bunny_gaussians
+    cam = view(g, VIEWS[0])
+    B, Bx, By, Bz = _affine_basis(g.positions)
+    c = g.positions.mean(axis=0)
+    gs.set_gaussians(g)
+    gs.distortion_map = True
+    try:
+        out = {}
+        for name, a in (("stretch", np.diag([2.0, 1.0, 1.0])),
+                        ("rigid", np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))):
+            gs.set_selection(np.ones(len(g), bool), None)
+            gs.set_basis(np.arange(len(g)), B, Bx, By, Bz)
+            gs.set_displacement(np.concatenate([(a - np.eye(3)).T, (c - a @ c)[None]], axis=0))
+            out[name] = gs.render(view(g, VIEWS[0]) if name == "rigid" else cam, W, H).astype(int)
+        gs.clear_basis()
+        gs.set_selection(None, None)
+        out["outside"] = gs.render(cam, W, H).astype(int)
+    finally:
+        gs.distortion_map = False
+    dense = {k: v[(255 - v[..., :3]).max(axis=2) > 15] for k, v in out.items()}    # scene pixels
+    r, gg, b = dense["stretch"][:, :3].mean(axis=0)
+    assert r > gg + 30 > b + 60, (r, gg, b)                     # orange: (0.99, 0.62, 0.25)
+    for k in ("rigid", "outside"):
+        assert np.ptp(dense[k][:, :3], axis=1).mean() < 12, k    # neutral greys
+    # measured: stretch (253, 191, 113), rigid (232, 232, 227), outside 144 grey
+    assert dense["outside"][:, :3].mean() < dense["rigid"][:, :3].mean() - 40
