@@ -47,7 +47,8 @@ from splatedit.render.camera import Camera
 from splatedit.render.renderer import RenderTarget, _unit_scale
 from splatedit.render.gs_resources import (_DEFORM_UBO_BYTES, _GS_SET, _MAX_GROUPS, _MAX_SIZE, _NONE, _PREP_WG,
                                            _REC_BYTES, _RESOLVE_SET, _RP_PICK, _SORT_WG, _UBO_BYTES, SORTS, _rp_accum,
-                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_geometry,
+                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_deform_block,
+                                           pack_geometry,
                                            selection_flags)
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
@@ -350,17 +351,7 @@ class GaussianRenderer:
         u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 1.0 if self.distortion_map else 0.0,
                     0.0)
         self.ubo.write(u)
-        pad = np.zeros((4 * _MAX_GROUPS, 3))
-        pad[:len(self._dC)] = self._dC / sc
-        rot = np.zeros((_MAX_GROUPS, 4, 4))     # per handle: (axis, angle), offsets D_0..D_3 (deform.glsl)
-        if self._rot is not None:
-            for g in self._rot.rotating:
-                r = self._rot.rotations[g]
-                rot[g, 0, :3] = r.w / r.angle
-                rot[g, 0, 3] = r.angle
-                rot[g, 1:, :] = (r.offsets / sc).T
-        block = np.concatenate([pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1), rot.reshape(-1)])
-        self.dC_ubo.write(np.ascontiguousarray(block, np.float32))
+        self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
         self._near_far = (near * sc, far * sc)
 
     def _record_prepass(self, cb):

@@ -121,6 +121,24 @@ def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     return geom, np.ascontiguousarray(rest).view(np.uint32)
 
 
+def pack_deform_block(dC: np.ndarray, rot, scale: float) -> np.ndarray:
+    """deform.glsl's uniform block as float32: dC (K, 3) (model units, divided
+    by ``scale``) zero-padded to 4 groups as rows dC[3g + i] = (dC_{4g..4g+3})[i];
+    then per group g the rotation of handle g of ``rot`` (a RotationDisplacement
+    or None): (unit axis, angle; 0 = none), frame offsets D_0..D_3 / ``scale``."""
+    pad = np.zeros((4 * _MAX_GROUPS, 3))
+    pad[:len(dC)] = np.asarray(dC, np.float64) / scale
+    blocks = np.zeros((_MAX_GROUPS, 4, 4))
+    if rot is not None:
+        for g in rot.rotating:
+            r = rot.rotations[g]
+            blocks[g, 0, :3] = r.w / r.angle
+            blocks[g, 0, 3] = r.angle
+            blocks[g, 1:, :] = (r.offsets / scale).T
+    block = np.concatenate([pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1), blocks.reshape(-1)])
+    return np.ascontiguousarray(block, np.float32)
+
+
 def pack_basis_rows(mats, scale: float) -> np.ndarray:
     """Basis rows for the GPU: B, Bx, By, Bz (N, K) -> (max(N, 1), G, 4, 4)
     float32, G = ceil(K / 4) groups of (B, Bx, By, Bz) x 4 columns, gradients
