@@ -334,7 +334,8 @@ class Editor:
         """M: the file's colours / uniform grey shading."""
         vp = self.viewport
         vp.grey = not vp.grey
-        self.say("colours: uniform grey shading" if vp.grey else "colours: the file's colours")
+        grey = "grey (luminance)" if vp.gaussians is not None else "uniform grey shading"
+        self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
 
     def scale_splats(self, factor: float) -> None:
         """Shift+[ / Shift+]: draw every splat's axes this much larger (display only)."""
