@@ -334,7 +334,7 @@ class Editor:
         """M: the file's colours / uniform grey shading."""
         vp = self.viewport
         vp.grey = not vp.grey
-        grey = "grey (luminance)" if vp.gaussians is not None else "uniform grey shading"
+        grey = "uniform grey shading" if getattr(vp, "gaussians", None) is None else "grey (luminance)"
         self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
 
     def scale_splats(self, factor: float) -> None:
