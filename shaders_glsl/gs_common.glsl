@@ -13,9 +13,12 @@ layout(std140, set = 0, binding = 0) uniform GsFrame {
     uvec4 counts;       // n, uints of SH bands 1-3 per Gaussian, sort length (power of 2), sRGB target
     vec4 tint_support;  // rgb, strength (the splat renderer's selection tints)
     vec4 tint_handle;   // rgb, strength
+    vec4 display;       // splat scale (standard deviations times this; display only), grey (1: luminance),
+                        // heat map (1: distortion colours), -
 } F;
 
-// 16 floats per Gaussian: centre (3), opacity (1), covariance xx xy xz yy yz zz (6), SH DC rgb (3), pad (3)
+// 16 floats per Gaussian: centre (3), opacity (1), covariance xx xy xz yy yz zz (6), SH DC rgb (3),
+// unit shortest axis (3, the heat map's normal)
 layout(std430, set = 0, binding = 1) readonly buffer GsGeom { float geom[]; };
 // SH bands 1-3 as half floats, coefficient-major (k = 1.., then rgb), counts.y uints per Gaussian
 layout(std430, set = 0, binding = 2) readonly buffer GsRest { uint rest[]; };

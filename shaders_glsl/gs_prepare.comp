@@ -7,14 +7,37 @@
 #include "gs_common.glsl"
 #define DEFORM_BINDING 9
 #include "deform.glsl"
+#include "rotation.glsl"
+const uint FLAG_SUPPORT = 1u;     // gflags bits (renderer.py FLAG_*), for distortion.glsl
+const uint FLAG_DEFORMED = 4u;
+#include "distortion.glsl"
 
-// the group g of 4 basis columns: dp += B dC, Jm += dC^T grad B (J = I + Jm), as splat_math.glsl
+// Heat-map colour (display values) of a Gaussian: the principal stretch of J on
+// its own plane (normal n = its shortest axis; the splat renderer's measure of
+// the proxy disc) through the ramp for support Gaussians, a dark grey of its
+// luminance for the others (as heat_resolve draws them).
+vec3 gs_heat(vec3 col, vec3 n, mat3 J, bool deformed, uint fl) {
+    vec3 lin = pow(col, vec3(2.2));
+    if (!deformed && (fl & FLAG_SUPPORT) == 0u)
+        return pow(vec3(0.10 + 0.20 * sqrt(clamp(dot(lin, vec3(0.2126, 0.7152, 0.0722)), 0.0, 1.0))),
+                   vec3(1.0 / 2.2));
+    vec3 t0 = normalize(cross(n, abs(n.x) < 0.9 ? vec3(1.0, 0.0, 0.0) : vec3(0.0, 1.0, 0.0)));
+    vec3 t1 = cross(n, t0);
+    float st = deformed ? splat_stretch(t0, t1, J * t0, J * t1) : 1.0;
+    return pow(heat_ramp(clamp(log(max(st, 1.0)) / log(HEAT_MAX_STRETCH), 0.0, 1.0)), vec3(1.0 / 2.2));
+}
+
+// the group g of 4 basis columns: dp += B dC, Jm += dC^T grad B (J = I + Jm), as splat_math.glsl;
+// a rotating handle (rotation-aware mode) adds its blended arc and that arc's Jacobian
 void deform_group(uint g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inout mat3 Jm) {
     vec4 dx = D.dC[3u * g], dy = D.dC[3u * g + 1u], dz = D.dC[3u * g + 2u];
     dp += vec3(dot(B, dx), dot(B, dy), dot(B, dz));
     Jm[0] += vec3(dot(dx, Bx), dot(dy, Bx), dot(dz, Bx));
     Jm[1] += vec3(dot(dx, By), dot(dy, By), dot(dz, By));
     Jm[2] += vec3(dot(dx, Bz), dot(dy, Bz), dot(dz, Bz));
+    if (D.rot[4u * g].w != 0.0)
+        rotation_blend(D.rot[4u * g], D.rot[4u * g + 1u], D.rot[4u * g + 2u], D.rot[4u * g + 3u],
+                       B, Bx, By, Bz, dp, Jm);
 }
 
 layout(local_size_x = 64) in;
@@ -87,6 +110,7 @@ void main() {
         vec3 dir = p;
         uint row = brow[i];
         mat3 R = mat3(1.0);
+        mat3 J = mat3(1.0);
         bool deformed = row != GS_NONE;
         if (deformed) {
             vec3 dp = vec3(0.0);
@@ -96,10 +120,11 @@ void main() {
                 deform_group(k, basis[b + 4u * k], basis[b + 4u * k + 1u], basis[b + 4u * k + 2u],
                              basis[b + 4u * k + 3u], dp, Jm);
             p += dp;
-            mat3 J = mat3(1.0) + Jm;
+            J = mat3(1.0) + Jm;
             S = J * S * transpose(J);
             R = polar_rotation(J);
         }
+        S *= F.display.x * F.display.x;       // the editor's splat size (display only)
         vec3 t = (F.view * vec4(p, 1.0)).xyz;
         float z = -t.z;
         if (z > F.params.w && op >= F.limits.w) {
@@ -132,10 +157,15 @@ void main() {
                     vec3 d = normalize(p - F.eye.xyz);
                     if (deformed) d = transpose(R) * d;
                     vec3 col = sh_color(i, dc, d, int(F.eye.w));
+                    if (F.display.y != 0.0) col = vec3(dot(col, vec3(0.2126, 0.7152, 0.0722)));
                     uint fl = gflags[i];
-                    if ((fl & 1u) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
-                    if ((fl & 2u) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
-                    if ((fl & 8u) != 0u) col *= 0.35;
+                    if (F.display.z != 0.0) {          // the distortion heat map (the editor's D)
+                        col = gs_heat(col, vec3(geom[g + 13u], geom[g + 14u], geom[g + 15u]), J, deformed, fl);
+                    } else {
+                        if ((fl & 1u) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
+                        if ((fl & 2u) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
+                        if ((fl & 8u) != 0u) col *= 0.35;
+                    }
                     float far = F.viewport.w, near = F.viewport.z;
                     float zn = far * (z - near) / (z * (far - near));
                     rec[4u * i] = vec4(c, zn, op);

@@ -710,3 +710,21 @@ INFO_PATCH_REACH_QUANTILE = 0.95
 #: LAS/LAZ written from a cloud not read from LAS: coordinate resolution
 #: (model units; millimetres for metre scans, the usual LiDAR grid)
 LAS_DEFAULT_SCALE = 0.001
+
+# ---------------------------------------------------------------------------
+# Gaussian splatting scenes in the editor (issue 13: editing, rigid reference)
+# ---------------------------------------------------------------------------
+#: a rigid motion applied as a deformation (support = every Gaussian, handle
+#: 80 % of them, 90 degrees about (0, 0.6, 0.8) plus a shift) vs the scene
+#: transformed rigidly with SH rotation, both drawn by the Vulkan renderer at
+#: 160x120 (tests/render/test_gaussians.py): mean |difference| over RGB on the
+#: scene pixels (8-bit steps) and the worst pixel.  Measured on
+#: bunny_gaussians.ply from 3 views: CPU-deformed scene 0.0 (identical images),
+#: GPU deformation (linear and rotation-aware) 0.004-0.009, worst 1 step
+#: (float32 basis rows, polar rotation by Newton iterations)
+GS_RIGID_IMAGE_MEAN_TOL = 0.1
+GS_RIGID_IMAGE_MAX_TOL = 3
+#: the same rigid reference drawn with the SH left unrotated (the colour bleed
+#: of graphdeco-inria/gaussian-splatting issue 176) must differ by at least
+#: this mean (8-bit steps on the scene pixels): measured 15.9-25.2
+GS_BLEED_MIN_MEAN = 5.0

@@ -408,7 +408,8 @@ class Editor:
         """M: the file's colours / uniform grey shading."""
         vp = self.viewport
         vp.grey = not vp.grey
-        self.say("colours: uniform grey shading" if vp.grey else "colours: the file's colours")
+        grey = "uniform grey shading" if getattr(vp, "gaussians", None) is None else "grey (luminance)"
+        self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
 
     def scale_splats(self, factor: float) -> None:
         """Shift+[ / Shift+]: draw every splat's axes this much larger (display only)."""

@@ -12,6 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
+from splatedit.app.gaussian_doc import describe, gaussians_of
 from splatedit.app.jobs import Cancelled, Job
 from splatedit.errors import InputError, SplatEditError
 from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
@@ -80,8 +81,14 @@ def check_model_file(path) -> None:
 def load_job(path: Path, wake) -> Job:
     """Read ``path`` in the background (the job's ``key`` is the path)."""
     def work(progress):
-        from splatedit.io import read
-        cloud = read(str(path), progress=progress)
+        from splatedit.io import is_gaussian_file, read, read_gaussians
+        if is_gaussian_file(path):      # a 3DGS/2DGS scene: its splat proxy with the Gaussians attached
+            from splatedit.app.gaussian_doc import gaussian_document
+            scene = read_gaussians(str(path), progress=progress)
+            scene.name = scene.name or path.name
+            cloud = gaussian_document(scene)
+        else:
+            cloud = read(str(path), progress=progress)
         if not cloud.name:
             cloud.name = path.name
         return cloud
@@ -185,10 +192,18 @@ def save(ed, path: Path) -> None:
     ed.save_as = path
     spath = script_path_for(path)
 
+    scene = gaussians_of(cloud)
+    if scene is not None and Path(path).suffix.lower() != ".ply":
+        ed.say(f"not saved: {path}: a Gaussian splatting scene is saved as a .ply")
+        return
+
     def work(progress):
-        from splatedit.io import write
+        from splatedit.io import write, write_gaussians
         progress("saving", 0.0)
-        write(str(path), cloud, overwrite=True)
+        if scene is not None:       # the committed edits' Gaussians (covariances, SH rotated), extras kept
+            write_gaussians(str(path), scene, overwrite=True, progress=progress)
+        else:
+            write(str(path), cloud, overwrite=True)
         script.save(spath)
         return path, spath, pos, s
 
@@ -219,7 +234,8 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
                            on_change=ed.wake)
     ed.viewport.set_cloud(cloud)
-    if cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
+    scene = gaussians_of(cloud)      # a Gaussian scene: drawn by the Gaussian renderer, no levels of detail
+    if scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
         # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
         # that a huge model's first full-quality frame is already drawn in the background
         w, h = ed.size
@@ -229,15 +245,16 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.camera.detect_up(cloud, ed.path)
     ed.camera.frame_all()
     ed.window.set_title(f"splatedit - {ed.cloud_name}")
-    if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
+    if ed.use_lod and scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
             from splatedit.model.lod import LodPyramid
             return LodPyramid(cloud, progress=progress, background=True)   # preview first
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
     ed.brush.tools.prepare(cloud)
     remember(ed, ed.path)
-    ed.say(f"loaded {ed.cloud_name}: {cloud.n:,} splats (up axis {ed.camera.up.label}, "
-             f"{ed.camera.up.source.value}; U changes it)")
+    what = f"{cloud.n:,} splats" if scene is None else describe(scene)
+    ed.say(f"loaded {ed.cloud_name}: {what} (up axis {ed.camera.up.label}, "
+           f"{ed.camera.up.source.value}; U changes it)")
 
 
 def poll_jobs(ed) -> None:

@@ -54,7 +54,8 @@ class Snapshot:
 
 
 def _cloud_bytes(cloud) -> int:
-    return int(sum(getattr(cloud, a).nbytes for a in ("positions", "u", "v")))
+    from splatedit.app.gaussian_doc import document_bytes
+    return int(sum(getattr(cloud, a).nbytes for a in ("positions", "u", "v"))) + document_bytes(cloud)
 
 
 @dataclass

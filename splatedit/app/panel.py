@@ -9,6 +9,7 @@ from dataclasses import dataclass
 
 from splatedit.app import overlay as ov
 from splatedit.app import selection_tools as seltools
+from splatedit.app.gaussian_doc import describe, gaussians_of
 from splatedit.select.selection import SUPPORT
 from splatedit.app.keymap import help_lines
 from splatedit.app.tools.curve import CURVE_RGB
@@ -65,7 +66,8 @@ def panel_lines(ed) -> list:
         return [f"splatedit - opening {ed.path}", "F1: help   Ctrl+O: open another model"]
     st = s.stats()
     brush = ed.brush
-    lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats"]
+    scene = gaussians_of(s.cloud)
+    lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats" if scene is None else f"{ed.cloud_name}   {describe(scene)}"]
     tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
     erase = "  ERASE" if brush.erase_toggle else ""
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"
@@ -103,7 +105,7 @@ def panel_lines(ed) -> list:
                      + (f"  splats {vp.splat_scale:.2f}x" if vp.splat_scale != 1.0 else "") + "   (U, M, Shift+[ ])")
     info = vp.last_info
     if info is not None:
-        what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div} res" if info.div > 1 else "")
+        what = f"{info.splats:,} {'Gaussians' if info.gaussians else 'splats'}" + (" LOD" if info.lod else "") + (f" 1/{info.div} res" if info.div > 1 else "")
         lines.append(f"frame: render {info.ms:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
     lines.append(f"edits {len(s.edits)}{'  unsaved' if s.dirty else ''}   undo {s.history.position}"
                  f"/{len(s.history) - 1}")

@@ -56,6 +56,7 @@ import numpy as np
 from splatedit.app import revision
 from splatedit.app.distortion_feed import DistortionFeed
 from splatedit.app.fitting import FitProgress, FitScheduler, FitStats, fitted_kind
+from splatedit.app.gaussian_doc import commit_cloud
 from splatedit.app.history import History, Snapshot
 from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.rig import Rig, _matrix_tuple
@@ -578,7 +579,8 @@ class Session:
         # the same arrays and the same checks as ``splatedit deform`` and as reading the
         # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
         # length is relative to the *whole* cloud's diagonal, which the edit may change)
-        new = self.basis.commit(self.cloud, dc)     # raises InputError on a degenerate splat
+        # a Gaussian document: the Gaussians deformed on the CPU (covariances, SH) and re-wrapped
+        new = commit_cloud(self.basis, self.cloud, dc)     # raises InputError on a degenerate splat
         self.last_commit_seconds = time.perf_counter() - t0
         sel = self.selection
         idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731

@@ -9,6 +9,8 @@ import os
 
 import numpy as np
 
+from splatedit.app.gaussian_doc import gaussians_of
+
 
 def _r(v, nd=1):
     return round(float(v), nd)
@@ -49,6 +51,7 @@ def status_dict(ed) -> dict:
                                     if vp.interactive_frames_ms else None),
           "last_render": {} if vp.last_info is None else
           {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
+          "gaussians": s is not None and gaussians_of(s.cloud) is not None,
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,

@@ -30,6 +30,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.app import revision
+from splatedit.app.gaussian_doc import gaussians_of
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.render.camera import Camera
 
@@ -59,6 +60,7 @@ class FrameInfo:
     div: int             # resolution divisor (1: full resolution)
     lod: bool            # a level of detail was drawn
     interactive: bool    # drawn as a fast frame while moving
+    gaussians: bool = False   # drawn by the Gaussian renderer (a Gaussian Splatting document)
 
 
 class Viewport:
@@ -94,11 +96,16 @@ class Viewport:
 
     # ----------------------------------------------------------- document
     def set_cloud(self, cloud) -> None:
+        """The document cloud; a Gaussian document (:mod:`splatedit.app.gaussian_doc`)
+        also sets its Gaussians (:meth:`set_gaussians`), a plain one clears them."""
         if self.cloud is not None and cloud is not None and cloud.n != self.cloud.n:
             self._measured = {}
             self._last_key = None
             self.ms_per_splat = None
         self.cloud = cloud
+        scene = gaussians_of(cloud)
+        if scene is not None or self.gaussians is not None:
+            self.set_gaussians(scene)
 
     def set_gaussians(self, gaussians) -> None:
         """The seam for Gaussian Splatting documents (issue 13).  With a
@@ -257,8 +264,7 @@ class Viewport:
             img = self.gs_slot.r.render(render_camera(cam), w, h)
             ms = (time.perf_counter() - t0) * 1e3
             (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
-            self.last_info = {"ms": ms, "splats": len(self.gaussians), "div": 1, "lod": False,
-                              "interactive": interactive, "gaussians": True}
+            self.last_info = FrameInfo(ms, len(self.gaussians), 1, False, interactive, gaussians=True)
             return img
         level, div = self.choose(interactive, w, h)
         slot = self.full if level is None else self._lod_slot()

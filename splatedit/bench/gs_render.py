@@ -18,7 +18,7 @@ from typing import Iterator
 import numpy as np
 
 from splatedit.bench.gs_scenes import gaussians_from_splats
-from splatedit.bench.render import _basis, _loadavg, sphere_cloud
+from splatedit.bench.render import _basis, _loadavg, _rotation_displacement, sphere_cloud
 from splatedit.render.camera import Camera
 from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
 
@@ -48,6 +48,8 @@ def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int 
     * ``ms_prepass_deformed`` / ``deformed_prepass_over_plain`` /
       ``ms_frame_deformed`` / ``deformed_frame_over_plain``: CPU-sort frames
       with every Gaussian deformed (4 basis columns, ~2% displacement);
+    * ``ms_prepass_rotation`` / ``rotation_prepass_over_linear``: the same
+      basis through the rotation-aware branch of the pre-pass (the editor's default mode);
     * ``loadavg_1min``, ``wall_s``.
     """
     w, h = size
@@ -79,6 +81,12 @@ def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int 
                     out["deformed_prepass_over_plain"] = round(d["prepass"] / m["prepass"], 3)
                     out["ms_frame_deformed"] = round(d["total"], 2)
                     out["deformed_frame_over_plain"] = round(d["total"] / m["total"], 3)
+                    # the editor's default mode: every Gaussian through the rotation-aware branch
+                    # (bench render's 120-degree handle with tiny frame offsets: same culling)
+                    r.set_displacement(_rotation_displacement(dC, *g.bounds()))
+                    q = _frames(r, cam, w, h, repeats)
+                    out["ms_prepass_rotation"] = round(q["prepass"], 2)
+                    out["rotation_prepass_over_linear"] = round(q["prepass"] / d["prepass"], 3)
         out["loadavg_1min"] = _loadavg()
         out["wall_s"] = round(time.perf_counter() - t0, 1)
         yield out

@@ -4,8 +4,9 @@ Per frame:
 
 1. compute pre-pass (``gs_prepare.comp``), once per Gaussian: deformation
    of the Gaussians that carry a basis row (centre p + B dC, covariance
-   J Sigma J^T with J = I + sum_k dC_k grad B_k^T, and the polar rotation R
-   of J), EWA projection to a screen conic (Jacobian of the perspective
+   J Sigma J^T with J = I + sum_k dC_k grad B_k^T, plus the blended arcs of
+   rotating handles in the rotation-aware mode (``rotation.glsl``, as the
+   splat renderer), and the polar rotation R of J), EWA projection to a screen conic (Jacobian of the perspective
    projection + GS_LOWPASS_PX2), colour from the SH at the view direction
    (R^T times it for a deformed Gaussian: its SH live in its original frame),
    culling, and the view depth as the sort key;
@@ -38,6 +39,7 @@ import time
 
 import numpy as np
 
+from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
@@ -45,7 +47,8 @@ from splatedit.render.camera import Camera
 from splatedit.render.renderer import RenderTarget, _unit_scale
 from splatedit.render.gs_resources import (_DEFORM_UBO_BYTES, _GS_SET, _MAX_GROUPS, _MAX_SIZE, _NONE, _PREP_WG,
                                            _REC_BYTES, _RESOLVE_SET, _RP_PICK, _SORT_WG, _UBO_BYTES, SORTS, _rp_accum,
-                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_geometry,
+                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_deform_block,
+                                           pack_geometry,
                                            selection_flags)
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
@@ -92,14 +95,20 @@ class GaussianRenderer:
         self.cloud = None
         self.n = 0
         self._dC = np.zeros((4, 3))
+        self._rot = None            # RotationDisplacement of the frame, or None
         self._cols = 4
         self._basis_idx = np.zeros(0, np.int64)
         self._reach = 0.0
         self._near_far = (1.0, 2.0)
         self._n_visible = 0
         self.last_timings_ms: dict[str, float] = {}
-        #: accepted for the editor's viewport; the heat map is not drawn for Gaussians
+        #: the editor's distortion heat map: support Gaussians coloured by the principal
+        #: stretch of J on their own plane (the splat renderer's ramp), the others dark grey
         self.distortion_map = False
+        #: display options of the editor (as Renderer's): every standard deviation
+        #: drawn this many times larger, and colours as their luminance (grey)
+        self.splat_scale = 1.0
+        self.grey_shading = False
         try:
             self.cache = V.PipelineCache(self.dev)
             self.sampler = V.Sampler(self.dev)
@@ -207,6 +216,7 @@ class GaussianRenderer:
         self.cloud = cloud
         self.n = n
         self._cols, self._dC, self._basis_idx, self._reach = 4, np.zeros((4, 3)), np.zeros(0, np.int64), 0.0
+        self._rot = None
         self._write_dset()
 
     def _write_dset(self):
@@ -263,7 +273,7 @@ class GaussianRenderer:
         brow[idx] = np.arange(len(idx), dtype=np.uint32)
         self._groups = g
         if k != self._cols:
-            self._cols, self._dC = k, np.zeros((k, 3))
+            self._cols, self._dC, self._rot = k, np.zeros((k, 3)), None
         self._basis_idx = idx
         grad = np.sqrt(mats[1] ** 2 + mats[2] ** 2 + mats[3] ** 2).sum(axis=1)
         self._reach = float((np.abs(mats[0]).sum(axis=1) + 3.0 * self._sigma_max[idx] * grad).max(initial=0.0))
@@ -277,12 +287,19 @@ class GaussianRenderer:
         self._reach = 0.0
 
     def set_displacement(self, dC) -> None:
-        """Control-frame displacement dC (K, 3), K = the basis' column count (model units)."""
+        """Control-frame displacement dC (K, 3), K = the basis' column count
+        (model units), or a :class:`~splatedit.deform.rotation.RotationDisplacement`
+        (rotation-aware handles: its residual dC plus each handle's rotation,
+        blended on the GPU as by :class:`~splatedit.render.renderer.Renderer`)."""
         self._check()
-        a = np.asarray(dC, dtype=np.float64)
+        a, rot = split_displacement(dC)
+        if rot is not None and len(rot.rotations) > _MAX_GROUPS:
+            raise ParameterError("dC", f"the renderer blends at most {_MAX_GROUPS} handle rotations")
+        a = np.asarray(a, dtype=np.float64)
         if a.shape != (self._cols, 3) or not np.isfinite(a).all():
             raise ParameterError("dC", f"must be finite with shape ({self._cols}, 3), got {a.shape}")
         self._dC = a.copy()
+        self._rot = rot
 
     # -------------------------------------------------------------- frame
     def _targets_for(self, width: int, height: int) -> _Targets:
@@ -306,8 +323,14 @@ class GaussianRenderer:
                          near=None if camera.near is None else camera.near / sc,
                          far=None if camera.far is None else camera.far / sc)
         lo, hi = self.bounds
+        grown = 3.0 * max(float(self.splat_scale) - 1.0, 0.0) * float(self._sigma_max.max())
+        lo, hi = lo - grown, hi + grown
         if len(self._basis_idx):
-            grow = self._reach * float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+            move = float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
+            if self._rot is not None:   # an arc moves a point by at most 2 angle |offset| (Renderer._clip_bounds)
+                move += max(2.0 * r.angle * float(np.linalg.norm(r.offsets, axis=1).max())
+                            for r in self._rot.rotations)
+            grow = self._reach * move
             lo, hi = lo - grow, hi + grow
         near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
         f = 1.0 / math.tan(math.radians(camera.fov_deg) / 2.0)
@@ -325,10 +348,10 @@ class GaussianRenderer:
                                        1 if srgb_target else 0)
         u[44:48] = RENDER_TINT_SUPPORT
         u[48:52] = RENDER_TINT_HANDLE
+        u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 1.0 if self.distortion_map else 0.0,
+                    0.0)
         self.ubo.write(u)
-        pad = np.zeros((4 * _MAX_GROUPS, 3))
-        pad[:len(self._dC)] = self._dC / sc
-        self.dC_ubo.write(np.ascontiguousarray(pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1), np.float32))
+        self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
         self._near_far = (near * sc, far * sc)
 
     def _record_prepass(self, cb):

@@ -13,11 +13,12 @@ from splatedit.render import vk as V
 from splatedit.render.renderer import RenderTarget
 from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
 
-_UBO_BYTES = 208
+_UBO_BYTES = 224
 _GEOM_FLOATS = 16
 _REC_BYTES = 64
 _MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
-_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS
+#: deform.glsl's block: dC (3 vec4 per group) and the handle rotations (4 vec4 per group)
+_DEFORM_UBO_BYTES = 48 * _MAX_GROUPS + 64 * _MAX_GROUPS
 _MAX_SIZE = 16384
 _PREP_WG = 64
 _SORT_WG = 256
@@ -104,7 +105,7 @@ class _Targets:
 def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     """GPU arrays of a scene: ((n, 16) float32 geometry: centre relative to
     ``origin`` / ``scale``, opacity, covariance xx xy xz yy yz zz / scale^2, SH DC
-    rgb; (n, m) uint32 SH bands 1-3 as pairs of half floats (m = 0 for degree 0))."""
+    rgb, unit shortest axis; (n, m) uint32 SH bands 1-3 as pairs of half floats (m = 0 for degree 0))."""
     n = len(cloud)
     geom = np.zeros((n, _GEOM_FLOATS), np.float32)
     geom[:, 0:3] = (cloud.positions - origin) / scale
@@ -112,10 +113,30 @@ def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     c = cloud.covariances() / (scale * scale)
     geom[:, 4:10] = c[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
     geom[:, 10:13] = cloud.sh[:, 0, :]
+    shortest = np.argmin(cloud.scales(), axis=1)          # the heat map's normal (2DGS: the third axis)
+    geom[:, 13:16] = cloud.rotation_matrices()[np.arange(n), :, shortest]
     rest = np.ascontiguousarray(cloud.sh[:, 1:, :], np.float32).reshape(n, -1).astype(np.float16)
     if rest.shape[1] % 2:
         rest = np.concatenate([rest, np.zeros((n, 1), np.float16)], axis=1)
     return geom, np.ascontiguousarray(rest).view(np.uint32)
+
+
+def pack_deform_block(dC: np.ndarray, rot, scale: float) -> np.ndarray:
+    """deform.glsl's uniform block as float32: dC (K, 3) (model units, divided
+    by ``scale``) zero-padded to 4 groups as rows dC[3g + i] = (dC_{4g..4g+3})[i];
+    then per group g the rotation of handle g of ``rot`` (a RotationDisplacement
+    or None): (unit axis, angle; 0 = none), frame offsets D_0..D_3 / ``scale``."""
+    pad = np.zeros((4 * _MAX_GROUPS, 3))
+    pad[:len(dC)] = np.asarray(dC, np.float64) / scale
+    blocks = np.zeros((_MAX_GROUPS, 4, 4))
+    if rot is not None:
+        for g in rot.rotating:
+            r = rot.rotations[g]
+            blocks[g, 0, :3] = r.w / r.angle
+            blocks[g, 0, 3] = r.angle
+            blocks[g, 1:, :] = (r.offsets / scale).T
+    block = np.concatenate([pad.reshape(_MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1), blocks.reshape(-1)])
+    return np.ascontiguousarray(block, np.float32)
 
 
 def pack_basis_rows(mats, scale: float) -> np.ndarray:

@@ -39,7 +39,7 @@ def test_gaussians_draw_pick_tint_and_deform_through_the_viewport(scene):
     splats = vp.render(cam, 160, 120)
     vp.set_gaussians(g)
     img = vp.render(cam, 160, 120)
-    assert vp.last_info["gaussians"] and vp.last_info["splats"] == len(g)
+    assert vp.last_info.gaussians and vp.last_info.splats == len(g)
     fg = img[..., :3].min(axis=2) < 240
     assert fg.mean() > 0.1
     assert np.abs(img.astype(int) - splats).mean() > 3          # not the splat renderer's image
@@ -61,4 +61,8 @@ def test_gaussians_draw_pick_tint_and_deform_through_the_viewport(scene):
     vp.set_gaussians(None)
     vp.set_basis(None)
     vp.set_selection(None, None, 2)
-    assert np.array_equal(vp.render(cam, 160, 120), splats)
+    # the splat renderer again: the same image up to one 8-bit step (its additive RGBA16F
+    # blending is not bit-reproducible on lavapipe's threads: measured 0-0.03 % of the
+    # channels off by one between identical frames, never more)
+    again = vp.render(cam, 160, 120).astype(int)
+    assert np.abs(again - splats).max() <= 1 and (again != splats).mean() < 0.005

@@ -275,3 +275,107 @@ def test_close_destroys_every_vulkan_object(bunny_gaussians):
     r.close()
     r.close()                             # idempotent
     assert live_handles() == before
+
+
+@pytest.mark.parametrize("mode", ["linear", "rotation"])
+def test_rigid_90_degrees_as_a_deformation_shows_no_colour_bleed(gs, mode):
+    """The issue's test on the shipped scene: a rigid motion (90 degrees about
+    (0, 0.6, 0.8) and a shift) applied as a deformation (support = every
+    Gaussian, handle = 80 % of them, so the free rest follows exactly) and
+    drawn by the Vulkan renderer -- deformed on the CPU (what a save writes)
+    and live on the GPU (the editor's frames, linear and rotation-aware) --
+    equals the scene transformed rigidly with its SH rotated, drawn the same
+    way; the rigid reference without the SH rotation differs clearly."""
+    from scipy.spatial.transform import Rotation
+
+    from splatedit.data import gaussian_scene_path
+    from splatedit.deform.basis import DeformationBasis
+    from splatedit.deform.gaussians import deform_with_evaluator, transform_gaussians
+    from splatedit.deform.modes import DeformationMode
+    from splatedit.io import read_gaussians
+    from splatedit.tolerances import GS_BLEED_MIN_MEAN, GS_RIGID_IMAGE_MAX_TOL, GS_RIGID_IMAGE_MEAN_TOL
+
+    g = read_gaussians(gaussian_scene_path())
+    a = np.eye(4)
+    a[:3, :3] = Rotation.from_rotvec(np.pi / 2 * np.array([0.0, 0.6, 0.8])).as_matrix()
+    a[:3, 3] = [0.3, -0.1, 0.2]
+    proxy = g.proxy_splats()
+    y = proxy.positions[:, 1]
+    basis = DeformationBasis.fit(proxy, np.ones(len(g), bool), [y > np.percentile(y, 20)], fill_holes=False)
+    dc = basis.displacement([a], mode=DeformationMode(mode))
+    rigid = transform_gaussians(g, a)
+    scenes = {"cpu": deform_with_evaluator(g, basis, dc), "unrotated": rigid.replace(sh=g.sh)}
+    lo, hi = gaussian_bounds(rigid)
+    for direction in VIEWS[:2]:
+        cam = Camera.frame(lo, hi, 4 / 3, direction=direction)
+        gs.set_gaussians(rigid)
+        ref = gs.render(cam, 160, 120).astype(np.int16)
+        imgs = {}
+        for name, sc in scenes.items():
+            gs.set_gaussians(sc)
+            imgs[name] = gs.render(cam, 160, 120)
+        gs.set_gaussians(g)
+        gs.set_basis(*basis.rows_for_gpu())
+        gs.set_displacement(dc)
+        imgs["gpu"] = gs.render(cam, 160, 120)
+        assert coverage(ref) > 0.05
+        for name in ("cpu", "gpu"):
+            diff = np.abs(imgs[name].astype(np.int16) - ref)[..., :3]
+            assert foreground_diff(imgs[name], ref) <= GS_RIGID_IMAGE_MEAN_TOL and diff.max() <= GS_RIGID_IMAGE_MAX_TOL, \
+                f"{name} ({mode}), view {direction}: mean {foreground_diff(imgs[name], ref):.3f}, worst {diff.max()}"
+        bleed = foreground_diff(imgs["unrotated"], ref)
+        assert bleed >= GS_BLEED_MIN_MEAN, f"unrotated SH should bleed visibly, mean {bleed:.2f}"
+
+
+def test_display_options_scale_the_gaussians_and_grey_their_colours(gs, bunny_gaussians):
+    """The editor's display options on Gaussians: splat size 2 draws every
+    standard deviation twice as long (more pixels covered, the same scene
+    centre), grey draws each colour's luminance (R = G = B); back to the
+    defaults gives the same image as before."""
+    cam = view(bunny_gaussians, VIEWS[0])
+    gs.set_gaussians(bunny_gaussians)
+    plain = gs.render(cam, W, H)
+    try:
+        gs.splat_scale = 2.0
+        big = gs.render(cam, W, H)
+        assert coverage(big) > 1.15 * coverage(plain)
+        gs.splat_scale, gs.grey_shading = 1.0, True
+        grey = gs.render(cam, W, H).astype(int)
+        fg = np.abs(grey[..., :3] - 255).max(axis=2) > 8
+        assert np.ptp(grey[..., :3], axis=2)[fg].max() <= 1 and np.ptp(plain[..., :3].astype(int), axis=2)[fg].mean() > 10
+    finally:
+        gs.splat_scale, gs.grey_shading = 1.0, False
+    assert np.array_equal(gs.render(cam, W, H), plain)
+
+
+def test_heat_map_colours_gaussians_by_their_stretch(gs, bunny_gaussians):
+    """The editor's D on Gaussians: an affine map stretching x by 2 (support =
+    every Gaussian) draws the support in the ramp's 2x orange, a rigid 90-degree
+    turn in its 1x light grey, and undeformed Gaussians outside the support
+    in dark grey."""
+    g = bunny_gaussians
+    cam = view(g, VIEWS[0])
+    B, Bx, By, Bz = _affine_basis(g.positions)
+    c = g.positions.mean(axis=0)
+    gs.set_gaussians(g)
+    gs.distortion_map = True
+    try:
+        out = {}
+        for name, a in (("stretch", np.diag([2.0, 1.0, 1.0])),
+                        ("rigid", np.array([[0.0, -1.0, 0.0], [1.0, 0.0, 0.0], [0.0, 0.0, 1.0]]))):
+            gs.set_selection(np.ones(len(g), bool), None)
+            gs.set_basis(np.arange(len(g)), B, Bx, By, Bz)
+            gs.set_displacement(np.concatenate([(a - np.eye(3)).T, (c - a @ c)[None]], axis=0))
+            out[name] = gs.render(view(g, VIEWS[0]) if name == "rigid" else cam, W, H).astype(int)
+        gs.clear_basis()
+        gs.set_selection(None, None)
+        out["outside"] = gs.render(cam, W, H).astype(int)
+    finally:
+        gs.distortion_map = False
+    dense = {k: v[(255 - v[..., :3]).max(axis=2) > 15] for k, v in out.items()}    # scene pixels
+    r, gg, b = dense["stretch"][:, :3].mean(axis=0)
+    assert r > gg + 30 > b + 60, (r, gg, b)                     # orange: (0.99, 0.62, 0.25)
+    for k in ("rigid", "outside"):
+        assert np.ptp(dense[k][:, :3], axis=1).mean() < 12, k    # neutral greys
+    # measured: stretch (253, 191, 113), rigid (232, 232, 227), outside 144 grey
+    assert dense["outside"][:, :3].mean() < dense["rigid"][:, :3].mean() - 40
