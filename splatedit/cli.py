@@ -352,21 +352,32 @@ def _render_gaussians(args, cloud) -> int:
     """``splatedit render`` of a GaussianCloud: camera flags as for splats, an
     edit script's single edit fitted on the Gaussians' splat proxy and applied
     on the GPU (centres, covariances, SH frames)."""
+    import numpy as np
     from splatedit.render.gs_headless import render_gaussians_to_png, splat_proxy
     if args.buffers is not None:
         raise ParameterError("--buffers", "is not available for Gaussian splatting scenes")
     proxy = splat_proxy(cloud)
     camera = _camera_from_args(args, proxy)
     basis_rows = d_c = None
+    on_cpu = False
     if args.edit is not None:
         from splatedit.script import load_script
         if len(load_script(args.edit).edits) != 1:
             raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
                                            "(chained edits need the Gaussian CPU deformation)")
         _, basis_rows, d_c = _gpu_edit(args, proxy)
+        if not isinstance(d_c, np.ndarray) or len(basis_rows) != 5:
+            # the Gaussian GPU pass draws a plain dC only: a turning handle (rotation mode) or the
+            # detail mode is applied on the CPU as `splatedit deform` does, then drawn undeformed
+            from splatedit.gaussian_script import run_script_gaussians
+            cloud, _ = run_script_gaussians(cloud, load_script(args.edit), source=str(args.edit),
+                                            progress=args.progress)
+            basis_rows = d_c = None
+            on_cpu = True
     render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c)
+    how = ", deformed on the CPU" if on_cpu else ", deformed on the GPU" if basis_rows is not None else ""
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {len(cloud)} Gaussians, SH degree "
-          f"{cloud.sh_degree}" + (", deformed on the GPU" if basis_rows is not None else "") + ")")
+          f"{cloud.sh_degree}{how})")
     return 0
 
 

@@ -17,6 +17,7 @@ import numpy as np
 
 from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.gaussians import deform_with_evaluator
+from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.script import EditReport, EditScript, fit_edit
@@ -35,6 +36,11 @@ def run_script_gaussians(scene: GaussianCloud, script: EditScript, *, method: st
     """
     reports = []
     for i, edit in enumerate(script.edits):
+        if edit.deformation is DeformationMode.DETAIL:
+            # the detail mode's offsets along a smoothed base are defined for surface splats only
+            raise EditScriptError("the detail mode is not available for Gaussian splatting scenes "
+                                  "(use \"rotation\" or \"linear\")",
+                                  json_path=f"{edit.json_path}.deformation", path=source)
         proxy = scene.proxy_splats()
         r, basis, d_c = fit_edit(proxy, edit, script.solver, method=method, tol=tol,
                                  source=source, progress=progress)

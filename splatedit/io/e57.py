@@ -7,8 +7,12 @@ file's frame and merged; or one scan picked by index with ``file.e57#2``
 gives none) are kept; without colours, grey from the intensity.  Points of
 invalid cartesian coordinates (``cartesianInvalidState`` != 0) are dropped.
 
-Write: one scan with an identity pose: world coordinates (float64),
-colours and intensity (0..65535) when the cloud has them.
+Write: one scan whose pose is a pure translation by the cloud's origin, with
+the local coordinates as its points (pye57 writes the points in single
+precision: world coordinates of a georeferenced scan would be rounded to
+0.5 m at y = 5,000,000; local ones keep float32 steps of about a micrometre
+at 10 m from the origin); colours and intensity (0..65535) when the cloud
+has them.
 """
 
 from __future__ import annotations
@@ -103,8 +107,8 @@ def write_e57(fh, cloud: SplatCloud, directory) -> None:
 
 def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
     import pye57
-    world = cloud.world_positions()
-    data = {"cartesianX": world[:, 0], "cartesianY": world[:, 1], "cartesianZ": world[:, 2]}
+    local = cloud.positions             # the pose's translation adds the origin back
+    data = {"cartesianX": local[:, 0], "cartesianY": local[:, 1], "cartesianZ": local[:, 2]}
     if cloud.colors is not None:
         for j, c in enumerate(("colorRed", "colorGreen", "colorBlue")):
             data[c] = cloud.colors[:, j].astype(np.uint8)
@@ -113,9 +117,10 @@ def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
     # the limits 0..65535 make a reader map our intensities back unchanged
     # (pye57 would otherwise store the data's own min/max as the limits)
     from types import SimpleNamespace
-    lo, hi = world.min(axis=0), world.max(axis=0)
+    lo, hi = local.min(axis=0), local.max(axis=0)   # cartesianBounds: the scan's own frame
     header = SimpleNamespace(name=cloud.name or "splatedit", rotation=np.array([1.0, 0, 0, 0]),
-                             translation=np.zeros(3), intensityMinimum=0.0,
+                             translation=np.asarray(cloud.origin, dtype=np.float64),
+                             intensityMinimum=0.0,
                              intensityMaximum=65535.0, xMinimum=lo[0], yMinimum=lo[1],
                              zMinimum=lo[2], xMaximum=hi[0], yMaximum=hi[1], zMaximum=hi[2])
     e57 = pye57.E57(tmp_path, mode="w")

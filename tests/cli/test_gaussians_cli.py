@@ -79,3 +79,15 @@ def test_deform_errors_are_one_line(tmp_path):
     broken.write_bytes(gaussian_scene_path().read_bytes().replace(b"property float opacity\n", b""))
     r = run_cli("info", broken)
     assert r.returncode == 2 and str(broken) in r.stderr and "'opacity'" in r.stderr, r.stderr
+
+
+def test_deform_detail_mode_of_a_gaussian_scene_is_a_one_line_error(tmp_path):
+    """The detail mode has no Gaussian version: a one-line error naming the key, not a traceback."""
+    script = tmp_path / "detail.json"
+    detail = json.loads(json.dumps(EARS))
+    detail["edits"][0]["deformation"] = "detail"
+    script.write_text(json.dumps(detail))
+    r = run_cli("deform", gaussian_scene_path(), "--edit", script, "-o", tmp_path / "o.ply")
+    assert r.returncode == 2 and r.stderr.count("\n") == 1, r.stderr
+    assert "$.edits[0].deformation" in r.stderr and "Traceback" not in r.stderr
+    assert not (tmp_path / "o.ply").exists()

@@ -59,6 +59,30 @@ def test_render_applies_one_edit_on_the_gpu(gs_file, tmp_path, capsys):
     assert 0.005 < changed < 0.5, changed
 
 
+
+def test_render_of_a_rotating_edit_matches_deform_then_render(tmp_path, capsys):
+    """A rotation (the default mode, which the Gaussian GPU pass does not draw) is applied on the
+    CPU: the image equals rendering the output of `splatedit deform` (it used to be a traceback)."""
+    from splatedit.data import default_model_path
+    scene = default_model_path().with_name("bunny_gaussians.ply")
+    script = tmp_path / "ears.json"
+    script.write_text(json.dumps({"version": 1, "edits": [
+        {"support": {"box": {"min": [-1, 0.1, -1], "max": [1, 1, 1]}},
+         "handle": {"box": {"min": [-1, 0.38, -1], "max": [1, 1, 1]}},
+         "transform": {"rotate": {"axis": [1, 0, 0], "degrees": 45}}}]}))
+    plain, direct, via = (tmp_path / n for n in ("plain.png", "direct.png", "via.png"))
+    deformed = tmp_path / "deformed.ply"
+    cam = ["--size", "96x96", "--eye", "0,0.1,2.2", "--target", "0,0.1,0"]
+    assert cli.main(["-q", "render", str(scene), "-o", str(plain), *cam]) == 0
+    assert cli.main(["-q", "render", str(scene), "-o", str(direct), "--edit", str(script), *cam]) == 0
+    assert "deformed on the CPU" in capsys.readouterr().out
+    assert cli.main(["-q", "deform", str(scene), "--edit", str(script), "-o", str(deformed)]) == 0
+    assert cli.main(["-q", "render", str(deformed), "-o", str(via), *cam]) == 0
+    a, b, c = (np.asarray(Image.open(p)).astype(int) for p in (plain, direct, via))
+    assert (np.abs(a - b)[..., :3].max(axis=2) > 16).mean() > 0.01     # the ears moved
+    assert np.abs(b - c).max() <= 2                                      # as deform + render draws them
+
+
 def test_buffers_flag_is_a_one_line_error(gs_file, tmp_path, capsys):
     code = cli.main(["-q", "render", str(gs_file), "-o", str(tmp_path / "x.png"), "--buffers", str(tmp_path / "b.npz")])
     err = capsys.readouterr().err

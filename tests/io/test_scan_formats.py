@@ -129,6 +129,18 @@ def test_e57_scans_merged_with_poses_or_picked_by_index(tmp_path):
     assert np.array_equal(again.intensity, second.intensity)
 
 
+def test_e57_round_trip_of_georeferenced_scan_keeps_millimetres(tmp_path):
+    """pye57 writes single-precision points: the writer must store local coordinates and put the
+    origin in the pose, else y ~ 5,123,000 is rounded to 0.5 m steps."""
+    from splatedit.tolerances import E57_ROUND_TRIP_ATOL
+    _laspy_file(tmp_path / "t.las")
+    cloud = read(tmp_path / "t.las")
+    write(tmp_path / "t.e57", cloud)
+    again = read(tmp_path / "t.e57")
+    err = np.abs(again.world_positions() - cloud.world_positions()).max()
+    assert err < E57_ROUND_TRIP_ATOL, f"E57 round trip moved points by up to {err:.3g} m"
+
+
 def _pcd_text(rows, binary=False, fields="x y z rgb"):
     n = len(rows)
     head = (f"# .PCD v0.7\nVERSION 0.7\nFIELDS {fields}\nSIZE 4 4 4 4\nTYPE F F F U\nCOUNT 1 1 1 1\n"
