@@ -566,14 +566,17 @@ ROTATION_FULL_DEGREES = 30.0
 #: a normal counts as aligned with a world axis when |n . axis| >= this
 #: (25.8 degrees).  Floors and flat undersides of scans fall well inside it
 UP_AXIS_ALIGNED_COS = 0.9
-#: ground signal: at least this fraction of all normals aligned with one axis.
-#: Measured: hippo1.ply (a scan resting on its flat underside, Z-up) has 37% of
-#: its normals within the cone of Z; the bunny (Y-up, no floor) 9-16% on every
-#: axis, the kitten 10-12%
+#: ground signal: at least this fraction of all normals facing one signed axis.
+#: Measured: the bunny (Y-up, no floor) 9-16% on every axis, the kitten 10-12%;
+#: hippo1.ply, a one-sided scan taken from +Z (Y-up: its legs point to -Y), has
+#: 37% facing +Z, which is why the band test below is needed
 UP_AXIS_GROUND_MIN_FRACTION = 0.25
-#: ... and at least this many times the fraction of the next axis (hippo: 37%
-#: against 0%; the bunny's largest, 16% on Z, is 1.3x its next)
-UP_AXIS_GROUND_DOMINANCE = 2.0
+#: ... and at least UP_AXIS_FLOOR_MIN_IN_BAND of those points lie within this
+#: fraction of the model's extent from its bottom along that axis (a floor, a
+#: flat underside).  hippo1's +Z-facing points: 3% within the bottom tenth of
+#: z (they cover its whole depth); a floor: all of them
+UP_AXIS_FLOOR_BAND = 0.1
+UP_AXIS_FLOOR_MIN_IN_BAND = 0.5
 #: splat size scale steps (Shift+[ / Shift+]) and its range: 0.25x makes a
 #: dense scan's splats visibly separate points, 4x closes the holes of a
 #: sparse one (poste_france at 1x shows gaps of ~2 splat radii)

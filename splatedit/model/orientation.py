@@ -8,10 +8,11 @@ from, in order:
    Z``, ``comment Z-up``, ``comment up: -y`` ...: :func:`header_up_hint`),
    else the format: LAS/LAZ and E57 are defined in a Z-up frame
    (georeferenced / scanner coordinates) -> +Z;
-2. a ground signal in the model: when one axis carries a clear majority of
-   the axis-aligned normals (floors, terrain, a scan's flat underside) and
-   the model is not tallest along it, that axis, signed by the side most of
-   those normals face;
+2. a ground signal in the model: a floor (or terrain, a flat underside):
+   many normals facing one signed axis whose points lie in a thin band at
+   the bottom of the model along that axis (a one-sided scan taken from
+   one side has many normals facing the scanner too, but spread over the
+   whole depth: that is no floor), and the model is not tallest along it;
 3. otherwise +Y (the graphics convention of PLY / OFF / OBJ meshes: the
    Stanford models, the bundled bunny).
 """
@@ -25,7 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from splatedit.tolerances import UP_AXIS_ALIGNED_COS, UP_AXIS_GROUND_DOMINANCE, UP_AXIS_GROUND_MIN_FRACTION
+from splatedit.tolerances import (UP_AXIS_ALIGNED_COS, UP_AXIS_FLOOR_BAND, UP_AXIS_FLOOR_MIN_IN_BAND,
+                                  UP_AXIS_GROUND_MIN_FRACTION)
 
 #: the formats whose coordinates are Z-up by definition
 Z_UP_SUFFIXES = (".las", ".laz", ".e57")
@@ -115,13 +117,21 @@ def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpA
     n = np.asarray(normals, float)
     p = np.asarray(positions, float)
     if len(n) and len(p):
-        aligned = np.abs(n) >= UP_AXIS_ALIGNED_COS             # (n, 3)
-        frac = aligned.mean(axis=0)
-        k = int(np.argmax(frac))
-        others = np.delete(frac, k)
-        extent = p.max(0) - p.min(0)
-        if (frac[k] >= UP_AXIS_GROUND_MIN_FRACTION and frac[k] >= UP_AXIS_GROUND_DOMINANCE * others.max()
-                and extent[k] < extent.max()):
-            sign = 1 if float(np.sign(n[aligned[:, k], k]).sum()) >= 0 else -1
-            return UpAxis(k, sign, UpSource.GROUND)
+        lo, hi = p.min(0), p.max(0)
+        extent = hi - lo
+        best = None                                             # (count, axis, sign)
+        for k in range(3):
+            if not extent[k] < extent.max() or extent[k] <= 0.0:
+                continue
+            for sign in (1, -1):
+                facing = n[:, k] * sign >= UP_AXIS_ALIGNED_COS
+                count = int(facing.sum())
+                if count < UP_AXIS_GROUND_MIN_FRACTION * len(n):
+                    continue
+                height = (p[facing, k] - lo[k]) if sign > 0 else (hi[k] - p[facing, k])
+                in_band = float(np.mean(height <= UP_AXIS_FLOOR_BAND * extent[k]))
+                if in_band >= UP_AXIS_FLOOR_MIN_IN_BAND and (best is None or count > best[0]):
+                    best = (count, k, sign)
+        if best is not None:
+            return UpAxis(best[1], best[2], UpSource.GROUND)
     return UpAxis(1, 1, UpSource.DEFAULT)

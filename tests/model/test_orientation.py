@@ -20,9 +20,24 @@ def test_bundled_bunny_is_y_up():
     assert (up.axis, up.sign, up.source) == (1, 1, UpSource.DEFAULT)
 
 
-def test_hippo_scan_resting_on_its_underside_is_z_up(shared_data):
+def test_one_sided_hippo_scan_is_not_taken_for_a_floor(shared_data):
+    """hippo1 was scanned from +Z (37% of its normals face +Z) but stands
+    upright along +Y (legs to -Y): the scanner side is no ground."""
     c = _read(shared_data / "hippo1.ply")
     up = detect_up_axis(c.normals, c.positions, shared_data / "hippo1.ply")
+    assert (up.label, up.source) == ("+Y", UpSource.DEFAULT)
+
+
+def test_an_object_standing_on_a_floor_slab_is_up_from_the_floor():
+    """A sphere (normals every way) standing on a square floor patch in the
+    x-y plane at its bottom: +Z, from the floor."""
+    rng = np.random.default_rng(2)
+    s = rng.normal(size=(1500, 3))
+    s /= np.linalg.norm(s, axis=1, keepdims=True)
+    floor = np.c_[rng.uniform(-3, 3, 2000), rng.uniform(-3, 3, 2000), np.full(2000, -1.0)]
+    p = np.vstack([s, floor])
+    n = np.vstack([s, np.tile([0.0, 0.0, 1.0], (2000, 1))])
+    up = detect_up_axis(n, p)
     assert (up.label, up.source) == ("+Z", UpSource.GROUND)
 
 
