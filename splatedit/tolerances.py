@@ -632,3 +632,26 @@ GS_REF_BAD_SHARE = 0.01
 #: once the singular values are near 1, each early step halves a large one:
 #: 12 reaches float32 precision for stretches up to 100x
 GS_POLAR_ITERATIONS = 12
+
+# --------------------------------------------------------------------------
+# Editor GUI (Dear ImGui panels and GPU overlays, issue 10 parts 1-2, 5)
+# --------------------------------------------------------------------------
+#: the last closure's highlight is drawn as small squares in ImGui's draw list,
+#: one per distinct pixel; above this many they are thinned evenly.  Measured
+#: (lavapipe, 2 loaded cores): ~1.1 us of Python per square for the draw-list
+#: calls, so 20,000 squares add ~22 ms to one frame that shows a highlight
+#: (it flashes for a moment after a grow/shrink/connected step); a 960x600
+#: view of the bunny has ~60,000 distinct surface pixels, so a highlight of
+#: the whole model still shows as a dense pattern
+EDITOR_GUI_MAX_HIGHLIGHT_DOTS = 20_000
+#: width of the side panel (pixels at font scale 1): the widest row, the
+#: three translate fields with their label, needs ~290 px in ImGui's
+#: default 13 px font; the panel still leaves 640 px of a 960 px window
+EDITOR_GUI_PANEL_WIDTH = 310
+#: the help window is placed beside the panel when at least this wide (px),
+#: else over the whole window (the panel steps aside); the longest help line
+#: is ~620 px in the default font, narrower windows scroll horizontally
+EDITOR_GUI_HELP_MIN_WIDTH = 420
+#: a numeric rotation whose axis is shorter than this (model-independent: the
+#: axis is a direction, normalised before use) is refused, not turned about noise
+EDITOR_GUI_MIN_AXIS_NORM = 1e-9

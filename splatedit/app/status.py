@@ -42,6 +42,13 @@ def status_dict(ed) -> dict:
           {k: (round(v, 1) if isinstance(v, float) else v) for k, v in dataclasses.asdict(vp.last_info).items()},
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "script": str(ed.saved_script) if ed.saved_script else None}
+    gui = getattr(ed, "gui", None)
+    st["gui"] = gui is not None
+    if gui is not None:
+        st["gui_rects"] = {k: [b.x, b.y, b.w, b.h] for k, b in sorted(gui.rects.items())}
+        st["gui_wants_mouse"] = bool(gui.wants_mouse)
+        st["background"] = [round(float(x), 4) for x in vp.background[:3]]
+        st["distortion_map"] = bool(vp.distortion_map)
     if s is None:
         return st
     ss = s.stats()
