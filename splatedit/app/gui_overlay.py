@@ -64,10 +64,10 @@ def polyline(dl, px, rgb, width: float = 2.0) -> None:
             run.append(_v(q))
             continue
         if len(run) > 1:
-            dl.add_polyline(run, col(rgb), 0, width)
+            dl.add_polyline(run, col(rgb), thickness=float(width), flags=0)
         run = []
     if len(run) > 1:
-        dl.add_polyline(run, col(rgb), 0, width)
+        dl.add_polyline(run, col(rgb), thickness=float(width), flags=0)
 
 
 def dot(dl, p, rgb, radius: float = 5.0) -> None:
