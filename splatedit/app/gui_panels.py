@@ -90,19 +90,57 @@ class EditorGui:
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
         self._help_scroll_set = None
         self._last = time.perf_counter()
+        self._windows: list[Box] = []       # GUI windows of the last frame (mouse routing)
+        self._menu_open = False
+        self._press_in_gui = False
 
     # ---------------------------------------------------------------- input
     def feed(self, ev) -> bool:
-        """Give ImGui the event first; True when it is ImGui's (the tools skip it)."""
-        return self.gui.feed(ev)
+        """Give ImGui the event first; True when it is ImGui's (the tools skip it).
+
+        Mouse events are routed by *where* they happen, against the windows
+        of the last frame (menu bar, panel, help, questions): ImGui's own
+        ``want_capture_mouse`` is only updated once per frame, so in a batch
+        of events "click a button, move to the model, click" the second click
+        would still be claimed.  Presses on a window, and the moves and the
+        release of a drag that started there (a slider), are ImGui's; so is
+        every click while a menu is open.  Keys are ImGui's while a text
+        field is being edited (:attr:`wants_keyboard`)."""
+        self.gui.feed(ev)
+        kind = ev.kind
+        if kind in ("key", "char"):
+            return self.wants_keyboard
+        if kind == "button":
+            if ev.action == 1:                    # press
+                self._press_in_gui = self._menu_open or self.owns_point(ev.x, ev.y)
+                return self._press_in_gui
+            taken, self._press_in_gui = self._press_in_gui, False
+            return taken
+        if kind == "scroll":
+            return self.owns_point(ev.x, ev.y)
+        if kind == "move":
+            return self._press_in_gui
+        return False
+
+    def owns_point(self, x: float, y: float) -> bool:
+        """(x, y) pixels are over a GUI window of the last frame."""
+        return any(b.x <= x < b.right and b.y <= y < b.bottom for b in self._windows)
 
     @property
     def wants_mouse(self) -> bool:
-        return self.gui.wants_mouse
+        """The pointer is over a GUI window (or drags one of its widgets)."""
+        mx, my = self.ed.mouse
+        return self._press_in_gui or self.owns_point(mx, my)
 
     @property
     def wants_keyboard(self) -> bool:
-        return self.gui.wants_keyboard
+        """A text field is being edited (``io.want_text_input``): keys and
+        characters are ImGui's.  ImGui's broader ``want_capture_keyboard`` also
+        holds while a clicked window keeps the focus, which would swallow the
+        editor's keys (Esc after a palette button) though ImGui does nothing
+        with them (keyboard navigation is off)."""
+        self.gui._current()
+        return bool(imgui.get_io().want_text_input)
 
     # ---------------------------------------------------------------- frame
     def build(self, w: int, h: int) -> None:
@@ -111,8 +149,10 @@ class EditorGui:
         self.gui.new_frame(w, h, now - self._last)
         self._last = now
         self.rects = {}
+        self._windows = []
+        self._menu_open = False
         gui_overlay.draw_tools(self.ed, w, h)
-        self._menu_bar()
+        self._menu_bar(w)
         help_full = self.ed.help.shown and self._help_area(w, h)[1]
         if self.ed.panel_visible and not help_full:
             self._panel(w, h)
@@ -139,12 +179,14 @@ class EditorGui:
         self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
 
     # ------------------------------------------------------------ menu bar
-    def _menu_bar(self) -> None:
+    def _menu_bar(self, w: int) -> None:
         ed = self.ed
         if not imgui.begin_main_menu_bar():
             return
         self.menu_height = imgui.get_window_size().y
+        self._windows.append(Box(0, 0, w, int(self.menu_height)))
         if imgui.begin_menu("File"):
+            self._menu_open = True
             for e in self.file_menu:
                 ok = e.enabled() if e.enabled is not None else True
                 if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
@@ -153,12 +195,14 @@ class EditorGui:
         self._rect("menu_file")
         s = ed.session
         if imgui.begin_menu("Edit", s is not None):
+            self._menu_open = True
             if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
                 ed.run_action(Action.UNDO)
             if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
                 ed.run_action(Action.REDO)
             imgui.end_menu()
         if imgui.begin_menu("View"):
+            self._menu_open = True
             if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
                 ed.run_action(Action.PANEL)
             if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
@@ -205,6 +249,7 @@ class EditorGui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self._panel_size = (size.x, size.y)
         self.panel_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
+        self._windows.append(self.panel_box)
         imgui.end()
 
     def _sections(self) -> None:
@@ -461,6 +506,7 @@ class EditorGui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self.help_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
         hv.box = self.help_box
+        self._windows.append(self.help_box)
         imgui.end()
 
     # --------------------------------------------------- progress, questions
