@@ -638,20 +638,21 @@ GS_POLAR_ITERATIONS = 12
 # --------------------------------------------------------------------------
 #: the last closure's highlight is drawn as small squares in ImGui's draw list,
 #: one per distinct pixel; above this many they are thinned evenly.  Measured
-#: (lavapipe, 2 loaded cores): ~1.1 us of Python per square for the draw-list
-#: calls, so 20,000 squares add ~22 ms to one frame that shows a highlight
-#: (it flashes for a moment after a grow/shrink/connected step); a 960x600
-#: view of the bunny has ~60,000 distinct surface pixels, so a highlight of
-#: the whole model still shows as a dense pattern
+#: (2 loaded cores): 0.73 us of Python per square for the draw-list calls, so
+#: 20,000 squares add ~14 ms to a frame that shows a highlight (it flashes for
+#: about a second after a grow / shrink / connected step); all 37,706 splat
+#: centres of the bundled bunny framed in a 960x600 view fall on 26,496
+#: distinct pixels, so even a whole-model highlight is barely thinned
 EDITOR_GUI_MAX_HIGHLIGHT_DOTS = 20_000
-#: width of the side panel (pixels at font scale 1): the widest row, the
-#: three translate fields with their label, needs ~290 px in ImGui's
-#: default 13 px font; the panel still leaves 640 px of a 960 px window
+#: width of the side panel (pixels, ImGui's default 13 px font): its widest
+#: row, the three "move" fields with their label, measures 252 px, plus the
+#: window padding and the scroll bar; a 960 px window keeps 640 px of view
 EDITOR_GUI_PANEL_WIDTH = 310
-#: the help window is placed beside the panel when at least this wide (px),
-#: else over the whole window (the panel steps aside); the longest help line
-#: is ~620 px in the default font, narrower windows scroll horizontally
+#: the help window goes beside the panel when that space is at least this wide
+#: (px), else over the whole window (the panel steps aside until it closes);
+#: the longest help line measures 763 px in the default font, narrower help
+#: windows scroll horizontally; 420 px shows every key column and most text
 EDITOR_GUI_HELP_MIN_WIDTH = 420
-#: a numeric rotation whose axis is shorter than this (model-independent: the
-#: axis is a direction, normalised before use) is refused, not turned about noise
+#: a numeric rotation whose axis is shorter than this is refused (the axis is
+#: a direction, normalised before use; a zero one has no direction)
 EDITOR_GUI_MIN_AXIS_NORM = 1e-9
