@@ -124,3 +124,22 @@ def test_gui_screenshot_shows_panel_and_gizmo_apart(xvfb, tmp_path):
         assert scene.min() < 200 and not math.isnan(float(np.mean(scene)))   # the gizmo area is not covered
     finally:
         ed.close()
+
+
+def test_cpu_overlay_fallback_still_presents(xvfb, tmp_path, monkeypatch):
+    """SPLATEDIT_GUI=0: frames read back, the text panel blended on the CPU."""
+    monkeypatch.setenv("SPLATEDIT_GUI", "0")
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 90)
+        assert not s["gui"] and s["panel_visible"]
+        x, y, pw, ph = s["panel_box"]
+        assert (x, y) == (PANEL_MARGIN, PANEL_MARGIN)       # the CPU panel: no menu bar above it
+        time.sleep(0.3)
+        px = ed.screenshot()[y + 4, x + 4, :3].astype(int)
+        assert px.max() < 90, px
+        ed.xdo("key", "p")
+        ed.idle(lambda s: not s["panel_visible"], "P hides the CPU panel")
+        assert ed.status()["validation_messages"] == 0
+    finally:
+        ed.close()
