@@ -656,3 +656,9 @@ EDITOR_GUI_HELP_MIN_WIDTH = 420
 #: a numeric rotation whose axis is shorter than this is refused (the axis is
 #: a direction, normalised before use; a zero one has no direction)
 EDITOR_GUI_MIN_AXIS_NORM = 1e-9
+#: frames the editor draws after an input event without waiting for the next
+#: one: ImGui trickles a click's press and release over two frames and shows
+#: the result (a highlighted button, a focused field) in the third; 4 leaves
+#: one to spare.  Without it the idle loop's 0.5 s wait delayed a click's
+#: effect by up to 0.5 s
+EDITOR_GUI_SETTLE_FRAMES = 4

@@ -438,7 +438,7 @@ class Editor:
             while self.running:
                 s = self.session
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
-                pending = fr.pending()
+                pending = fr.pending() or (self.gui is not None and self.gui.needs_frames())
                 busy = busy or fr.busy()
                 w, h = self.size
                 if w == 0 or h == 0 or self.window.iconified():

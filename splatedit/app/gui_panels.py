@@ -41,8 +41,8 @@ from splatedit.app.panel import PANEL_MARGIN, Box
 from splatedit.app.transform_fields import TransformInput, apply_transform
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
-from splatedit.tolerances import (EDITOR_GUI_HELP_MIN_WIDTH, EDITOR_GUI_PANEL_WIDTH, EDITOR_SPLAT_SCALE_MAX,
-                                  EDITOR_SPLAT_SCALE_MIN)
+from splatedit.tolerances import (EDITOR_GUI_HELP_MIN_WIDTH, EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+                                  EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
 RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
@@ -93,6 +93,7 @@ class EditorGui:
         self._windows: list[Box] = []       # GUI windows of the last frame (mouse routing)
         self._menu_open = False
         self._press_in_gui = False
+        self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
 
     # ---------------------------------------------------------------- input
     def feed(self, ev) -> bool:
@@ -107,6 +108,7 @@ class EditorGui:
         every click while a menu is open.  Keys are ImGui's while a text
         field is being edited (:attr:`wants_keyboard`)."""
         self.gui.feed(ev)
+        self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
         kind = ev.kind
         if kind in ("key", "char"):
             return self.wants_keyboard
@@ -121,6 +123,12 @@ class EditorGui:
         if kind == "move":
             return self._press_in_gui
         return False
+
+    def needs_frames(self) -> bool:
+        """ImGui still has input to process: draw the next frames without
+        waiting for events (it hands a press and a release of one click to
+        two successive frames, and hover / focus changes show a frame later)."""
+        return self._frames_wanted > 0
 
     def owns_point(self, x: float, y: float) -> bool:
         """(x, y) pixels are over a GUI window of the last frame."""
@@ -146,6 +154,7 @@ class EditorGui:
     def build(self, w: int, h: int) -> None:
         """Start the frame and lay out every window (call before :meth:`render_into`)."""
         now = time.perf_counter()
+        self._frames_wanted = max(self._frames_wanted - 1, 0)
         self.gui.new_frame(w, h, now - self._last)
         self._last = now
         self.rects = {}
