@@ -15,7 +15,6 @@ import numpy as np
 from imgui_bundle import imgui
 
 from splatedit.app import overlay as ov
-from splatedit.app.tools.brush import ERASE_RGB  # noqa: F401 (colour of the brush, via cursor_colour)
 from splatedit.app.tools.curve import CURVE_RGB
 from splatedit.app.tools.gizmo import READOUT_RGB
 from splatedit.app import selection_tools as seltools

@@ -34,19 +34,18 @@ from typing import Callable
 
 from imgui_bundle import imgui
 
-from splatedit.app import gui_overlay
+from splatedit.app import gui_help, gui_overlay
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
 from splatedit.app.transform_fields import TransformInput, apply_transform
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
-from splatedit.tolerances import (EDITOR_GUI_HELP_MIN_WIDTH, EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
                                   EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
 RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
-BLUE = imgui.ImVec4(0.55, 0.75, 1.0, 1.0)
 #: button colour of the palette entry that is on
 ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 #: the message line is shown this long (s)
@@ -88,9 +87,9 @@ class EditorGui:
         self.help_box: Box | None = None
         self.menu_height = 0.0
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
-        self._help_scroll_set = None
+        self.help_scroll_set = None
         self._last = time.perf_counter()
-        self._windows: list[Box] = []       # GUI windows of the last frame (mouse routing)
+        self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
         self._menu_open = False
         self._press_in_gui = False
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
@@ -132,7 +131,7 @@ class EditorGui:
 
     def owns_point(self, x: float, y: float) -> bool:
         """(x, y) pixels are over a GUI window of the last frame."""
-        return any(b.x <= x < b.right and b.y <= y < b.bottom for b in self._windows)
+        return any(b.x <= x < b.right and b.y <= y < b.bottom for b in self.windows)
 
     @property
     def wants_mouse(self) -> bool:
@@ -158,7 +157,7 @@ class EditorGui:
         self.gui.new_frame(w, h, now - self._last)
         self._last = now
         self.rects = {}
-        self._windows = []
+        self.windows = []
         self._menu_open = False
         gui_overlay.draw_tools(self.ed, w, h)
         self._menu_bar(w)
@@ -193,7 +192,7 @@ class EditorGui:
         if not imgui.begin_main_menu_bar():
             return
         self.menu_height = imgui.get_window_size().y
-        self._windows.append(Box(0, 0, w, int(self.menu_height)))
+        self.windows.append(Box(0, 0, w, int(self.menu_height)))
         if imgui.begin_menu("File"):
             self._menu_open = True
             for e in self.file_menu:
@@ -258,11 +257,11 @@ class EditorGui:
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self._panel_size = (size.x, size.y)
         self.panel_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
-        self._windows.append(self.panel_box)
+        self.windows.append(self.panel_box)
         imgui.end()
 
     def _sections(self) -> None:
-        ed, s = self.ed, self.ed.session
+        s = self.ed.session
         st = s.stats()
         imgui.text(f"{s.cloud.n:,} splats   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
         if s.manip is not None:               # the live readout of a running move
@@ -294,8 +293,8 @@ class EditorGui:
         self._rect(name)
 
     def _palette(self) -> None:
-        ed, s = self.ed, self.ed.session
-        b = ed.brush
+        s = self.ed.session
+        b = self.ed.brush
         manip = s.manip.mode if s.manip is not None else None
         self._tool_button("Support", "tool_support", Action.BRUSH_SUPPORT, s.brush_target == SUPPORT)
         imgui.same_line()
@@ -462,61 +461,11 @@ class EditorGui:
         self.ed.motion()
 
     # ---------------------------------------------------------------- help
-    def _help_area(self, w: int, h: int) -> tuple[Box, bool]:
-        """(where the help goes, whether it covers the panel's place)."""
-        m = PANEL_MARGIN
-        top = int(self.menu_height) + m
-        pb = self.panel_box
-        if self.ed.panel_visible and pb is not None:
-            if pb.x <= m:                                   # panel on the left: the help to its right
-                area = Box(pb.right + m, top, w - pb.right - 2 * m, h - top - m)
-            else:
-                area = Box(m, top, pb.x - 2 * m, h - top - m)
-            if area.w >= EDITOR_GUI_HELP_MIN_WIDTH:
-                return area, False
-        return Box(m, top, w - 2 * m, h - top - m), self.ed.panel_visible
+    def _help_area(self, w: int, h: int):
+        return gui_help.help_area(self, w, h)
 
     def _help(self, w: int, h: int) -> None:
-        hv = self.ed.help
-        if not hv.shown:
-            self.help_box = None
-            return
-        area, covers = self._help_area(w, h)
-        hv.covers_panel = covers
-        imgui.set_next_window_pos(imgui.ImVec2(area.x, area.y), imgui.Cond_.always)
-        imgui.set_next_window_size(imgui.ImVec2(max(area.w, 100), max(area.h, 80)), imgui.Cond_.always)
-        flags = (imgui.WindowFlags_.no_move.value | imgui.WindowFlags_.no_resize.value
-                 | imgui.WindowFlags_.no_collapse.value | imgui.WindowFlags_.no_scrollbar.value)
-        imgui.begin("Help (F1 / Esc: close)###help", None, flags)
-        lh = imgui.get_text_line_height_with_spacing()
-        foot = imgui.get_frame_height_with_spacing()
-        avail = imgui.get_content_region_avail()
-        hv.rows = max(int((avail.y - foot) // lh), 1)
-        child_h = hv.rows * lh
-        imgui.begin_child("help_lines", imgui.ImVec2(-1, child_h), 0,
-                          imgui.WindowFlags_.horizontal_scrollbar.value)
-        sy = imgui.get_scroll_y()
-        if self._help_scroll_set is not None and abs(sy - self._help_scroll_set) > 0.5:
-            hv.top = int(round(sy / lh))            # the wheel or the scroll bar moved it
-        hv.scroll(0)
-        target = hv.top * lh
-        if abs(sy - target) > 0.5:
-            imgui.set_scroll_y(target)
-        self._help_scroll_set = target
-        for text, title in hv._lines:
-            if title:
-                imgui.text_colored(BLUE, text)
-            else:
-                imgui.text(text)
-        imgui.end_child()
-        end = min(hv.top + hv.rows, hv.total)
-        more = "PageDown / PageUp, arrows or wheel: scroll   " if hv.rows < hv.total else ""
-        imgui.text_colored(YELLOW, f"lines {hv.top + 1}-{end} of {hv.total}   {more}")
-        pos, size = imgui.get_window_pos(), imgui.get_window_size()
-        self.help_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
-        hv.box = self.help_box
-        self._windows.append(self.help_box)
-        imgui.end()
+        gui_help.draw_help(self, w, h)
 
     # --------------------------------------------------- progress, questions
     def _progress(self, w: int, h: int) -> None:

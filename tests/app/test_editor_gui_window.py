@@ -40,7 +40,7 @@ def _paint_support_and_handle(ed, cx: int, cy: int) -> dict:
            "sleep", "0.1", "mouseup", "1")
     ed.idle(lambda s: s["support"] > 200, "support painted")
     _click(ed, "tool_handle")                           # the palette instead of the 2 key
-    s = ed.idle(lambda s: s["brush"] == "handle", "handle brush from the palette")
+    ed.idle(lambda s: s["brush"] == "handle", "handle brush from the palette")
     ed.xdo("key", "bracketleft", "bracketleft", "bracketleft", "bracketleft", "bracketleft",
            "mousemove", cx, cy, "click", "1")
     return ed.idle(lambda s: s["handle"] > 0 and s["state"] == "ready", "handle painted and fitted")
