@@ -50,3 +50,48 @@ def test_half_resolution_frame_is_pixel_doubled(renderer):
     img = renderer.render_resident(cam, 48, 32)
     got = _blit_read(renderer, img, 96, 64, (48, 32))
     assert np.array_equal(got[..., :3], np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[..., :3])
+
+
+def test_uploaded_pixels_then_gui_pass_over_them(renderer):
+    """The presenter's host-pixel path of the GPU frame (a background-refined
+    frame): pixels copied into the target, then the GUI pass loads and draws
+    over them; no validation message, the pixels outside the GUI unchanged."""
+    from imgui_bundle import imgui
+
+    from splatedit.render.gui import Gui
+    from splatedit.render.vk.swapchain import SwapchainPresenter
+
+    dev = renderer.dev
+    w, h = 64, 48
+    pres = SwapchainPresenter.__new__(SwapchainPresenter)     # its staging helpers, without a window
+    pres.dev, pres._staging, pres._bgra = dev, None, True
+    target = V.Image(dev, w, h, "bgra8", ("color", "transfer_dst", "transfer_src"))
+    buf = V.Buffer(dev, w * h * 4, ("transfer_dst",), host_visible=True)
+    gui = Gui(dev)
+    rgba = np.zeros((h, w, 4), np.uint8)
+    rgba[..., 0] = np.arange(w, dtype=np.uint8)[None, :] * 3
+    rgba[..., 1] = np.arange(h, dtype=np.uint8)[:, None] * 5
+    fb = None
+    try:
+        fb = V.Framebuffer(dev, gui.painter.render_pass("bgra8"), [target], w, h)
+        gui.new_frame(w, h, 1 / 60)
+        imgui.get_background_draw_list().add_rect_filled(imgui.ImVec2(0, 0), imgui.ImVec2(10, 10),
+                                                         imgui.IM_COL32(255, 0, 255, 255))
+
+        def rec(cb):
+            pres.upload_into(cb, target, rgba)
+            gui.render(cb, fb, fmt="bgra8", final="transfer_src")
+            cb.copy_image_to_buffer(target, buf)
+            cb.host_read_barrier()
+        dev.submit(rec)
+        got = buf.read().reshape(h, w, 4)[..., [2, 1, 0]]
+        assert np.array_equal(got[20:, 20:], rgba[20:, 20:, :3])          # the scene pixels
+        assert np.array_equal(got[2, 2], [255, 0, 255])                    # the GUI drew over them
+    finally:
+        dev.wait_idle()
+        if fb is not None:
+            fb.destroy()
+        gui.close()
+        pres._free_staging()
+        buf.destroy()
+        target.destroy()
