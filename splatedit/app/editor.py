@@ -192,22 +192,11 @@ class Editor:
     def handle_events(self, events) -> None:
         for e in events:
             try:
-                if self.gui is not None and self._gui_takes(e):
+                if self.gui is not None and self.gui.takes(e):
                     continue
                 getattr(self, f"on_{e.kind}")(e)
             except SplatEditError as exc:
                 self.say(str(exc))
-
-    def _gui_takes(self, e) -> bool:
-        """ImGui sees every event first; those it claims (a click on a panel,
-        keys while a text field is edited) do not reach the tools.  The
-        release that ends a tool's drag always reaches the tool."""
-        taken = self.gui.feed(e)
-        if e.kind == "button" and e.action == self.g.RELEASE and self.drag is not DragMode.NONE:
-            return False
-        if taken:
-            self.motion()         # the GUI changes: draw a frame
-        return taken
 
     def on_resize(self, e) -> None:
         self.frames.invalidate()

@@ -38,6 +38,7 @@ from splatedit.app import gui_help, gui_overlay
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
+from splatedit.app.tools.base import DragMode
 from splatedit.app.transform_fields import TransformInput, apply_transform
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
@@ -122,6 +123,14 @@ class EditorGui:
         if kind == "move":
             return self._press_in_gui
         return False
+
+    def takes(self, ev) -> bool:
+        """The editor's routing: :meth:`feed`, except that the release ending a
+        tool's drag always reaches the tool."""
+        taken = self.feed(ev)
+        if ev.kind == "button" and ev.action == 0 and self.ed.drag is not DragMode.NONE:
+            return False
+        return taken
 
     def needs_frames(self) -> bool:
         """ImGui still has input to process: draw the next frames without
