@@ -149,8 +149,9 @@ class Viewport:
         slot.r.distortion_map = self.distortion_map
         slot.r.grey_shading = self.grey
         slot.r.splat_scale = self.splat_scale
-        if hasattr(slot.r, "background"):
-            slot.r.background = (*self.background[:3], *tuple(slot.r.background)[3:])
+        bg = tuple(float(x) for x in self.background[:3])
+        if tuple(slot.r.background[:3]) != bg:       # only a change (GUI colour picker)
+            slot.r.background = (*bg, *tuple(slot.r.background)[3:])
         if level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
