@@ -737,3 +737,33 @@ GS_BLEED_MIN_MEAN = 5.0
 # written to E57 and read back is within 4e-6 m of the original (float32 step at 50 m from the
 # origin); world coordinates in the points themselves were off by up to 0.25 m.
 E57_ROUND_TRIP_ATOL = 1e-5
+
+# --------------------------------------------------------------------------
+# Editor GUI (Dear ImGui panels and GPU overlays, issue 10 parts 1-2, 5)
+# --------------------------------------------------------------------------
+#: the last closure's highlight is drawn as small squares in ImGui's draw list,
+#: one per distinct pixel; above this many they are thinned evenly.  Measured
+#: (2 loaded cores): 0.73 us of Python per square for the draw-list calls, so
+#: 20,000 squares add ~14 ms to a frame that shows a highlight (it flashes for
+#: about a second after a grow / shrink / connected step); all 37,706 splat
+#: centres of the bundled bunny framed in a 960x600 view fall on 26,496
+#: distinct pixels, so even a whole-model highlight is barely thinned
+EDITOR_GUI_MAX_HIGHLIGHT_DOTS = 20_000
+#: width of the side panel (pixels, ImGui's default 13 px font): its widest
+#: row, the three "move" fields with their label, measures 252 px, plus the
+#: window padding and the scroll bar; a 960 px window keeps 640 px of view
+EDITOR_GUI_PANEL_WIDTH = 310
+#: the help window goes beside the panel when that space is at least this wide
+#: (px), else over the whole window (the panel steps aside until it closes);
+#: the longest help line measures 763 px in the default font, narrower help
+#: windows scroll horizontally; 420 px shows every key column and most text
+EDITOR_GUI_HELP_MIN_WIDTH = 420
+#: a numeric rotation whose axis is shorter than this is refused (the axis is
+#: a direction, normalised before use; a zero one has no direction)
+EDITOR_GUI_MIN_AXIS_NORM = 1e-9
+#: frames the editor draws after an input event without waiting for the next
+#: one: ImGui trickles a click's press and release over two frames and shows
+#: the result (a highlighted button, a focused field) in the third; 4 leaves
+#: one to spare.  Without it the idle loop's 0.5 s wait delayed a click's
+#: effect by up to 0.5 s
+EDITOR_GUI_SETTLE_FRAMES = 4

@@ -13,6 +13,10 @@ the editor frames a model.  For each count it measures, through the editor's
 * ``orbit_ms``: frames while the camera orbits (interactive mode);
 * ``compose_ms``: overlay compositing of one frame (CPU), to add to the above
   with the ~2-5 ms of the swapchain copy and present;
+* with ``presentation=True`` (default) the presentation cost of an idle
+  frame on the readback path and on the GUI's GPU path, same run
+  (:mod:`splatedit.app.bench_present`: ``present_cpu_ms``,
+  ``present_gpu_ms``, their ratio and the whole frames);
 * the level used while moving, the LOD build time and the basis fit time;
 * with ``rigs=True`` (default) also ``drag4h_ms`` (four handles at once: a
   16-column basis, all columns drawn with a new dC per frame) and
@@ -100,7 +104,8 @@ def _drag_frames(vp, cam, w, h, basis, frames, scale):
 
 
 def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), frames: int = 6,
-                        budget_ms: float = 100.0, progress=None, rigs: bool = True) -> Iterator[dict]:
+                        budget_ms: float = 100.0, progress=None, rigs: bool = True,
+                        presentation: bool = True) -> Iterator[dict]:
     from splatedit.app import overlay as ov
     from splatedit.app.camera_control import OrbitCamera
     from splatedit.app.viewport import Viewport
@@ -133,6 +138,15 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
             vp.set_dc(None)
             vp.render(cam, w, h)                       # upload + warm-up
             idle = [vp.render(cam, w, h) is not None and vp.last_info.ms for _ in range(2)]
+            present = {}
+            if presentation:
+                try:
+                    from splatedit.app.bench_present import bench_presentation
+                except ImportError:          # imgui-bundle missing: no GPU-path comparison
+                    pass
+                else:
+                    vp.set_dc(None)
+                    present = bench_presentation(vp, cam, w, h)
             # dragging the handle: a new dC every frame
             piv = cloud.positions[hnd].mean(0)
             drag, info = [], {}
@@ -188,7 +202,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
                    "moving_resolution_divisor": int(info.get("div", 1)),
                    "lod_levels": [lvl.n for lvl in pyr.levels], "lod_build_s": round(lod_s, 2),
                    "support": int(sup.sum()), "handle": int(hnd.sum()),
-                   "fit_s": round(fit_s, 2), "compose_ms": round(compose, 2), **extra}
+                   "fit_s": round(fit_s, 2), "compose_ms": round(compose, 2), **present, **extra}
     finally:
         vp.close()
 

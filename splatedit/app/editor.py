@@ -3,8 +3,11 @@
 A glfw window presenting through a Vulkan swapchain
 (:mod:`splatedit.render.vk.swapchain`); frames come from the EWA splat
 renderer (:mod:`splatedit.app.viewport`) scheduled by
-:class:`~splatedit.app.frames.FrameScheduler`, the overlay is composited on
-the CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
+:class:`~splatedit.app.frames.FrameScheduler`; with the Dear ImGui interface
+(:mod:`splatedit.app.gui_panels`: menu bar, panels, help) they stay on the
+presenter's device and the GUI and the tools' overlays are drawn over them on
+the GPU; without it (``SPLATEDIT_GUI=0`` or a surface that cannot be a blit
+target) the overlay is composited on the CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
 worker threads; the loop polls them and stays responsive.
 
 The :class:`Editor` is a thin loop: window events go to the tools
@@ -75,7 +78,15 @@ class Editor:
         try:
             self.presenter = SwapchainPresenter(self.window.handle, vsync=vsync)
             from splatedit.app.viewport import Viewport
-            self.viewport = Viewport(budget_ms=budget_ms)
+            pres = self.presenter
+            if pres.gpu_targets and pres.can_blit and os.environ.get("SPLATEDIT_GUI", "1") != "0":
+                # GPU path: one device renders, draws the GUI and presents (no readback)
+                from splatedit.app.gui_panels import EditorGui
+                from splatedit.render.renderer import Renderer
+                self.viewport = Viewport(budget_ms=budget_ms, renderer=Renderer(device=pres.dev))
+                self.gui = EditorGui(self, pres.dev)
+            else:       # CPU fallback: frames read back, overlay blended on the CPU
+                self.viewport = Viewport(budget_ms=budget_ms)
         except BaseException:
             self.close()
             raise
@@ -84,6 +95,8 @@ class Editor:
         """Everything but the window and the GPU (tests build editors on this)."""
         self.cam = cam
         self.g = g
+        #: the Dear ImGui interface (None: the CPU overlay fallback, or no window)
+        self.gui = None
         self.session: Session | None = None
         self.cloud_name = self.path.name if self.path else "model"
         self.jobs: dict[str, Job] = {}
@@ -222,6 +235,8 @@ class Editor:
     def handle_events(self, events) -> None:
         for e in events:
             try:
+                if self.gui is not None and self.gui.takes(e):
+                    continue
                 getattr(self, f"on_{e.kind}")(e)
             except SplatEditError as exc:
                 self.say(str(exc))
@@ -357,9 +372,17 @@ class Editor:
             return
         if action is Action.TYPE_VALUE:
             self.gizmo.type_key(k)
+            self.motion()
         else:
-            table = self.manip_actions if manip and action in self.manip_actions else self.actions
-            table[action]()
+            self.run_action(action)
+
+    def run_action(self, action: Action) -> None:
+        """Run the handler bound to ``action`` (keys and GUI buttons share it):
+        during a G/R/S move its own handler when it has one."""
+        s = self.session
+        manip = s is not None and s.manip is not None
+        table = self.manip_actions if manip and action in self.manip_actions else self.actions
+        table[action]()
         if s is not None:
             self.motion()
 
@@ -481,7 +504,7 @@ class Editor:
             while self.running:
                 s = self.session
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
-                pending = fr.pending()
+                pending = fr.pending() or (self.gui is not None and self.gui.needs_frames())
                 busy = busy or fr.busy()
                 w, h = self.size
                 if w == 0 or h == 0 or self.window.iconified():
@@ -518,6 +541,11 @@ class Editor:
             if j.name == "saving":
                 j.wait()     # never leave a half-written file behind
         self.frames.close()
+        if self.gui is not None:
+            if self.presenter is not None:
+                self.presenter.dev.wait_idle()
+            self.gui.close()
+            self.gui = None
         if self.viewport is not None:
             self.viewport.close()
             self.viewport = None

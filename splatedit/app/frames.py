@@ -1,7 +1,14 @@
 """Frame scheduling of the editor: when to draw a fast interactive frame,
 when the full-quality one (here, or in the background refiner for slow
-models), compositing the overlay and presenting; the frame-time
-bookkeeping that sizes the interactive budget."""
+models), presenting it with the overlay, and the frame-time bookkeeping
+that sizes the interactive budget.
+
+Two presentation paths: the GPU path (the editor has a GUI,
+:mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
+blitted into the swapchain image, the GUI and the tools' overlays are drawn
+over it by the GUI pass, nothing is read back; and the CPU fallback (no
+GUI): the frame is read back, the overlay patches are blended on the CPU
+(:mod:`splatedit.app.overlay`) and the pixels copied into the swapchain."""
 
 from __future__ import annotations
 
@@ -14,7 +21,7 @@ from splatedit.app import overlay as ov
 from splatedit.app import revision
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
-from splatedit.app.viewport import FrameInfo
+from splatedit.app.viewport import FrameInfo, ResidentFrame
 from splatedit.tolerances import EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_REFINE_DELAY_S
 
 
@@ -28,7 +35,7 @@ class SceneKey:
     sel_version: int
     basis_rev: int
     dc: bytes | None
-    display: tuple          # heat map, grey shading, splat scale
+    display: tuple          # heat map, grey shading, splat scale, background
 
 
 class FrameScheduler:
@@ -72,7 +79,7 @@ class FrameScheduler:
         ed, s, vp = self.ed, self.ed.session, self.ed.viewport
         dc = None if vp.dc is None else vp.dc.tobytes()
         return SceneKey(ed.cam.state(), ed.size, revision.of(s.cloud), s.version, revision.of(s.basis), dc,
-                        (vp.distortion_map, vp.grey, vp.splat_scale))
+                        (vp.distortion_map, vp.grey, vp.splat_scale, vp.background))
 
     def async_refine(self) -> bool:
         """True when full-quality frames are slow enough to be drawn in the background."""
@@ -93,19 +100,28 @@ class FrameScheduler:
         return refining or (self.scene_interactive and s is not None and self.async_refine())
 
     # --------------------------------------------------------------- draw
+    @property
+    def gpu(self) -> bool:
+        """The GPU presentation path: the scene stays on the device (blitted into
+        the swapchain image), the GUI and the tools' overlays are drawn over it."""
+        return getattr(self.ed, "gui", None) is not None
+
     def draw(self) -> None:
         ed = self.ed
         w, h = ed.size
         if w == 0 or h == 0 or ed.window.iconified():
             return
         t0 = time.perf_counter()
-        if ed.session is None:
-            frame = np.full((h, w, 4), 255, np.uint8)
+        if self.gpu:
+            self._draw_gpu(w, h)
         else:
-            frame = self._scene_frame(w, h)
-        for p in ed.overlay_patches(w, h):
-            ov.blend(frame, p)
-        ed.presenter.present(frame)
+            if ed.session is None:
+                frame = np.full((h, w, 4), 255, np.uint8)
+            else:
+                frame = self._scene_frame(w, h)
+            for p in ed.overlay_patches(w, h):
+                ov.blend(frame, p)
+            ed.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
         if self._rendered_interactive:
@@ -117,8 +133,46 @@ class FrameScheduler:
             vp.budget_ms = max(self.budget_ms - self.frame_overhead_ms, 0.3 * self.budget_ms)
         self._rendered_interactive = False
 
-    def _scene_frame(self, w: int, h: int) -> np.ndarray:
+    def _draw_gpu(self, w: int, h: int) -> None:
+        """One presented frame on the GPU: the scene (a device-resident frame
+        blitted, or pixels from the background refiner uploaded), then the GUI
+        pass (panels, help, the tools' overlays) into the swapchain image."""
         ed = self.ed
+        src = None
+        if ed.session is not None:
+            self._update_scene(w, h)
+            src = self.scene
+        ed.gui.build(w, h)
+        pres = ed.presenter
+
+        def record(cb, target):
+            if isinstance(src, ResidentFrame):
+                pres.blit_into(cb, src.image, target, (src.width, src.height))
+                ed.gui.render_into(cb, target)
+            elif src is not None:
+                pres.upload_into(cb, target, src)
+                ed.gui.render_into(cb, target)
+            else:
+                ed.gui.gui.render_into(cb, target, clear=(1.0, 1.0, 1.0, 1.0), final="present")
+        if not pres.render_frame(record):
+            ed.gui.discard()
+
+    def _scene_frame(self, w: int, h: int) -> np.ndarray:
+        self._update_scene(w, h)
+        frame = self.scene.copy()
+        if frame.shape[:2] != (h, w):
+            fr = np.full((h, w, 4), 255, np.uint8)
+            hh, ww = min(h, frame.shape[0]), min(w, frame.shape[1])
+            fr[:hh, :ww] = frame[:hh, :ww]
+            frame = fr
+        return frame
+
+    def _update_scene(self, w: int, h: int) -> None:
+        """Render (or take from the background refiner) the scene when it is stale."""
+        ed = self.ed
+        sc = self.scene
+        if isinstance(sc, ResidentFrame) and getattr(sc.image, "handle", None) is None:
+            self.scene = self.scene_key = None      # its renderer's images were re-created (a resize)
         self.sync_document()
         key = self.state()
         now = time.perf_counter()
@@ -146,18 +200,13 @@ class FrameScheduler:
             if img is not None and img.shape[:2] == (h, w):
                 self.scene, self.scene_interactive = img, False
                 ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
-        frame = self.scene.copy()
-        if frame.shape[:2] != (h, w):
-            fr = np.full((h, w, 4), 255, np.uint8)
-            hh, ww = min(h, frame.shape[0]), min(w, frame.shape[1])
-            fr[:hh, :ww] = frame[:hh, :ww]
-            frame = fr
-        return frame
 
     def render_scene(self, key, interactive: bool) -> None:
         ed = self.ed
         w, h = ed.size
-        self.scene = ed.viewport.render(ed.cam, w, h, interactive=interactive)
+        if self.gpu:
+            ed.presenter.wait_previous()     # the last frame may still read the image redrawn now
+        self.scene = ed.viewport.render(ed.cam, w, h, interactive=interactive, resident=self.gpu)
         self._rendered_interactive = interactive
         self.scene_key = key
         info = ed.viewport.last_info
@@ -178,7 +227,7 @@ class FrameScheduler:
                                        handle=s.selection.handle.copy(), sel_version=s.version,
                                        inactive=s.selection.others(), basis=s.basis, dc=vp.dc, camera=cam,
                                        w=w, h=h, distortion_map=vp.distortion_map, grey=vp.grey,
-                                       splat_scale=vp.splat_scale, pick_key=ed.brush.pick_key()))
+                                       splat_scale=vp.splat_scale, background=vp.background, pick_key=ed.brush.pick_key()))
 
     def close(self) -> None:
         if self.refiner is not None:

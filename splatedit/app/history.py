@@ -119,6 +119,11 @@ class History:
         return self.current
 
     @property
+    def labels(self) -> list[str]:
+        """The label of every kept state, oldest first (index = :attr:`position`)."""
+        return [s.label for s in self._states]
+
+    @property
     def position(self) -> int:
         return self._pos
 

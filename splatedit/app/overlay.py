@@ -1,7 +1,10 @@
 """On-screen overlay: text panels, brush circle and gizmo, composited on the CPU.
 
-Choice (versus Dear ImGui through imgui-bundle drawn by a Vulkan pipeline):
-the editor needs a status panel, a help page, a text prompt and a few
+This is the editor's fallback path (``SPLATEDIT_GUI=0``, or a swapchain
+that cannot receive a blit); the default draws the same things with Dear
+ImGui on the GPU (:mod:`splatedit.app.gui_panels`,
+:mod:`splatedit.app.gui_overlay`).  The original choice for a keyboard-only
+editor: it needs a status panel, a help page, a text prompt and a few
 lines -- no widgets.  Text is rasterised with Pillow (DejaVu Sans Mono when
 installed, else Pillow's built-in font) into small RGBA *patches* cached by
 content; each frame the patches are alpha-blended into the RGBA frame the

@@ -57,6 +57,14 @@ def status_dict(ed) -> dict:
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
           "browser": _browser(ed.browser),
           "script": str(ed.saved_script) if ed.saved_script else None}
+    gui = getattr(ed, "gui", None)
+    st["gui"] = gui is not None
+    if gui is not None:
+        st["gui_rects"] = {k: [b.x, b.y, b.w, b.h] for k, b in sorted(gui.rects.items())}
+        st["gui_wants_mouse"] = bool(gui.wants_mouse)
+        st["gui_wants_keyboard"] = bool(gui.wants_keyboard)
+        st["background"] = [round(float(x), 4) for x in vp.background[:3]]
+        st["distortion_map"] = bool(vp.distortion_map)
     if s is None:
         return st
     ss = s.stats()

@@ -63,6 +63,15 @@ class FrameInfo:
     gaussians: bool = False   # drawn by the Gaussian renderer (a Gaussian Splatting document)
 
 
+@dataclass(frozen=True)
+class ResidentFrame:
+    """A frame left on the device: the ``width`` x ``height`` top-left part of
+    ``image`` (rgba8, TRANSFER_SRC layout), valid until its renderer draws again."""
+    image: object
+    width: int
+    height: int
+
+
 class Viewport:
     def __init__(self, *, budget_ms: float = 100.0, renderer=None):
         from splatedit.render.renderer import Renderer
@@ -83,6 +92,9 @@ class Viewport:
         #: display options (Renderer.grey_shading, Renderer.splat_scale)
         self.grey = False
         self.splat_scale = 1.0
+        #: background colour (linear RGB 0..1, Renderer.background)
+        from splatedit.tolerances import RENDER_BACKGROUND
+        self.background = tuple(float(x) for x in RENDER_BACKGROUND[:3])
         #: a GaussianCloud drawn and picked instead of the splats (set_gaussians)
         self.gaussians = None
         self.gs_slot: _Slot | None = None
@@ -144,6 +156,9 @@ class Viewport:
         slot.r.distortion_map = self.distortion_map
         slot.r.grey_shading = self.grey
         slot.r.splat_scale = self.splat_scale
+        bg = tuple(float(x) for x in self.background[:3])
+        if tuple(slot.r.background[:3]) != bg:       # only a change (GUI colour picker)
+            slot.r.background = (*bg, *tuple(slot.r.background)[3:])
         if level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
@@ -256,8 +271,11 @@ class Viewport:
                 return cfg
         return configs[-1]
 
-    def render(self, cam: OrbitCamera, w: int, h: int, interactive: bool = False) -> np.ndarray:
-        """An (h, w, 4) uint8 frame."""
+    def render(self, cam: OrbitCamera, w: int, h: int, interactive: bool = False,
+               resident: bool = False):
+        """An (h, w, 4) uint8 frame; with ``resident`` (the GPU presentation
+        path) a :class:`ResidentFrame` instead when the splat renderer drew it
+        (no readback; the Gaussian renderer still returns pixels)."""
         if self.gaussians is not None:
             self._sync(self.gs_slot)
             t0 = time.perf_counter()
@@ -271,8 +289,11 @@ class Viewport:
         self._sync(slot, level)          # uploads (new cloud, selection...) are not frame cost
         t0 = time.perf_counter()
         rw, rh = max(1, w // div), max(1, h // div)
-        img = slot.r.render(render_camera(cam), rw, rh)
-        if div > 1:
+        if resident:
+            img = ResidentFrame(slot.r.render_resident(render_camera(cam), rw, rh), rw, rh)
+        else:
+            img = slot.r.render(render_camera(cam), rw, rh)
+        if div > 1 and not resident:
             img = np.repeat(np.repeat(img, div, axis=0), div, axis=1)[:h, :w]
             if img.shape[0] < h or img.shape[1] < w:
                 pad = np.zeros((h, w, 4), np.uint8)
@@ -294,7 +315,7 @@ class Viewport:
             self.ms_per_splat = est if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + est)
         (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
         self.last_info = FrameInfo(ms, count, div, level is not None, interactive)
-        return np.ascontiguousarray(img)
+        return img if resident else np.ascontiguousarray(img)
 
     def pick(self, cam: OrbitCamera, w: int, h: int):
         """(index map (h, w) int64, -1 background; depth (h, w)) of the full cloud."""
@@ -398,6 +419,8 @@ class BackgroundRefiner:
                     vp.distortion_map = bool(st.get("distortion_map", False))
                     vp.grey = bool(st.get("grey", False))
                     vp.splat_scale = float(st.get("splat_scale", 1.0))
+                    if st.get("background") is not None:
+                        vp.background = tuple(st["background"])
                     img = vp.render(st["camera"], st["w"], st["h"])
                     self.last_ms = vp.last_info.ms
                     if st.get("pick_key") is not None and st.get("dc") is None:

@@ -934,6 +934,19 @@ class Renderer:
         self._read_timings(("prepass", "visibility", "attributes", "shading"))
         return out
 
+    def render_resident(self, camera: Camera, width: int, height: int):
+        """Render without reading back: the frame stays on the device in an
+        ``rgba8`` image (TRANSFER_SRC layout, sRGB values) that is returned and
+        valid until the next frame of this renderer (the editor blits it into
+        the swapchain image, :meth:`SwapchainPresenter.render_frame`).  The
+        caller must not re-render while a submitted frame still reads it."""
+        self._check_open()
+        self._require_cloud()
+        t = self._targets_for(width, height)
+        self.dev.submit(lambda cb: self.record_frame(cb, camera, t.offscreen))
+        self._read_timings(("prepass", "visibility", "attributes", "shading"))
+        return t.out
+
     def render_buffers(self, camera: Camera, width: int, height: int) -> dict[str, np.ndarray]:
         """Float buffers of one frame, (height, width[, c]) float32:
 

@@ -112,6 +112,22 @@ class CommandBuffer:
         vk.vkCmdCopyBufferToImage(self.handle, buf.handle, image.handle,
                                   vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, [region])
 
+    def blit_image(self, src, dst, src_rect=None, dst_rect=None, nearest: bool = True):
+        """Copy ``src_rect`` = (x, y, w, h) of ``src`` (TRANSFER_SRC layout) into
+        ``dst_rect`` of ``dst`` (TRANSFER_DST layout), scaling and converting the
+        format (e.g. rgba8 -> a bgra8 swapchain image); ``nearest`` filtering."""
+        sx, sy, sw, sh = src_rect if src_rect is not None else (0, 0, src.width, src.height)
+        dx, dy, dw, dh = dst_rect if dst_rect is not None else (0, 0, dst.width, dst.height)
+        sub = lambda im: vk.VkImageSubresourceLayers(aspectMask=im.aspect, mipLevel=0,  # noqa: E731
+                                                     baseArrayLayer=0, layerCount=1)
+        region = vk.VkImageBlit(srcSubresource=sub(src),
+                                srcOffsets=[vk.VkOffset3D(sx, sy, 0), vk.VkOffset3D(sx + sw, sy + sh, 1)],
+                                dstSubresource=sub(dst),
+                                dstOffsets=[vk.VkOffset3D(dx, dy, 0), vk.VkOffset3D(dx + dw, dy + dh, 1)])
+        vk.vkCmdBlitImage(self.handle, src.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
+                          dst.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, [region],
+                          vk.VK_FILTER_NEAREST if nearest else vk.VK_FILTER_LINEAR)
+
     # ------------------------------------------------------------- barriers
     def host_read_barrier(self):
         """Make transfer writes visible to host reads."""

@@ -82,6 +82,7 @@ class SwapchainPresenter:
         self._images = []
         self.targets: list[SwapchainTarget] = []   # the images as render targets (GPU path)
         self.gpu_targets = False                   # True when the images can be colour attachments
+        self.can_blit = False
         self._render_done = []
         self._acquired = None
         self._fence = None
@@ -233,6 +234,11 @@ class SwapchainPresenter:
         self._render_done = []
         for _ in self._images:
             self._render_done.append(self._new_semaphore())
+        props = vk.vkGetPhysicalDeviceFormatProperties(self.physical, fmt.format)
+        src = vk.vkGetPhysicalDeviceFormatProperties(self.physical, vk.VK_FORMAT_R8G8B8A8_UNORM)
+        #: a device-resident rgba8 frame can be blitted into the images (blit_into)
+        self.can_blit = bool(props.optimalTilingFeatures & vk.VK_FORMAT_FEATURE_BLIT_DST_BIT
+                             and src.optimalTilingFeatures & vk.VK_FORMAT_FEATURE_BLIT_SRC_BIT)
         if self.gpu_targets:
             self.targets = [SwapchainTarget(self.dev, img, fmt.format, w, h, i)
                             for i, img in enumerate(self._images)]
@@ -363,6 +369,52 @@ class SwapchainPresenter:
                                  | vk.VK_PIPELINE_STAGE_TRANSFER_BIT)
         return True
 
+    def wait_previous(self) -> None:
+        """Wait until the last submitted frame has finished on the device (before
+        rewriting an image that frame reads, e.g. a resident scene frame)."""
+        if self.device is not None and self._fence is not None:
+            call(vk.vkWaitForFences, self.device, 1, [self._fence], vk.VK_TRUE, _UINT64_MAX)
+
+    def upload_into(self, cb, target, rgba: np.ndarray) -> None:
+        """Inside :meth:`render_frame`'s ``record``: copy an (h, w, 4) uint8 RGBA
+        frame (row 0 at the top) into ``target`` through the staging buffer
+        (the CPU path's pixels, e.g. a background-refined frame); a frame
+        smaller than the target is padded with black.  ``target`` is left in
+        TRANSFER_DST layout."""
+        w, h = target.width, target.height
+        self._ensure_staging(w * h * 4)
+        self._fill_staging(np.asarray(rgba), w, h)
+        cb.image_barrier(target, "transfer_dst", "transfer", "none", "transfer", "transfer_write")
+        cb.copy_buffer_to_image(self._staging, target)
+
+    def blit_into(self, cb, image, target, src_size=None) -> None:
+        """Inside :meth:`render_frame`'s ``record``: scale the ``src_size`` =
+        (w, h) top-left part of a device image (rgba8, TRANSFER_SRC layout, on
+        this presenter's device) onto the whole ``target`` (nearest filter:
+        a half-resolution frame is pixel-doubled, as the CPU path does),
+        converting to the swapchain's format.  No host copy.  ``target`` is
+        left in TRANSFER_DST layout.  Needs :attr:`can_blit`."""
+        sw, sh = src_size if src_size is not None else (image.width, image.height)
+        cb.memory_barrier("color_output", "color_write", "transfer", "transfer_read")   # the scene's passes
+        cb.image_barrier(target, "transfer_dst", "transfer", "none", "transfer", "transfer_write")
+        cb.blit_image(image, target, (0, 0, sw, sh), (0, 0, target.width, target.height))
+
+    def _fill_staging(self, img: np.ndarray, w: int, h: int) -> None:
+        if img.ndim != 3 or img.shape[2] != 4 or img.dtype != np.uint8:
+            raise ValueError(f"present() needs an (h, w, 4) uint8 image, got {img.shape} {img.dtype}")
+        dst = self._staging.view()[:w * h * 4].reshape(h, w, 4)
+        ch, cw = min(h, img.shape[0]), min(w, img.shape[1])
+        if (ch, cw) != (h, w):
+            dst[:] = 0
+        if self._bgra:
+            dst[:ch, :cw, 0] = img[:ch, :cw, 2]
+            dst[:ch, :cw, 1] = img[:ch, :cw, 1]
+            dst[:ch, :cw, 2] = img[:ch, :cw, 0]
+            dst[:ch, :cw, 3] = 255
+        else:
+            dst[:ch, :cw, :3] = img[:ch, :cw, :3]
+            dst[:ch, :cw, 3] = 255
+
     def present(self, rgba: np.ndarray) -> bool:
         """Show ``rgba`` ((h, w, 4) uint8, row 0 at the top).
 
@@ -381,18 +433,7 @@ class SwapchainPresenter:
             return False
         w, h = self.extent
         # --- pixels into the staging buffer (BGRA or RGBA, exactly w x h)
-        dst = self._staging.view()[:w * h * 4].reshape(h, w, 4)
-        ch, cw = min(h, img.shape[0]), min(w, img.shape[1])
-        if (ch, cw) != (h, w):
-            dst[:] = 0
-        if self._bgra:
-            dst[:ch, :cw, 0] = img[:ch, :cw, 2]
-            dst[:ch, :cw, 1] = img[:ch, :cw, 1]
-            dst[:ch, :cw, 2] = img[:ch, :cw, 0]
-            dst[:ch, :cw, 3] = 255
-        else:
-            dst[:ch, :cw, :3] = img[:ch, :cw, :3]
-            dst[:ch, :cw, 3] = 255
+        self._fill_staging(img, w, h)
         # --- record: undefined -> transfer dst, copy, -> present src
         image = self._images[index]
         cmd = self._begin_commands()

@@ -1,0 +1,511 @@
+"""The editor's Dear ImGui interface: menu bar, side panel, help, questions.
+
+:class:`EditorGui` owns a :class:`~splatedit.render.gui.Gui` on the
+presenter's Vulkan device.  Each presented frame it builds, between
+``new_frame`` and ``render``:
+
+* the **menu bar**: File (:attr:`EditorGui.file_menu`, a list of
+  :class:`MenuEntry` that other parts of the editor extend, e.g. Open and
+  recent files), Edit (undo / redo), View (panels, help, frame all);
+* the **side panel** (collapsible sections; P hides it, as before; placed at
+  the left below the menu bar, or at the right when the gizmo is on the
+  left: it never covers the gizmo): tool palette, selection and solver,
+  deformation mode, numeric transform of the active handle, display
+  options, the edit history (click an entry to jump there), the live G/R/S
+  readout and the last message;
+* the **help** window (F1): the keymap's help lines, sized to the space
+  beside the panel (or the whole window), scrolled by PageUp/PageDown, the
+  arrows or the wheel;
+* the centred **questions** (quit with unsaved changes, save-as path) and
+  **progress** of loads, saves and fits;
+* the tools' overlays (:mod:`splatedit.app.gui_overlay`).
+
+Buttons call the keymap's action handlers (:meth:`Editor.run_action`), so a
+click and a key share one code path.  ``rects`` keeps the screen rectangle of
+every named widget of the last frame (the status file reports them: window
+tests click them).
+"""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass
+from typing import Callable
+
+from imgui_bundle import imgui
+
+from splatedit.app import gui_help, gui_overlay
+from splatedit.app import selection_tools as seltools
+from splatedit.app.keymap import Action
+from splatedit.app.panel import PANEL_MARGIN, Box
+from splatedit.app.tools.base import DragMode
+from splatedit.app.transform_fields import TransformInput, apply_transform
+from splatedit.deform.modes import DeformationMode
+from splatedit.select.selection import SUPPORT
+from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+                                  EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
+
+YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
+RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
+#: button colour of the palette entry that is on
+ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
+#: the message line is shown this long (s)
+MESSAGE_SECONDS = 8.0
+
+
+@dataclass
+class MenuEntry:
+    """One File-menu item: ``label``, the callback, a shortcut text shown at the
+    right, and an optional predicate that enables it (default: always)."""
+    label: str
+    action: Callable[[], None]
+    shortcut: str = ""
+    enabled: Callable[[], bool] | None = None
+
+
+def _entered() -> bool:
+    """The last input field was left with Enter this frame."""
+    return imgui.is_item_deactivated() and (imgui.is_key_pressed(imgui.Key.enter)
+                                            or imgui.is_key_pressed(imgui.Key.keypad_enter))
+
+
+class EditorGui:
+    def __init__(self, ed, device):
+        from splatedit.render.gui import Gui
+        self.ed = ed
+        self.gui = Gui(device)
+        imgui.get_io().config_flags &= ~imgui.ConfigFlags_.nav_enable_keyboard.value   # keys are the editor's
+        has = lambda: ed.session is not None  # noqa: E731
+        #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
+        self.file_menu: list[MenuEntry] = [
+            MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
+            MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
+            MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
+            MenuEntry("Quit", lambda: ed.run_action(Action.QUIT), "Q")]
+        self.fields = TransformInput()
+        self.rects: dict[str, Box] = {}
+        self.panel_box: Box | None = None
+        self.help_box: Box | None = None
+        self.menu_height = 0.0
+        self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
+        self.help_scroll_set = None
+        self._last = time.perf_counter()
+        self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
+        self._menu_open = False
+        self._press_in_gui = False
+        self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
+
+    # ---------------------------------------------------------------- input
+    def feed(self, ev) -> bool:
+        """Give ImGui the event first; True when it is ImGui's (the tools skip it).
+
+        Mouse events are routed by *where* they happen, against the windows
+        of the last frame (menu bar, panel, help, questions): ImGui's own
+        ``want_capture_mouse`` is only updated once per frame, so in a batch
+        of events "click a button, move to the model, click" the second click
+        would still be claimed.  Presses on a window, and the moves and the
+        release of a drag that started there (a slider), are ImGui's; so is
+        every click while a menu is open.  Keys are ImGui's while a text
+        field is being edited (:attr:`wants_keyboard`)."""
+        self.gui.feed(ev)
+        self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
+        kind = ev.kind
+        if kind in ("key", "char"):
+            return self.wants_keyboard
+        if kind == "button":
+            if ev.action == 1:                    # press
+                self._press_in_gui = self._menu_open or self.owns_point(ev.x, ev.y)
+                return self._press_in_gui
+            taken, self._press_in_gui = self._press_in_gui, False
+            return taken
+        if kind == "scroll":
+            return self.owns_point(ev.x, ev.y)
+        if kind == "move":
+            return self._press_in_gui
+        return False
+
+    def takes(self, ev) -> bool:
+        """The editor's routing: :meth:`feed`, except that the release ending a
+        tool's drag always reaches the tool."""
+        taken = self.feed(ev)
+        if ev.kind == "button" and ev.action == 0 and self.ed.drag is not DragMode.NONE:
+            return False
+        return taken
+
+    def needs_frames(self) -> bool:
+        """ImGui still has input to process: draw the next frames without
+        waiting for events (it hands a press and a release of one click to
+        two successive frames, and hover / focus changes show a frame later)."""
+        return self._frames_wanted > 0
+
+    def owns_point(self, x: float, y: float) -> bool:
+        """(x, y) pixels are over a GUI window of the last frame."""
+        return any(b.x <= x < b.right and b.y <= y < b.bottom for b in self.windows)
+
+    @property
+    def wants_mouse(self) -> bool:
+        """The pointer is over a GUI window (or drags one of its widgets)."""
+        mx, my = self.ed.mouse
+        return self._press_in_gui or self.owns_point(mx, my)
+
+    @property
+    def wants_keyboard(self) -> bool:
+        """A text field is being edited (``io.want_text_input``): keys and
+        characters are ImGui's.  ImGui's broader ``want_capture_keyboard`` also
+        holds while a clicked window keeps the focus, which would swallow the
+        editor's keys (Esc after a palette button) though ImGui does nothing
+        with them (keyboard navigation is off)."""
+        self.gui._current()
+        return bool(imgui.get_io().want_text_input)
+
+    # ---------------------------------------------------------------- frame
+    def build(self, w: int, h: int) -> None:
+        """Start the frame and lay out every window (call before :meth:`render_into`)."""
+        now = time.perf_counter()
+        self._frames_wanted = max(self._frames_wanted - 1, 0)
+        self.gui.new_frame(w, h, now - self._last)
+        self._last = now
+        self.rects = {}
+        self.windows = []
+        self._menu_open = False
+        gui_overlay.draw_tools(self.ed, w, h)
+        self._menu_bar(w)
+        help_full = self.ed.help.shown and self._help_area(w, h)[1]
+        if self.ed.panel_visible and not help_full:
+            self._panel(w, h)
+        else:
+            self.panel_box = None
+        b = self.panel_box
+        self.ed.panel_box = None if b is None else (b.x, b.y, b.w, b.h)
+        self._help(w, h)
+        self._progress(w, h)
+        self._question(w, h)
+
+    def render_into(self, cb, target):
+        """Record the GUI pass over ``target`` (the swapchain image holding the scene)."""
+        return self.gui.render_into(cb, target, final="present")
+
+    def discard(self) -> None:
+        self.gui.discard_frame()
+
+    def close(self) -> None:
+        self.gui.close()
+
+    def _rect(self, name: str) -> None:
+        a, b = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
+
+    # ------------------------------------------------------------ menu bar
+    def _menu_bar(self, w: int) -> None:
+        ed = self.ed
+        if not imgui.begin_main_menu_bar():
+            return
+        self.menu_height = imgui.get_window_size().y
+        self.windows.append(Box(0, 0, w, int(self.menu_height)))
+        if imgui.begin_menu("File"):
+            self._menu_open = True
+            for e in self.file_menu:
+                ok = e.enabled() if e.enabled is not None else True
+                if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
+                    e.action()
+            imgui.end_menu()
+        self._rect("menu_file")
+        s = ed.session
+        if imgui.begin_menu("Edit", s is not None):
+            self._menu_open = True
+            if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
+                ed.run_action(Action.UNDO)
+            if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
+                ed.run_action(Action.REDO)
+            imgui.end_menu()
+        if imgui.begin_menu("View"):
+            self._menu_open = True
+            if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
+                ed.run_action(Action.PANEL)
+            if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
+                ed.run_action(Action.HELP)
+            if imgui.menu_item("Frame all", "Home", False, s is not None)[0]:
+                ed.run_action(Action.FRAME_ALL)
+            imgui.end_menu()
+        imgui.end_main_menu_bar()
+
+    # --------------------------------------------------------------- panel
+    def _place_panel(self, w: int, h: int) -> tuple[float, float]:
+        """Top-left below the menu bar, or top-right when that would cover the gizmo."""
+        ed = self.ed
+        m = PANEL_MARGIN
+        top = self.menu_height + m
+        pw, ph = self._panel_size
+        avoid = ed.gizmo.avoid_box(w, h) if ed.session is not None else None
+        left = Box(m, int(top), int(pw), int(ph))
+        if left.overlaps(avoid):
+            right = Box(int(w - pw - m), int(top), int(pw), int(ph))
+            if not right.overlaps(avoid):
+                return right.x, right.y
+        return left.x, left.y
+
+    def _panel(self, w: int, h: int) -> None:
+        ed = self.ed
+        x, y = self._place_panel(w, h)
+        imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
+        imgui.set_next_window_size_constraints(imgui.ImVec2(EDITOR_GUI_PANEL_WIDTH, 0),
+                                               imgui.ImVec2(EDITOR_GUI_PANEL_WIDTH, max(h - y - PANEL_MARGIN, 60)))
+        flags = imgui.WindowFlags_.always_auto_resize.value | imgui.WindowFlags_.no_move.value
+        title = f"{ed.cloud_name}###panel"
+        expanded, _ = imgui.begin(title, None, flags)
+        if expanded:
+            if ed.session is None:
+                imgui.text(f"opening {ed.path}")
+            else:
+                self._sections()
+            if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
+                imgui.push_text_wrap_pos(0.0)
+                imgui.text_colored(YELLOW, ed.message)
+                imgui.pop_text_wrap_pos()
+            imgui.text_disabled("F1: help   P: hide panels")
+        pos, size = imgui.get_window_pos(), imgui.get_window_size()
+        self._panel_size = (size.x, size.y)
+        self.panel_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
+        self.windows.append(self.panel_box)
+        imgui.end()
+
+    def _sections(self) -> None:
+        s = self.ed.session
+        st = s.stats()
+        imgui.text(f"{s.cloud.n:,} splats   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        if s.manip is not None:               # the live readout of a running move
+            imgui.text_colored(YELLOW, s.manip.readout())
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_disabled(s.manip.describe())
+            imgui.pop_text_wrap_pos()
+        open_ = imgui.TreeNodeFlags_.default_open.value
+        if imgui.collapsing_header("Tools", open_):
+            self._palette()
+        if imgui.collapsing_header("Selection and solver", open_):
+            self._stats(st)
+        if imgui.collapsing_header("Deformation", open_):
+            self._deformation()
+        if imgui.collapsing_header("Transform", open_):
+            self._transform()
+        if imgui.collapsing_header("Display", open_):
+            self._display()
+        if imgui.collapsing_header("History", open_):
+            self._history()
+
+    def _tool_button(self, label: str, name: str, action: Action, on: bool) -> None:
+        if on:
+            imgui.push_style_color(imgui.Col_.button.value, ACTIVE_BUTTON)
+        if imgui.button(label):
+            self.ed.run_action(action)
+        if on:
+            imgui.pop_style_color()
+        self._rect(name)
+
+    def _palette(self) -> None:
+        s = self.ed.session
+        b = self.ed.brush
+        manip = s.manip.mode if s.manip is not None else None
+        self._tool_button("Support", "tool_support", Action.BRUSH_SUPPORT, s.brush_target == SUPPORT)
+        imgui.same_line()
+        self._tool_button("Handle", "tool_handle", Action.BRUSH_HANDLE, s.brush_target != SUPPORT)
+        imgui.same_line()
+        self._tool_button("Erase", "tool_erase", Action.ERASE_TOGGLE, b.erase_toggle)
+        imgui.same_line()
+        self._tool_button("Curve", "tool_curve", Action.CURVE_TOOL, s.curve_mode)
+        self._tool_button("Grab", "tool_grab", Action.GRAB, manip == "grab")
+        imgui.same_line()
+        self._tool_button("Rotate", "tool_rotate", Action.ROTATE, manip == "rotate")
+        imgui.same_line()
+        self._tool_button("Scale", "tool_scale", Action.SCALE, manip == "scale")
+        imgui.same_line()
+        self._tool_button("3D" if b.mode == seltools.BRUSH_3D else "Visible", "tool_brush_mode",
+                          Action.BRUSH_MODE, False)
+        imgui.set_next_item_width(150)
+        changed, r = imgui.slider_float("brush radius", float(b.radius), 2.0, 300.0, "%.0f px",
+                                        imgui.SliderFlags_.logarithmic.value)
+        if changed:
+            b.set_radius(r)
+
+    def _stats(self, st) -> None:
+        s = self.ed.session
+        imgui.text(f"support {st.support:,}   handle {st.handle:,}")
+        if st.handles > 1 or st.curve_points:
+            sizes = " ".join(f"[{n:,}]" if k == st.active_handle else f"{n:,}"
+                             for k, n in enumerate(st.handle_sizes))
+            imgui.text(f"handles {st.handles}: {sizes}")
+            imgui.text(f"curve {st.curve_points} pts   columns {st.columns}/16")
+        fit, prog = st.fit, st.progress
+        if prog is not None:
+            imgui.progress_bar(prog.fraction, imgui.ImVec2(-1, 0), f"{prog.stage} {prog.fraction * 100:.0f}%")
+        elif fit is not None:
+            imgui.text(f"{fit.method}: {fit.centers} centers / {fit.constraints} constraints")
+            imgui.text(f"residual {fit.residual:.1e}   {fit.fit_seconds:.2f} s + {fit.basis_seconds:.2f} s")
+        elif st.error:
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_colored(RED, f"solver: {st.error}")
+            imgui.pop_text_wrap_pos()
+        else:
+            imgui.text_disabled("paint a support, then a handle")
+        d = s.distortion()
+        if d is not None:
+            imgui.text_colored(RED if d.exceeds_warn else imgui.ImVec4(0.92, 0.92, 0.92, 1.0),
+                               f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
+        info = self.ed.viewport.last_info
+        if info is not None and not isinstance(info, dict):
+            what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")
+            imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {self.ed.frame_ms:.0f} ms")
+
+    def _deformation(self) -> None:
+        ed, s = self.ed, self.ed.session
+        detail_ok = bool(getattr(s, "detail_available", False))
+        for m in DeformationMode:
+            if m is DeformationMode.DETAIL and not detail_ok:
+                imgui.begin_disabled()
+            if imgui.radio_button(m.value, s.deformation is m) and s.deformation is not m:
+                if hasattr(s, "set_deformation"):
+                    s.set_deformation(m)
+                else:
+                    s.deformation = m
+                    s.on_change()
+                ed.say(f"deformation: {m.value}")
+            self._rect(f"mode_{m.value}")
+            if m is DeformationMode.DETAIL and not detail_ok:
+                imgui.end_disabled()
+            imgui.same_line()
+        imgui.new_line()
+        if s.pose_pending and s.manip is None:
+            imgui.text_colored(YELLOW, "pending moves")
+            if imgui.button("Apply (Enter)"):
+                ed.run_action(Action.COMMIT_POSE)
+            imgui.same_line()
+            if imgui.button("Discard (Esc)"):
+                ed.run_action(Action.CANCEL)
+
+    def _transform(self) -> None:
+        """Move / rotate / scale fields of the active handle; Enter in a field or Apply applies."""
+        f = self.fields
+        go = False
+        imgui.set_next_item_width(220)
+        _, v = imgui.input_float3("move", f.translate, "%.4g")
+        f.translate = list(v)
+        go |= _entered()
+        self._rect("field_translate")
+        imgui.set_next_item_width(220)
+        _, v = imgui.input_float3("axis", f.axis, "%.3g")
+        f.axis = list(v)
+        go |= _entered()
+        imgui.set_next_item_width(100)
+        _, f.degrees = imgui.input_float("degrees", f.degrees, 0.0, 0.0, "%.4g")
+        go |= _entered()
+        self._rect("field_degrees")
+        imgui.set_next_item_width(100)
+        _, f.factor = imgui.input_float("scale", f.factor, 0.0, 0.0, "%.4g")
+        go |= _entered()
+        self._rect("field_scale")
+        if imgui.button("Apply"):
+            go = True
+        self._rect("transform_apply")
+        imgui.same_line()
+        if imgui.button("Reset fields"):
+            f.reset()
+        bad = f.problem()
+        if bad:
+            imgui.text_colored(RED, bad)
+        if go and apply_transform(self.ed, f):
+            f.reset()
+
+    def _display(self) -> None:
+        ed, vp = self.ed, self.ed.viewport
+        modes = (("file colours", not vp.grey and not vp.distortion_map),
+                 ("grey", vp.grey and not vp.distortion_map), ("heat map", vp.distortion_map))
+        for k, (name, on) in enumerate(modes):
+            if imgui.radio_button(name, on) and not on:
+                if vp.distortion_map != (k == 2):
+                    ed.run_action(Action.DISTORTION_MAP)
+                if k < 2 and vp.grey != (k == 1):
+                    ed.run_action(Action.COLOUR_MODE)
+            self._rect(f"display_{name.split()[0]}")
+            if k < 2:
+                imgui.same_line()
+        imgui.set_next_item_width(150)
+        ch, v = imgui.slider_float("splat size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
+                                   EDITOR_SPLAT_SCALE_MAX, "%.2fx", imgui.SliderFlags_.logarithmic.value)
+        if ch:
+            vp.splat_scale = float(v)
+        imgui.set_next_item_width(150)
+        ch, c = imgui.color_edit3("background", list(vp.background[:3]))
+        if ch:
+            vp.background = tuple(float(x) for x in c)
+        imgui.text_disabled(f"up axis {ed.camera.up.label} ({ed.camera.up.source.value}), U to change")
+
+    def _history(self) -> None:
+        ed, s = self.ed, self.ed.session
+        hist = s.history
+        if imgui.button("Undo"):
+            ed.run_action(Action.UNDO)
+        imgui.same_line()
+        if imgui.button("Redo"):
+            ed.run_action(Action.REDO)
+        labels = hist.labels
+        rows = min(len(labels), 8)
+        lh = imgui.get_text_line_height_with_spacing()
+        if imgui.begin_child("history", imgui.ImVec2(-1, rows * lh + 8), imgui.ChildFlags_.borders.value):
+            for k, text in enumerate(labels):
+                here = k == hist.position
+                saved = " (saved)" if k == hist.saved_pos else ""
+                if imgui.selectable(f"{k}. {text or 'state'}{saved}##h{k}", here)[0] and not here:
+                    self.jump(k)
+                if imgui.is_item_visible():
+                    self._rect(f"history_{k}")
+        imgui.end_child()           # always (ImGui's rule for begin_child)
+
+    def jump(self, k: int) -> None:
+        """Go to history entry ``k`` (repeated undo / redo)."""
+        s = self.ed.session
+        while s.history.position > k and s.undo():
+            pass
+        while s.history.position < k and s.redo():
+            pass
+        self.ed.say(f"history: at {k}. {s.history.labels[s.history.position] or 'state'}")
+        self.ed.motion()
+
+    # ---------------------------------------------------------------- help
+    def _help_area(self, w: int, h: int):
+        return gui_help.help_area(self, w, h)
+
+    def _help(self, w: int, h: int) -> None:
+        gui_help.draw_help(self, w, h)
+
+    # --------------------------------------------------- progress, questions
+    def _progress(self, w: int, h: int) -> None:
+        ed, s = self.ed, self.ed.session
+        bars = [(j.stage, j.fraction) for j in ed.jobs.values()]
+        if s is not None and s.fit_job is not None and ed.panel_box is None:
+            bars.append((s.fit_job.stage, s.fit_job.fraction))
+        if not bars:
+            return
+        imgui.set_next_window_pos(imgui.ImVec2(w / 2, self.menu_height + PANEL_MARGIN), imgui.Cond_.always,
+                                  imgui.ImVec2(0.5, 0.0))
+        imgui.set_next_window_size(imgui.ImVec2(380, 0), imgui.Cond_.always)
+        imgui.begin("##progress", None, imgui.WindowFlags_.no_decoration.value | imgui.WindowFlags_.no_inputs.value)
+        for stage, frac in bars:
+            imgui.progress_bar(float(frac), imgui.ImVec2(-1, 0), f"{stage} {frac * 100:3.0f}%")
+        imgui.end()
+
+    def _question(self, w: int, h: int) -> None:
+        ed = self.ed
+        if ed.confirm_quit:
+            lines = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing", "(Ctrl+S saves)")
+        elif ed.prompt is not None:
+            lines = ("Save as (type a path; Enter: save, Esc: cancel):",
+                     ed.prompt + ("" if ed.prompt_fresh else "_"))
+        else:
+            return
+        imgui.set_next_window_pos(imgui.ImVec2(w / 2, h / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
+        imgui.set_next_window_bg_alpha(0.95)
+        imgui.begin("##question", None, imgui.WindowFlags_.no_decoration.value
+                    | imgui.WindowFlags_.always_auto_resize.value | imgui.WindowFlags_.no_inputs.value)
+        imgui.text_colored(YELLOW, lines[0])
+        for t in lines[1:]:
+            imgui.text(t)
+        imgui.end()

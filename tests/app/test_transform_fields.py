@@ -1,0 +1,94 @@
+"""The GUI's numeric transform fields without a window: the matrix they build
+(scale and rotate about the handle's centroid, then translate), their
+refusals, and applying them through the same path as a finished G/R/S move
+(one handle: an edit committed at once; two handles: a pending pose)."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from splatedit.app.transform_fields import TransformInput, apply_transform
+from splatedit.select.selection import HANDLE, SUPPORT
+from tests.app.test_editor_routing import ed, key  # noqa: F401 (fixture)
+
+glfw = pytest.importorskip("glfw")
+
+
+def _rig(s, handles=((0.0, 0.0),)):
+    r = np.linalg.norm(s.cloud.positions[:, :2], axis=1)
+    s.brush_target = SUPPORT
+    s.end_stroke(s.paint(np.flatnonzero(r < 0.9)))
+    s.brush_target = HANDLE
+    for k, (x, y) in enumerate(handles):
+        if k:
+            assert s.add_handle()
+        d = np.linalg.norm(s.cloud.positions[:, :2] - [x, y], axis=1)
+        s.end_stroke(s.paint(np.flatnonzero(d < 0.15)))
+    assert s.wait_fit() and s.active_fitted()
+
+
+def test_fields_matrix_scales_and_turns_about_the_pivot_then_moves():
+    f = TransformInput([0.1, -0.2, 0.3], [0.0, 0.0, 2.0], 90.0, 2.0)
+    pivot = np.array([1.0, 1.0, 0.0])
+    m = f.matrix(pivot)
+    assert np.allclose(m[:3, :3] @ pivot + m[:3, 3], pivot + [0.1, -0.2, 0.3])    # the pivot only moves
+    # a point one unit right of the pivot: doubled, turned 90 deg about +z (to +y), moved
+    q = pivot + [1.0, 0.0, 0.0]
+    assert np.allclose(m[:3, :3] @ q + m[:3, 3], pivot + [0.0, 2.0, 0.0] + [0.1, -0.2, 0.3])
+    assert TransformInput().is_identity() and np.allclose(TransformInput().matrix(pivot), np.eye(4))
+
+
+@pytest.mark.parametrize("fields,why", [
+    (TransformInput(factor=0.0), "scale factor must be > 0"),
+    (TransformInput(factor=-1.0), "scale factor must be > 0"),
+    (TransformInput(axis=[0.0, 0.0, 0.0], degrees=10.0), "axis is zero"),
+    (TransformInput(translate=[float("nan"), 0.0, 0.0]), "not a finite number"),
+])
+def test_fields_that_cannot_be_applied_say_why(fields, why):
+    assert why in fields.problem()
+
+
+def test_single_handle_typed_move_commits_one_edit_like_g(ed):  # noqa: F811
+    s = ed.session
+    _rig(s)
+    hc = s.handle_centroid()
+    before = s.cloud.positions.copy()
+    inside = np.linalg.norm(before[:, :2], axis=1) < 0.15
+    assert apply_transform(ed, TransformInput(translate=[0.0, 0.0, 0.25]))
+    assert len(s.edits) == 1 and s.manip is None and not s.pose_pending
+    moved = s.cloud.positions - before
+    # the handle's splats follow the typed translation exactly, the far ones stay
+    assert np.allclose(moved[inside], [0.0, 0.0, 0.25], atol=1e-6)
+    outside = np.linalg.norm(before[:, :2], axis=1) > 0.95
+    assert np.abs(moved[outside]).max() < 1e-9
+    assert np.allclose(s.handle_centroid(), hc + [0.0, 0.0, 0.25], atol=1e-6)
+    # one undo takes it back, as for a G move
+    key(ed, glfw.KEY_Z, glfw.MOD_CONTROL)
+    assert len(s.edits) == 0 and np.allclose(s.cloud.positions, before)
+
+
+def test_two_handles_typed_rotation_is_a_pending_pose(ed):  # noqa: F811
+    s = ed.session
+    _rig(s, handles=((-0.4, 0.0), (0.4, 0.0)))
+    assert s.selection.active == 1
+    assert apply_transform(ed, TransformInput(axis=[1.0, 0.0, 0.0], degrees=30.0))
+    assert len(s.edits) == 0 and s.pose_pending and s.manip is None
+    m = s.pose[1]
+    assert np.allclose(m[:3, :3], [[1, 0, 0], [0, np.cos(np.pi / 6), -np.sin(np.pi / 6)],
+                                   [0, np.sin(np.pi / 6), np.cos(np.pi / 6)]], atol=1e-12)
+    assert np.allclose(s.pose[0], np.eye(4))          # the other handle is untouched
+
+
+def test_refused_while_a_move_runs_or_without_a_fitted_handle(ed):  # noqa: F811
+    s = ed.session
+    assert not apply_transform(ed, TransformInput(translate=[0.1, 0.0, 0.0]))
+    assert "paint a support" in ed.messages[-1]
+    _rig(s)
+    key(ed, glfw.KEY_G)
+    assert s.manip is not None
+    assert not apply_transform(ed, TransformInput(translate=[0.1, 0.0, 0.0]))
+    assert "a move is running" in ed.messages[-1] and s.manip.mode == "grab"
+    key(ed, glfw.KEY_ESCAPE)
+    assert not apply_transform(ed, TransformInput())
+    assert "nothing to apply" in ed.messages[-1] and len(s.edits) == 0
