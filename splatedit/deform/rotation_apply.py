@@ -9,7 +9,8 @@ Per frame and support splat the mode needs (:mod:`splatedit.deform.rotation`)
 with ``K = [w_h / |w_h|]x``, ``g = Wu_h offsets_h`` (``Wu = u_x Bx + u_y By +
 u_z Bz``, the tangent-axis rows of the linear mode's hot path, ``Wu_h`` its
 columns of handle h), the arc coefficients ``a1, a2, b1, b2`` of the weight
-``s_h`` (:func:`~splatedit.deform.rotation.arc_coefficients`) and likewise
+``s_h`` (:func:`~splatedit.deform.rotation.arc_coefficients`, here from one
+tangent: :func:`arc_coefficients_tan`) and likewise
 for ``v'``.  Everything but the arc coefficients is linear in the rows of the
 linear mode's three hot-path arrays ``[B | p]``, ``[Wu | u]``, ``[Wv | v]``:
 ``K v = B_h (offsets_h K^T)``, ``s_h = B_h 1`` and ``grad s_h . u = Wu_h 1``.
@@ -34,7 +35,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.rotation import arc_coefficients
+from splatedit.deform.rotation import _SERIES_X
 from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, ROTATION_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
 
 
@@ -73,6 +74,56 @@ def frame_matrix(d: np.ndarray, rot, blocks) -> tuple[np.ndarray, list[float]]:
     return np.ascontiguousarray(x.T), angles
 
 
+def arc_coefficients_tan(theta: float, s: np.ndarray):
+    """:func:`~splatedit.deform.rotation.arc_coefficients` from one tangent:
+    ``sin x = 2 t / (1 + t^2)`` and ``1 - cos x = 2 t^2 / (1 + t^2)`` with
+    ``t = tan(x / 2)`` (exact identities for every x; numpy's float64 tan is
+    vectorised and about 5x faster than its sin here: 12 against 62 us per
+    7,500 values), the rest as there (same closed forms, same series below
+    ``|x| = 1e-3``).  Agrees with it within 1e-12 of theta (a1, a2) and
+    theta^2 (b1, b2) (both lose digits to the same cancellation in b1 near the
+    series switch; ``tests/deform/test_rotation.py``).
+
+    Args:
+        theta: the angle (radians, > 0).
+        s: (N,) float64 weights.
+    Returns:
+        (a1, a2, b1, b2), each (N,) float64.
+    """
+    x = np.multiply(s, theta)
+    with np.errstate(divide="ignore", invalid="ignore", over="ignore"):   # x = 0: replaced below
+        t = np.multiply(x, 0.5)
+        np.tan(t, out=t)
+        d = np.multiply(t, t)
+        omc = d.copy()
+        d += 1.0
+        np.divide(2.0, d, out=d)                    # 2 / (1 + t^2)
+        omc *= d                                    # 1 - cos x
+        sn = t
+        sn *= d                                     # sin x
+        inv = np.divide(1.0, x)
+        f1 = sn * inv                               # sin x / x
+        f2 = omc * inv                              # (1 - cos x) / x
+        g1 = np.subtract(1.0, omc)
+        g1 -= f1
+        g1 *= inv                                   # (x cos x - sin x) / x^2
+        g2 = np.subtract(sn, f2)
+        g2 *= inv                                   # (x sin x - 1 + cos x) / x^2
+    small = np.flatnonzero(np.abs(x) < _SERIES_X)
+    if len(small):
+        xs = x[small]
+        x2 = xs * xs
+        f1[small] = 1.0 - x2 / 6.0
+        f2[small] = xs / 2.0 - xs * x2 / 24.0
+        g1[small] = -xs / 3.0 + xs * x2 / 30.0
+        g2[small] = 0.5 - x2 / 8.0
+    f1 *= theta
+    f2 *= theta
+    g1 *= theta * theta
+    g2 *= theta * theta
+    return f1, f2, g1, g2
+
+
 def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles) -> None:
     """Add the blended rotations to the linear rows of one sub-chunk.
 
@@ -88,7 +139,7 @@ def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles) -> None
         q = slice(3 + 7 * i, 6 + 7 * i)             # K v, K g
         q2 = slice(6 + 7 * i, 9 + 7 * i)            # K^2 v, K^2 g
         si = 9 + 7 * i                              # s_h, grad s_h . u, grad s_h . v
-        a1, a2, b1, b2 = arc_coefficients(theta, o0[si])
+        a1, a2, b1, b2 = arc_coefficients_tan(theta, o0[si])
         kv, k2v = o0[q], o0[q2]
         fv = b1 * kv
         fv += b2 * k2v                              # F'(s) v

@@ -325,3 +325,19 @@ def test_fused_apply_memory_is_the_linear_cache_plus_a_chunk():
     assert fused < 2 * chunk
     assert unfused > 2 * chunk           # the bound is tight enough to catch support-sized temporaries
     assert sum(a.nbytes for a in basis._cpu["arrays"]) == cached
+
+
+def test_tangent_arc_coefficients_agree_with_the_sine_ones():
+    """The fused apply's arc coefficients (one tan per splat) against the
+    reference's (two sines), over weights with overshoot, exact 0 and 1 and
+    the series switch, for angles up to pi."""
+    from splatedit.deform.rotation_apply import arc_coefficients_tan
+    rng = np.random.default_rng(3)
+    for theta in (np.pi, np.nextafter(np.pi, 0.0), 2.0, 0.2, 1e-3):
+        s = np.concatenate([rng.uniform(-0.2, 1.2, 5000), [0.0, 1.0, -1.0],
+                            1.0 + 1e-9 * rng.standard_normal(50),
+                            1e-3 / theta * rng.uniform(0.5, 2.0, 500)])
+        ref, fast = arc_coefficients(theta, s), arc_coefficients_tan(theta, s)
+        for r, f, scale in zip(ref, fast, (theta, theta, theta**2, theta**2)):
+            assert np.isfinite(f).all()
+            assert np.abs(r - f).max() < 1e-12 * scale
