@@ -124,17 +124,22 @@ def arc_coefficients_tan(theta: float, s: np.ndarray):
     return f1, f2, g1, g2
 
 
-def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles) -> None:
+def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles, dests=None) -> None:
     """Add the blended rotations to the linear rows of one sub-chunk.
 
     Args:
         o0, o1, o2: (3 + 7 r, c) float64 ``X^T A^T`` of the position and the
             two axis arrays; rows 0-2 (the linear p', u', v') are updated in
             place.
-        angles: the r rotating handles' angles (radians), in the order of
-            :func:`frame_matrix`.
+        angles: the r (>= 1) rotating handles' angles (radians), in the order
+            of :func:`frame_matrix`.
+        dests: None, or three (3, c) views (transposed slices of the output
+            arrays) that receive the final p', u', v' instead of rows 0-2
+            (the last sum writes them: no separate transposing copy).
     """
-    p, u, v = o0[:3], o1[:3], o2[:3]
+    rows = [o0[:3], o1[:3], o2[:3]]
+    last = len(angles) - 1
+    t = np.empty_like(rows[0])
     for i, theta in enumerate(angles):
         q = slice(3 + 7 * i, 6 + 7 * i)             # K v, K g
         q2 = slice(6 + 7 * i, 9 + 7 * i)            # K^2 v, K^2 g
@@ -142,17 +147,21 @@ def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles) -> None
         a1, a2, b1, b2 = arc_coefficients_tan(theta, o0[si])
         kv, k2v = o0[q], o0[q2]
         fv = b1 * kv
-        fv += b2 * k2v                              # F'(s) v
-        t = a1 * kv
-        t += a2 * k2v
-        p += t                                      # F(s) v
-        for j, oj in ((u, o1), (v, o2)):
+        np.multiply(b2, k2v, out=t)
+        fv += t                                     # F'(s) v
+        np.multiply(a1, kv, out=t)
+        rows[0] += t
+        np.multiply(a2, k2v, out=t)                 # F(s) v = a1 K v + a2 K^2 v
+        out = (dests[0] if dests is not None and i == last else rows[0])
+        np.add(rows[0], t, out=out)
+        for j, oj in ((1, o1), (2, o2)):
             np.multiply(a1, oj[q], out=t)
-            j += t
+            rows[j] += t
             np.multiply(a2, oj[q2], out=t)
-            j += t
+            rows[j] += t
             np.multiply(fv, oj[si], out=t)
-            j += t
+            out = (dests[j] if dests is not None and i == last else rows[j])
+            np.add(rows[j], t, out=out)
 
 
 def chunk_rows(n_out: int, n_in: int) -> int:
@@ -184,10 +193,11 @@ def apply_segments(arrays, segments, outs, d: np.ndarray, rot, blocks) -> None:
             ce = min(hi, cs + step)
             o0, o1, o2 = (np.matmul(xt, a[cs:ce].T, out=b[:xt.shape[0] * (ce - cs)].reshape(-1, ce - cs))
                           for a, b in zip(arrays, bufs))
-            add_rotation(o0, o1, o2, angles)
-            if isinstance(dest, slice):
+            if isinstance(dest, slice):            # the last sums write the outputs
                 rows = slice(dest.start + cs - lo, dest.start + ce - lo)
+                add_rotation(o0, o1, o2, angles, [o[rows].T for o in outs])
             else:
+                add_rotation(o0, o1, o2, angles)
                 rows = dest[cs - lo:ce - lo]
-            for o, r in zip(outs, (o0, o1, o2)):
-                o[rows] = r[:3].T
+                for o, r in zip(outs, (o0, o1, o2)):
+                    o[rows] = r[:3].T
