@@ -31,6 +31,9 @@ outside the support are copied bitwise (one plain copy of the cloud, or only
 the complement's runs when the support is most of the cloud).  float64 is kept:
 float32 would lose positional accuracy (p is part of the GEMM) and showed no
 reliable gain in measurements here (the product is memory- and call-bound).
+A rotating frame (:class:`~splatedit.deform.rotation.RotationDisplacement`)
+uses the same arrays and run plan with extra output columns
+(:mod:`splatedit.deform.rotation_apply`).
 """
 
 from __future__ import annotations
