@@ -139,14 +139,14 @@ def add_rotation(o0: np.ndarray, o1: np.ndarray, o2: np.ndarray, angles, dests=N
     """
     rows = [o0[:3], o1[:3], o2[:3]]
     last = len(angles) - 1
-    t = np.empty_like(rows[0])
+    t, fv = np.empty_like(rows[0]), np.empty_like(rows[0])
     for i, theta in enumerate(angles):
         q = slice(3 + 7 * i, 6 + 7 * i)             # K v, K g
         q2 = slice(6 + 7 * i, 9 + 7 * i)            # K^2 v, K^2 g
         si = 9 + 7 * i                              # s_h, grad s_h . u, grad s_h . v
         a1, a2, b1, b2 = arc_coefficients_tan(theta, o0[si])
         kv, k2v = o0[q], o0[q2]
-        fv = b1 * kv
+        np.multiply(b1, kv, out=fv)
         np.multiply(b2, k2v, out=t)
         fv += t                                     # F'(s) v
         np.multiply(a1, kv, out=t)
