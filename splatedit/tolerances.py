@@ -719,10 +719,11 @@ LAS_DEFAULT_SCALE = 0.001
 #: stay in L2).  Single-threaded (10, 7) @ (7, c) products over 200k splats,
 #: loaded 2-core machine: 2.0 ms at c = 1024, 1.5-1.7 ms for c = 2048-6144
 ROTATION_APPLY_CHUNK = 8192
-#: ... and at least this many (the Python and call overhead per sub-chunk:
-#: 6.1 ms at c = 1024 against ~3 ms for larger single-threaded (17, 15)
-#: products over 200k splats)
-ROTATION_APPLY_MIN_CHUNK = 1024
+#: ... and at least this many (the Python and call overhead per sub-chunk).
+#: Four rotating handles, (31, 19) @ (19, c) over 200k splats: single-threaded
+#: c = 256 / 512 / 889 took 10.0 / 9.8 / 9.0 ms (median of 7), two threads
+#: at c = 1024 22.6 ms: below the thread limit even small chunks are cheap
+ROTATION_APPLY_MIN_CHUNK = 256
 #: OpenBLAS (0.3.31, the venv's numpy wheel) runs a dgemm on one thread while
 #: m n k < 2 * 65536 * 4 (its SMP threshold times 2 threads).  Measured,
 #: (10, 7) @ (7, c) over 200k splats, loaded 2-core machine, 7 runs: m n k =

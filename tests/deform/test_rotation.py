@@ -341,3 +341,18 @@ def test_tangent_arc_coefficients_agree_with_the_sine_ones():
         for r, f, scale in zip(ref, fast, (theta, theta, theta**2, theta**2)):
             assert np.isfinite(f).all()
             assert np.abs(r - f).max() < 1e-12 * scale
+
+
+def test_fused_apply_sub_chunks_stay_on_one_blas_thread():
+    """1-4 rotating handles (plus curves' columns): every sub-chunk product is
+    below the m n k where OpenBLAS starts a second thread, and no sub-chunk
+    exceeds the cache-sized maximum."""
+    from splatedit.deform.rotation_apply import chunk_rows
+    from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, ROTATION_APPLY_CHUNK
+    for handles in range(1, 5):
+        for curve_columns in (0, 6, 12):
+            k = 4 * handles + curve_columns
+            n_out = 3 + 7 * handles
+            c = chunk_rows(n_out, k + 3)
+            assert c <= ROTATION_APPLY_CHUNK
+            assert n_out * (k + 3) * c < BLAS_SINGLE_THREAD_MNK, (handles, curve_columns, c)
