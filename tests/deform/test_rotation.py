@@ -338,9 +338,9 @@ def test_tangent_arc_coefficients_agree_with_the_sine_ones():
                             1.0 + 1e-9 * rng.standard_normal(50),
                             1e-3 / theta * rng.uniform(0.5, 2.0, 500)])
         ref, fast = arc_coefficients(theta, s), arc_coefficients_tan(theta, s)
-        for r, f, scale in zip(ref, fast, (theta, theta, theta**2, theta**2)):
+        for r, f, unit in zip(ref, fast, (theta, theta, theta**2, theta**2)):
             assert np.isfinite(f).all()
-            assert np.abs(r - f).max() < 1e-12 * scale
+            assert np.abs(r - f).max() < 1e-12 * unit
 
 
 def test_fused_apply_sub_chunks_stay_on_one_blas_thread():
