@@ -767,3 +767,24 @@ EDITOR_GUI_MIN_AXIS_NORM = 1e-9
 #: one to spare.  Without it the idle loop's 0.5 s wait delayed a click's
 #: effect by up to 0.5 s
 EDITOR_GUI_SETTLE_FRAMES = 4
+# ---------------------------------------------------------------------------
+# Rotation-aware mode: CPU apply (issue 9 follow-up)
+# ---------------------------------------------------------------------------
+#: at most this many support splats per sub-chunk of the rotation mode's CPU
+#: apply (splatedit.deform.rotation_apply: three (3 + 7 r, c) GEMM outputs and
+#: a few (c,) temporaries, ~0.7 MB at c = 8192 and one rotating handle: they
+#: stay in L2).  Single-threaded (10, 7) @ (7, c) products over 200k splats,
+#: loaded 2-core machine: 2.0 ms at c = 1024, 1.5-1.7 ms for c = 2048-6144
+ROTATION_APPLY_CHUNK = 8192
+#: ... and at least this many (the Python and call overhead per sub-chunk).
+#: Four rotating handles, (31, 19) @ (19, c) over 200k splats: single-threaded
+#: c = 256 / 512 / 889 took 10.0 / 9.8 / 9.0 ms (median of 7), two threads
+#: at c = 1024 22.6 ms: below the thread limit even small chunks are cheap
+ROTATION_APPLY_MIN_CHUNK = 256
+#: OpenBLAS (0.3.31, the venv's numpy wheel) runs a dgemm on one thread while
+#: m n k < 2 * 65536 * 4 (its SMP threshold times 2 threads).  Measured,
+#: (10, 7) @ (7, c) over 200k splats, loaded 2-core machine, 7 runs: m n k =
+#: 430,080 (1 thread) 1.6 / 1.7 ms min / median, 573,440 (2 threads) 0.9 /
+#: 17 ms; (17, 15) @ (15, c): 261,120 6.1 / 6.8 ms, 783,360 3.4 / 80 ms.  The
+#: threads only contend on this machine: the sub-chunks stay below this
+BLAS_SINGLE_THREAD_MNK = 2 * 65536 * 4

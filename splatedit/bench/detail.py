@@ -1,7 +1,8 @@
 """``splatedit bench detail``: the detail-preserving mode's cost beside the
 linear and the rotation mode's, on the bumpy plane of its tests scaled up (one handle rotated
 90 degrees about the bend line): precompute (fit) seconds, CPU apply ms per
-frame and the GPU pre-pass ms (GPU timestamps, lavapipe here)."""
+frame (the rotation row also times the unfused reference apply) and the GPU
+pre-pass ms (GPU timestamps, lavapipe here)."""
 
 from __future__ import annotations
 
@@ -44,7 +45,10 @@ def _ms(fn, repeats):
 
 def bench_detail(sizes=((300, 300), (1000, 1000)), repeats: int = 3, gpu: bool = True):
     """Yield one dict per (size, mode): n, n_support, fit_s, decompose_s,
-    apply_ms (CPU, median), prepass_ms (GPU, median; NaN without --gpu)."""
+    apply_ms (CPU, median of 7), prepass_ms (GPU, median; NaN without --gpu);
+    the rotation row also has apply_unfused_ms (the unfused reference
+    :func:`~splatedit.deform.rotation.apply_rotation`, the CPU path before the
+    folded one of :mod:`splatedit.deform.rotation_apply`)."""
     from splatedit.deform.basis import DeformationBasis
     from splatedit.deform.detail import DetailBasis
     for nx, ny in sizes:
@@ -58,13 +62,18 @@ def bench_detail(sizes=((300, 300), (1000, 1000)), repeats: int = 3, gpu: bool =
                 fitted[cls] = (cls.fit(cloud, sup, [handle]), time.perf_counter() - t)
             b, fit_s = fitted[cls]
             dc = b.displacement([m], mode=DeformationMode(name))
-            apply_ms = _ms(lambda: b.apply_arrays(cloud, dc), repeats)
+            apply_ms = _ms(lambda: b.apply_arrays(cloud, dc), max(7, repeats))
+            extra = {}
+            if name == "rotation":     # before/after: the unfused reference in the same run
+                from splatedit.deform.rotation import apply_rotation
+                extra["apply_unfused_ms"] = round(_ms(lambda: apply_rotation(b, cloud, dc.dC, dc),
+                                                      repeats), 2)
             prep = float("nan")
             if gpu:
                 prep = _prepass_ms(cloud, b, dc, repeats)
             yield {"bench": "detail", "mode": name, "n": cloud.n, "n_support": int(len(b.indices)),
                    "fit_s": round(fit_s, 3), "decompose_s": round(b.stats.get("decompose_seconds", 0.0), 3),
-                   "apply_ms": round(apply_ms, 2), "prepass_ms": round(prep, 2),
+                   "apply_ms": round(apply_ms, 2), **extra, "prepass_ms": round(prep, 2),
                    "loadavg_1min": os.getloadavg()[0]}
 
 

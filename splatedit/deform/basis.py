@@ -31,6 +31,9 @@ outside the support are copied bitwise (one plain copy of the cloud, or only
 the complement's runs when the support is most of the cloud).  float64 is kept:
 float32 would lose positional accuracy (p is part of the GEMM) and showed no
 reliable gain in measurements here (the product is memory- and call-bound).
+A rotating frame (:class:`~splatedit.deform.rotation.RotationDisplacement`)
+uses the same arrays and run plan with extra output columns
+(:mod:`splatedit.deform.rotation_apply`).
 """
 
 from __future__ import annotations
@@ -49,8 +52,9 @@ from splatedit.deform.constraints import (
 )
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
-from splatedit.deform.rotation import (apply_rotation, blend_jacobians, blend_terms, handle_blocks,
+from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_blocks,
                                        rotation_displacement, split_displacement)
+from splatedit.deform.rotation_apply import apply_segments
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
@@ -475,10 +479,8 @@ class DeformationBasis:
         self._check_cloud(cloud)
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
-        if rot is not None:
-            return apply_rotation(self, cloud, d, rot)
         srcs = (cloud.positions, cloud.u, cloud.v)
-        if not d.any():
+        if not d.any() and rot is None:
             return tuple(s.copy() for s in srcs)
         c = self._cpu_arrays(cloud)
         # splats outside the support: bitwise copies (never recomputed)
@@ -489,13 +491,16 @@ class DeformationBasis:
             for dest in c["comp_segments"]:
                 for s, o in zip(srcs, outs):
                     o[dest] = s[dest]
-        mx = np.vstack([d, np.eye(3)])
-        for lo, hi, dest in c["segments"]:
-            for a, o in zip(c["arrays"], outs):
-                if isinstance(dest, slice):
-                    np.matmul(a[lo:hi], mx, out=o[dest])
-                else:
-                    o[dest] = a[lo:hi] @ mx
+        if rot is not None:   # rotating handles: extra GEMM columns (splatedit.deform.rotation_apply)
+            apply_segments(c["arrays"], c["segments"], outs, d, rot, handle_blocks(self))
+        else:
+            mx = np.vstack([d, np.eye(3)])
+            for lo, hi, dest in c["segments"]:
+                for a, o in zip(c["arrays"], outs):
+                    if isinstance(dest, slice):
+                        np.matmul(a[lo:hi], mx, out=o[dest])
+                    else:
+                        o[dest] = a[lo:hi] @ mx
         if len(c["filler"]):  # fixed splats computed through: restore them bitwise
             for s, o in zip(srcs, outs):
                 o[c["filler"]] = s[c["filler"]]

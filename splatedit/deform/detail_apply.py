@@ -33,12 +33,8 @@ import numpy as np
 
 from splatedit.deform.basis import _fill_small_gaps, _run_plan
 from splatedit.deform.rotation import arc_coefficients, handle_blocks
+from splatedit.deform.rotation_apply import _skew
 from splatedit.tolerances import DETAIL_APPLY_CHUNK
-
-
-def _skew(k: np.ndarray) -> np.ndarray:
-    """(3, 3) matrix of ``k x``."""
-    return np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
 
 
 class DetailHotPath:

