@@ -196,3 +196,37 @@ def draw_tools(ed, w: int, h: int) -> None:
     draw_curve(ed, dl, w, h)
     draw_gizmo(ed, dl, w, h)
     draw_readout(ed, imgui.get_foreground_draw_list(), w, h)      # over the panels
+
+
+def text_box(dl, lines, w: int, h: int, *, top: float | None = None, pad: int = 8,
+             bg=(12, 16, 26), min_width: float = 0.0) -> tuple[int, int, int, int, int]:
+    """Rows of coloured text [(text, rgb)] in a filled box centred in a
+    ``w`` x ``h`` window (at ``top`` when given, else centred vertically), on
+    the foreground draw list (over the panels; clicks are not taken by ImGui,
+    so the editor's own hit tests apply).  Returns (x, y, box w, box h, line height)."""
+    lh = int(imgui.get_text_line_height_with_spacing())
+    tw = max([imgui.calc_text_size(t).x for t, _ in lines] + [min_width])
+    bw, bh = int(tw) + 2 * pad, lh * len(lines) + 2 * pad
+    x = max((w - bw) // 2, 0)
+    y = max((h - bh) // 2, 0) if top is None else int(min(max(top, 0), max(h - bh, 0)))
+    dl.add_rect_filled(_v((x, y)), _v((x + bw, y + bh)), col(bg, 240), 4.0)
+    for k, (text, rgb) in enumerate(lines):
+        dl.add_text(_v((x + pad, y + pad + k * lh)), col(rgb), text)
+    return x, y, bw, bh, lh
+
+
+def draw_modal_boxes(ed, w: int, h: int, top: float) -> None:
+    """The file browser (Ctrl+O) and the load/save error box, drawn like the
+    CPU overlay draws them, with their hit rectangles recorded for clicks."""
+    from splatedit.app import panel
+    dl = imgui.get_foreground_draw_list()
+    b = ed.browser
+    if b.shown:
+        lh = int(imgui.get_text_line_height_with_spacing())
+        x, y, bw, bh, lh = text_box(dl, b.lines(h, lh, 8), w, h, min_width=560)
+        b.placed((x, y, bw, bh), 8, lh)
+    if ed.error_box is None:
+        ed.error_rect = None
+    else:
+        x, y, bw, bh, _ = text_box(dl, panel.error_lines(ed.error_box), w, h, top=top, bg=(70, 18, 18))
+        ed.error_rect = (x, y, bw, bh)

@@ -180,6 +180,7 @@ class EditorGui:
         self._help(w, h)
         self._progress(w, h)
         self._question(w, h)
+        gui_overlay.draw_modal_boxes(self.ed, w, h, self.menu_height + PANEL_MARGIN)
 
     def render_into(self, cb, target):
         """Record the GUI pass over ``target`` (the swapchain image holding the scene)."""
@@ -494,7 +495,10 @@ class EditorGui:
 
     def _question(self, w: int, h: int) -> None:
         ed = self.ed
-        if ed.confirm_quit:
+        from splatedit.app.panel import open_question
+        if ed.confirm_open is not None:
+            lines = open_question(ed)
+        elif ed.confirm_quit:
             lines = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing", "(Ctrl+S saves)")
         elif ed.prompt is not None:
             lines = ("Save as (type a path; Enter: save, Esc: cancel):",

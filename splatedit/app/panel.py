@@ -199,16 +199,30 @@ ERROR_BOX_RGB = (255, 150, 140)
 ERROR_BOX_CHARS = 100
 
 
+def error_lines(message: str) -> list:
+    """The error box's rows [(text, rgb)]: a title, the wrapped message, how to close it."""
+    import textwrap
+    lines = [("Error", ERROR_BOX_RGB)]
+    lines += [(t, (245, 235, 235)) for t in textwrap.wrap(message, ERROR_BOX_CHARS)[:8]]
+    lines.append(("Esc, Enter or a click here: close", (200, 200, 200)))
+    return lines
+
+
+def open_question(ed) -> tuple | None:
+    """The unsaved-changes question before opening another model (rows), or None."""
+    if ed.confirm_open is None:
+        return None
+    return ("Unsaved changes.", f"Y: open {ed.confirm_open.name} without saving     N / Esc: keep editing",
+            "(Ctrl+S saves)")
+
+
 def error_box(ed, w: int, h: int, y: int) -> list:
     """The error box (a load / save error) at the top centre below ``y``,
     shown until dismissed; records its rectangle in ``ed.error_rect``."""
     if ed.error_box is None:
         ed.error_rect = None
         return []
-    import textwrap
-    lines = [("Error", ERROR_BOX_RGB)]
-    lines += [(t, (245, 235, 235)) for t in textwrap.wrap(ed.error_box, ERROR_BOX_CHARS)[:8]]
-    lines.append(("Esc, Enter or a click here: close", (200, 200, 200)))
+    lines = error_lines(ed.error_box)
     img = ov.text_panel(tuple(lines), size=14, bg=(70, 18, 18, 240))
     img = img[:max(h, 1), :max(w, 1)]
     x = max((w - img.shape[1]) // 2, 0)
@@ -251,10 +265,9 @@ def compose_overlay(ed, w: int, h: int) -> list:
         patches.append(help_patch)
     patches += ed.browser.overlay(w, h)
     patches += error_box(ed, w, h, y)
-    center_msg = None
-    if ed.confirm_open is not None:
-        center_msg = ("Unsaved changes.", f"Y: open {ed.confirm_open.name} without saving     N / Esc: keep editing",
-                      "(Ctrl+S saves)")
+    center_msg = open_question(ed)
+    if center_msg is not None:
+        pass
     elif ed.confirm_quit:
         center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
                       "(Ctrl+S saves)")

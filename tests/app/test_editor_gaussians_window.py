@@ -37,8 +37,14 @@ def _shot(ed, name):
     return img
 
 
-def _foreground(img):
-    return img[..., :3].astype(int).min(axis=2) < 230
+def _foreground(img, status=None):
+    """Model pixels: darker than the white background, below the GUI's menu
+    bar (a dark strip along the top when the GUI is on)."""
+    fg = img[..., :3].astype(int).min(axis=2) < 230
+    menu = (status or {}).get("gui_rects", {}).get("menu_file")
+    if menu is not None:
+        fg[:menu[1] + menu[3] + 2] = False
+    return fg
 
 
 def _ears(fg):
@@ -67,7 +73,7 @@ def test_gaussian_scene_edit_rotate_save(xvfb, tmp_path):
         s = ed.idle(lambda s: not s["panel_visible"], "panel hidden")
         cam = s["camera"]
         before = _shot(ed, "0-loaded")
-        fg = _foreground(before)
+        fg = _foreground(before, s)
         assert fg.mean() > 0.05, "the Gaussians are not drawn"
         top, band, (tx, ty) = _ears(fg)
         # --- support: strokes over the ear band (the highest ear, the head below it), visible-only brush

@@ -265,14 +265,11 @@ class FileBrowserTool(Tool):
             self.pick()
 
     # ------------------------------------------------------------ drawing
-    def overlay(self, w: int, h: int) -> list:
-        if not self.shown:
-            return []
-        f = ov.font(BROWSER_FONT)
-        asc, desc = f.getmetrics()
-        lh = asc + desc + 2
-        pad = 8
-        self.rows = max((h - 40 - 2 * pad) // lh - _CHROME_LINES, 1)
+    def lines(self, h: int, line_h: int, pad: int) -> list:
+        """The browser's text rows for a window ``h`` pixels tall with rows of
+        ``line_h`` pixels: title, folder, the entries that fit (sets
+        :attr:`rows`, scrolls to the selection), footer; [(text, rgb)]."""
+        self.rows = max((h - 40 - 2 * pad) // max(line_h, 1) - _CHROME_LINES, 1)
         self._scroll_to()
         shown = self.entries[self.top:self.top + self.rows]
         lines: list = [("Open a model - Enter: open   Backspace: up   type: jump to a name   Esc: cancel",
@@ -293,9 +290,23 @@ class FileBrowserTool(Tool):
             foot = (f"{n} model file(s) here   {self.top + 1}-{self.top + len(shown)} of {len(self.entries)}",
                     (200, 200, 200))
         lines.append(foot)
+        return lines
+
+    def placed(self, box: tuple[int, int, int, int], pad: int, line_h: int) -> None:
+        """Record where the rows were drawn (``box`` x, y, w, h) for :meth:`row_at`."""
+        self.box = box
+        self.row0, self.line_h = box[1] + pad + 2 * line_h, line_h
+
+    def overlay(self, w: int, h: int) -> list:
+        if not self.shown:
+            return []
+        f = ov.font(BROWSER_FONT)
+        asc, desc = f.getmetrics()
+        lh = asc + desc + 2
+        pad = 8
+        lines = self.lines(h, lh, pad)
         img = ov.text_panel(tuple(lines), size=BROWSER_FONT, bg=(12, 16, 26, 240), pad=pad, min_width=560)
         img = img[:max(h, 1), :max(w, 1)]
         x, y = max((w - img.shape[1]) // 2, 0), max((h - img.shape[0]) // 2, 0)
-        self.box = (x, y, img.shape[1], img.shape[0])
-        self.row0, self.line_h = y + pad + 2 * lh, lh
+        self.placed((x, y, img.shape[1], img.shape[0]), pad, lh)
         return [ov.Patch(x, y, img)]
