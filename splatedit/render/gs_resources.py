@@ -80,11 +80,11 @@ class _Targets:
         return obj
 
     def target_fb(self, target: RenderTarget):
-        hit = self.target_fbs.get(id(target))
-        if hit is None or hit[0] is not target:
+        hit = self.target_fbs.get(target.serial)
+        if hit is None:
             rp = self._r.cache.render_pass(_rp_resolve(target))
             fb = self._add(V.Framebuffer(self._r.dev, rp, [target.attachment], self.width, self.height))
-            hit = self.target_fbs[id(target)] = (target, fb)
+            hit = self.target_fbs[target.serial] = (target, fb)
         return hit[1]
 
     def ensure_pick(self):

@@ -19,6 +19,8 @@ Only :mod:`splatedit.render.vk` calls Vulkan.
 
 from __future__ import annotations
 
+import itertools
+
 import numpy as np
 
 from splatedit.deform.rotation import split_displacement
@@ -83,7 +85,11 @@ class RenderTarget:
     ``width``, ``height``, a format name and the layout to leave it in
     (``final``: ``"transfer_src"`` for readback, ``"present"`` for a swapchain)."""
 
+    _serials = itertools.count(1)
+
     def __init__(self, attachment, fmt: str, final: str, apply_gamma: bool = True):
+        #: never reused (unlike id()): the key of the framebuffers cached for it
+        self.serial = next(RenderTarget._serials)
         self.attachment = attachment
         self.format = fmt
         self.final = final
@@ -105,7 +111,7 @@ class _Targets:
     def __init__(self, r: "Renderer", width: int, height: int):
         self.width, self.height = width, height
         self.objects = []
-        self.target_fbs = {}      # id(target) -> (target, framebuffer)
+        self.target_fbs = {}      # target.serial -> (target, framebuffer)
         try:
             self._create(r)
         except BaseException:
@@ -142,11 +148,11 @@ class _Targets:
         return fb
 
     def target_fb(self, target: RenderTarget):
-        hit = self.target_fbs.get(id(target))
-        if hit is None or hit[0] is not target:
+        hit = self.target_fbs.get(target.serial)
+        if hit is None:
             rp = self._r.cache.render_pass(_rp_resolve(target))
             fb = self._fb(self._r.dev, rp, [target.attachment])
-            hit = self.target_fbs[id(target)] = (target, fb)
+            hit = self.target_fbs[target.serial] = (target, fb)
         return hit[1]
 
     def ensure_pick(self):
