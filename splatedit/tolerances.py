@@ -767,3 +767,14 @@ EDITOR_GUI_MIN_AXIS_NORM = 1e-9
 #: one to spare.  Without it the idle loop's 0.5 s wait delayed a click's
 #: effect by up to 0.5 s
 EDITOR_GUI_SETTLE_FRAMES = 4
+
+# ---------------------------------------------------------------------------
+# Windowed compute pre-pass (renderer, clouds above one storage binding)
+# ---------------------------------------------------------------------------
+#: splats per pre-pass window when the whole cloud's records (48 bytes per
+#: splat) or geometry do not fit one storage binding (lavapipe's
+#: maxStorageBufferRange is 128 MiB: 2,796,202 splats of records).  2^21
+#: splats keep the records at 96 MiB + 64 MiB and are a multiple of every
+#: basis window (524,288 splats at 16 columns) and of any offset alignment;
+#: the window is also capped by the device limit at run time
+RENDER_PREPASS_WINDOW_SPLATS = 1 << 21
