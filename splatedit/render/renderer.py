@@ -32,7 +32,8 @@ from splatedit.render.uniforms import FRAME_UBO
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
                                   RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
-                                  RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_PREPASS_WINDOW_SPLATS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
+                                  RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_PREPASS_WINDOW_SPLATS,
+                                  RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
                                   RENDER_UPLOAD_CHUNK_SPLATS, RENDER_VISIBILITY_EPS_RADII)
 
 #: per-splat flag bits (shaders_glsl/frame.glsl)
