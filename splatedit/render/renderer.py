@@ -774,6 +774,15 @@ class Renderer:
         # not fit one storage binding are drawn in splat windows
         return not (t is not None and max(t.width, t.height) > _PREP_MAX_SIZE)
 
+    @property
+    def prepass_windows(self) -> int:
+        """Splat windows the compute pre-pass prepares and draws the cloud in at
+        the current image size: 1 when the cloud fits one storage binding, 0 for
+        the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
+        if self.cloud is None or not self._use_prepass():
+            return 0
+        return len(self._prep_windows())
+
     def _prep_windows(self) -> list[tuple[int, int]]:
         """(first splat, splat count) windows of the pre-pass: the whole cloud
         when its records and per-splat arrays fit one storage binding (up to

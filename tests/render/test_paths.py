@@ -64,6 +64,7 @@ def test_windowed_prepass_matches_the_vertex_path(renderer, monkeypatch):
 
     cam = Camera(eye=(0.2, 0.3, 1.9), target=(0, 0, 0), fov_deg=60)
     ref = _frames(renderer, cam)[(False, False)]
+    assert renderer.prepass_windows == 1
     monkeypatch.setattr(renderer.dev, "limits", Small())
     renderer._free_prep()
     try:
@@ -71,6 +72,7 @@ def test_windowed_prepass_matches_the_vertex_path(renderer, monkeypatch):
         renderer.prepass = True
         img, pick = renderer.render(cam, W, H), renderer.pick(cam, W, H)[0]
         windows = renderer._prep.windows
+        assert renderer.prepass_windows == 4
     finally:
         renderer.prepass = saved
         monkeypatch.undo()
