@@ -16,16 +16,20 @@ shared uint s_base[2];
 // The dispatch covers splats base .. base + count - 1 (the basis binding is a
 // window starting at row base: a 16-column basis takes 256 bytes per splat and
 // maxStorageBufferRange is 128 MiB on lavapipe, so large clouds are dispatched
-// in chunks); n = all splats (record slots).
+// in chunks). The per-splat bindings (geometry, colours, flags, detail) and the
+// records are a window too, of n splats starting at splat wbase (the whole
+// cloud when it fits one binding; otherwise the renderer draws window after
+// window); base .. base + count - 1 lies inside it. n = record slots.
 layout(push_constant) uniform Push {
     uint base;
     uint count;
     uint n;
+    uint wbase;
 } P;
 
-layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // 9 floats per splat
-layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8
-layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };
+layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // 9 floats per splat, from splat P.wbase
+layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8, from splat P.wbase
+layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };     // from splat P.wbase
 layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat, from row P.base
 layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // 3 per slot
 layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // 2 per slot
@@ -55,15 +59,16 @@ vec2 oct_encode(vec3 n) {
 
 void main() {
     uint li = gl_GlobalInvocationID.x;          // row in the basis window
-    uint i = P.base + li;                       // splat index
-    if (i == 0u) { draws[0] = 4u; draws[4] = 1u; }
+    uint i = P.base + li;                       // splat index (the pick id is i + 1)
+    uint w = i - P.wbase;                       // row in the per-splat window, record slot range
+    if (w == 0u) { draws[0] = 4u; draws[4] = 1u; }
     int kind = SPLAT_CULLED;
     Splat S;
     if (li < P.count) {
-        vec3 p = vec3(geom[9 * i], geom[9 * i + 1], geom[9 * i + 2]);
-        vec3 u = vec3(geom[9 * i + 3], geom[9 * i + 4], geom[9 * i + 5]);
-        vec3 v = vec3(geom[9 * i + 6], geom[9 * i + 7], geom[9 * i + 8]);
-        uint fl = flags[i];
+        vec3 p = vec3(geom[9 * w], geom[9 * w + 1], geom[9 * w + 2]);
+        vec3 u = vec3(geom[9 * w + 3], geom[9 * w + 4], geom[9 * w + 5]);
+        vec3 v = vec3(geom[9 * w + 6], geom[9 * w + 7], geom[9 * w + 8]);
+        uint fl = flags[w];
         vec3 u0 = u, v0 = v;
         if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
             vec3 dp = vec3(0.0);
@@ -73,14 +78,14 @@ void main() {
                 deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
                              dp, Jm);
 #ifdef DETAIL
-            detail_attach(detail[i], dp, Jm, p, u, v);
+            detail_attach(detail[w], dp, Jm, p, u, v);
 #else
             p += dp;
             u += Jm * u;
             v += Jm * v;
 #endif
         }
-        vec3 srgb = unpackUnorm4x8(colors[i]).rgb;
+        vec3 srgb = unpackUnorm4x8(colors[w]).rgb;
         kind = prepare_splat(p, u, v, srgb, fl, S);
         if (F.options.z == 1u)                // heat map: the stretch of the same J (distortion.glsl)
             S.color = heat_encode((fl & FLAG_DEFORMED) != 0u ? splat_stretch(u0, v0, u, v) : 1.0, srgb, fl);

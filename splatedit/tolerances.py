@@ -788,3 +788,16 @@ ROTATION_APPLY_MIN_CHUNK = 256
 #: 17 ms; (17, 15) @ (15, c): 261,120 6.1 / 6.8 ms, 783,360 3.4 / 80 ms.  The
 #: threads only contend on this machine: the sub-chunks stay below this
 BLAS_SINGLE_THREAD_MNK = 2 * 65536 * 4
+
+# ---------------------------------------------------------------------------
+# Windowed compute pre-pass (renderer, clouds above one storage binding)
+# ---------------------------------------------------------------------------
+#: splats per pre-pass window when the whole cloud's records (48 bytes per
+#: splat) or geometry do not fit one storage binding (lavapipe's
+#: maxStorageBufferRange is 128 MiB: 2,796,202 splats of records).  Measured
+#: on `splatedit render` of a 10M sphere at 1280x720 (2 cores, load 2.1-2.3,
+#: two rounds): 2^21 splats 9.4 / 12.0 s, 1.71 / 1.68 GB peak; 2^20 8.5 / 9.3 s,
+#: 1.63 / 1.64 GB; 2^19 8.6 / 9.1 s, 1.55 / 1.56 GB.  2^20 keeps the records
+#: at 48 + 32 MiB and is a multiple of every basis window (524,288 splats at
+#: 16 columns) and of any offset alignment; the device limit caps it too
+RENDER_PREPASS_WINDOW_SPLATS = 1 << 20

@@ -20,6 +20,7 @@ Only :mod:`splatedit.render.vk` calls Vulkan.
 from __future__ import annotations
 
 import itertools
+from dataclasses import replace
 
 import numpy as np
 
@@ -32,7 +33,8 @@ from splatedit.render.uniforms import FRAME_UBO
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_DEFAULT_COLOR, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS,
                                   RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MAX_BASIS_COLUMNS,
-                                  RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
+                                  RENDER_MIN_WEIGHT, RENDER_POINT_SPLAT_MAX_PX, RENDER_PREPASS_WINDOW_SPLATS,
+                                  RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
                                   RENDER_UPLOAD_CHUNK_SPLATS, RENDER_VISIBILITY_EPS_RADII)
 
 #: per-splat flag bits (shaders_glsl/frame.glsl)
@@ -72,6 +74,18 @@ _RP_POINTS = V.RenderPassDesc(colors=(V.Attachment("rgba8", "clear", final="colo
                               depth=V.Attachment("d32f", "clear", final="depth"))
 _RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
                             depth=V.Attachment("d32f", "clear", final="transfer_src"))
+
+
+def _rp_window(desc: V.RenderPassDesc, first: bool, last: bool) -> V.RenderPassDesc:
+    """``desc`` for one splat window of a windowed pre-pass frame: windows after
+    the first load what the previous one left instead of clearing it, and all
+    but the last leave the attachments in attachment layouts."""
+    def att(a: V.Attachment, layout: str) -> V.Attachment:
+        if not first and a.load == "clear":
+            a = replace(a, load="load", initial=layout)
+        return a if last else replace(a, final=layout)
+    return replace(desc, colors=tuple(att(a, "color") for a in desc.colors),
+                   depth=None if desc.depth is None else att(desc.depth, "depth"))
 
 
 def _rp_attr(fmt: str, final: str) -> V.RenderPassDesc:
@@ -181,12 +195,15 @@ class _Targets:
 
 
 class _Prep:
-    """Buffers and descriptor sets of the compute pre-pass (one set per basis window)."""
+    """Buffers and descriptor sets of the compute pre-pass: one set per basis
+    window inside each splat window (one splat window when the cloud fits one
+    storage binding)."""
 
-    def __init__(self, objects, dset, rec_a, rec_b, draws, chunks):
+    def __init__(self, objects, dset, rec_a, rec_b, draws, windows):
         self.objects = objects
         self.dset, self.rec_a, self.rec_b, self.draws = dset, rec_a, rec_b, draws
-        self.chunks = chunks          # (descriptor set, first splat, count)
+        #: per splat window: (first splat, count, [(descriptor set, first splat, count)])
+        self.windows = windows
 
 
 def _rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
@@ -221,8 +238,11 @@ class Renderer:
             once per frame in a compute pre-pass that writes compact records;
             both splat passes then draw them indirectly with a fetch-only
             vertex shader (``prepared.vert``).  Off: every vertex of both
-            passes runs ``splat.vert``.  Falls back to off when a buffer
-            exceeds the device's storage-buffer range.
+            passes runs ``splat.vert``.  A cloud whose records or geometry
+            exceed the device's storage-buffer range (2.8M splats on
+            lavapipe) is prepared and drawn in windows of
+            ``RENDER_PREPASS_WINDOW_SPLATS`` splats:
+            each pass runs the pre-pass of a window, then draws it.
         device: share an existing :class:`splatedit.render.vk.Device` (then
             the renderer does not close it).
     """
@@ -755,29 +775,52 @@ class Renderer:
             return True
         if not self.prepass:
             return False
-        if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
-            return False
-        # the basis is bound in windows (chunked dispatches), so only the
-        # per-slot records and the geometry must fit one storage binding:
-        # 48 bytes per splat -> 2,796,202 splats with lavapipe's 128 MiB
-        limit = int(self.dev.limits.maxStorageBufferRange)
-        sizes = [self.n * _REC_A_BYTES, self.n * _REC_B_BYTES, self._geom.size]
-        return max(sizes) <= limit
+        # any size: clouds whose records (48 bytes per splat) or geometry do
+        # not fit one storage binding are drawn in splat windows
+        return not (t is not None and max(t.width, t.height) > _PREP_MAX_SIZE)
 
-    def _basis_chunks(self, basis) -> list[tuple[int, int, int, int]]:
+    @property
+    def prepass_windows(self) -> int:
+        """Splat windows the compute pre-pass prepares and draws the cloud in at
+        the current image size: 1 when the cloud fits one storage binding, 0 for
+        the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
+        if self.cloud is None or not self._use_prepass():
+            return 0
+        return len(self._prep_windows())
+
+    def _prep_windows(self) -> list[tuple[int, int]]:
+        """(first splat, splat count) windows of the pre-pass: the whole cloud
+        when its records and per-splat arrays fit one storage binding (up to
+        2,796,202 splats with lavapipe's 128 MiB), else windows of
+        RENDER_PREPASS_WINDOW_SPLATS (or fewer where the device limit is
+        smaller), each prepared and drawn in turn."""
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        per_splat = max(_REC_A_BYTES, _GEOM_STRIDE, 16 if self._detail_buf is not None else 0)
+        if self.n * per_splat <= limit:
+            return [(0, self.n)]
+        align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
+        per = min(RENDER_PREPASS_WINDOW_SPLATS, limit // per_splat) // _WORKGROUP * _WORKGROUP
+        while per > _WORKGROUP and (per * 4) % align:       # 4: the smallest per-splat stride
+            per -= _WORKGROUP
+        per = max(per, _WORKGROUP)
+        return [(b, min(per, self.n - b)) for b in range(0, self.n, per)]
+
+    def _basis_chunks(self, basis, first: int = 0, count: int | None = None) -> list[tuple[int, int, int, int]]:
         """(first splat, splat count, byte offset, byte range) windows of the
-        basis buffer that each fit one storage binding."""
+        basis buffer that each fit one storage binding, covering splats
+        first .. first + count - 1 (all by default)."""
+        count = self.n - first if count is None else count
         row_bytes = 64 * self._basis_groups
         if basis.size < self.n * row_bytes:          # the dummy (nothing deformed): one window
-            return [(0, self.n, 0, basis.size)]
+            return [(first, count, 0, basis.size)]
         limit = int(self.dev.limits.maxStorageBufferRange)
         align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
         per = max(limit // row_bytes // _WORKGROUP * _WORKGROUP, _WORKGROUP)
         while (per * row_bytes) % align:
             per -= _WORKGROUP
         out = []
-        for base in range(0, self.n, per):
-            cnt = min(per, self.n - base)
+        for base in range(first, first + count, per):
+            cnt = min(per, first + count - base)
             out.append((base, cnt, base * row_bytes, cnt * row_bytes))
         return out
 
@@ -785,51 +828,66 @@ class Renderer:
         if self._prep is None:
             objs = []
             try:
-                rec_a = V.Buffer(self.dev, self.n * _REC_A_BYTES, ("storage",))
+                spans = self._prep_windows()
+                slots = max(cnt for _, cnt in spans)
+                rec_a = V.Buffer(self.dev, slots * _REC_A_BYTES, ("storage",))
                 objs.append(rec_a)
-                rec_b = V.Buffer(self.dev, self.n * _REC_B_BYTES, ("storage",))
+                rec_b = V.Buffer(self.dev, slots * _REC_B_BYTES, ("storage",))
                 objs.append(rec_b)
                 draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
                 objs.append(draws)
                 basis = self._basis_binding()
-                chunks = []
-                for base, cnt, off, rng in self._basis_chunks(basis):
-                    detail = self._detail_buf
-                    dset = V.DescriptorSet(self.dev, self.cache.set_layout(
-                        _PREP_SET if detail is None else _PREP_SET_DETAIL))
-                    objs.append(dset)
-                    writes = {0: self.ubo, 1: self._geom, 2: self._color, 3: self._flags, 4: (basis, off, rng),
-                              5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
-                    if detail is not None:
-                        writes[9] = detail
-                    dset.write(writes)
-                    chunks.append((dset, base, cnt))
+                detail = self._detail_buf
+                windowed = len(spans) > 1
+                windows = []
+                for w0, wn in spans:
+                    def span(buf, stride):
+                        return (buf, w0 * stride, wn * stride) if windowed else buf
+                    chunks = []
+                    for base, cnt, off, rng in self._basis_chunks(basis, w0, wn):
+                        dset = V.DescriptorSet(self.dev, self.cache.set_layout(
+                            _PREP_SET if detail is None else _PREP_SET_DETAIL))
+                        objs.append(dset)
+                        writes = {0: self.ubo, 1: span(self._geom, _GEOM_STRIDE), 2: span(self._color, 4),
+                                  3: span(self._flags, 4), 4: (basis, off, rng),
+                                  5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
+                        if detail is not None:
+                            writes[9] = span(detail, 16)
+                        dset.write(writes)
+                        chunks.append((dset, base, cnt))
+                    windows.append((w0, wn, chunks))
             except BaseException:
                 for o in reversed(objs):
                     o.destroy()
                 raise
-            self._prep = _Prep(objs, chunks[0][0], rec_a, rec_b, draws, chunks)
+            self._prep = _Prep(objs, windows[0][2][0][0], rec_a, rec_b, draws, windows)
         return self._prep
 
-    def _record_prepass(self, cb):
-        """Compute pre-pass: records + indirect draw counts for this frame's camera
-        (one dispatch per basis window)."""
+    def _record_prepass(self, cb, window: int = 0):
+        """Compute pre-pass of splat window ``window``: records + indirect draw
+        counts for this frame's camera (one dispatch per basis window). Before
+        any window but the first of a frame, it waits for the draws that read
+        the previous window's records."""
         prep = self._prep_objects()
+        w0, wn, chunks = prep.windows[window]
         g = self._basis_groups
         detail = self._detail_buf is not None
         stem = "prepare_detail" if detail else "prepare"
         comp = f"{stem}.comp" if g == 1 else f"{stem}_k{4 * g}.comp"
-        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=12,
+        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=16,
                               push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
+        if len(prep.windows) > 1:        # the previous window's draws read records and counts
+            cb.memory_barrier("draw_indirect|vertex", "indirect_read|shader_read", "transfer|compute",
+                              "transfer_write|shader_write")
         cb.fill_buffer(prep.draws, 0)
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
-        for j, (dset, base, cnt) in enumerate(prep.chunks):
+        for j, (dset, base, cnt) in enumerate(chunks):
             if j:
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
             cb.bind_descriptor_set(pipe, dset)
-            cb.push_constants(pipe, np.array([base, cnt, self.n], np.uint32))
+            cb.push_constants(pipe, np.array([base, cnt, wn, w0], np.uint32))
             cb.dispatch((cnt + _WORKGROUP - 1) // _WORKGROUP)
         cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
                           "indirect_read|shader_read")
@@ -851,12 +909,13 @@ class Renderer:
                                   depth_compare="less", **common)
         return self.cache.pipeline(desc)
 
-    def _record_splats(self, cb, kind: str, prepared: bool = False):
-        """Draw every splat: as quads, or (point_splats) tiny ones as points + the others as quads."""
+    def _record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
+        """Draw every splat: as quads, or (point_splats) tiny ones as points +
+        the others as quads; ``prepared``: the records of pre-pass window ``window``."""
         if prepared:
             prep = self._prep_objects()
             dset, draws = prep.dset, prep.draws
-            n = np.array([self.n], np.uint32)
+            n = np.array([prep.windows[window][1]], np.uint32)
             for mode, offset in ((1, 0), (2, 16)):
                 pipeline = self._prepared_pipeline(kind, mode)
                 cb.bind_pipeline(pipeline)
@@ -876,22 +935,41 @@ class Renderer:
             else:
                 cb.draw(1, self.n)
 
+    def _prep_window_count(self, prepared: bool) -> int:
+        """Pre-pass windows of this frame (1 for the vertex path)."""
+        return len(self._prep_objects().windows) if prepared else 1
+
+    def _record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
+        """One splat pass (``kind`` depth, attr or pick) into ``fb``. With several
+        pre-pass windows: per window, its pre-pass then its draws (in a render
+        pass that keeps the previous windows' results)."""
+        count = self._prep_window_count(prepared)
+        if count == 1:
+            cb.begin_render_pass(self.cache.render_pass(desc), fb, clears)
+            self._record_splats(cb, kind, prepared)
+            cb.end_render_pass()
+            return
+        for k in range(count):
+            self._record_prepass(cb, k)
+            cb.begin_render_pass(self.cache.render_pass(_rp_window(desc, k == 0, k == count - 1)), fb, clears)
+            self._record_splats(cb, kind, True, k)
+            cb.end_render_pass()
+
     def _record_passes_12(self, cb, t: _Targets, attr_final: str):
+        """Visibility and attribute passes. Timings: with several pre-pass
+        windows the pre-pass runs inside each pass (once per window and pass),
+        so its time is part of the visibility and attribute times."""
         self.frames_recorded += 1
         cb.timestamp(self._query, 0, bottom=False)
         prepared = self._use_prepass()
-        if prepared:
+        if prepared and self._prep_window_count(prepared) == 1:
             self._record_prepass(cb)
         cb.timestamp(self._query, 1)
-        cb.begin_render_pass(self.cache.render_pass(_RP_DEPTH), t.fb_depth, [1.0])
-        self._record_splats(cb, "depth", prepared)
-        cb.end_render_pass()
+        self._record_splat_pass(cb, "depth", _RP_DEPTH, t.fb_depth, [1.0], prepared)
         cb.timestamp(self._query, 2)
-        rp_attr = self.cache.render_pass(_rp_attr(self.accum_format, attr_final))
-        cb.begin_render_pass(rp_attr, t.fb_attr if attr_final == "shader_read" else self._fb_attr_readback(t),
-                             [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None])
-        self._record_splats(cb, "attr", prepared)
-        cb.end_render_pass()
+        self._record_splat_pass(cb, "attr", _rp_attr(self.accum_format, attr_final),
+                                t.fb_attr if attr_final == "shader_read" else self._fb_attr_readback(t),
+                                [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None], prepared)
         cb.timestamp(self._query, 3)
 
     def _fb_attr_readback(self, t: _Targets):
@@ -1053,11 +1131,9 @@ class Renderer:
                 cb.reset_queries(self._query)
                 cb.timestamp(self._query, 0, bottom=False)
                 prepared = self._use_prepass()
-                if prepared:
+                if prepared and self._prep_window_count(prepared) == 1:
                     self._record_prepass(cb)
-                cb.begin_render_pass(self.cache.render_pass(_RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
-                self._record_splats(cb, "pick", prepared)
-                cb.end_render_pass()
+                self._record_splat_pass(cb, "pick", _RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
                 cb.timestamp(self._query, 1)
                 cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
                 cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)

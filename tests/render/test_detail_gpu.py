@@ -68,3 +68,32 @@ def test_detail_renders_through_the_prepass_even_when_it_is_off(renderer, plane)
         assert renderer._detail_buf is None
     finally:
         renderer.prepass = saved
+
+
+def test_detail_matches_cpu_in_prepass_windows(renderer, plane, monkeypatch):
+    """A cloud above the storage-buffer range (forced small here: 2,700 splats
+    in 3 windows of 1,024) renders the detail mode window by window with the
+    CPU apply's image (the detail rows are bound per window too)."""
+    c = plane.cloud
+    det = DetailBasis.fit(c, plane.support, [plane.handle])
+    dC = det.displacement([bend(plane)])
+    deformed = det.apply(c, dC)
+    cam = Camera.frame(*deformed.bounds(), 1.0, direction=(0.3, -1.0, 0.6))
+    limits = renderer.dev.limits
+
+    class Small:
+        def __getattr__(self, name):
+            return getattr(limits, name)
+        maxStorageBufferRange = 48 * 1024
+
+    setup = _setup(renderer, det, dC)
+
+    def windowed():
+        setup()
+        monkeypatch.setattr(renderer.dev, "limits", Small())
+    try:
+        _compare(renderer, c, deformed, cam, windowed)
+        assert [cnt for _, cnt, _ in renderer._prep.windows] == [1024, 1024, c.n - 2048]
+    finally:
+        monkeypatch.undo()
+        renderer.set_cloud(c)
