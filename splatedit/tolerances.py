@@ -767,3 +767,13 @@ EDITOR_GUI_MIN_AXIS_NORM = 1e-9
 #: one to spare.  Without it the idle loop's 0.5 s wait delayed a click's
 #: effect by up to 0.5 s
 EDITOR_GUI_SETTLE_FRAMES = 4
+
+# ---------------------------------------------------------------------------
+# Progressive refinement in the editor (issue 11 part 5)
+# ---------------------------------------------------------------------------
+#: smallest chunk of splats per progressive step (below it the per-submit cost
+#: of lavapipe, ~5-10 ms for resolve + readback at 1280x720, dominates)
+EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
+#: a step's chunk grows at most this factor at a time (the first steps' times
+#: include pipeline creation and are not representative of the cost per splat)
+EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
