@@ -58,6 +58,7 @@ class FrameScheduler:
         self.progressive = None          # ProgressiveRefinement of the current view
         #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
         self.last_progressive = None
+        self._stepped = None             # the refinement stepped in the frame being drawn
         self._refine_failed_key = None   # view whose background frame failed (not retried)
         self.last_motion = 0.0
         self.frame_ms = 0.0
@@ -143,6 +144,9 @@ class FrameScheduler:
             ed.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+        if self._stepped is not None:
+            self._stepped.frame_ms.append(self.frame_ms)
+            self._stepped = None
         if self._rendered_interactive:
             self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
             # the frame budget is for the whole frame: leave room for overlay + present
@@ -249,6 +253,7 @@ class FrameScheduler:
             if under is None or under.shape[:2] != (h, w):
                 under = vp.render(ed.cam, w, h, interactive=True)
             p = self.progressive = ProgressiveRefinement(frame, key, under, vp.budget_ms)
+        self._stepped = p
         try:
             img = p.step()
         except SplatEditError as exc:

@@ -42,8 +42,10 @@ class ProgressiveRefinement:
         #: seconds from the start to the first shown chunk, and to full quality
         self.first_chunk_s: float | None = None
         self.done_s: float | None = None
-        #: milliseconds of every step (one GPU submit each)
+        #: milliseconds of every step (one GPU submit each), and of every whole
+        #: presented frame while refining (step + composite + present + GUI)
         self.step_ms: list[float] = []
+        self.frame_ms: list[float] = []
         #: splats drawn in the attribute phase when each image was shown
         self.shown_splats: list[int] = []
         #: pixels covered by full-quality splats in each shown image
