@@ -253,6 +253,9 @@ class FrameScheduler:
             if under is None or under.shape[:2] != (h, w):
                 under = vp.render(ed.cam, w, h, interactive=True)
             p = self.progressive = ProgressiveRefinement(frame, key, under, vp.budget_ms)
+            # shown until the first chunk arrives: pixels, not the renderers' images (a
+            # ResidentFrame of the full renderer is destroyed when the steps resize its targets)
+            self.scene = under
         self._stepped = p
         try:
             img = p.step()
