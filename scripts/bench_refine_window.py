@@ -46,9 +46,11 @@ def _status(path: Path) -> dict:
         return {}
 
 
-def _wait(path: Path, cond, timeout: float) -> dict:
+def _wait(path: Path, cond, timeout: float, proc=None) -> dict:
     t0 = time.time()
     while time.time() - t0 < timeout:
+        if proc is not None and proc.poll() is not None:
+            raise RuntimeError(f"the editor exited with code {proc.returncode}")
         s = _status(path)
         if s and cond(s):
             return s
@@ -70,7 +72,7 @@ def measure(n: int, size: tuple[int, int], folder: Path, display: str) -> dict:
                            "--size", f"{size[0]}x{size[1]}"], env=env, stdout=log, stderr=subprocess.STDOUT)
     try:
         t_open = time.time()
-        s = _wait(st, lambda s: s.get("idle") and s.get("last_refinement"), 600)
+        s = _wait(st, proc=ed, cond=lambda s: s.get("idle") and s.get("last_refinement"), timeout=600)
         opened_s = time.time() - t_open
         # a camera change: one wheel step over the model, then the refinement of the new view
         def xdo(*a):
@@ -78,15 +80,15 @@ def measure(n: int, size: tuple[int, int], folder: Path, display: str) -> dict:
         xdo("mousemove", size[0] // 2, size[1] // 2)
         d0 = s["camera"]["distance"]
         xdo("click", 5)
-        _wait(st, lambda s: s["camera"]["distance"] != d0, 60)
-        _wait(st, lambda s: s.get("refining") is not None and s["refining"] > 0.55, 300)
+        _wait(st, proc=ed, cond=lambda s: s["camera"]["distance"] != d0, timeout=60)
+        _wait(st, proc=ed, cond=lambda s: s.get("refining") is not None and s["refining"] > 0.55, timeout=300)
         # input during refinement: a second wheel step, time until the status shows it
         d1 = _status(st)["camera"]["distance"]
         t_in = time.time()
         xdo("click", 4)
-        _wait(st, lambda s: s["camera"]["distance"] != d1, 60)
+        _wait(st, proc=ed, cond=lambda s: s["camera"]["distance"] != d1, timeout=60)
         latency = time.time() - t_in
-        s = _wait(st, lambda s: s.get("idle") and s.get("last_refinement") and s["camera"]["distance"] != d1, 600)
+        s = _wait(st, proc=ed, cond=lambda s: s.get("idle") and s.get("last_refinement") and s["camera"]["distance"] != d1, timeout=600)
         lr = s["last_refinement"]
         return {"case": "editor_refine_window", "splats": n, "size": list(size), "open_to_full_quality_s":
                 round(opened_s, 2), "input_latency_during_refine_ms": round(latency * 1e3),

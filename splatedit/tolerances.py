@@ -771,8 +771,10 @@ EDITOR_GUI_SETTLE_FRAMES = 4
 # ---------------------------------------------------------------------------
 # Progressive refinement in the editor (issue 11 part 5)
 # ---------------------------------------------------------------------------
-#: smallest chunk of splats per progressive step (below it the per-submit cost
-#: of lavapipe, ~5-10 ms for resolve + readback at 1280x720, dominates)
+#: smallest chunk of splats per progressive step: 1M splats at 1280x720 on lavapipe
+#: (2 loaded cores) took 39 ms per visibility step and 66 ms per colour step (resolve +
+#: readback included) at 20k, 5.5 s in all vs 3.2 s in one submit; smaller chunks
+#: add more per-submit overhead than they save in frame time
 EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
 #: a step's chunk grows at most this factor at a time (the first steps' times
 #: include pipeline creation and are not representative of the cost per splat)
