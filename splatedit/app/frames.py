@@ -1,7 +1,16 @@
 """Frame scheduling of the editor: when to draw a fast interactive frame,
-when the full-quality one (here, or in the background refiner for slow
-models), presenting it with the overlay, and the frame-time bookkeeping
-that sizes the interactive budget.
+when the full-quality one, presenting it with the overlay, and the
+frame-time bookkeeping that sizes the interactive budget.
+
+Full quality: drawn at once when it is cheap; when it is slow (a large model,
+drawn at a level of detail while moving) it is drawn after motion stops by
+the background refiner (a whole frame on a second device, with the compute
+pre-pass, shown when done) or, with ``SPLATEDIT_REFINE=progressive``, refined
+progressively (:mod:`splatedit.app.progressive_refine`: a chunk of splats per
+idle frame on the same device, composited over the level-of-detail frame,
+dropped on any change: the image sharpens instead of switching, but without
+the pre-pass full quality comes 3-5x later; the detail mode always uses the
+refiner).
 
 Two presentation paths: the GPU path (the editor has a GUI,
 :mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
@@ -12,6 +21,7 @@ GUI): the frame is read back, the overlay patches are blended on the CPU
 
 from __future__ import annotations
 
+import os
 import time
 from dataclasses import dataclass
 
@@ -21,8 +31,11 @@ from splatedit.app import overlay as ov
 from splatedit.app import revision
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
+from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
-from splatedit.tolerances import EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS, EDITOR_REFINE_DELAY_S
+from splatedit.errors import SplatEditError
+from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS,
+                                  EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_REFINE_DELAY_S)
 
 
 @dataclass(frozen=True)
@@ -45,6 +58,10 @@ class FrameScheduler:
         self.scene_key: SceneKey | None = None
         self.scene_interactive = False
         self.refiner = None
+        self.progressive = None          # ProgressiveRefinement of the current view
+        #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
+        self.last_progressive = None
+        self._stepped = None             # the refinement stepped in the frame being drawn
         self._refine_failed_key = None   # view whose background frame failed (not retried)
         self.last_motion = 0.0
         self.frame_ms = 0.0
@@ -57,6 +74,12 @@ class FrameScheduler:
 
     def invalidate(self) -> None:
         self.scene_key = None
+        self.drop_progressive()
+
+    def drop_progressive(self) -> None:
+        if self.progressive is not None:
+            self.progressive.close()
+            self.progressive = None
 
     def motion(self) -> None:
         self.last_motion = time.perf_counter()
@@ -89,7 +112,7 @@ class FrameScheduler:
     def pending(self) -> bool:
         """A frame must be drawn now (the scene is stale or still interactive)."""
         s = self.ed.session
-        return (self.scene_key is None or self.ed.drag is not DragMode.NONE
+        return (self.scene_key is None or self.ed.drag is not DragMode.NONE or self.progressive is not None
                 or (self.scene_interactive and not (s is not None and self.async_refine()))
                 or (s is not None and self.scene_key != self.state()))
 
@@ -124,6 +147,9 @@ class FrameScheduler:
             ed.presenter.present(frame)
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
+        if self._stepped is not None:
+            self._stepped.frame_ms.append(self.frame_ms)
+            self._stepped = None
         if self._rendered_interactive:
             self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
             # the frame budget is for the whole frame: leave room for overlay + present
@@ -178,13 +204,18 @@ class FrameScheduler:
         now = time.perf_counter()
         moving = now - self.last_motion < EDITOR_REFINE_DELAY_S or ed.drag is not DragMode.NONE
         stale = self.scene is None or key != self.scene_key
+        if self.progressive is not None and (moving or self.progressive.key != key):
+            self.drop_progressive()          # any change: camera, selection, pose, display
         if stale or (self.scene_interactive and not moving):
             if not moving and self.async_refine():
-                # a slow full-quality frame: drawn by the background refiner, once the
-                # view has been still for a while (a started frame cannot be aborted)
+                # a slow full-quality frame: refined progressively, a chunk per frame
                 if stale:
                     self.render_scene(key, interactive=True)
-                if (self.scene_interactive and key != self._refine_failed_key
+                if self.scene_interactive and self._progressive_step(key, w, h):
+                    pass
+                # the detail mode: drawn by the background refiner, once the view
+                # has been still for a while (a started frame cannot be aborted)
+                elif (self.scene_interactive and key != self._refine_failed_key
                         and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S):
                     self.request_refine(key)
             else:
@@ -200,6 +231,58 @@ class FrameScheduler:
             if img is not None and img.shape[:2] == (h, w):
                 self.scene, self.scene_interactive = img, False
                 ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
+
+    def _progressive_step(self, key, w: int, h: int) -> bool:
+        """One step of the progressive refinement of ``key`` (started here); False
+        where it is not used (the background refiner draws the frame instead):
+        unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame draws
+        without the compute pre-pass, so full quality arrives 3-5x later than
+        from the background refiner: 8 s against about 2 s at 1M splats, see
+        docs/PERFORMANCE.md), and always in the detail mode, which it cannot draw."""
+        if os.environ.get("SPLATEDIT_REFINE", "background") != "progressive":
+            return False
+        ed, vp = self.ed, self.ed.viewport
+        p = self.progressive
+        if p is None:
+            if key == self._refine_failed_key:
+                return True
+            chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK, int(vp.budget_ms / max(vp.ms_per_splat, 1e-9)))
+            if self.gpu:
+                ed.presenter.wait_previous()     # the shown frame may be the full renderer's image
+            try:
+                frame = vp.progressive(ed.cam, w, h, chunk)
+            except SplatEditError as exc:
+                ed.say(f"full-quality frame failed: {exc}")
+                self._refine_failed_key = key
+                return True
+            if frame is None:
+                return False
+            # the level-of-detail frame as pixels, under the chunks
+            under = self.scene if isinstance(self.scene, np.ndarray) else None
+            if under is None or under.shape[:2] != (h, w):
+                under = vp.render(ed.cam, w, h, interactive=True)
+            p = self.progressive = ProgressiveRefinement(frame, key, under, vp.budget_ms)
+            # shown until the first chunk arrives: pixels, not the renderers' images (a
+            # ResidentFrame of the full renderer is destroyed when the steps resize its targets)
+            self.scene = under
+        self._stepped = p
+        try:
+            img = p.step()
+        except SplatEditError as exc:
+            ed.say(f"full-quality frame failed: {exc}")
+            self._refine_failed_key = key
+            self.drop_progressive()
+            return True
+        if img is not None:
+            self.scene = img
+        if p.done:
+            self.scene_interactive = False
+            n = ed.session.cloud.n
+            vp.last_info = FrameInfo(p.total_ms, n, 1, False, False)
+            vp.ms_per_splat = p.total_ms / max(n, 1)
+            self.last_progressive = p
+            self.drop_progressive()
+        return True
 
     def render_scene(self, key, interactive: bool) -> None:
         ed = self.ed
@@ -230,6 +313,7 @@ class FrameScheduler:
                                        splat_scale=vp.splat_scale, background=vp.background, pick_key=ed.brush.pick_key()))
 
     def close(self) -> None:
+        self.drop_progressive()
         if self.refiner is not None:
             self.refiner.close()
             self.refiner = None

@@ -83,6 +83,15 @@ def status_dict(ed) -> dict:
               brush_mode=tools.mode, closure_added=tools.last_added,
               closure_highlight=tools.highlighted(s.cloud) is not None)
     st["idle"] = bool(ed.idle())
+    fr = ed.frames
+    pr = fr.progressive
+    st["refining"] = None if pr is None else round(pr.frame.fraction, 3)
+    last = fr.last_progressive
+    st["last_refinement"] = None if last is None else {
+        "first_chunk_s": _r(last.first_chunk_s, 3), "done_s": _r(last.done_s, 3), "steps": len(last.step_ms),
+        "step_ms_max": _r(max(last.step_ms)), "shown": len(last.shown_splats),
+        "frame_ms_median": _r(np.median(last.frame_ms)) if last.frame_ms else None,
+        "frame_ms_max": _r(max(last.frame_ms)) if last.frame_ms else None}
     w, h = ed.size
     gz = ed.gizmo
     if not (w and h):

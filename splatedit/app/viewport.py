@@ -317,6 +317,19 @@ class Viewport:
         self.last_info = FrameInfo(ms, count, div, level is not None, interactive)
         return img if resident else np.ascontiguousarray(img)
 
+    def progressive(self, cam: OrbitCamera, w: int, h: int, chunk: int):
+        """A :class:`~splatedit.render.progressive.ProgressiveFrame` of the full
+        cloud (``chunk`` splats per step) on the full renderer, synced with the
+        document; None where it cannot draw the frame (a Gaussian document, or
+        the detail mode, which has no vertex-path variant)."""
+        if self.gaussians is not None or self.cloud is None:
+            return None
+        from splatedit.render.progressive import ProgressiveFrame
+        self._sync(self.full)
+        if self.full.r._detail_buf is not None:
+            return None
+        return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)
+
     def pick(self, cam: OrbitCamera, w: int, h: int):
         """(index map (h, w) int64, -1 background; depth (h, w)) of the full cloud."""
         if self.gaussians is not None:

@@ -24,7 +24,7 @@ renderer draws any other frame in between (or the selection, basis or
 displacement change), start a new one; :meth:`step` detects another frame
 (:attr:`Renderer.frames_recorded`) and starts over by itself.
 
-Editor use (not wired in yet): when motion stops, create
+Editor use (:mod:`splatedit.app.progressive_refine`): when motion stops, create
 ``ProgressiveFrame(full_renderer, camera, w, h, chunk)`` with ``chunk`` sized
 to the frame budget (``budget_ms / ms_per_splat``), call :meth:`step` once
 per idle frame and show ``composite(image, lod_frame)`` until :attr:`done`;

@@ -1,0 +1,119 @@
+"""Progressive refinement in the real editor window (Xvfb, lavapipe).
+
+    PYTHONPATH=$PWD python scripts/bench_refine_window.py 1000000 4000000 [--size 1280x720] [--dir /tmp]
+
+For each count: writes a bunny-surface model (``bench_editor``'s cloud) as
+binary PLY, opens it in the editor under a private Xvfb with a status file,
+and once it is idle: scrolls the wheel once (a camera change) and waits for
+the refinement of the new view.  One JSON line per model: time to the first
+refined chunk and to full quality after motion stopped, frame times while
+refining (whole presented frames), the number of steps, and the input
+latency (wheel event sent during refinement -> the new camera in the status
+file).  Needs Xvfb and xdotool.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+import os
+import subprocess
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+
+def _xvfb():
+    r, w = os.pipe()
+    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
+                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, pass_fds=(w,))
+    os.close(w)
+    text = b""
+    with os.fdopen(r, "rb") as pipe:
+        while not text.endswith(b"\n"):
+            c = pipe.read(1)
+            if not c:
+                break
+            text += c
+    return proc, f":{int(text)}"
+
+
+def _status(path: Path) -> dict:
+    try:
+        return json.loads(path.read_text())
+    except (FileNotFoundError, json.JSONDecodeError):
+        return {}
+
+
+def _wait(path: Path, cond, timeout: float, proc=None) -> dict:
+    t0 = time.time()
+    while time.time() - t0 < timeout:
+        if proc is not None and proc.poll() is not None:
+            raise RuntimeError(f"the editor exited with code {proc.returncode}")
+        s = _status(path)
+        if s and cond(s):
+            return s
+        time.sleep(0.02)
+    raise TimeoutError(f"last status: { {k: _status(path).get(k) for k in ('idle', 'refining', 'last_refinement')} }")
+
+
+def measure(n: int, size: tuple[int, int], folder: Path, display: str) -> dict:
+    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.io import write
+    model = folder / f"refine_bench_{n}.ply"
+    if not model.exists():
+        write(model, bunny_surface_cloud(n), overwrite=True)
+    st = folder / f"refine_status_{n}.json"
+    st.unlink(missing_ok=True)
+    env = dict(os.environ, DISPLAY=display)
+    log = open(folder / f"refine_editor_{n}.log", "w")
+    ed = subprocess.Popen([sys.executable, "-m", "splatedit.app.editor", str(model), "--status-file", str(st),
+                           "--size", f"{size[0]}x{size[1]}"], env=env, stdout=log, stderr=subprocess.STDOUT)
+    try:
+        t_open = time.time()
+        s = _wait(st, proc=ed, cond=lambda s: s.get("idle") and s.get("last_refinement"), timeout=600)
+        opened_s = time.time() - t_open
+        # a camera change: one wheel step over the model, then the refinement of the new view
+        def xdo(*a):
+            subprocess.run(["xdotool", *map(str, a)], env=env, check=True)
+        xdo("mousemove", size[0] // 2, size[1] // 2)
+        d0 = s["camera"]["distance"]
+        xdo("click", 5)
+        _wait(st, proc=ed, cond=lambda s: s["camera"]["distance"] != d0, timeout=60)
+        _wait(st, proc=ed, cond=lambda s: s.get("refining") is not None and s["refining"] > 0.55, timeout=300)
+        # input during refinement: a second wheel step, time until the status shows it
+        d1 = _status(st)["camera"]["distance"]
+        t_in = time.time()
+        xdo("click", 4)
+        _wait(st, proc=ed, cond=lambda s: s["camera"]["distance"] != d1, timeout=60)
+        latency = time.time() - t_in
+        s = _wait(st, proc=ed, cond=lambda s: s.get("idle") and s.get("last_refinement") and s["camera"]["distance"] != d1, timeout=600)
+        lr = s["last_refinement"]
+        return {"case": "editor_refine_window", "splats": n, "size": list(size), "open_to_full_quality_s":
+                round(opened_s, 2), "input_latency_during_refine_ms": round(latency * 1e3),
+                "moving_frame_ms_median": s.get("moving_frame_ms_median"), **lr}
+    finally:
+        ed.kill()
+        ed.wait(10)
+        log.close()
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser()
+    ap.add_argument("counts", type=int, nargs="+")
+    ap.add_argument("--size", default="1280x720")
+    ap.add_argument("--dir", default=tempfile.gettempdir())
+    a = ap.parse_args()
+    size = tuple(int(x) for x in a.size.split("x"))
+    proc, display = _xvfb()
+    try:
+        for n in a.counts:
+            print(json.dumps(measure(n, size, Path(a.dir), display)), flush=True)
+    finally:
+        proc.terminate()
+        proc.wait(5)
+
+
+if __name__ == "__main__":
+    main()
