@@ -37,6 +37,8 @@ from typing import Iterator
 
 import numpy as np
 
+from splatedit.bench.render import fibonacci_sphere
+
 _CHUNK = 1_000_000
 
 _CHILD = r"""
@@ -87,16 +89,8 @@ def write_sphere_ply(path: Path, n: int) -> int:
     with open(path, "wb") as fh:
         fh.write("\n".join(head).encode("ascii"))
         for lo in range(0, n, _CHUNK):
-            i = np.arange(lo, min(n, lo + _CHUNK)) + 0.5
-            z = 1.0 - 2.0 * i / n
-            phi = np.pi * (1.0 + 5 ** 0.5) * i
-            r = np.sqrt(1.0 - z * z)
-            nrm = np.stack([r * np.cos(phi), r * np.sin(phi), z], axis=1)
-            a = np.where(np.abs(nrm[:, [0]]) < 0.9, np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]))
-            t1 = np.cross(nrm, a)
-            t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-            t2 = np.cross(nrm, t1)
-            arr = np.empty(len(i), dtype=fields)
+            nrm, t1, t2 = fibonacci_sphere(n, lo, min(n, lo + _CHUNK))
+            arr = np.empty(len(nrm), dtype=fields)
             for j, p in enumerate("xyz"):
                 arr[p] = nrm[:, j]
                 arr["n" + p] = nrm[:, j]

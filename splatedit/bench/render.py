@@ -22,8 +22,11 @@ from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
 
 
-def sphere_cloud(n: int, overlap: float = 1.0) -> SplatCloud:
-    i = np.arange(n) + 0.5
+def fibonacci_sphere(n: int, start: int = 0, stop: int | None = None):
+    """Points ``start..stop`` of an ``n``-point Fibonacci sphere (unit radius):
+    ``(normals, t1, t2)``, each (stop - start, 3) float64 (the points are the
+    normals; t1, t2 unit tangents)."""
+    i = np.arange(start, n if stop is None else stop) + 0.5
     z = 1.0 - 2.0 * i / n
     phi = np.pi * (1.0 + 5 ** 0.5) * i
     r = np.sqrt(1.0 - z * z)
@@ -31,7 +34,11 @@ def sphere_cloud(n: int, overlap: float = 1.0) -> SplatCloud:
     a = np.where(np.abs(nrm[:, [0]]) < 0.9, np.array([[1.0, 0, 0]]), np.array([[0, 1.0, 0]]))
     t1 = np.cross(nrm, a)
     t1 /= np.linalg.norm(t1, axis=1, keepdims=True)
-    t2 = np.cross(nrm, t1)
+    return nrm, t1, np.cross(nrm, t1)
+
+
+def sphere_cloud(n: int, overlap: float = 1.0) -> SplatCloud:
+    nrm, t1, t2 = fibonacci_sphere(n)
     s = overlap * np.sqrt(4 * np.pi / n)
     return SplatCloud(nrm, t1 * s, t2 * s, None, name=f"sphere{n}")
 

@@ -261,6 +261,14 @@ def arc_coefficients(theta: float, s: np.ndarray):
         f2 = omc * inv                                      # (1 - cos x) / x
         g1 = ((1.0 - omc) - f1) * inv                       # d/dx f1 = (x cos x - sin x) / x^2
         g2 = (sn - f2) * inv                                # d/dx f2 = (x sin x - 1 + cos x) / x^2
+    series_fill(x, f1, f2, g1, g2)
+    return theta * f1, theta * f2, theta * theta * g1, theta * theta * g2
+
+
+def series_fill(x: np.ndarray, f1, f2, g1, g2) -> None:
+    """Overwrite, where ``|x| < _SERIES_X``, the closed forms of ``sin x / x``,
+    ``(1 - cos x) / x`` and their derivatives (arrays like ``x``) by their
+    Taylor series (the closed forms cancel there)."""
     small = np.flatnonzero(np.abs(x) < _SERIES_X)
     if len(small):
         xs = x[small]
@@ -269,7 +277,6 @@ def arc_coefficients(theta: float, s: np.ndarray):
         f2[small] = xs / 2.0 - xs * x2 / 24.0
         g1[small] = -xs / 3.0 + xs * x2 / 30.0
         g2[small] = 0.5 - x2 / 8.0
-    return theta * f1, theta * f2, theta * theta * g1, theta * theta * g2
 
 
 def _cross(k: np.ndarray, y: np.ndarray) -> np.ndarray:

@@ -37,7 +37,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.rotation import _SERIES_X
+from splatedit.deform.rotation import series_fill
 from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, ROTATION_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
 
 
@@ -111,14 +111,7 @@ def arc_coefficients_tan(theta: float, s: np.ndarray):
         g1 *= inv                                   # (x cos x - sin x) / x^2
         g2 = np.subtract(sn, f2)
         g2 *= inv                                   # (x sin x - 1 + cos x) / x^2
-    small = np.flatnonzero(np.abs(x) < _SERIES_X)
-    if len(small):
-        xs = x[small]
-        x2 = xs * xs
-        f1[small] = 1.0 - x2 / 6.0
-        f2[small] = xs / 2.0 - xs * x2 / 24.0
-        g1[small] = -xs / 3.0 + xs * x2 / 30.0
-        g2[small] = 0.5 - x2 / 8.0
+    series_fill(x, f1, f2, g1, g2)
     f1 *= theta
     f2 *= theta
     g1 *= theta * theta
