@@ -48,7 +48,7 @@ from splatedit.render.gpu_units import (DEFORM_UBO_BYTES, MAX_GROUPS, displaceme
                                         pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
 from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
-from splatedit.render.targets import RP_PICK, RenderTarget, clip_rect, decode_pick, rp_resolve, targets_for
+from splatedit.render.targets import RP_PICK, RenderTarget, rp_resolve, targets_for
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -464,32 +464,21 @@ class GaussianRenderer:
         or ``rect`` = (x, y, w, h) (clipped): the API of Renderer.pick."""
         self._check()
         t = self._targets_for(width, height)
-        t.ensure_pick()
-        x, y, w, h = clip_rect(rect, width, height)
-        self._write_ubo(camera, width, height)
-        self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
-        nbytes = w * h * 4
-        rb = V.Buffer(self.dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
         layout = V.LayoutDesc(sets=(_GS_SET,))
         pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
                                                   depth_write=True, depth_compare="less", spec=((0, 1),)))
-        try:
-            def rec(cb):
-                # records of culled Gaussians are stale: draw in index order those the
-                # pre-pass wrote this frame (order = identity, count = all; the
-                # vertex shader drops the culled through their zeroed opacity)
-                self._record_prepass(cb)
-                cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
-                cb.begin_render_pass(self.cache.render_pass(RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
-                cb.bind_pipeline(pipe)
-                cb.bind_descriptor_set(pipe, self._dset)
-                cb.draw(4, self.n)
-                cb.end_render_pass()
-                cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
-                cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            raw = rb.read()
-        finally:
-            rb.destroy()
-        return decode_pick(raw, w, h, self._near_far)
+
+        def rec(cb):
+            self._write_ubo(camera, width, height)
+            self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
+            # records of culled Gaussians are stale: draw in index order those the
+            # pre-pass wrote this frame (order = identity, count = all; the
+            # vertex shader drops the culled through their zeroed opacity)
+            self._record_prepass(cb)
+            cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
+            cb.begin_render_pass(self.cache.render_pass(RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
+            cb.bind_pipeline(pipe)
+            cb.bind_descriptor_set(pipe, self._dset)
+            cb.draw(4, self.n)
+            cb.end_render_pass()
+        return t.read_pick(rect, rec)

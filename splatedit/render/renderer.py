@@ -32,7 +32,7 @@ from splatedit.render.splat_layout import (FLAG_DEFORMED, FLAG_HANDLE, FLAG_INAC
                                            FLAG_SUPPORT, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS,
                                            _SPLAT_SET, _UBO_BYTES, _rp_attr)
 from splatedit.render.targets import RP_PICK as _RP_PICK
-from splatedit.render.targets import RenderTarget, _Targets, clip_rect, decode_pick, targets_for
+from splatedit.render.targets import RenderTarget, _Targets, targets_for
 from splatedit.render.targets import rp_resolve as _rp_resolve
 from splatedit.render.uniforms import FRAME_UBO
 from splatedit.render.uploads import SceneUploadsMixin
@@ -466,26 +466,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._check_open()
         self._require_cloud()
         t = self._targets_for(width, height)
-        t.ensure_pick()
-        x, y, w, h = clip_rect(rect, width, height)
-        nbytes = w * h * 4
-        rb = V.Buffer(self.dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
-        try:
-            def rec(cb):
-                self._write_ubo(camera, width, height)
-                cb.reset_queries(self._query)
-                cb.timestamp(self._query, 0, bottom=False)
-                prepared = self._use_prepass()
-                if prepared and self._prep_window_count(prepared) == 1:
-                    self._record_prepass(cb)
-                self._record_splat_pass(cb, "pick", _RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
-                cb.timestamp(self._query, 1)
-                cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
-                cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            raw = rb.read()
-        finally:
-            rb.destroy()
+
+        def rec(cb):
+            self._write_ubo(camera, width, height)
+            cb.reset_queries(self._query)
+            cb.timestamp(self._query, 0, bottom=False)
+            prepared = self._use_prepass()
+            if prepared and self._prep_window_count(prepared) == 1:
+                self._record_prepass(cb)
+            self._record_splat_pass(cb, "pick", _RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
+            cb.timestamp(self._query, 1)
+        out = t.read_pick(rect, rec)
         self._read_timings(("pick",))
-        return decode_pick(raw, w, h, self._near_far)
+        return out

@@ -109,6 +109,28 @@ class SizedTargets:
                 self.pick_index = self.pick_depth = self.fb_pick = None
                 raise
 
+    def read_pick(self, rect, record):
+        """Index (h, w) int64 (-1 background) and view-axis depth (h, w)
+        float64 (model units, NaN background) of the pixels ``rect`` (see
+        :func:`clip_rect`): submits ``record(cb)`` (the renderer's pick pass
+        into :attr:`fb_pick`, which sets its ``_near_far``) and reads back."""
+        self.ensure_pick()
+        x, y, w, h = clip_rect(rect, self.width, self.height)
+        nbytes = w * h * 4
+        dev = self._r.dev
+        rb = V.Buffer(dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                record(cb)
+                cb.copy_image_to_buffer(self.pick_index, rb, (x, y, w, h))
+                cb.copy_image_to_buffer(self.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
+                cb.host_read_barrier()
+            dev.submit(rec)
+            raw = rb.read()
+        finally:
+            rb.destroy()
+        return decode_pick(raw, w, h, self._r._near_far)
+
     def destroy(self):
         for o in reversed(self.objects):
             o.destroy()
