@@ -95,15 +95,7 @@ class ProgressiveFrame:
         return (self.next + (self.n if self.phase == "attr" else 0)) / (2.0 * self.n)
 
     def _draw(self, cb, kind: str, first: int, count: int) -> None:
-        r = self.r
-        modes = ((1, 4), (2, 1)) if r.point_splats else ((0, 4),)
-        bufs = [r._geom, r._color, r._flags, r._basis_binding()]
-        for mode, verts in modes:
-            pipe = r._splat_pipeline(kind, mode)
-            cb.bind_pipeline(pipe)
-            cb.bind_descriptor_set(pipe, r.splat_set)
-            cb.bind_vertex_buffers(0, bufs)
-            cb.draw(verts, count, 0, first)
+        self.r._record_vertex_splats(cb, kind, first, count)
 
     def step(self) -> np.ndarray | None:
         """Draw the next chunk.  Returns the (height, width, 4) uint8 image

@@ -298,6 +298,12 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                 cb.push_constants(pipeline, n)
                 cb.draw_indirect(draws, offset)
             return
+        self._record_vertex_splats(cb, kind, 0, self.n)
+
+    def _record_vertex_splats(self, cb, kind: str, first: int, count: int) -> None:
+        """Vertex path: draw splats ``first`` .. ``first + count - 1`` (one
+        instance each) as quads, or (point_splats) tiny ones as points + the
+        others as quads (:mod:`splatedit.render.progressive` draws its chunks so)."""
         modes = ((1, 4), (2, 1)) if self.point_splats else ((0, 4),)
         bufs = [self._geom, self._color, self._flags, self._basis_binding()]
         for mode, verts in modes:
@@ -305,10 +311,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.bind_pipeline(pipeline)
             cb.bind_descriptor_set(pipeline, self.splat_set)
             cb.bind_vertex_buffers(0, bufs)
-            if verts == 4:
-                cb.draw(4, self.n)
-            else:
-                cb.draw(1, self.n)
+            cb.draw(verts, count, 0, first)
 
     def _record_passes_12(self, cb, t: _Targets, attr_final: str):
         """Visibility and attribute passes. Timings: with several pre-pass
