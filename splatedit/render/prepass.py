@@ -15,27 +15,30 @@ Only :mod:`splatedit.render.vk` calls Vulkan.
 
 from __future__ import annotations
 
+from dataclasses import dataclass
+
 import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.splat_layout import (_GEOM_STRIDE, _PREP_MAX_SIZE, _PREP_SET, _PREP_SET_DETAIL, _REC_A_BYTES,
-                                           _REC_B_BYTES, _RP_DEPTH, _WORKGROUP, _rp_attr, _rp_window)
-from splatedit.render.targets import RP_PICK as _RP_PICK
+                                           _REC_B_BYTES, _WORKGROUP, _rp_window, _splat_desc)
 from splatedit.tolerances import RENDER_PREPASS_WINDOW_SPLATS
 
 
+@dataclass
 class _Prep:
     """Buffers and descriptor sets of the compute pre-pass: one set per basis
     window inside each splat window (one splat window when the cloud fits one
     storage binding)."""
 
-    def __init__(self, objects, dset, rec_a, rec_b, draws, windows):
-        self.objects = objects
-        self.dset, self.rec_a, self.rec_b, self.draws = dset, rec_a, rec_b, draws
-        #: per splat window: (first splat, count, [(descriptor set, first splat, count)])
-        self.windows = windows
-
+    objects: list            # every Vulkan object above, destroyed in reverse
+    dset: V.DescriptorSet    # the first window's first set (the draws' set)
+    rec_a: V.Buffer          # records A, 48 bytes per splat of the largest window
+    rec_b: V.Buffer          # records B, 32 bytes per splat
+    draws: V.Buffer          # two indirect draws (quads, points)
+    #: per splat window: (first splat, count, [(descriptor set, first splat, count)])
+    windows: list
 
 
 class PrepassMixin:
@@ -177,19 +180,8 @@ class PrepassMixin:
     def _prepared_pipeline(self, kind: str, mode: int):
         layout = V.LayoutDesc(sets=(_PREP_SET if self._detail_buf is None else _PREP_SET_DETAIL,),
                               push_bytes=4, push_stages="vert")
-        common = dict(depth_test=True, spec=((0, mode),),
-                      topology="point_list" if mode == 2 else "triangle_strip")
-        if kind == "depth":
-            desc = V.GraphicsDesc("prepared.vert", "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
-                                  depth_compare="less", **common)
-        elif kind == "attr":
-            desc = V.GraphicsDesc("prepared.vert", "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"),
-                                  layout, depth_write=False, depth_compare="less_equal", blend_add=(True, True),
-                                  **common)
-        else:
-            desc = V.GraphicsDesc("prepared.vert", "splat_pick.frag", _RP_PICK, layout, depth_write=True,
-                                  depth_compare="less", **common)
-        return self.cache.pipeline(desc)
+        return self.cache.pipeline(_splat_desc("prepared.vert", kind, self.accum_format, layout, spec=((0, mode),),
+                                               topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _prep_window_count(self, prepared: bool) -> int:
         """Pre-pass windows of this frame (1 for the vertex path)."""

@@ -28,10 +28,9 @@ from splatedit.render.gpu_units import DEFORM_UBO_BYTES, displacement_bound, gpu
 from splatedit.render.gpu_units import unit_scale as _unit_scale  # noqa: F401 - importable from here
 from splatedit.render.prepass import PrepassMixin
 # the splat layout, importable from here as before the split (progressive.py, tests)
-from splatedit.render.splat_layout import (FLAG_DEFORMED, FLAG_HANDLE, FLAG_INACTIVE,  # noqa: F401 - re-exported
-                                           FLAG_SUPPORT, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS,
-                                           _SPLAT_SET, _UBO_BYTES, _rp_attr)
-from splatedit.render.targets import RP_PICK as _RP_PICK
+from splatedit.render.splat_layout import FLAG_DEFORMED, FLAG_HANDLE, FLAG_INACTIVE, FLAG_SUPPORT  # noqa: F401
+from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
+                                           _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, targets_for
 from splatedit.render.targets import rp_resolve as _rp_resolve
 from splatedit.render.uniforms import FRAME_UBO
@@ -197,7 +196,6 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             raise ParameterError("renderer", "is closed")
 
     # -------------------------------------------------------------- scene
-    # -------------------------------------------------------------- scene
     def _require_cloud(self):
         if self.cloud is None:
             raise ParameterError("cloud", "no cloud set (call set_cloud first)")
@@ -231,18 +229,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
         layout = V.LayoutDesc(sets=(_SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
-        common = dict(bindings=bindings, attributes=attrs, depth_test=True, spec=((0, mode),),
-                      topology="point_list" if mode == 2 else "triangle_strip")
-        if kind == "depth":
-            desc = V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, depth_write=True,
-                                  depth_compare="less", **common)
-        elif kind == "attr":
-            desc = V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(self.accum_format, "shader_read"), layout,
-                                  depth_write=False, depth_compare="less_equal", blend_add=(True, True), **common)
-        else:
-            desc = V.GraphicsDesc(vert, "splat_pick.frag", _RP_PICK, layout, depth_write=True,
-                                  depth_compare="less", **common)
-        return self.cache.pipeline(desc)
+        return self.cache.pipeline(_splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
+                                               attributes=attrs, spec=((0, mode),),
+                                               topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _resolve_pipeline(self, target: RenderTarget):
         layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
@@ -477,7 +466,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             prepared = self._use_prepass()
             if prepared and self._prep_window_count(prepared) == 1:
                 self._record_prepass(cb)
-            self._record_splat_pass(cb, "pick", _RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
+            self._record_splat_pass(cb, "pick", RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
             cb.timestamp(self._query, 1)
         out = t.read_pick(rect, rec)
         self._read_timings(("pick",))

@@ -39,6 +39,9 @@ _PREP_MAX_SIZE = 4095
 _RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(1, "sampled", "frag"),
                 V.Binding(2, "sampled", "frag"))
 
+#: the pick pass (of both renderers): splat / Gaussian index + 1 (0 background) and depth, both read back
+RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
+                           depth=V.Attachment("d32f", "clear", final="transfer_src"))
 _RP_DEPTH = V.RenderPassDesc(depth=V.Attachment("d32f", "clear", final="depth"))
 _RP_POINTS = V.RenderPassDesc(colors=(V.Attachment("rgba8", "clear", final="color"),),
                               depth=V.Attachment("d32f", "clear", final="depth"))
@@ -61,3 +64,17 @@ def _rp_attr(fmt: str, final: str) -> V.RenderPassDesc:
                                     V.Attachment(fmt, "clear", final=final)),
                             depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 
+
+def _splat_desc(vert: str, kind: str, accum_format: str, layout: V.LayoutDesc, **common) -> V.GraphicsDesc:
+    """The pipeline of splat pass ``kind`` (``"depth"``: visibility, ``"attr"``:
+    attribute accumulation into ``accum_format``, else pick) with vertex
+    shader ``vert``; ``common``: the vertex input, topology and specialisation."""
+    if kind == "depth":
+        return V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, depth_write=True, depth_compare="less",
+                              depth_test=True, **common)
+    if kind == "attr":
+        return V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(accum_format, "shader_read"), layout,
+                              depth_write=False, depth_compare="less_equal", blend_add=(True, True),
+                              depth_test=True, **common)
+    return V.GraphicsDesc(vert, "splat_pick.frag", RP_PICK, layout, depth_write=True, depth_compare="less",
+                          depth_test=True, **common)

@@ -15,14 +15,11 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
-from splatedit.render.splat_layout import _RESOLVE_SET, _RP_DEPTH, _rp_attr
+from splatedit.render.splat_layout import RP_PICK, _RESOLVE_SET, _RP_DEPTH, _rp_attr
 
 #: largest image side (pixels) either renderer accepts
 MAX_SIZE = 16384
 
-#: the pick pass: splat / Gaussian index + 1 (0 background) and depth, both read back
-RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
-                           depth=V.Attachment("d32f", "clear", final="transfer_src"))
 
 
 class RenderTarget:
