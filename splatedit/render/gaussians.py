@@ -44,11 +44,11 @@ from splatedit.errors import ParameterError
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.gpu_units import (DEFORM_UBO_BYTES, MAX_GROUPS, displacement_bound, gpu_camera,
+from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_camera,
                                         pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
 from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
-from splatedit.render.targets import RP_PICK, RenderTarget, rp_resolve, targets_for
+from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, rp_resolve, targets_for
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -109,11 +109,7 @@ class GaussianRenderer:
         self.splat_scale = 1.0
         self.grey_shading = False
         try:
-            self.cache = V.PipelineCache(self.dev)
-            self.sampler = V.Sampler(self.dev)
-            self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo = V.Buffer(self.dev, DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo.view(np.float32)[:] = 0.0
+            create_frame_objects(self, _UBO_BYTES)
             self._query = V.QueryPool(self.dev, 8)
         except BaseException:
             self.close()

@@ -24,14 +24,14 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.gpu_units import DEFORM_UBO_BYTES, displacement_bound, gpu_camera
+from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.gpu_units import unit_scale as _unit_scale  # noqa: F401 - importable from here
 from splatedit.render.prepass import PrepassMixin
 # the splat layout, importable from here as before the split (progressive.py, tests)
 from splatedit.render.splat_layout import FLAG_DEFORMED, FLAG_HANDLE, FLAG_INACTIVE, FLAG_SUPPORT  # noqa: F401
 from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
                                            _UBO_BYTES, _rp_attr, _splat_desc)
-from splatedit.render.targets import RenderTarget, _Targets, targets_for
+from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, targets_for
 from splatedit.render.targets import rp_resolve as _rp_resolve
 from splatedit.render.uniforms import FRAME_UBO
 from splatedit.render.uploads import SceneUploadsMixin
@@ -132,11 +132,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._query = None
         self._max_point_size = float(self.dev.limits.pointSizeRange[1]) if self.dev.features.largePoints else 1.0
         try:
-            self.cache = V.PipelineCache(self.dev)
-            self.sampler = V.Sampler(self.dev)
-            self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo = V.Buffer(self.dev, DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo.view(np.float32)[:] = 0.0
+            create_frame_objects(self, _UBO_BYTES)
             self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 8)

@@ -15,6 +15,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
+from splatedit.render.gpu_units import DEFORM_UBO_BYTES
 from splatedit.render.splat_layout import RP_PICK, _RESOLVE_SET, _RP_DEPTH, _rp_attr
 
 #: largest image side (pixels) either renderer accepts
@@ -158,6 +159,19 @@ class _Targets(SizedTargets):
         self.fb_attr = self._fb(rp_attr, [self.accum_color, self.accum_normal, self.depth])
         self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
+
+
+def create_frame_objects(r, ubo_bytes: int) -> None:
+    """The objects of a renderer ``r`` (with ``dev``) shared by all its frame
+    sizes, as attributes of ``r``: ``cache`` (pipeline cache), ``sampler``,
+    ``ubo`` (the frame uniforms, ``ubo_bytes``) and ``dC_ubo`` (deform.glsl's
+    block, zeros: nothing deformed).  On failure those created stay set for
+    the caller's ``close``."""
+    r.cache = V.PipelineCache(r.dev)
+    r.sampler = V.Sampler(r.dev)
+    r.ubo = V.Buffer(r.dev, ubo_bytes, ("uniform",), host_visible=True)
+    r.dC_ubo = V.Buffer(r.dev, DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
+    r.dC_ubo.view(np.float32)[:] = 0.0
 
 
 def targets_for(r, width: int, height: int, make):
