@@ -48,7 +48,7 @@ from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_came
                                         pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
 from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
-from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, rp_resolve, targets_for
+from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -421,14 +421,7 @@ class GaussianRenderer:
         cb.draw_indirect(self._draws, 0)
         cb.end_render_pass()
         cb.timestamp(self._query, 3)
-        layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
-        rpipe = self.cache.pipeline(V.GraphicsDesc("fullscreen.vert", "gs_resolve.frag", rp_resolve(target),
-                                                   layout, topology="triangle_list"))
-        cb.begin_render_pass(self.cache.render_pass(rp_resolve(target)), t.target_fb(target), [None])
-        cb.bind_pipeline(rpipe)
-        cb.bind_descriptor_set(rpipe, t.resolve_set)
-        cb.draw(3)
-        cb.end_render_pass()
+        t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
         cb.timestamp(self._query, 4)
 
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:

@@ -38,7 +38,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr, _rp_resolve
+from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 
@@ -135,13 +135,7 @@ class ProgressiveFrame:
                 cb.begin_render_pass(rp, t.fb_attr, clear)
                 self._draw(cb, "attr", first, count)
                 cb.end_render_pass()
-                pipe = r._resolve_pipeline(t.offscreen)
-                cb.begin_render_pass(r.cache.render_pass(_rp_resolve(t.offscreen)),
-                                     t.target_fb(t.offscreen), [None])
-                cb.bind_pipeline(pipe)
-                cb.bind_descriptor_set(pipe, t.resolve_set)
-                cb.draw(3)
-                cb.end_render_pass()
+                r._record_resolve(cb, t, t.offscreen)
                 cb.copy_image_to_buffer(t.out, self._rb)
                 cb.host_read_barrier()
             r.dev.submit(rec)

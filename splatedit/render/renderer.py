@@ -31,8 +31,8 @@ from splatedit.render.prepass import PrepassMixin
 from splatedit.render.splat_layout import FLAG_DEFORMED, FLAG_HANDLE, FLAG_INACTIVE, FLAG_SUPPORT  # noqa: F401
 from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
                                            _UBO_BYTES, _rp_attr, _splat_desc)
-from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, targets_for
-from splatedit.render.targets import rp_resolve as _rp_resolve
+from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
+from splatedit.render.targets import rp_resolve as _rp_resolve  # noqa: F401 - importable from here
 from splatedit.render.uniforms import FRAME_UBO
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
@@ -230,10 +230,11 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                                                topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _resolve_pipeline(self, target: RenderTarget):
-        layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
-        desc = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _rp_resolve(target), layout,
-                              topology="triangle_list")
-        return self.cache.pipeline(desc)
+        return self.cache.pipeline(resolve_desc(target, "resolve.frag", _RESOLVE_SET))
+
+    def _record_resolve(self, cb, t: _Targets, target: RenderTarget) -> None:
+        """The shading pass: normalise the accumulators of ``t``, shade, write ``target``."""
+        t.record_resolve(cb, target, "resolve.frag", _RESOLVE_SET)
 
     # ------------------------------------------------------------- frames
     def _targets_for(self, width: int, height: int) -> _Targets:
@@ -329,12 +330,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._write_ubo(camera, target.width, target.height, target.apply_gamma)
         cb.reset_queries(self._query)
         self._record_passes_12(cb, t, "shader_read")
-        pipe = self._resolve_pipeline(target)
-        cb.begin_render_pass(self.cache.render_pass(_rp_resolve(target)), t.target_fb(target), [None])
-        cb.bind_pipeline(pipe)
-        cb.bind_descriptor_set(pipe, t.resolve_set)
-        cb.draw(3)
-        cb.end_render_pass()
+        self._record_resolve(cb, t, target)
         cb.timestamp(self._query, 4)
 
     def _read_timings(self, names):

@@ -52,6 +52,13 @@ def rp_resolve(target: RenderTarget) -> V.RenderPassDesc:
     return V.RenderPassDesc(colors=(V.Attachment(target.format, "dont_care", final=target.final),))
 
 
+def resolve_desc(target: RenderTarget, frag: str, set_layout: tuple) -> V.GraphicsDesc:
+    """The full-screen pass (``fullscreen.vert`` + ``frag``, descriptor set
+    ``set_layout``) writing ``target``."""
+    return V.GraphicsDesc("fullscreen.vert", frag, rp_resolve(target), V.LayoutDesc(sets=(set_layout,)),
+                          topology="triangle_list")
+
+
 class SizedTargets:
     """Images and framebuffers of one image size, owned by renderer ``r``
     (anything with ``dev`` and ``cache``).  Subclasses create theirs in
@@ -88,6 +95,17 @@ class SizedTargets:
             fb = self._fb(self._r.cache.render_pass(rp_resolve(target)), [target.attachment])
             hit = self.target_fbs[target.serial] = (target, fb)
         return hit[1]
+
+    def record_resolve(self, cb, target: RenderTarget, frag: str, set_layout: tuple) -> None:
+        """Record the full-screen pass :func:`resolve_desc` reading
+        ``self.resolve_set`` (layout ``set_layout``) into ``target``."""
+        cache = self._r.cache
+        pipe = cache.pipeline(resolve_desc(target, frag, set_layout))
+        cb.begin_render_pass(cache.render_pass(rp_resolve(target)), self.target_fb(target), [None])
+        cb.bind_pipeline(pipe)
+        cb.bind_descriptor_set(pipe, self.resolve_set)
+        cb.draw(3)
+        cb.end_render_pass()
 
     def ensure_pick(self):
         """Create the pick images and framebuffer on first use (none left on failure)."""
