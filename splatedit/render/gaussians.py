@@ -428,18 +428,12 @@ class GaussianRenderer:
         """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
         self.prepare_frame(camera, width, height)
         t = self._targets
-        rb = V.Buffer(self.dev, width * height * 4, ("transfer_dst",), host_visible=True)
-        try:
-            def rec(cb):
-                cb.reset_queries(self._query, 2, 3)
-                cb.timestamp(self._query, 2, bottom=False)
-                self.record_draw(cb, t.offscreen)
-                cb.copy_image_to_buffer(t.out, rb)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            out = rb.read().reshape(height, width, 4)
-        finally:
-            rb.destroy()
+
+        def rec(cb):
+            cb.reset_queries(self._query, 2, 3)
+            cb.timestamp(self._query, 2, bottom=False)
+            self.record_draw(cb, t.offscreen)
+        out = t.read_output(rec)
         ts = self._query.results_ns(5)
         self.last_timings_ms["draw"] = float(ts[3] - ts[2]) * 1e-6
         self.last_timings_ms["resolve"] = float(ts[4] - ts[3]) * 1e-6

@@ -344,16 +344,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._check_open()
         self._require_cloud()
         t = self._targets_for(width, height)
-        rb = V.Buffer(self.dev, width * height * 4, ("transfer_dst",), host_visible=True)
-        try:
-            def rec(cb):
-                self.record_frame(cb, camera, t.offscreen)
-                cb.copy_image_to_buffer(t.out, rb)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            out = rb.read().reshape(height, width, 4)
-        finally:
-            rb.destroy()
+        out = t.read_output(lambda cb: self.record_frame(cb, camera, t.offscreen))
         self._read_timings(("prepass", "visibility", "attributes", "shading"))
         return out
 

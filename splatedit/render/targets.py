@@ -125,6 +125,21 @@ class SizedTargets:
                 self.pick_index = self.pick_depth = self.fb_pick = None
                 raise
 
+    def read_output(self, record) -> np.ndarray:
+        """Submit ``record(cb)`` (a frame writing :attr:`offscreen`) and read
+        the output image back: (height, width, 4) uint8 RGBA."""
+        dev = self._r.dev
+        rb = V.Buffer(dev, self.width * self.height * 4, ("transfer_dst",), host_visible=True)
+        try:
+            def rec(cb):
+                record(cb)
+                cb.copy_image_to_buffer(self.out, rb)
+                cb.host_read_barrier()
+            dev.submit(rec)
+            return rb.read().reshape(self.height, self.width, 4)
+        finally:
+            rb.destroy()
+
     def read_pick(self, rect, record):
         """Index (h, w) int64 (-1 background) and view-axis depth (h, w)
         float64 (model units, NaN background) of the pixels ``rect`` (see
