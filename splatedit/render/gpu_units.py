@@ -3,7 +3,8 @@ relative to an origin (the model's box centre), divided by a power of two near
 the model's size, so that float32 keeps its precision for a model of any size.
 Helpers to go there from model units: the scale, the camera, the deformation
 uniform block and basis rows, and the bound on how far a deformation moves a
-point (near/far planes).  Pure numpy."""
+point (near/far planes); and the per-splat selection tint flags.  Shared by
+the splat and the Gaussian renderer.  Pure numpy."""
 
 from __future__ import annotations
 

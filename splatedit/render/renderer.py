@@ -14,6 +14,14 @@ One vertex shader (``shaders_glsl/splat_vs.glsl``) serves both splat passes
 and the picking pass; it applies the deformation p' = p + B dC, u' = J u,
 v' = J v of splats that carry a basis row.
 
+:class:`Renderer` coordinates the frame; its parts live in
+:mod:`~splatedit.render.uploads` (cloud, selection, basis, detail and dC
+uploads), :mod:`~splatedit.render.prepass` (the compute pre-pass and its
+windows), :mod:`~splatedit.render.targets` (render targets and per-size
+images, shared with the Gaussian renderer), :mod:`~splatedit.render.splat_layout`
+(descriptor sets, render passes, pipeline descriptions) and
+:mod:`~splatedit.render.gpu_units` (model units to GPU units).
+
 Only :mod:`splatedit.render.vk` calls Vulkan.
 """
 
