@@ -44,12 +44,11 @@ from splatedit.errors import ParameterError
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import RenderTarget, _unit_scale
-from splatedit.render.gs_resources import (_DEFORM_UBO_BYTES, _GS_SET, _MAX_GROUPS, _MAX_SIZE, _NONE, _PREP_WG,
-                                           _REC_BYTES, _RESOLVE_SET, _RP_PICK, _SORT_WG, _UBO_BYTES, SORTS, _rp_accum,
-                                           _rp_resolve, _Targets, gaussian_bounds, pack_basis_rows, pack_deform_block,
-                                           pack_geometry,
-                                           selection_flags)
+from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_camera,
+                                        pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
+from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
+                                           SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
+from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -110,11 +109,7 @@ class GaussianRenderer:
         self.splat_scale = 1.0
         self.grey_shading = False
         try:
-            self.cache = V.PipelineCache(self.dev)
-            self.sampler = V.Sampler(self.dev)
-            self.ubo = V.Buffer(self.dev, _UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo = V.Buffer(self.dev, _DEFORM_UBO_BYTES, ("uniform",), host_visible=True)
-            self.dC_ubo.view(np.float32)[:] = 0.0
+            create_frame_objects(self, _UBO_BYTES)
             self._query = V.QueryPool(self.dev, 8)
         except BaseException:
             self.close()
@@ -191,7 +186,7 @@ class GaussianRenderer:
         self._free_scene()
         lo, hi = gaussian_bounds(cloud)
         self.origin = 0.5 * (cloud.positions.min(axis=0) + cloud.positions.max(axis=0))
-        self.scale = _unit_scale(float(np.linalg.norm(hi - lo)), 0.0)
+        self.scale = unit_scale(float(np.linalg.norm(hi - lo)), 0.0)
         self.bounds = (lo, hi)
         self._sigma_max = cloud.scales().max(axis=1)
         geom, rest = pack_geometry(cloud, self.origin, self.scale)
@@ -293,8 +288,8 @@ class GaussianRenderer:
         blended on the GPU as by :class:`~splatedit.render.renderer.Renderer`)."""
         self._check()
         a, rot = split_displacement(dC)
-        if rot is not None and len(rot.rotations) > _MAX_GROUPS:
-            raise ParameterError("dC", f"the renderer blends at most {_MAX_GROUPS} handle rotations")
+        if rot is not None and len(rot.rotations) > MAX_GROUPS:
+            raise ParameterError("dC", f"the renderer blends at most {MAX_GROUPS} handle rotations")
         a = np.asarray(a, dtype=np.float64)
         if a.shape != (self._cols, 3) or not np.isfinite(a).all():
             raise ParameterError("dC", f"must be finite with shape ({self._cols}, 3), got {a.shape}")
@@ -303,34 +298,16 @@ class GaussianRenderer:
 
     # -------------------------------------------------------------- frame
     def _targets_for(self, width: int, height: int) -> _Targets:
-        for name, v in (("width", width), ("height", height)):
-            if not isinstance(v, (int, np.integer)) or not 1 <= v <= _MAX_SIZE:
-                raise ParameterError(name, f"must be an integer in 1..{_MAX_SIZE}, got {v!r}")
-        t = self._targets
-        if t is None or (t.width, t.height) != (width, height):
-            if t is not None:
-                self.dev.wait_idle()
-                t.destroy()
-                self._targets = None
-            self._targets = _Targets(self, int(width), int(height))
-        return self._targets
+        return targets_for(self, width, height, _Targets)
 
     def _write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
-        if not isinstance(camera, Camera):
-            raise ParameterError("camera", f"must be a Camera, got {type(camera).__name__}")
         o, sc = self.origin, self.scale
-        gpu_cam = Camera((camera.eye - o) / sc, (camera.target - o) / sc, up=camera.up, fov_deg=camera.fov_deg,
-                         near=None if camera.near is None else camera.near / sc,
-                         far=None if camera.far is None else camera.far / sc)
+        gpu_cam = gpu_camera(camera, o, sc)
         lo, hi = self.bounds
         grown = 3.0 * max(float(self.splat_scale) - 1.0, 0.0) * float(self._sigma_max.max())
         lo, hi = lo - grown, hi + grown
         if len(self._basis_idx):
-            move = float(np.linalg.norm(self._dC, axis=1).max(initial=0.0))
-            if self._rot is not None:   # an arc moves a point by at most 2 angle |offset| (Renderer._clip_bounds)
-                move += max(2.0 * r.angle * float(np.linalg.norm(r.offsets, axis=1).max())
-                            for r in self._rot.rotations)
-            grow = self._reach * move
+            grow = self._reach * displacement_bound(self._dC, self._rot)
             lo, hi = lo - grow, hi + grow
         near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
         f = 1.0 / math.tan(math.radians(camera.fov_deg) / 2.0)
@@ -444,32 +421,19 @@ class GaussianRenderer:
         cb.draw_indirect(self._draws, 0)
         cb.end_render_pass()
         cb.timestamp(self._query, 3)
-        layout = V.LayoutDesc(sets=(_RESOLVE_SET,))
-        rpipe = self.cache.pipeline(V.GraphicsDesc("fullscreen.vert", "gs_resolve.frag", _rp_resolve(target),
-                                                   layout, topology="triangle_list"))
-        cb.begin_render_pass(self.cache.render_pass(_rp_resolve(target)), t.target_fb(target), [None])
-        cb.bind_pipeline(rpipe)
-        cb.bind_descriptor_set(rpipe, t.resolve_set)
-        cb.draw(3)
-        cb.end_render_pass()
+        t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
         cb.timestamp(self._query, 4)
 
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
         self.prepare_frame(camera, width, height)
         t = self._targets
-        rb = V.Buffer(self.dev, width * height * 4, ("transfer_dst",), host_visible=True)
-        try:
-            def rec(cb):
-                cb.reset_queries(self._query, 2, 3)
-                cb.timestamp(self._query, 2, bottom=False)
-                self.record_draw(cb, t.offscreen)
-                cb.copy_image_to_buffer(t.out, rb)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            out = rb.read().reshape(height, width, 4)
-        finally:
-            rb.destroy()
+
+        def rec(cb):
+            cb.reset_queries(self._query, 2, 3)
+            cb.timestamp(self._query, 2, bottom=False)
+            self.record_draw(cb, t.offscreen)
+        out = t.read_output(rec)
         ts = self._query.results_ns(5)
         self.last_timings_ms["draw"] = float(ts[3] - ts[2]) * 1e-6
         self.last_timings_ms["resolve"] = float(ts[4] - ts[3]) * 1e-6
@@ -483,45 +447,21 @@ class GaussianRenderer:
         or ``rect`` = (x, y, w, h) (clipped): the API of Renderer.pick."""
         self._check()
         t = self._targets_for(width, height)
-        t.ensure_pick()
-        if rect is None:
-            x, y, w, h = 0, 0, width, height
-        else:
-            x, y, w, h = (int(v) for v in rect)
-            x0, y0, x1, y1 = max(x, 0), max(y, 0), min(x + w, width), min(y + h, height)
-            if x1 <= x0 or y1 <= y0:
-                raise ParameterError("rect", f"{tuple(rect)} does not overlap the {width}x{height} image")
-            x, y, w, h = x0, y0, x1 - x0, y1 - y0
-        self._write_ubo(camera, width, height)
-        self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
-        nbytes = w * h * 4
-        rb = V.Buffer(self.dev, 2 * nbytes, ("transfer_dst",), host_visible=True)
         layout = V.LayoutDesc(sets=(_GS_SET,))
-        pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", _RP_PICK, layout, depth_test=True,
+        pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
                                                   depth_write=True, depth_compare="less", spec=((0, 1),)))
-        try:
-            def rec(cb):
-                # records of culled Gaussians are stale: draw in index order those the
-                # pre-pass wrote this frame (order = identity, count = all; the
-                # vertex shader drops the culled through their zeroed opacity)
-                self._record_prepass(cb)
-                cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
-                cb.begin_render_pass(self.cache.render_pass(_RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
-                cb.bind_pipeline(pipe)
-                cb.bind_descriptor_set(pipe, self._dset)
-                cb.draw(4, self.n)
-                cb.end_render_pass()
-                cb.copy_image_to_buffer(t.pick_index, rb, (x, y, w, h))
-                cb.copy_image_to_buffer(t.pick_depth, rb, (x, y, w, h), buf_offset=nbytes)
-                cb.host_read_barrier()
-            self.dev.submit(rec)
-            raw = rb.read()
-        finally:
-            rb.destroy()
-        idx = raw[:nbytes].view(np.uint32).reshape(h, w).astype(np.int64) - 1
-        d = raw[nbytes:].view(np.float32).reshape(h, w).astype(np.float64)
-        near, far = self._near_far
-        with np.errstate(divide="ignore", invalid="ignore"):
-            depth = near / (1.0 - d * (far - near) / far)
-        depth[idx < 0] = np.nan
-        return idx, depth
+
+        def rec(cb):
+            self._write_ubo(camera, width, height)
+            self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
+            # records of culled Gaussians are stale: draw in index order those the
+            # pre-pass wrote this frame (order = identity, count = all; the
+            # vertex shader drops the culled through their zeroed opacity)
+            self._record_prepass(cb)
+            cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
+            cb.begin_render_pass(self.cache.render_pass(RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
+            cb.bind_pipeline(pipe)
+            cb.bind_descriptor_set(pipe, self._dset)
+            cb.draw(4, self.n)
+            cb.end_render_pass()
+        return t.read_pick(rect, rec)

@@ -14,7 +14,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render.camera import Camera
 from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
-from splatedit.render.headless import _prepare_output, _write, check_render_memory
+from splatedit.render.headless import _prepare_output, _size_and_basis, _write, check_render_memory
 
 
 def splat_proxy(cloud: GaussianCloud) -> SplatCloud:
@@ -51,12 +51,7 @@ def render_gaussians_to_png(cloud: GaussianCloud, out_png, *, size=(512, 512), c
     """
     if not isinstance(cloud, GaussianCloud):
         raise ParameterError("cloud", f"must be a GaussianCloud, got {type(cloud).__name__}")
-    try:
-        w, h = (int(s) for s in size)
-    except (TypeError, ValueError):
-        raise ParameterError("size", f"must be (width, height), got {size!r}") from None
-    if dC is not None and basis is None:
-        raise ParameterError("dC", "given without a basis")
+    w, h = _size_and_basis(size, basis, dC)
     check_render_memory((w, h))
     out_png = Path(out_png)
     _prepare_output(out_png)

@@ -70,12 +70,7 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             disk is full, ...); the directories are checked (and created)
             before rendering.
     """
-    try:
-        w, h = (int(s) for s in size)
-    except (TypeError, ValueError):
-        raise ParameterError("size", f"must be (width, height), got {size!r}") from None
-    if dC is not None and basis is None:
-        raise ParameterError("dC", "given without a basis")
+    w, h = _size_and_basis(size, basis, dC)
     check_render_memory((w, h), buffers_path is not None)
     out_png = Path(out_png)
     outputs = [out_png] + ([Path(buffers_path)] if buffers_path is not None else [])
@@ -103,6 +98,18 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
     if bufs is not None:
         _write(Path(buffers_path), lambda fh: np.savez_compressed(fh, **bufs))
     return out_png
+
+
+def _size_and_basis(size, basis, dC) -> tuple[int, int]:
+    """(width, height) of a headless render's ``size``; ParameterError for a
+    bad size or a ``dC`` without a ``basis``."""
+    try:
+        w, h = (int(s) for s in size)
+    except (TypeError, ValueError):
+        raise ParameterError("size", f"must be (width, height), got {size!r}") from None
+    if dC is not None and basis is None:
+        raise ParameterError("dC", "given without a basis")
+    return w, h
 
 
 def _prepare_output(path: Path) -> None:

@@ -38,7 +38,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr, _rp_resolve
+from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 
@@ -95,15 +95,7 @@ class ProgressiveFrame:
         return (self.next + (self.n if self.phase == "attr" else 0)) / (2.0 * self.n)
 
     def _draw(self, cb, kind: str, first: int, count: int) -> None:
-        r = self.r
-        modes = ((1, 4), (2, 1)) if r.point_splats else ((0, 4),)
-        bufs = [r._geom, r._color, r._flags, r._basis_binding()]
-        for mode, verts in modes:
-            pipe = r._splat_pipeline(kind, mode)
-            cb.bind_pipeline(pipe)
-            cb.bind_descriptor_set(pipe, r.splat_set)
-            cb.bind_vertex_buffers(0, bufs)
-            cb.draw(verts, count, 0, first)
+        self.r._record_vertex_splats(cb, kind, first, count)
 
     def step(self) -> np.ndarray | None:
         """Draw the next chunk.  Returns the (height, width, 4) uint8 image
@@ -143,13 +135,7 @@ class ProgressiveFrame:
                 cb.begin_render_pass(rp, t.fb_attr, clear)
                 self._draw(cb, "attr", first, count)
                 cb.end_render_pass()
-                pipe = r._resolve_pipeline(t.offscreen)
-                cb.begin_render_pass(r.cache.render_pass(_rp_resolve(t.offscreen)),
-                                     t.target_fb(t.offscreen), [None])
-                cb.bind_pipeline(pipe)
-                cb.bind_descriptor_set(pipe, t.resolve_set)
-                cb.draw(3)
-                cb.end_render_pass()
+                r._record_resolve(cb, t, t.offscreen)
                 cb.copy_image_to_buffer(t.out, self._rb)
                 cb.host_read_barrier()
             r.dev.submit(rec)

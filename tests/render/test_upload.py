@@ -14,7 +14,7 @@ def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monke
     """The bundled bunny (with colours) uploaded in chunks of 1000 splats, the
     last one partial: the device buffers hold exactly the float32 geometry and
     the colours of a one-chunk upload, and the frames agree."""
-    import splatedit.render.renderer as rmod
+    import splatedit.render.uploads as umod
     bunny = read(default_model_path())
     rng = np.random.default_rng(4)
     colors = rng.integers(0, 256, (bunny.n, 4), dtype=np.uint8)
@@ -22,7 +22,7 @@ def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monke
     cam = Camera.frame(*cloud.bounds(), aspect=1.0, direction=(0.3, 0.4, 1.0))
     out = []
     for chunk in (cloud.n, 1000):
-        monkeypatch.setattr(rmod, "RENDER_UPLOAD_CHUNK_SPLATS", chunk)
+        monkeypatch.setattr(umod, "RENDER_UPLOAD_CHUNK_SPLATS", chunk)
         renderer.set_cloud(cloud)
         geom = renderer._geom.read().view(np.float32).reshape(cloud.n, 9)
         col = renderer._color.read().reshape(cloud.n, 4)

@@ -1,0 +1,204 @@
+"""The splat renderer's compute pre-pass (``prepare*.comp``) and its windows.
+
+Once per frame the pre-pass does the per-splat work (deformation, culling,
+screen setup) and writes compact records that both splat passes draw
+indirectly with the fetch-only ``prepared.vert``.  A cloud whose records or
+geometry exceed one storage binding is prepared and drawn in windows of
+``RENDER_PREPASS_WINDOW_SPLATS`` splats; a basis larger than one binding is
+bound in several descriptor sets (one dispatch each).
+
+:class:`PrepassMixin` is part of :class:`splatedit.render.renderer.Renderer`
+(it uses the renderer's device, cloud buffers and pipeline cache).
+
+Only :mod:`splatedit.render.vk` calls Vulkan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+
+from splatedit.errors import ParameterError
+from splatedit.render import vk as V
+from splatedit.render.splat_layout import (_GEOM_STRIDE, _PREP_MAX_SIZE, _PREP_SET, _PREP_SET_DETAIL, _REC_A_BYTES,
+                                           _REC_B_BYTES, _WORKGROUP, _rp_window, _splat_desc)
+from splatedit.tolerances import RENDER_PREPASS_WINDOW_SPLATS
+
+
+@dataclass
+class _Prep:
+    """Buffers and descriptor sets of the compute pre-pass: one set per basis
+    window inside each splat window (one splat window when the cloud fits one
+    storage binding)."""
+
+    objects: list            # every Vulkan object above, destroyed in reverse
+    dset: V.DescriptorSet    # the first window's first set (the draws' set)
+    rec_a: V.Buffer          # records A, 48 bytes per splat of the largest window
+    rec_b: V.Buffer          # records B, 32 bytes per splat
+    draws: V.Buffer          # two indirect draws (quads, points)
+    #: per splat window: (first splat, count, [(descriptor set, first splat, count)])
+    windows: list
+
+
+class PrepassMixin:
+    """The pre-pass part of :class:`~splatedit.render.renderer.Renderer`:
+    its buffers (``_prep``, a :class:`_Prep` or None), windows and recording."""
+
+    def _free_prep(self):
+        if self._prep is not None:
+            for obj in reversed(self._prep.objects):
+                obj.destroy()
+            self._prep = None
+
+    def _use_prepass(self) -> bool:
+        t = self._targets
+        if self._detail_buf is not None:   # the detail mode has no vertex-path variant
+            if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
+                raise ParameterError("size", f"the detail mode renders images up to {_PREP_MAX_SIZE} "
+                                             f"pixels wide and high, got {t.width}x{t.height}")
+            return True
+        if not self.prepass:
+            return False
+        # any size: clouds whose records (48 bytes per splat) or geometry do
+        # not fit one storage binding are drawn in splat windows
+        return not (t is not None and max(t.width, t.height) > _PREP_MAX_SIZE)
+
+    @property
+    def prepass_windows(self) -> int:
+        """Splat windows the compute pre-pass prepares and draws the cloud in at
+        the current image size: 1 when the cloud fits one storage binding, 0 for
+        the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
+        if self.cloud is None or not self._use_prepass():
+            return 0
+        return len(self._prep_windows())
+
+    def _prep_windows(self) -> list[tuple[int, int]]:
+        """(first splat, splat count) windows of the pre-pass: the whole cloud
+        when its records and per-splat arrays fit one storage binding (up to
+        2,796,202 splats with lavapipe's 128 MiB), else windows of
+        RENDER_PREPASS_WINDOW_SPLATS (or fewer where the device limit is
+        smaller), each prepared and drawn in turn."""
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        per_splat = max(_REC_A_BYTES, _GEOM_STRIDE, 16 if self._detail_buf is not None else 0)
+        if self.n * per_splat <= limit:
+            return [(0, self.n)]
+        align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
+        per = min(RENDER_PREPASS_WINDOW_SPLATS, limit // per_splat) // _WORKGROUP * _WORKGROUP
+        while per > _WORKGROUP and (per * 4) % align:       # 4: the smallest per-splat stride
+            per -= _WORKGROUP
+        per = max(per, _WORKGROUP)
+        return [(b, min(per, self.n - b)) for b in range(0, self.n, per)]
+
+    def _basis_chunks(self, basis, first: int = 0, count: int | None = None) -> list[tuple[int, int, int, int]]:
+        """(first splat, splat count, byte offset, byte range) windows of the
+        basis buffer that each fit one storage binding, covering splats
+        first .. first + count - 1 (all by default)."""
+        count = self.n - first if count is None else count
+        row_bytes = 64 * self._basis_groups
+        if basis.size < self.n * row_bytes:          # the dummy (nothing deformed): one window
+            return [(first, count, 0, basis.size)]
+        limit = int(self.dev.limits.maxStorageBufferRange)
+        align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
+        per = max(limit // row_bytes // _WORKGROUP * _WORKGROUP, _WORKGROUP)
+        while (per * row_bytes) % align:
+            per -= _WORKGROUP
+        out = []
+        for base in range(first, first + count, per):
+            cnt = min(per, first + count - base)
+            out.append((base, cnt, base * row_bytes, cnt * row_bytes))
+        return out
+
+    def _prep_objects(self):
+        if self._prep is None:
+            objs = []
+            try:
+                spans = self._prep_windows()
+                slots = max(cnt for _, cnt in spans)
+                rec_a = V.Buffer(self.dev, slots * _REC_A_BYTES, ("storage",))
+                objs.append(rec_a)
+                rec_b = V.Buffer(self.dev, slots * _REC_B_BYTES, ("storage",))
+                objs.append(rec_b)
+                draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
+                objs.append(draws)
+                basis = self._basis_binding()
+                detail = self._detail_buf
+                windowed = len(spans) > 1
+                windows = []
+                for w0, wn in spans:
+                    def span(buf, stride):
+                        return (buf, w0 * stride, wn * stride) if windowed else buf
+                    chunks = []
+                    for base, cnt, off, rng in self._basis_chunks(basis, w0, wn):
+                        dset = V.DescriptorSet(self.dev, self.cache.set_layout(
+                            _PREP_SET if detail is None else _PREP_SET_DETAIL))
+                        objs.append(dset)
+                        writes = {0: self.ubo, 1: span(self._geom, _GEOM_STRIDE), 2: span(self._color, 4),
+                                  3: span(self._flags, 4), 4: (basis, off, rng),
+                                  5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
+                        if detail is not None:
+                            writes[9] = span(detail, 16)
+                        dset.write(writes)
+                        chunks.append((dset, base, cnt))
+                    windows.append((w0, wn, chunks))
+            except BaseException:
+                for o in reversed(objs):
+                    o.destroy()
+                raise
+            self._prep = _Prep(objs, windows[0][2][0][0], rec_a, rec_b, draws, windows)
+        return self._prep
+
+    def _record_prepass(self, cb, window: int = 0):
+        """Compute pre-pass of splat window ``window``: records + indirect draw
+        counts for this frame's camera (one dispatch per basis window). Before
+        any window but the first of a frame, it waits for the draws that read
+        the previous window's records."""
+        prep = self._prep_objects()
+        w0, wn, chunks = prep.windows[window]
+        g = self._basis_groups
+        detail = self._detail_buf is not None
+        stem = "prepare_detail" if detail else "prepare"
+        comp = f"{stem}.comp" if g == 1 else f"{stem}_k{4 * g}.comp"
+        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=16,
+                              push_stages="comp")
+        pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
+        if len(prep.windows) > 1:        # the previous window's draws read records and counts
+            cb.memory_barrier("draw_indirect|vertex", "indirect_read|shader_read", "transfer|compute",
+                              "transfer_write|shader_write")
+        cb.fill_buffer(prep.draws, 0)
+        cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
+        cb.bind_pipeline(pipe)
+        for j, (dset, base, cnt) in enumerate(chunks):
+            if j:
+                cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
+            cb.bind_descriptor_set(pipe, dset)
+            cb.push_constants(pipe, np.array([base, cnt, wn, w0], np.uint32))
+            cb.dispatch((cnt + _WORKGROUP - 1) // _WORKGROUP)
+        cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
+                          "indirect_read|shader_read")
+
+    def _prepared_pipeline(self, kind: str, mode: int):
+        layout = V.LayoutDesc(sets=(_PREP_SET if self._detail_buf is None else _PREP_SET_DETAIL,),
+                              push_bytes=4, push_stages="vert")
+        return self.cache.pipeline(_splat_desc("prepared.vert", kind, self.accum_format, layout, spec=((0, mode),),
+                                               topology="point_list" if mode == 2 else "triangle_strip"))
+
+    def _prep_window_count(self, prepared: bool) -> int:
+        """Pre-pass windows of this frame (1 for the vertex path)."""
+        return len(self._prep_objects().windows) if prepared else 1
+
+    def _record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
+        """One splat pass (``kind`` depth, attr or pick) into ``fb``. With several
+        pre-pass windows: per window, its pre-pass then its draws (in a render
+        pass that keeps the previous windows' results)."""
+        count = self._prep_window_count(prepared)
+        if count == 1:
+            cb.begin_render_pass(self.cache.render_pass(desc), fb, clears)
+            self._record_splats(cb, kind, prepared)
+            cb.end_render_pass()
+            return
+        for k in range(count):
+            self._record_prepass(cb, k)
+            cb.begin_render_pass(self.cache.render_pass(_rp_window(desc, k == 0, k == count - 1)), fb, clears)
+            self._record_splats(cb, kind, True, k)
+            cb.end_render_pass()

@@ -1,0 +1,80 @@
+"""GPU layout of the splat renderer (:mod:`splatedit.render.renderer`): flag
+bits, buffer strides, descriptor-set layouts and render passes shared by its
+vertex path, compute pre-pass (:mod:`splatedit.render.prepass`), per-size
+targets (:mod:`splatedit.render.targets`) and progressive frames.
+
+Only :mod:`splatedit.render.vk` calls Vulkan.
+"""
+
+from __future__ import annotations
+
+from dataclasses import replace
+
+from splatedit.render import vk as V
+from splatedit.render.uniforms import FRAME_UBO
+
+FLAG_SUPPORT = 1
+FLAG_HANDLE = 2
+FLAG_DEFORMED = 4
+FLAG_INACTIVE = 8            # an inactive handle (the editor's several handles): darker
+
+_UBO_BYTES = FRAME_UBO.itemsize   # splatedit/render/uniforms.py, checked against frame.glsl
+_GEOM_STRIDE = 36           # centre, u, v as float32
+
+#: vertex path: frame UBO, deformation UBO
+_SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"), V.Binding(1, "uniform", "vert"))
+#: compute pre-pass + prepared draws: frame UBO, cloud (geometry, colours,
+#: flags, basis), records A/B, indirect draw commands, deformation UBO
+_PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
+             V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
+             V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "vert|comp"),
+             V.Binding(7, "storage", "comp"), V.Binding(8, "uniform", "comp"))
+#: the detail mode's pre-pass adds (n_b, lambda) per splat (shaders_glsl/detail.glsl)
+_PREP_SET_DETAIL = _PREP_SET + (V.Binding(9, "storage", "comp"),)
+_REC_A_BYTES = 48
+_REC_B_BYTES = 32
+_WORKGROUP = 64
+#: the pre-pass packs quad bounds as 12.4 fixed-point pixels
+_PREP_MAX_SIZE = 4095
+_RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(1, "sampled", "frag"),
+                V.Binding(2, "sampled", "frag"))
+
+#: the pick pass (of both renderers): splat / Gaussian index + 1 (0 background) and depth, both read back
+RP_PICK = V.RenderPassDesc(colors=(V.Attachment("r32ui", "clear", final="transfer_src"),),
+                           depth=V.Attachment("d32f", "clear", final="transfer_src"))
+_RP_DEPTH = V.RenderPassDesc(depth=V.Attachment("d32f", "clear", final="depth"))
+_RP_POINTS = V.RenderPassDesc(colors=(V.Attachment("rgba8", "clear", final="color"),),
+                              depth=V.Attachment("d32f", "clear", final="depth"))
+
+
+def _rp_window(desc: V.RenderPassDesc, first: bool, last: bool) -> V.RenderPassDesc:
+    """``desc`` for one splat window of a windowed pre-pass frame: windows after
+    the first load what the previous one left instead of clearing it, and all
+    but the last leave the attachments in attachment layouts."""
+    def att(a: V.Attachment, layout: str) -> V.Attachment:
+        if not first and a.load == "clear":
+            a = replace(a, load="load", initial=layout)
+        return a if last else replace(a, final=layout)
+    return replace(desc, colors=tuple(att(a, "color") for a in desc.colors),
+                   depth=None if desc.depth is None else att(desc.depth, "depth"))
+
+
+def _rp_attr(fmt: str, final: str) -> V.RenderPassDesc:
+    return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final=final),
+                                    V.Attachment(fmt, "clear", final=final)),
+                            depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
+
+
+def _splat_desc(vert: str, kind: str, accum_format: str, layout: V.LayoutDesc, **common) -> V.GraphicsDesc:
+    """The pipeline of splat pass ``kind`` (``"depth"``: visibility, ``"attr"``:
+    attribute accumulation into ``accum_format``, else pick) with vertex
+    shader ``vert``; ``common``: the vertex input, topology and specialisation."""
+    if kind == "depth":
+        return V.GraphicsDesc(vert, "splat_depth.frag", _RP_DEPTH, layout, depth_write=True, depth_compare="less",
+                              depth_test=True, **common)
+    if kind == "attr":
+        return V.GraphicsDesc(vert, "splat_attr.frag", _rp_attr(accum_format, "shader_read"), layout,
+                              depth_write=False, depth_compare="less_equal", blend_add=(True, True),
+                              depth_test=True, **common)
+    return V.GraphicsDesc(vert, "splat_pick.frag", RP_PICK, layout, depth_write=True, depth_compare="less",
+                          depth_test=True, **common)

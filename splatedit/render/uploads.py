@@ -1,0 +1,292 @@
+"""Uploads of the splat renderer's scene: the cloud (geometry and colours in
+chunks), the selection flags, the deformation basis rows, the detail rows
+and the per-frame displacement dC.
+
+:class:`SceneUploadsMixin` is part of
+:class:`splatedit.render.renderer.Renderer` (it uses the renderer's device
+and drops its pre-pass buffers when the bound buffers change).
+
+Only :mod:`splatedit.render.vk` calls Vulkan.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from splatedit.deform.rotation import split_displacement
+from splatedit.errors import ParameterError
+from splatedit.model.cloud import SplatCloud
+from splatedit.render import vk as V
+from splatedit.render.gpu_units import (MAX_GROUPS, pack_basis_rows, pack_deform_block, selection_flags,
+                                        unit_scale)
+from splatedit.render.splat_layout import FLAG_DEFORMED, _GEOM_STRIDE
+from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
+                                  RENDER_VISIBILITY_EPS_RADII)
+
+
+class SceneUploadsMixin:
+    """The scene part of :class:`~splatedit.render.renderer.Renderer`:
+    ``set_cloud``, ``set_selection``, ``set_basis``, ``set_detail``,
+    ``clear_basis``, ``set_displacement`` and the buffers they fill."""
+
+    def _free_cloud(self):
+        self._free_prep()
+        for b in self._cloud_bufs:
+            b.destroy()
+        self._cloud_bufs = []
+        if self._basis_buf is not None:
+            self._basis_buf.destroy()
+            self._basis_buf = None
+        self._drop_detail()
+        for b in self._dummy_basis.values():
+            b.destroy()
+        self._dummy_basis = {}
+        self.cloud = None
+        self.n = 0
+
+    def set_cloud(self, cloud: SplatCloud) -> None:
+        """Upload a cloud (float32 relative to its bounding-box centre, in units
+        of :attr:`scale`, a power of two near its size, so that a model of
+        any size from 1e-15 to 1e15 renders the same); clears selection and
+        basis."""
+        self._check_open()
+        if not isinstance(cloud, SplatCloud):
+            raise ParameterError("cloud", f"must be a SplatCloud, got {type(cloud).__name__}")
+        self._free_cloud()
+        n = cloud.n
+        lo, hi = cloud.bounds()
+        self.origin = 0.5 * (lo + hi)
+        # the largest semi-axis without the (n,) radii array (per-splat radii
+        # are computed for the basis rows only, in _basis_radii)
+        rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
+                                 np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
+        #: undeformed bounds padded by the largest splat radius; near/far come
+        #: from these grown by the deformation's reach (:meth:`_clip_bounds`)
+        self.bounds = (lo - rmax, hi + rmax)
+        #: model units per GPU unit: eye space, positions, axes and dC are
+        #: divided by it (an exact power of two), depths multiplied back
+        self.scale = unit_scale(float(np.linalg.norm(hi - lo)), rmax)
+        self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
+        self._cloud_bufs.append(self._geom)
+        self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
+        self._cloud_bufs.append(self._color)
+        self._upload_cloud(cloud)
+        self._flags = V.Buffer(self.dev, 4 * n, ("vertex", "storage"), host_visible=True)
+        self._cloud_bufs.append(self._flags)
+        self._flags.view(np.uint32)[:] = 0
+        self.cloud = cloud
+        self.n = n
+        self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_reach = 0.0
+        self._basis_cols = 4
+        self._dC = np.zeros((4, 3))
+        self._rot = None
+        self._dC_dirty = True
+
+    def _upload_cloud(self, cloud: SplatCloud) -> None:
+        """Geometry (float32 centre - origin, u, v in GPU units) and colours
+        through one staging buffer of ``RENDER_UPLOAD_CHUNK_SPLATS`` splats:
+        no whole-cloud float32 copy and no whole-cloud staging buffer (at 10M
+        splats they were 360 MB each on top of the 360 MB device buffer)."""
+        n = cloud.n
+        chunk = min(n, RENDER_UPLOAD_CHUNK_SPLATS)
+        staging = V.Buffer(self.dev, chunk * _GEOM_STRIDE, ("transfer_src",), host_visible=True)
+        try:
+            inv = 1.0 / self.scale                   # an exact power of two
+            default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
+            for lo in range(0, n, chunk):
+                m = min(chunk, n - lo)
+                geom = staging.view(np.float32)[:9 * m].reshape(m, 9)
+                np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom[:, 0:3],
+                            casting="same_kind")
+                np.multiply(cloud.u[lo:lo + m], inv, out=geom[:, 3:6], casting="same_kind")
+                np.multiply(cloud.v[lo:lo + m], inv, out=geom[:, 6:9], casting="same_kind")
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
+                                                          lo * _GEOM_STRIDE))
+                col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
+                col[:] = default if cloud.colors is None else cloud.colors[lo:lo + m]
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
+        finally:
+            staging.destroy()
+
+    def _basis_radii(self, idx: np.ndarray) -> np.ndarray:
+        """(N,) float64 larger semi-axis of the splats ``idx`` (model units)."""
+        u, v = self.cloud.u[idx], self.cloud.v[idx]
+        return np.sqrt(np.maximum(np.einsum("ij,ij->i", u, u), np.einsum("ij,ij->i", v, v)))
+
+    @property
+    def _basis_groups(self) -> int:
+        """Groups of 4 columns of the (zero-padded) basis."""
+        return (self._basis_cols + 3) // 4
+
+    def _require_cloud(self):
+        if self.cloud is None:
+            raise ParameterError("cloud", "no cloud set (call set_cloud first)")
+
+    def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
+        """Tint the support region (blue) and handle (green); boolean masks of
+        shape (n,) or index arrays; None clears.  ``inactive_mask``: splats
+        of inactive handles, tinted green and drawn darker."""
+        self._check_open()
+        self._require_cloud()
+        tint = selection_flags(self.n, support_mask, handle_mask, inactive_mask)
+        f = self._flags.view(np.uint32)
+        f &= np.uint32(FLAG_DEFORMED)
+        f |= tint
+
+    def set_basis(self, indices, B, Bx, By, Bz) -> None:
+        """Deformation basis rows for the splats ``indices`` (N,); B, Bx, By, Bz
+        are (N, K) with any K in 1..``RENDER_MAX_BASIS_COLUMNS`` (16), e.g.
+        4 per rigid handle or k+1 spline control points; they are zero-padded
+        to a multiple of 4 columns internally.  Other splats are not deformed.
+        Only the given rows (and the rows of the previous basis, which are
+        cleared) are written to the GPU.  A new K resets the displacement to
+        zeros (K, 3).  Drops a :meth:`set_detail` (set it again after this)."""
+        self._check_open()
+        self._require_cloud()
+        self._drop_detail()
+        idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+        mats = []
+        for name, m in (("B", B), ("Bx", Bx), ("By", By), ("Bz", Bz)):
+            a = np.asarray(m, dtype=np.float64)
+            if a.ndim != 2 or a.shape[0] != len(idx):
+                raise ParameterError(name, f"must have shape ({len(idx)}, K), got {a.shape}")
+            mats.append(a)
+        k = mats[0].shape[1]
+        if any(a.shape[1] != k for a in mats):
+            raise ParameterError("B", "B, Bx, By, Bz must have the same number of columns")
+        if not 1 <= k <= RENDER_MAX_BASIS_COLUMNS:
+            raise ParameterError("B", f"basis must have 1..{RENDER_MAX_BASIS_COLUMNS} columns "
+                                      f"(RENDER_MAX_BASIS_COLUMNS), got {k}")
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
+            raise ParameterError("indices", f"must be in 0..{self.n - 1}")
+        if len(np.unique(idx)) != len(idx):
+            raise ParameterError("indices", "must not repeat")
+        if not all(np.isfinite(a).all() for a in mats):
+            raise ParameterError("B", "basis rows must be finite")
+        g = (k + 3) // 4
+        row_bytes = 64 * g
+        if self._basis_buf is None or self._basis_groups != g:
+            if self._basis_buf is not None:
+                self._basis_buf.destroy()
+                self._basis_buf = None
+            self._free_prep()
+            self._basis_buf = V.Buffer(self.dev, self.n * row_bytes, ("vertex", "storage"), host_visible=True)
+            self._basis_buf.view(np.float32)[:] = 0.0
+            self._basis_rows = np.zeros(0, dtype=np.int64)
+        if self._basis_cols != k:
+            self._basis_cols = k
+        if self._dC.shape[0] != k:
+            self._dC = np.zeros((k, 3))
+            self._rot = None
+            self._dC_dirty = True
+        # gradients per GPU unit (positions are divided by scale); B is unitless
+        rows = pack_basis_rows(mats, self.scale)[:len(idx)]
+        view = self._basis_buf.view(np.float32).reshape(self.n, 16 * g)
+        flags = self._flags.view(np.uint32)
+        stale = np.setdiff1d(self._basis_rows, idx, assume_unique=True)
+        if len(stale):
+            view[stale] = 0.0
+            flags[stale] &= np.uint32(~FLAG_DEFORMED & 0xFFFFFFFF)
+        view[idx] = rows.reshape(len(idx), 16 * g)
+        flags[idx] |= np.uint32(FLAG_DEFORMED)
+        self._basis_rows = idx
+        self._basis_reach = self._reach(idx, *mats)
+
+    def _reach(self, idx, B, Bx, By, Bz) -> float:
+        """max over the rows i of sum_k |B_ik| + (1 + RENDER_VISIBILITY_EPS_RADII)
+        r_i sum_k |grad B_ik|: times max_k |dC_k| it bounds how far any part of
+        a deformed splat (or its visibility-pass copy) can move.
+
+        Splat i's centre moves by |sum_k B_ik dC_k| <= sum_k |B_ik| |dC_k|.  Its
+        axes become J u, J v with J = I + sum_k dC_k (grad B_ik)^T, so its
+        radius grows by at most r_i ||J - I|| <= r_i sum_k |dC_k| |grad B_ik|;
+        the visibility pass pushes the splat back by RENDER_VISIBILITY_EPS_RADII
+        of its new radius, which grows by the same factor."""
+        if not len(idx):
+            return 0.0
+        grad = np.sqrt(Bx * Bx + By * By + Bz * Bz).sum(axis=1)
+        per_row = np.abs(B).sum(axis=1) + (1.0 + RENDER_VISIBILITY_EPS_RADII) * self._basis_radii(idx) * grad
+        return float(per_row.max())
+
+    def set_detail(self, indices, detail) -> None:
+        """Detail-preserving mode (splatedit.deform.detail): ``detail`` (N, 4)
+        = (base normal n_b, offset lambda in model units) of the splats
+        ``indices``, whose :meth:`set_basis` rows were evaluated at their base
+        points b = p - lambda n_b.  Uploaded once; per frame only dC changes.
+        Drawn by the compute pre-pass (images up to 4095 pixels); cleared by
+        :meth:`clear_basis` and :meth:`set_cloud`."""
+        self._check_open()
+        self._require_cloud()
+        idx = np.asarray(indices, dtype=np.int64).reshape(-1)
+        d = np.asarray(detail, dtype=np.float64)
+        if d.shape != (len(idx), 4):
+            raise ParameterError("detail", f"must have shape ({len(idx)}, 4), got {d.shape}")
+        if not np.isfinite(d).all():
+            raise ParameterError("detail", "must be finite")
+        if len(idx) and (idx.min() < 0 or idx.max() >= self.n):
+            raise ParameterError("indices", f"must be in 0..{self.n - 1}")
+        if self._detail_buf is None:
+            self._free_prep()
+            self._detail_buf = V.Buffer(self.dev, self.n * 16, ("storage",), host_visible=True)
+        view = self._detail_buf.view(np.float32).reshape(self.n, 4)
+        view[:] = 0.0
+        view[idx, :3] = d[:, :3]
+        view[idx, 3] = d[:, 3] / self.scale
+        # an offset swings by at most 2 |lambda| when its normal turns (clip bounds)
+        self._detail_reach = 2.0 * float(np.abs(d[:, 3]).max(initial=0.0))
+
+    def _drop_detail(self):
+        if self._detail_buf is not None:
+            self._free_prep()
+            self._detail_buf.destroy()
+            self._detail_buf = None
+        self._detail_reach = 0.0
+
+    def clear_basis(self) -> None:
+        """Drop the deformation basis (every splat undeformed)."""
+        self._check_open()
+        self._drop_detail()
+        if self.cloud is None or self._basis_buf is None:
+            return
+        flags = self._flags.view(np.uint32)
+        flags[self._basis_rows] &= np.uint32(~FLAG_DEFORMED & 0xFFFFFFFF)
+        self._basis_buf.view(np.float32).reshape(self.n, -1)[self._basis_rows] = 0.0
+        self._basis_rows = np.zeros(0, dtype=np.int64)
+        self._basis_reach = 0.0
+
+    def set_displacement(self, dC) -> None:
+        """Control-frame displacement dC (K, 3), K = the basis' column count
+        (K = 4 before any :meth:`set_basis`).  Only dC (192 bytes) is uploaded
+        to the GPU, when the next frame is recorded; that frame's near/far
+        planes are chosen from the model bounds grown by the largest possible
+        splat displacement (:meth:`_clip_bounds`), so geometry moved outside
+        the undeformed model is not clipped."""
+        self._check_open()
+        a, rot = split_displacement(dC)
+        if rot is not None and len(rot.rotations) > MAX_GROUPS:
+            raise ParameterError("dC", f"the renderer blends at most {MAX_GROUPS} handle rotations")
+        a = np.asarray(a, dtype=np.float64)
+        if a.ndim != 2 or a.shape[1] != 3 or a.shape[0] != self._basis_cols:
+            raise ParameterError("dC", f"must have shape ({self._basis_cols}, 3) (the basis has "
+                                       f"{self._basis_cols} columns), got {a.shape}")
+        if not np.isfinite(a).all():
+            raise ParameterError("dC", "must be finite")
+        self._dC = a.copy()
+        self._rot = rot
+        self._dC_dirty = True
+
+    def _dC_block(self) -> np.ndarray:
+        """deform.glsl's block of this frame's dC and handle rotations in GPU
+        units (:func:`splatedit.render.gpu_units.pack_deform_block`)."""
+        return pack_deform_block(self._dC, self._rot, self.scale)
+
+    def _basis_binding(self):
+        if self._basis_buf is not None and len(self._basis_rows) > 0:
+            return self._basis_buf
+        g = self._basis_groups
+        buf = self._dummy_basis.get(g)
+        if buf is None:
+            buf = self._dummy_basis[g] = V.Buffer(self.dev, 64 * g, ("vertex", "storage"), host_visible=True)
+            buf.view(np.float32)[:] = 0.0
+        return buf
