@@ -5,7 +5,8 @@
 // block is uploaded when the displacement changes.  rot: per group g the
 // rotation of handle g (rotation-aware mode, rotation.glsl): rot[4g] = (unit
 // axis, angle; 0 = none), rot[4g + 1 + i] = (D_0, .., D_3)[i] (frame offsets).
-// Mirrors splatedit/render/renderer.py:_DEFORM_UBO_BYTES.
+// Declared once as DEFORM_UBO in splatedit/render/uniforms.py (checked by
+// tests/render/test_uniforms.py).
 
 const int MAX_BASIS_GROUPS = 4;
 
