@@ -96,6 +96,40 @@ GS_REC = np.dtype([
     ("color", "<f4", (4,)),           # rgb, index + 1 as bits
 ])
 
+#: one splat of the splat renderer's geometry buffer (vertex buffer of the
+#: vertex path; ``float geom[]`` of prepare_cs.glsl, GEOM_* constants in
+#: splat_records.glsl): centre relative to the origin, axes u, v (GPU units)
+SPLAT_GEOM = np.dtype([
+    ("center", "<f4", (3,)),
+    ("u", "<f4", (3,)),
+    ("v", "<f4", (3,)),
+])
+
+#: one slot of the pre-pass record buffer A (``vec4 recA[]``, written by
+#: prepare_cs.glsl, read by prepared.vert; RECA_* constants): the splat's
+#: screen-space mapping rows (Splat.ms_cn, mt_tc, mw_r, splat_math.glsl)
+SPLAT_REC_A = np.dtype([
+    ("ms_cn", "<f4", (4,)),
+    ("mt_tc", "<f4", (4,)),
+    ("mw_r", "<f4", (4,)),
+])
+
+#: one slot of the pre-pass record buffer B (``uvec4 recB[]``, RECB_*
+#: constants): center = (x, y, w float bits, splat index + 1); packed =
+#: (quad low corner as 12.4 fixed-point pixels, or point size float bits;
+#: quad high corner; rgba8 colour; octahedral normal as snorm 2x16)
+SPLAT_REC_B = np.dtype([
+    ("center", "<u4", (4,)),
+    ("packed", "<u4", (4,)),
+])
+
+#: one row of the detail buffer (``vec4 detail[]``, detail.glsl): base normal
+#: n_b (unit), offset lambda (GPU units) of a splat; zero for the others
+DETAIL_ROW = np.dtype([
+    ("normal", "<f4", (3,)),
+    ("lam", "<f4"),
+])
+
 _BASES = {"f": "float", "u": "uint", "i": "int"}
 _VEC = {"float": "vec", "uint": "uvec", "int": "ivec"}
 

@@ -114,3 +114,30 @@ def test_gaussian_frame_block_bytes_equal_the_hand_packing(bunny_gaussians):
     np.testing.assert_array_equal(np.delete(got.view(np.float32), [22, 23, 35]), np.delete(u, [22, 23, 35]))
     np.testing.assert_allclose(got.view(np.float32)[[22, 23, 35]], u[[22, 23, 35]], rtol=1e-6)
     assert got.view(np.uint32)[40] == len(bunny_gaussians)
+
+
+def test_splat_geometry_and_detail_rows_bytes_equal_the_hand_packing(renderer, monkeypatch):
+    from splatedit.render import uploads
+    from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
+    cloud = read(default_model_path())
+    monkeypatch.setattr(uploads, "RENDER_UPLOAD_CHUNK_SPLATS", 3000)    # several chunks, a partial last one
+    renderer.set_cloud(cloud)
+    got = renderer._geom.read(cloud.n * SPLAT_GEOM.itemsize)
+    inv = 1.0 / renderer.scale
+    old = np.zeros((cloud.n, 9), np.float32)                             # the previous hand offsets
+    np.multiply(cloud.positions - renderer.origin, inv, out=old[:, 0:3], casting="same_kind")
+    np.multiply(cloud.u, inv, out=old[:, 3:6], casting="same_kind")
+    np.multiply(cloud.v, inv, out=old[:, 6:9], casting="same_kind")
+    assert cloud.n > 2 * 3000 and got.tobytes() == old.tobytes()
+
+    rng = np.random.default_rng(8)
+    idx = rng.choice(cloud.n, 500, replace=False)
+    n_b = rng.normal(size=(500, 3))
+    detail = np.column_stack([n_b / np.linalg.norm(n_b, axis=1, keepdims=True), rng.normal(size=500) * 1e-3])
+    renderer.set_detail(idx, detail)
+    got = renderer._detail_buf.read(cloud.n * DETAIL_ROW.itemsize)
+    old = np.zeros((cloud.n, 4), np.float32)
+    old[idx, :3] = detail[:, :3]
+    old[idx, 3] = detail[:, 3] / renderer.scale
+    assert got.tobytes() == old.tobytes() and np.count_nonzero(old[:, 3]) == 500
+    renderer.clear_basis()

@@ -15,8 +15,9 @@ import pytest
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.uniforms import (DEFORM_UBO, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_REC, MAX_GROUPS,
-                                       check_glsl_block, check_glsl_records, glsl_members, layout, parse_glsl_block)
+from splatedit.render.uniforms import (DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_REC, MAX_GROUPS,
+                                       SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
+                                       glsl_members, layout, parse_glsl_block)
 from tests.render.scenes import plane
 
 SHADERS = Path(__file__).resolve().parents[2] / "shaders_glsl"
@@ -26,14 +27,23 @@ FRAME_GLSL = SHADERS / "frame.glsl"
 BLOCKS = [("frame.glsl", "Frame", FRAME_UBO), ("deform.glsl", "Deform", DEFORM_UBO),
           ("gs_common.glsl", "GsFrame", GS_FRAME_UBO)]
 #: (file, block, record dtype, constant prefix): flat record buffers
-RECORDS = [("gs_common.glsl", "GsGeom", GS_GEOM, "GEOM"), ("gs_common.glsl", "GsRec", GS_REC, "REC")]
+RECORDS = [("gs_common.glsl", "GsGeom", GS_GEOM, "GEOM"), ("gs_common.glsl", "GsRec", GS_REC, "REC"),
+           ("prepare_cs.glsl", "Geom", SPLAT_GEOM, "GEOM"), ("prepare_cs.glsl", "RecA", SPLAT_REC_A, "RECA"),
+           ("prepare_cs.glsl", "RecB", SPLAT_REC_B, "RECB"), ("prepared.vert", "RecA", SPLAT_REC_A, "RECA"),
+           ("prepared.vert", "RecB", SPLAT_REC_B, "RECB")]
+#: (file, block, row dtype): buffers of one vec4 row per item
+ROWS = [("detail.glsl", "Detail", DETAIL_ROW)]
 #: plain arrays of one value per item (block -> GLSL member type)
 PLAIN = {"GsRest": "uint[]", "GsBasisRow": "uint[]", "GsBasis": "vec4[]", "GsKeys": "uint[]", "GsOrder": "uint[]",
          "GsDraws": "uint[4]", "GsFlags": "uint[]", "Colors": "uint[]", "Flags": "uint[]", "Basis": "vec4[]",
          "Draws": "uint[8]"}
-#: not declared as dtypes yet (issue 10 part 1 leftovers): the splat renderer's
-#: geometry (9 floats), pre-pass records, detail rows, and push constants
-NOT_YET = {"Geom", "RecA", "RecB", "Detail", "Push", "GuiPush"}
+#: not declared as dtypes: push constants (packed where they are pushed)
+NOT_YET = {"Push", "GuiPush"}
+
+
+def _source(fname: str) -> str:
+    """A shader with its ``#include`` files expanded (recursively)."""
+    return re.sub(r'#include\s+"([^"]+)"', lambda m: _source(m.group(1)), (SHADERS / fname).read_text())
 W = H = 96
 
 
@@ -50,7 +60,7 @@ def test_glsl_block_matches_its_dtype(fname, block, dtype):
 
 @pytest.mark.parametrize("fname, block, dtype, prefix", RECORDS, ids=[r[1] for r in RECORDS])
 def test_record_buffer_constants_match_the_dtype(fname, block, dtype, prefix):
-    text = (SHADERS / fname).read_text()
+    text = _source(fname)
     assert check_glsl_records(text, block, dtype, prefix) == []
     moved = text.replace(f"const uint {prefix}_STRIDE = ", f"const uint {prefix}_STRIDE = 1u + ")
     assert any("STRIDE" in p for p in check_glsl_records(moved, block, dtype, prefix))
@@ -61,11 +71,17 @@ def test_every_glsl_block_is_declared_or_listed():
     for f in sorted(SHADERS.iterdir()):
         for block in re.findall(r"\b(?:uniform|buffer)\s+(\w+)\s*\{", f.read_text()):
             seen.setdefault(block, f.name)
-    checked = {b for _, b, _ in BLOCKS} | {b for _, b, _, _ in RECORDS}
+    checked = {b for _, b, _ in BLOCKS} | {b for _, b, _, _ in RECORDS} | {b for _, b, _ in ROWS}
     assert set(seen) == checked | set(PLAIN) | NOT_YET
     for block, typ in PLAIN.items():
         members = parse_glsl_block((SHADERS / seen[block]).read_text(), block)
         assert [m[0] for m in members] == [typ], block
+
+
+@pytest.mark.parametrize("fname, block, dtype", ROWS, ids=[r[1] for r in ROWS])
+def test_row_buffers_hold_one_vec4_of_the_dtype_per_item(fname, block, dtype):
+    assert [m[0] for m in parse_glsl_block(_source(fname), block)] == ["vec4[]"]
+    assert dtype.itemsize == 16 and all(dtype.fields[f][0].base == np.float32 for f in dtype.names)
 
 
 def test_the_deform_block_size_follows_the_basis_column_limit():
