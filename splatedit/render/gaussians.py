@@ -49,7 +49,7 @@ from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_came
 from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
 from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
-from splatedit.render.uniforms import GS_FRAME_UBO
+from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH, GS_SORT_PUSH
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -332,17 +332,17 @@ class GaussianRenderer:
         self._near_far = (near * sc, far * sc)
 
     def _record_prepass(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_PREP_PUSH.itemsize, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc("gs_prepare.comp", layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
         groups = self._groups if len(self._basis_idx) else 1
-        cb.push_constants(pipe, np.array([groups, GS_POLAR_ITERATIONS], np.uint32))
+        cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS), GS_PREP_PUSH))
         count = self._n2 if self.sort == "gpu" else self.n
         cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
 
     def _record_gpu_sort(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_SORT_PUSH.itemsize, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc("gs_sort.comp", layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
@@ -352,7 +352,7 @@ class GaussianRenderer:
             j = k // 2
             while j >= 1:
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
-                cb.push_constants(pipe, np.array([k, j], np.uint32))
+                cb.push_constants(pipe, np.array((k, j), GS_SORT_PUSH))
                 cb.dispatch((n2 + _SORT_WG - 1) // _SORT_WG)
                 j //= 2
             k *= 2

@@ -41,7 +41,7 @@ from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, 
                                            _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.targets import rp_resolve as _rp_resolve  # noqa: F401 - importable from here
-from splatedit.render.uniforms import FRAME_UBO, SPLAT_GEOM
+from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MIN_WEIGHT,
@@ -285,7 +285,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if prepared:
             prep = self._prep_objects()
             dset, draws = prep.dset, prep.draws
-            n = np.array([prep.windows[window][1]], np.uint32)
+            n = np.array((prep.windows[window][1],), PREPARED_PUSH)
             for mode, offset in ((1, 0), (2, 16)):
                 pipeline = self._prepared_pipeline(kind, mode)
                 cb.bind_pipeline(pipeline)

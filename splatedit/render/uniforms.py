@@ -130,6 +130,18 @@ DETAIL_ROW = np.dtype([
     ("lam", "<f4"),
 ])
 
+#: push constants (std430) of gs_prepare.comp: basis groups per row, polar iterations
+GS_PREP_PUSH = np.dtype([("groups", "<u4"), ("polar_iterations", "<u4")])
+#: push constants of gs_sort.comp: bitonic stage k, step j
+GS_SORT_PUSH = np.dtype([("k", "<u4"), ("j", "<u4")])
+#: push constants of prepare_cs.glsl: basis window (base, count), record slots
+#: n, first splat wbase of the per-splat window
+PREP_PUSH = np.dtype([("base", "<u4"), ("count", "<u4"), ("n", "<u4"), ("wbase", "<u4")])
+#: push constants of prepared.vert: record slots
+PREPARED_PUSH = np.dtype([("n", "<u4")])
+#: push constants of gui.vert: pixels -> NDC scale and translation
+GUI_PUSH = np.dtype([("scale", "<f4", (2,)), ("translate", "<f4", (2,))])
+
 _BASES = {"f": "float", "u": "uint", "i": "int"}
 _VEC = {"float": "vec", "uint": "uvec", "int": "ivec"}
 
@@ -223,7 +235,7 @@ def _parse(text: str, block: str) -> tuple[str, list[tuple[str, str, int, int | 
         m = re.search(r"()\b(?:uniform|buffer)\s+" + re.escape(block) + r"\s*\{(.*?)\}", src, flags=re.S)
     if m is None:
         raise ValueError(f"no uniform or buffer block {block!r}")
-    packing = "std430" if "std430" in m.group(1) else "std140"
+    packing = "std430" if "std430" in m.group(1) or "push_constant" in m.group(1) else "std140"
     consts = glsl_constants(text)
     out, off, max_align = [], 0, 16 if packing == "std140" else 4
     for decl in m.group(2).split(";"):

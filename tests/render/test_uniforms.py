@@ -15,8 +15,8 @@ import pytest
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.uniforms import (DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_REC, MAX_GROUPS,
-                                       SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
+from splatedit.render.uniforms import (DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_PREP_PUSH,
+                                       GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH, PREPARED_PUSH, SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
                                        glsl_members, layout, parse_glsl_block)
 from tests.render.scenes import plane
 
@@ -25,7 +25,9 @@ FRAME_GLSL = SHADERS / "frame.glsl"
 
 #: (file, block, dtype): blocks compared member by member
 BLOCKS = [("frame.glsl", "Frame", FRAME_UBO), ("deform.glsl", "Deform", DEFORM_UBO),
-          ("gs_common.glsl", "GsFrame", GS_FRAME_UBO)]
+          ("gs_common.glsl", "GsFrame", GS_FRAME_UBO), ("gs_prepare.comp", "Push", GS_PREP_PUSH),
+          ("gs_sort.comp", "Push", GS_SORT_PUSH), ("prepare_cs.glsl", "Push", PREP_PUSH),
+          ("prepared.vert", "Push", PREPARED_PUSH), ("gui.vert", "GuiPush", GUI_PUSH)]
 #: (file, block, record dtype, constant prefix): flat record buffers
 RECORDS = [("gs_common.glsl", "GsGeom", GS_GEOM, "GEOM"), ("gs_common.glsl", "GsRec", GS_REC, "REC"),
            ("prepare_cs.glsl", "Geom", SPLAT_GEOM, "GEOM"), ("prepare_cs.glsl", "RecA", SPLAT_REC_A, "RECA"),
@@ -37,8 +39,6 @@ ROWS = [("detail.glsl", "Detail", DETAIL_ROW)]
 PLAIN = {"GsRest": "uint[]", "GsBasisRow": "uint[]", "GsBasis": "vec4[]", "GsKeys": "uint[]", "GsOrder": "uint[]",
          "GsDraws": "uint[4]", "GsFlags": "uint[]", "Colors": "uint[]", "Flags": "uint[]", "Basis": "vec4[]",
          "Draws": "uint[8]"}
-#: not declared as dtypes: push constants (packed where they are pushed)
-NOT_YET = {"Push", "GuiPush"}
 
 
 def _source(fname: str) -> str:
@@ -53,12 +53,12 @@ def test_frame_glsl_block_matches_the_dtype():
     assert [n for _, n, _ in parse_glsl_block(text, "Frame")] == list(FRAME_UBO.names)
 
 
-@pytest.mark.parametrize("fname, block, dtype", BLOCKS, ids=[b[1] for b in BLOCKS])
+@pytest.mark.parametrize("fname, block, dtype", BLOCKS, ids=[f"{b[0]}:{b[1]}" for b in BLOCKS])
 def test_glsl_block_matches_its_dtype(fname, block, dtype):
     assert check_glsl_block((SHADERS / fname).read_text(), block, dtype) == []
 
 
-@pytest.mark.parametrize("fname, block, dtype, prefix", RECORDS, ids=[r[1] for r in RECORDS])
+@pytest.mark.parametrize("fname, block, dtype, prefix", RECORDS, ids=[f"{r[0]}:{r[1]}" for r in RECORDS])
 def test_record_buffer_constants_match_the_dtype(fname, block, dtype, prefix):
     text = _source(fname)
     assert check_glsl_records(text, block, dtype, prefix) == []
@@ -67,15 +67,15 @@ def test_record_buffer_constants_match_the_dtype(fname, block, dtype, prefix):
 
 
 def test_every_glsl_block_is_declared_or_listed():
-    seen = {}
-    for f in sorted(SHADERS.iterdir()):
-        for block in re.findall(r"\b(?:uniform|buffer)\s+(\w+)\s*\{", f.read_text()):
-            seen.setdefault(block, f.name)
-    checked = {b for _, b, _ in BLOCKS} | {b for _, b, _, _ in RECORDS} | {b for _, b, _ in ROWS}
-    assert set(seen) == checked | set(PLAIN) | NOT_YET
-    for block, typ in PLAIN.items():
-        members = parse_glsl_block((SHADERS / seen[block]).read_text(), block)
-        assert [m[0] for m in members] == [typ], block
+    seen = [(f.name, block) for f in sorted(SHADERS.iterdir())
+            for block in re.findall(r"\b(?:uniform|buffer)\s+(\w+)\s*\{", f.read_text())]
+    listed = {(f, b) for f, b, *_ in BLOCKS + RECORDS + ROWS}
+    missing = [(f, b) for f, b in seen if (f, b) not in listed and b not in PLAIN]
+    assert not missing, f"GLSL blocks with no declared dtype: {missing}"
+    assert {(f, b) for f, b, *_ in BLOCKS + ROWS} <= set(seen) and set(PLAIN) <= {b for _, b in seen}
+    for f, block in seen:
+        if block in PLAIN:
+            assert [m[0] for m in parse_glsl_block((SHADERS / f).read_text(), block)] == [PLAIN[block]], block
 
 
 @pytest.mark.parametrize("fname, block, dtype", ROWS, ids=[r[1] for r in ROWS])
