@@ -8,10 +8,14 @@ names, types and std140 offsets; a test runs it on frame.glsl), so the two
 cannot drift apart.  :func:`glsl_members` prints the GLSL members of a dtype
 (to paste when adding a field).
 
-The deformation block ``Deform`` of deform.glsl (:data:`DEFORM_UBO`), the
-Gaussian renderer's frame block ``GsFrame`` (:data:`GS_FRAME_UBO`) and its
-per-Gaussian records (:data:`GS_GEOM`, :data:`GS_REC`, gs_common.glsl) are
-declared the same way.  A uniform/storage block is compared member by member
+Declared the same way: the deformation block ``Deform`` of deform.glsl
+(:data:`DEFORM_UBO`), the Gaussian renderer's frame block ``GsFrame``
+(:data:`GS_FRAME_UBO`) and per-Gaussian records (:data:`GS_GEOM`,
+:data:`GS_REC`, gs_common.glsl), the splat renderer's per-splat geometry
+and pre-pass records (:data:`SPLAT_GEOM`, :data:`SPLAT_REC_A`,
+:data:`SPLAT_REC_B`, splat_records.glsl), the detail rows
+(:data:`DETAIL_ROW`, detail.glsl) and the push-constant blocks
+(``*_PUSH``).  A uniform/storage block is compared member by member
 (:func:`check_glsl_block`: std140 / std430 offsets, vec3 alignment, array
 strides, block size); a buffer of flat ``float`` / ``vec4`` records is
 compared through the GLSL constants naming its stride and field offsets

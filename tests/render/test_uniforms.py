@@ -64,6 +64,15 @@ def test_record_buffer_constants_match_the_dtype(fname, block, dtype, prefix):
     assert check_glsl_records(text, block, dtype, prefix) == []
     moved = text.replace(f"const uint {prefix}_STRIDE = ", f"const uint {prefix}_STRIDE = 1u + ")
     assert any("STRIDE" in p for p in check_glsl_records(moved, block, dtype, prefix))
+    last = dtype.names[-1].upper()
+    shifted = re.sub(rf"(const uint {prefix}_{last} = )(\d+)u;", lambda m: f"{m.group(1)}{int(m.group(2)) + 1}u;", text)
+    assert shifted != text and any(last in p for p in check_glsl_records(shifted, block, dtype, prefix))
+
+
+def test_record_check_catches_a_field_of_the_wrong_scalar_type():
+    text = _source("prepare_cs.glsl")
+    as_float = np.dtype([(n, "<f4", SPLAT_REC_B.fields[n][0].shape) for n in SPLAT_REC_B.names])
+    assert any("not made of uint" in p for p in check_glsl_records(text, "RecB", as_float, "RECB"))
 
 
 def test_every_glsl_block_is_declared_or_listed():
@@ -117,6 +126,7 @@ def test_std140_offsets_follow_the_glsl_rules():
     assert check_glsl_block("layout(std140) uniform B { float a[6]; vec2 b; };", "B", dt)
     assert layout(FRAME_UBO)[-1] == ("vec4", "display", FRAME_UBO.itemsize - 16)
     assert "    uvec4 options;" in glsl_members(FRAME_UBO).splitlines()
+    assert glsl_members(DEFORM_UBO).splitlines() == [f"    vec4 dC[{3 * MAX_GROUPS}];", f"    vec4 rot[{4 * MAX_GROUPS}];"]
 
 
 def test_renderer_buffer_size_is_the_dtype_size():
