@@ -425,7 +425,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             t.fb_points = t._fb(self.cache.render_pass(_RP_POINTS), [t.points_color, t.points_depth])
         desc = V.GraphicsDesc("points.vert", "points.frag", _RP_POINTS, V.LayoutDesc(sets=(_SPLAT_SET,)),
                               topology="point_list", bindings=(V.VertexBinding(0, _GEOM_STRIDE, per_instance=False),),
-                              attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),), depth_test=True, depth_write=True)
+                              attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),
+                              depth_test=True, depth_write=True)
         pipe = self.cache.pipeline(desc)
 
         def rec(cb):

@@ -16,7 +16,8 @@ import pytest
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.uniforms import (DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_PREP_PUSH,
-                                       GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH, PREPARED_PUSH, SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
+                                       GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH, PREPARED_PUSH,
+                                       SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
                                        glsl_members, layout, parse_glsl_block)
 from tests.render.scenes import plane
 
@@ -126,7 +127,8 @@ def test_std140_offsets_follow_the_glsl_rules():
     assert check_glsl_block("layout(std140) uniform B { float a[6]; vec2 b; };", "B", dt)
     assert layout(FRAME_UBO)[-1] == ("vec4", "display", FRAME_UBO.itemsize - 16)
     assert "    uvec4 options;" in glsl_members(FRAME_UBO).splitlines()
-    assert glsl_members(DEFORM_UBO).splitlines() == [f"    vec4 dC[{3 * MAX_GROUPS}];", f"    vec4 rot[{4 * MAX_GROUPS}];"]
+    assert glsl_members(DEFORM_UBO).splitlines() == [f"    vec4 dC[{3 * MAX_GROUPS}];",
+                                                     f"    vec4 rot[{4 * MAX_GROUPS}];"]
 
 
 def test_renderer_buffer_size_is_the_dtype_size():
