@@ -10,6 +10,15 @@
 
 const int MAX_BASIS_GROUPS = 4;
 
+// Basis rows (storage vec4 basis[], or the vertex path's in_basis attributes):
+// BASIS_STRIDE vec4 per group of 4 columns, B, Bx, By, Bz at BASIS_<FIELD>
+// (BASIS_GROUP in splatedit/render/uniforms.py).
+const uint BASIS_STRIDE = 4u;
+const uint BASIS_B = 0u;
+const uint BASIS_BX = 1u;
+const uint BASIS_BY = 2u;
+const uint BASIS_BZ = 3u;
+
 layout(std140, set = 0, binding = DEFORM_BINDING) uniform Deform {
     vec4 dC[3 * MAX_BASIS_GROUPS];
     vec4 rot[4 * MAX_BASIS_GROUPS];

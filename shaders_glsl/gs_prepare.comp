@@ -116,10 +116,10 @@ void main() {
         if (deformed) {
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
-            uint b = 4u * P.groups * row;
+            uint b = BASIS_STRIDE * P.groups * row;
             for (uint k = 0u; k < P.groups; ++k)
-                deform_group(k, basis[b + 4u * k], basis[b + 4u * k + 1u], basis[b + 4u * k + 2u],
-                             basis[b + 4u * k + 3u], dp, Jm);
+                deform_group(k, basis[b + BASIS_STRIDE * k + BASIS_B], basis[b + BASIS_STRIDE * k + BASIS_BX],
+                             basis[b + BASIS_STRIDE * k + BASIS_BY], basis[b + BASIS_STRIDE * k + BASIS_BZ], dp, Jm);
             p += dp;
             J = mat3(1.0) + Jm;
             S = J * S * transpose(J);

@@ -31,7 +31,7 @@ layout(push_constant) uniform Push {
 layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // GEOM_STRIDE floats per splat, from splat P.wbase
 layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8, from splat P.wbase
 layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };     // from splat P.wbase
-layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat, from row P.base
+layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // BASIS_STRIDE * BASIS_GROUPS per splat, from row P.base
 layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // RECA_STRIDE per slot
 layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // RECB_STRIDE per slot
 layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };             // 2 VkDrawIndirectCommand
@@ -75,10 +75,12 @@ void main() {
         if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
-            uint b = uint(4 * BASIS_GROUPS) * li;
-            for (int g = 0; g < BASIS_GROUPS; ++g)
-                deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
+            uint b = BASIS_STRIDE * uint(BASIS_GROUPS) * li;
+            for (int g = 0; g < BASIS_GROUPS; ++g) {
+                uint k = b + BASIS_STRIDE * uint(g);
+                deform_group(g, basis[k + BASIS_B], basis[k + BASIS_BX], basis[k + BASIS_BY], basis[k + BASIS_BZ],
                              dp, Jm);
+            }
 #ifdef DETAIL
             detail_attach(detail[w], dp, Jm, p, u, v);
 #else

@@ -13,7 +13,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render.camera import Camera
 # MAX_GROUPS: groups of 4 basis columns (deform.glsl), re-exported
-from splatedit.render.uniforms import DEFORM_UBO, MAX_GROUPS  # noqa: F401
+from splatedit.render.uniforms import BASIS_GROUP, DEFORM_UBO, MAX_GROUPS  # noqa: F401
 
 #: deform.glsl's block: dC (3 vec4 per group) and the handle rotations (4 vec4 per group)
 DEFORM_UBO_BYTES = DEFORM_UBO.itemsize
@@ -74,17 +74,17 @@ def pack_deform_block(dC: np.ndarray, rot, scale: float) -> np.ndarray:
 
 def pack_basis_rows(mats, scale: float) -> np.ndarray:
     """Basis rows for the GPU: B, Bx, By, Bz (N, K) -> (max(N, 1), G, 4, 4)
-    float32, G = ceil(K / 4) groups of (B, Bx, By, Bz) x 4 columns, gradients
+    float32 (G :data:`~splatedit.render.uniforms.BASIS_GROUP` records per row), G = ceil(K / 4) groups of (B, Bx, By, Bz) x 4 columns, gradients
     per GPU unit (times ``scale``; B is unitless), zero-padded."""
     k = mats[0].shape[1]
     g = (k + 3) // 4
     n = len(mats[0])
-    rows = np.zeros((max(n, 1), g, 4, 4), np.float32)
-    for j, a in enumerate([mats[0]] + [m * scale for m in mats[1:]]):
+    rows = np.zeros((max(n, 1), g), BASIS_GROUP)
+    for name, a in zip(BASIS_GROUP.names, [mats[0]] + [m * scale for m in mats[1:]]):
         padded = np.zeros((n, 4 * g))
         padded[:, :k] = a
-        rows[:n, :, j, :] = padded.reshape(n, g, 4)
-    return rows
+        rows[name][:n] = padded.reshape(n, g, 4)
+    return rows.view(np.float32).reshape(max(n, 1), g, 4, 4)
 
 
 def selection_flags(n: int, support=None, handle=None, inactive=None) -> np.ndarray:

@@ -13,8 +13,9 @@ Declared the same way: the deformation block ``Deform`` of deform.glsl
 (:data:`GS_FRAME_UBO`) and per-Gaussian records (:data:`GS_GEOM`,
 :data:`GS_REC`, gs_common.glsl), the splat renderer's per-splat geometry
 and pre-pass records (:data:`SPLAT_GEOM`, :data:`SPLAT_REC_A`,
-:data:`SPLAT_REC_B`, splat_records.glsl), the detail rows
-(:data:`DETAIL_ROW`, detail.glsl) and the push-constant blocks
+:data:`SPLAT_REC_B`, splat_records.glsl), the basis rows
+(:data:`BASIS_GROUP`, deform.glsl), the detail rows (:data:`DETAIL_ROW`,
+detail.glsl) and the push-constant blocks
 (``*_PUSH``).  A uniform/storage block is compared member by member
 (:func:`check_glsl_block`: std140 / std430 offsets, vec3 alignment, array
 strides, block size); a buffer of flat ``float`` / ``vec4`` records is
@@ -132,6 +133,17 @@ SPLAT_REC_B = np.dtype([
 DETAIL_ROW = np.dtype([
     ("normal", "<f4", (3,)),
     ("lam", "<f4"),
+])
+
+#: one group of 4 basis columns of a basis row (``vec4 basis[]`` of
+#: prepare_cs.glsl / gs_common.glsl, the vertex path's ``in_basis``;
+#: BASIS_* constants in deform.glsl): B, and its gradient x, y, z (per GPU
+#: unit) of the 4 columns; a row is G such records
+BASIS_GROUP = np.dtype([
+    ("B", "<f4", (4,)),
+    ("Bx", "<f4", (4,)),
+    ("By", "<f4", (4,)),
+    ("Bz", "<f4", (4,)),
 ])
 
 #: push constants (std430) of gs_prepare.comp: basis groups per row, polar iterations

@@ -1,8 +1,9 @@
 """Packing through the declared dtypes (splatedit.render.uniforms) writes the
 same bytes as the hand-offset packing it replaced: the deformation block (with
-rotating handles), the Gaussian geometry records of a bunny scene and the
-Gaussian frame block of a rendered frame.  The ``_legacy_*`` functions are the
-previous packing code, kept here as the reference."""
+rotating handles), the basis rows, the Gaussian geometry records of a bunny
+scene, the Gaussian frame block of a rendered frame, the splat geometry upload
+and the detail rows.  The ``_legacy_*`` functions (and the inline hand
+offsets) are the previous packing code, kept here as the reference."""
 
 from __future__ import annotations
 
@@ -17,9 +18,9 @@ from splatedit.deform.rotation import HandleRotation, RotationDisplacement
 from splatedit.io import read
 from splatedit.render.camera import Camera
 from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
-from splatedit.render.gpu_units import gpu_camera, pack_deform_block
+from splatedit.render.gpu_units import gpu_camera, pack_basis_rows, pack_deform_block
 from splatedit.render.gs_resources import pack_geometry
-from splatedit.render.uniforms import DEFORM_UBO, GS_FRAME_UBO, GS_GEOM, MAX_GROUPS
+from splatedit.render.uniforms import BASIS_GROUP, DEFORM_UBO, GS_FRAME_UBO, GS_GEOM, MAX_GROUPS
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
 
@@ -36,6 +37,27 @@ def _legacy_deform_block(dC, rot, scale):
             blocks[g, 1:, :] = (r.offsets / scale).T
     block = np.concatenate([pad.reshape(MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1), blocks.reshape(-1)])
     return np.ascontiguousarray(block, np.float32)
+
+
+def _legacy_basis_rows(mats, scale):
+    k = mats[0].shape[1]
+    g = (k + 3) // 4
+    n = len(mats[0])
+    rows = np.zeros((max(n, 1), g, 4, 4), np.float32)
+    for j, a in enumerate([mats[0]] + [m * scale for m in mats[1:]]):
+        padded = np.zeros((n, 4 * g))
+        padded[:, :k] = a
+        rows[:n, :, j, :] = padded.reshape(n, g, 4)
+    return rows
+
+
+def test_basis_rows_bytes_equal_the_hand_packing():
+    rng = np.random.default_rng(9)
+    for n, k in ((300, 16), (50, 7), (0, 4)):
+        mats = [rng.normal(size=(n, k)) for _ in range(4)]
+        new, old = pack_basis_rows(mats, 8.0), _legacy_basis_rows(mats, 8.0)
+        assert new.dtype == old.dtype and new.shape == old.shape and new.tobytes() == old.tobytes()
+        assert new.shape[1:] == ((k + 3) // 4, 4, 4) and new.itemsize * 16 == BASIS_GROUP.itemsize
 
 
 def _legacy_geometry(cloud, origin, scale):

@@ -15,7 +15,7 @@ import pytest
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.uniforms import (DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_PREP_PUSH,
+from splatedit.render.uniforms import (BASIS_GROUP, DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_PREP_PUSH,
                                        GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH, PREPARED_PUSH,
                                        SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
                                        glsl_members, layout, parse_glsl_block)
@@ -33,7 +33,8 @@ BLOCKS = [("frame.glsl", "Frame", FRAME_UBO), ("deform.glsl", "Deform", DEFORM_U
 RECORDS = [("gs_common.glsl", "GsGeom", GS_GEOM, "GEOM"), ("gs_common.glsl", "GsRec", GS_REC, "REC"),
            ("prepare_cs.glsl", "Geom", SPLAT_GEOM, "GEOM"), ("prepare_cs.glsl", "RecA", SPLAT_REC_A, "RECA"),
            ("prepare_cs.glsl", "RecB", SPLAT_REC_B, "RECB"), ("prepared.vert", "RecA", SPLAT_REC_A, "RECA"),
-           ("prepared.vert", "RecB", SPLAT_REC_B, "RECB")]
+           ("prepared.vert", "RecB", SPLAT_REC_B, "RECB"), ("prepare_cs.glsl", "Basis", BASIS_GROUP, "BASIS"),
+           ("gs_prepare.comp", "GsBasis", BASIS_GROUP, "BASIS")]
 #: (file, block, row dtype): buffers of one vec4 row per item
 ROWS = [("detail.glsl", "Detail", DETAIL_ROW)]
 #: plain arrays of one value per item (block -> GLSL member type)
