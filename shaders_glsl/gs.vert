@@ -12,7 +12,8 @@ layout(location = 2) flat out vec4 v_color;    // rgb, index + 1 as bits
 
 void main() {
     uint g = order[gl_InstanceIndex];
-    vec4 r0 = rec[4u * g], r1 = rec[4u * g + 1u], r2 = rec[4u * g + 2u], r3 = rec[4u * g + 3u];
+    uint b = REC_STRIDE * g;
+    vec4 r0 = rec[b + REC_CENTER], r1 = rec[b + REC_CONIC], r2 = rec[b + REC_AXES], r3 = rec[b + REC_COLOR];
     vec2 s = vec2(float(gl_VertexIndex & 1), float((gl_VertexIndex >> 1) & 1)) * 2.0 - 1.0;
     float scale = MODE == 1 ? r1.w : 1.0;
     vec2 px = r0.xy + scale * (s.x * r2.xy + s.y * r2.zw);

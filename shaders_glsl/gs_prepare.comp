@@ -100,13 +100,14 @@ void main() {
     uint n = F.counts.x;
     bool visible = false;
     if (i < n) {
-        uint g = 16u * i;
-        vec3 p = vec3(geom[g], geom[g + 1u], geom[g + 2u]);
-        float op = geom[g + 3u];
-        mat3 S = mat3(geom[g + 4u], geom[g + 5u], geom[g + 6u],
-                      geom[g + 5u], geom[g + 7u], geom[g + 8u],
-                      geom[g + 6u], geom[g + 8u], geom[g + 9u]);
-        vec3 dc = vec3(geom[g + 10u], geom[g + 11u], geom[g + 12u]);
+        uint g = GEOM_STRIDE * i;
+        uint c0 = g + GEOM_CENTER, s0 = g + GEOM_COV, d0 = g + GEOM_SH_DC;
+        vec3 p = vec3(geom[c0], geom[c0 + 1u], geom[c0 + 2u]);
+        float op = geom[g + GEOM_OPACITY];
+        mat3 S = mat3(geom[s0], geom[s0 + 1u], geom[s0 + 2u],
+                      geom[s0 + 1u], geom[s0 + 3u], geom[s0 + 4u],
+                      geom[s0 + 2u], geom[s0 + 4u], geom[s0 + 5u]);
+        vec3 dc = vec3(geom[d0], geom[d0 + 1u], geom[d0 + 2u]);
         vec3 dir = p;
         uint row = brow[i];
         mat3 R = mat3(1.0);
@@ -115,10 +116,10 @@ void main() {
         if (deformed) {
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
-            uint b = 4u * P.groups * row;
+            uint b = BASIS_STRIDE * P.groups * row;
             for (uint k = 0u; k < P.groups; ++k)
-                deform_group(k, basis[b + 4u * k], basis[b + 4u * k + 1u], basis[b + 4u * k + 2u],
-                             basis[b + 4u * k + 3u], dp, Jm);
+                deform_group(k, basis[b + BASIS_STRIDE * k + BASIS_B], basis[b + BASIS_STRIDE * k + BASIS_BX],
+                             basis[b + BASIS_STRIDE * k + BASIS_BY], basis[b + BASIS_STRIDE * k + BASIS_BZ], dp, Jm);
             p += dp;
             J = mat3(1.0) + Jm;
             S = J * S * transpose(J);
@@ -160,7 +161,8 @@ void main() {
                     if (F.display.y != 0.0) col = vec3(dot(col, vec3(0.2126, 0.7152, 0.0722)));
                     uint fl = gflags[i];
                     if (F.display.z != 0.0) {          // the distortion heat map (the editor's D)
-                        col = gs_heat(col, vec3(geom[g + 13u], geom[g + 14u], geom[g + 15u]), J, deformed, fl);
+                        uint a0 = g + GEOM_NORMAL;
+                        col = gs_heat(col, vec3(geom[a0], geom[a0 + 1u], geom[a0 + 2u]), J, deformed, fl);
                     } else {
                         if ((fl & 1u) != 0u) col = mix(col, F.tint_support.rgb, F.tint_support.a);
                         if ((fl & 2u) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
@@ -168,16 +170,16 @@ void main() {
                     }
                     float far = F.viewport.w, near = F.viewport.z;
                     float zn = far * (z - near) / (z * (far - near));
-                    rec[4u * i] = vec4(c, zn, op);
-                    rec[4u * i + 1u] = vec4(yy / det, -xy / det, xx / det, sqrt(F.params.z / q));
-                    rec[4u * i + 2u] = vec4(a1, a2);
-                    rec[4u * i + 3u] = vec4(col, uintBitsToFloat(i + 1u));
+                    rec[REC_STRIDE * i + REC_CENTER] = vec4(c, zn, op);
+                    rec[REC_STRIDE * i + REC_CONIC] = vec4(yy / det, -xy / det, xx / det, sqrt(F.params.z / q));
+                    rec[REC_STRIDE * i + REC_AXES] = vec4(a1, a2);
+                    rec[REC_STRIDE * i + REC_COLOR] = vec4(col, uintBitsToFloat(i + 1u));
                     keys[i] = floatBitsToUint(z);
                 }
             }
         }
     }
-    if (!visible && i < n) rec[4u * i] = vec4(0.0);       // the pick pass draws every record
+    if (!visible && i < n) rec[REC_STRIDE * i + REC_CENTER] = vec4(0.0);       // the pick pass draws every record
     if (!visible && i < F.counts.z) keys[i] = GS_NONE;
     if (i < F.counts.z) order[i] = i;
     if (gl_LocalInvocationIndex == 0u) s_count = 0u;

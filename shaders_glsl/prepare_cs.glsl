@@ -27,12 +27,13 @@ layout(push_constant) uniform Push {
     uint wbase;
 } P;
 
-layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // 9 floats per splat, from splat P.wbase
+#include "splat_records.glsl"
+layout(std430, set = 0, binding = 1) readonly buffer Geom { float geom[]; };      // GEOM_STRIDE floats per splat, from splat P.wbase
 layout(std430, set = 0, binding = 2) readonly buffer Colors { uint colors[]; };   // sRGB rgba8, from splat P.wbase
 layout(std430, set = 0, binding = 3) readonly buffer Flags { uint flags[]; };     // from splat P.wbase
-layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // 4 * BASIS_GROUPS per splat, from row P.base
-layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // 3 per slot
-layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // 2 per slot
+layout(std430, set = 0, binding = 4) readonly buffer Basis { vec4 basis[]; };     // BASIS_STRIDE * BASIS_GROUPS per splat, from row P.base
+layout(std430, set = 0, binding = 5) writeonly buffer RecA { vec4 recA[]; };      // RECA_STRIDE per slot
+layout(std430, set = 0, binding = 6) writeonly buffer RecB { uvec4 recB[]; };     // RECB_STRIDE per slot
 layout(std430, set = 0, binding = 7) buffer Draws { uint draws[8]; };             // 2 VkDrawIndirectCommand
 
 #include "splat_math.glsl"
@@ -65,18 +66,21 @@ void main() {
     int kind = SPLAT_CULLED;
     Splat S;
     if (li < P.count) {
-        vec3 p = vec3(geom[9 * w], geom[9 * w + 1], geom[9 * w + 2]);
-        vec3 u = vec3(geom[9 * w + 3], geom[9 * w + 4], geom[9 * w + 5]);
-        vec3 v = vec3(geom[9 * w + 6], geom[9 * w + 7], geom[9 * w + 8]);
+        uint gc = GEOM_STRIDE * w + GEOM_CENTER, gu = GEOM_STRIDE * w + GEOM_U, gv = GEOM_STRIDE * w + GEOM_V;
+        vec3 p = vec3(geom[gc], geom[gc + 1u], geom[gc + 2u]);
+        vec3 u = vec3(geom[gu], geom[gu + 1u], geom[gu + 2u]);
+        vec3 v = vec3(geom[gv], geom[gv + 1u], geom[gv + 2u]);
         uint fl = flags[w];
         vec3 u0 = u, v0 = v;
         if ((fl & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
             vec3 dp = vec3(0.0);
             mat3 Jm = mat3(0.0);
-            uint b = uint(4 * BASIS_GROUPS) * li;
-            for (int g = 0; g < BASIS_GROUPS; ++g)
-                deform_group(g, basis[b + 4 * g], basis[b + 4 * g + 1], basis[b + 4 * g + 2], basis[b + 4 * g + 3],
+            uint b = BASIS_STRIDE * uint(BASIS_GROUPS) * li;
+            for (int g = 0; g < BASIS_GROUPS; ++g) {
+                uint k = b + BASIS_STRIDE * uint(g);
+                deform_group(g, basis[k + BASIS_B], basis[k + BASIS_BX], basis[k + BASIS_BY], basis[k + BASIS_BZ],
                              dp, Jm);
+            }
 #ifdef DETAIL
             detail_attach(detail[w], dp, Jm, p, u, v);
 #else
@@ -104,13 +108,14 @@ void main() {
     barrier();
     if (kind == SPLAT_CULLED) return;
     uint slot = kind == SPLAT_QUAD ? s_base[0] + local : P.n - 1u - (s_base[1] + local);
-    recA[3 * slot] = S.ms_cn;
-    recA[3 * slot + 1] = S.mt_tc;
-    recA[3 * slot + 2] = S.mw_r;
+    recA[RECA_STRIDE * slot + RECA_MS_CN] = S.ms_cn;
+    recA[RECA_STRIDE * slot + RECA_MT_TC] = S.mt_tc;
+    recA[RECA_STRIDE * slot + RECA_MW_R] = S.mw_r;
     vec2 pos = kind == SPLAT_QUAD ? S.lo : S.cc;
-    recB[2 * slot] = uvec4(floatBitsToUint(S.center.x), floatBitsToUint(S.center.y), floatBitsToUint(S.center.w),
-                           i + 1u);
-    recB[2 * slot + 1] = uvec4(kind == SPLAT_QUAD ? pack_px(S.lo, -1.0) : floatBitsToUint(S.psize),
-                               kind == SPLAT_QUAD ? pack_px(S.hi, 1.0) : 0u,
-                               packUnorm4x8(vec4(S.color, 1.0)), packSnorm2x16(oct_encode(S.normal)));
+    recB[RECB_STRIDE * slot + RECB_CENTER] = uvec4(floatBitsToUint(S.center.x), floatBitsToUint(S.center.y),
+                                                   floatBitsToUint(S.center.w), i + 1u);
+    recB[RECB_STRIDE * slot + RECB_PACKED] = uvec4(kind == SPLAT_QUAD ? pack_px(S.lo, -1.0) : floatBitsToUint(S.psize),
+                                                   kind == SPLAT_QUAD ? pack_px(S.hi, 1.0) : 0u,
+                                                   packUnorm4x8(vec4(S.color, 1.0)),
+                                                   packSnorm2x16(oct_encode(S.normal)));
 }

@@ -15,6 +15,7 @@ layout(push_constant) uniform Push {
     uint n;
 } P;
 
+#include "splat_records.glsl"
 layout(std430, set = 0, binding = 5) readonly buffer RecA { vec4 recA[]; };
 layout(std430, set = 0, binding = 6) readonly buffer RecB { uvec4 recB[]; };
 
@@ -26,10 +27,10 @@ vec3 oct_decode(vec2 e) {
 
 void main() {
     uint slot = PRIM_MODE == 2 ? P.n - 1u - uint(gl_InstanceIndex) : uint(gl_InstanceIndex);
-    v_ms_cn = recA[3 * slot];
-    v_mt_tc = recA[3 * slot + 1];
-    v_mw_r = recA[3 * slot + 2];
-    uvec4 b0 = recB[2 * slot], b1 = recB[2 * slot + 1];
+    v_ms_cn = recA[RECA_STRIDE * slot + RECA_MS_CN];
+    v_mt_tc = recA[RECA_STRIDE * slot + RECA_MT_TC];
+    v_mw_r = recA[RECA_STRIDE * slot + RECA_MW_R];
+    uvec4 b0 = recB[RECB_STRIDE * slot + RECB_CENTER], b1 = recB[RECB_STRIDE * slot + RECB_PACKED];
     float lp = F.depth_params.w;
     v_center = vec4(uintBitsToFloat(b0.x), uintBitsToFloat(b0.y), 1.0 / (lp * lp), uintBitsToFloat(b0.z));
     v_index = b0.w;

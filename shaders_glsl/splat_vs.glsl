@@ -24,7 +24,7 @@ layout(location = 1) in vec3 in_u;
 layout(location = 2) in vec3 in_v;
 layout(location = 3) in vec4 in_color;      // sRGB unorm8x4
 layout(location = 4) in uint in_flags;
-layout(location = 5) in vec4 in_basis[4 * BASIS_GROUPS];  // per group: B, Bx, By, Bz
+layout(location = 5) in vec4 in_basis[int(BASIS_STRIDE) * BASIS_GROUPS];  // per group: B, Bx, By, Bz
 
 // 0: every splat as a quad; 1: only the SPLAT_QUAD ones (see prepare_splat);
 // 2: only the SPLAT_POINT ones, as square points (POINT_LIST).  Modes 1 + 2
@@ -48,8 +48,11 @@ void main() {
     if ((flags & FLAG_DEFORMED) != 0u) {     // splats outside the support skip this
         vec3 dp = vec3(0.0);
         mat3 Jm = mat3(0.0);                  // J - I
-        for (int g = 0; g < BASIS_GROUPS; ++g)
-            deform_group(g, in_basis[4 * g], in_basis[4 * g + 1], in_basis[4 * g + 2], in_basis[4 * g + 3], dp, Jm);
+        for (int g = 0; g < BASIS_GROUPS; ++g) {
+            uint k = BASIS_STRIDE * uint(g);
+            deform_group(g, in_basis[k + BASIS_B], in_basis[k + BASIS_BX], in_basis[k + BASIS_BY],
+                         in_basis[k + BASIS_BZ], dp, Jm);
+        }
         p += dp;
         u += Jm * u;
         v += Jm * v;

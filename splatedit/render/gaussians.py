@@ -49,6 +49,7 @@ from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_came
 from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
 from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
+from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH, GS_SORT_PUSH
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
                                   RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -312,37 +313,36 @@ class GaussianRenderer:
         near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
         f = 1.0 / math.tan(math.radians(camera.fov_deg) / 2.0)
         fpx = 0.5 * f * height
-        u = np.zeros(_UBO_BYTES // 4, np.float32)
-        u[0:16] = gpu_cam.view_matrix().T.reshape(-1)
-        u[16:20] = (fpx, fpx, 0.5 * width, 0.5 * height)
-        u[20:24] = (width, height, near, far)
-        u[24:28] = (*gpu_cam.eye, self.degree)
-        u[28:32] = (GS_FRUSTUM_CLAMP * 0.5 * width / fpx, GS_FRUSTUM_CLAMP * 0.5 * height / fpx, GS_LOWPASS_PX2,
-                    GS_ALPHA_MIN)
-        u[32:36] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
-        u[36:40] = (*self.background, 1.0)
-        u[40:44].view(np.uint32)[:] = (self.n, self._rest_uints, self._n2 if self.sort == "gpu" else self.n,
-                                       1 if srgb_target else 0)
-        u[44:48] = RENDER_TINT_SUPPORT
-        u[48:52] = RENDER_TINT_HANDLE
-        u[52:56] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0, 1.0 if self.distortion_map else 0.0,
-                    0.0)
-        self.ubo.write(u)
+        u = np.zeros((), GS_FRAME_UBO)           # gs_common.glsl GsFrame
+        u["view"] = gpu_cam.view_matrix().T
+        u["focal"] = (fpx, fpx, 0.5 * width, 0.5 * height)
+        u["viewport"] = (width, height, near, far)
+        u["eye"] = (*gpu_cam.eye, self.degree)
+        u["limits"] = (GS_FRUSTUM_CLAMP * 0.5 * width / fpx, GS_FRUSTUM_CLAMP * 0.5 * height / fpx, GS_LOWPASS_PX2,
+                       GS_ALPHA_MIN)
+        u["params"] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
+        u["background"] = (*self.background, 1.0)
+        u["counts"] = (self.n, self._rest_uints, self._n2 if self.sort == "gpu" else self.n, 1 if srgb_target else 0)
+        u["tint_support"] = RENDER_TINT_SUPPORT
+        u["tint_handle"] = RENDER_TINT_HANDLE
+        u["display"] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0,
+                        1.0 if self.distortion_map else 0.0, 0.0)
+        self.ubo.write(u.reshape(1).view(np.float32))
         self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
         self._near_far = (near * sc, far * sc)
 
     def _record_prepass(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_PREP_PUSH.itemsize, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc("gs_prepare.comp", layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
         groups = self._groups if len(self._basis_idx) else 1
-        cb.push_constants(pipe, np.array([groups, GS_POLAR_ITERATIONS], np.uint32))
+        cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS), GS_PREP_PUSH))
         count = self._n2 if self.sort == "gpu" else self.n
         cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
 
     def _record_gpu_sort(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=8, push_stages="comp")
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_SORT_PUSH.itemsize, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc("gs_sort.comp", layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
@@ -352,7 +352,7 @@ class GaussianRenderer:
             j = k // 2
             while j >= 1:
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
-                cb.push_constants(pipe, np.array([k, j], np.uint32))
+                cb.push_constants(pipe, np.array((k, j), GS_SORT_PUSH))
                 cb.dispatch((n2 + _SORT_WG - 1) // _SORT_WG)
                 j //= 2
             k *= 2

@@ -12,12 +12,11 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render.camera import Camera
-from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
+# MAX_GROUPS: groups of 4 basis columns (deform.glsl), re-exported
+from splatedit.render.uniforms import BASIS_GROUP, DEFORM_UBO, MAX_GROUPS  # noqa: F401
 
-#: groups of 4 basis columns (deform.glsl)
-MAX_GROUPS = (RENDER_MAX_BASIS_COLUMNS + 3) // 4
 #: deform.glsl's block: dC (3 vec4 per group) and the handle rotations (4 vec4 per group)
-DEFORM_UBO_BYTES = 48 * MAX_GROUPS + 64 * MAX_GROUPS
+DEFORM_UBO_BYTES = DEFORM_UBO.itemsize
 
 
 def unit_scale(diagonal: float, max_radius: float) -> float:
@@ -52,10 +51,12 @@ def displacement_bound(dC: np.ndarray, rot) -> float:
 
 
 def pack_deform_block(dC: np.ndarray, rot, scale: float) -> np.ndarray:
-    """deform.glsl's uniform block as float32: dC (K, 3) (model units, divided
-    by ``scale``) zero-padded to 4 groups as rows dC[3g + i] = (dC_{4g..4g+3})[i];
-    then per group g the rotation of handle g of ``rot`` (a RotationDisplacement
-    or None): (unit axis, angle; 0 = none), frame offsets D_0..D_3 / ``scale``."""
+    """deform.glsl's uniform block (a :data:`~splatedit.render.uniforms.DEFORM_UBO`
+    record) as (DEFORM_UBO.itemsize / 4,) float32: dC (K, 3) (model units,
+    divided by ``scale``) zero-padded to 4 groups as rows dC[3g + i] =
+    (dC_{4g..4g+3})[i]; per group g the rotation of handle g of ``rot`` (a
+    RotationDisplacement or None): rot[4g] = (unit axis, angle; 0 = none),
+    rot[4g + 1 + i] = (D_0..D_3)[i] / ``scale``."""
     pad = np.zeros((4 * MAX_GROUPS, 3))
     pad[:len(dC)] = np.asarray(dC, np.float64) / scale
     blocks = np.zeros((MAX_GROUPS, 4, 4))
@@ -65,23 +66,25 @@ def pack_deform_block(dC: np.ndarray, rot, scale: float) -> np.ndarray:
             blocks[g, 0, :3] = r.w / r.angle
             blocks[g, 0, 3] = r.angle
             blocks[g, 1:, :] = (r.offsets / scale).T     # translation-free: no origin shift
-    block = np.concatenate([pad.reshape(MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(-1), blocks.reshape(-1)])
-    return np.ascontiguousarray(block, np.float32)
+    rec = np.zeros((), DEFORM_UBO)
+    rec["dC"] = pad.reshape(MAX_GROUPS, 4, 3).transpose(0, 2, 1).reshape(3 * MAX_GROUPS, 4)
+    rec["rot"] = blocks.reshape(4 * MAX_GROUPS, 4)
+    return rec.reshape(1).view(np.float32)
 
 
 def pack_basis_rows(mats, scale: float) -> np.ndarray:
     """Basis rows for the GPU: B, Bx, By, Bz (N, K) -> (max(N, 1), G, 4, 4)
-    float32, G = ceil(K / 4) groups of (B, Bx, By, Bz) x 4 columns, gradients
+    float32 (G :data:`~splatedit.render.uniforms.BASIS_GROUP` records per row), G = ceil(K / 4) groups of (B, Bx, By, Bz) x 4 columns, gradients
     per GPU unit (times ``scale``; B is unitless), zero-padded."""
     k = mats[0].shape[1]
     g = (k + 3) // 4
     n = len(mats[0])
-    rows = np.zeros((max(n, 1), g, 4, 4), np.float32)
-    for j, a in enumerate([mats[0]] + [m * scale for m in mats[1:]]):
+    rows = np.zeros((max(n, 1), g), BASIS_GROUP)
+    for name, a in zip(BASIS_GROUP.names, [mats[0]] + [m * scale for m in mats[1:]]):
         padded = np.zeros((n, 4 * g))
         padded[:, :k] = a
-        rows[:n, :, j, :] = padded.reshape(n, g, 4)
-    return rows
+        rows[name][:n] = padded.reshape(n, g, 4)
+    return rows.view(np.float32).reshape(max(n, 1), g, 4, 4)
 
 
 def selection_flags(n: int, support=None, handle=None, inactive=None) -> np.ndarray:

@@ -13,10 +13,11 @@ from splatedit.render import vk as V
 # shared with the splat renderer; the packers stay importable from here
 from splatedit.render.gpu_units import pack_basis_rows, pack_deform_block, selection_flags  # noqa: F401
 from splatedit.render.targets import RenderTarget, SizedTargets
+from splatedit.render.uniforms import GS_FRAME_UBO, GS_GEOM, GS_REC
 
-_UBO_BYTES = 224
-_GEOM_FLOATS = 16
-_REC_BYTES = 64
+_UBO_BYTES = GS_FRAME_UBO.itemsize
+_GEOM_FLOATS = GS_GEOM.itemsize // 4
+_REC_BYTES = GS_REC.itemsize
 _PREP_WG = 64
 _SORT_WG = 256
 _NONE = 0xFFFFFFFF
@@ -58,18 +59,20 @@ class _Targets(SizedTargets):
 
 
 def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
-    """GPU arrays of a scene: ((n, 16) float32 geometry: centre relative to
+    """GPU arrays of a scene: ((n, 16) float32 geometry, the
+    :data:`~splatedit.render.uniforms.GS_GEOM` records: centre relative to
     ``origin`` / ``scale``, opacity, covariance xx xy xz yy yz zz / scale^2, SH DC
     rgb, unit shortest axis; (n, m) uint32 SH bands 1-3 as pairs of half floats (m = 0 for degree 0))."""
     n = len(cloud)
-    geom = np.zeros((n, _GEOM_FLOATS), np.float32)
-    geom[:, 0:3] = (cloud.positions - origin) / scale
-    geom[:, 3] = cloud.opacities()
+    rec = np.zeros(n, GS_GEOM)
+    rec["center"] = (cloud.positions - origin) / scale
+    rec["opacity"] = cloud.opacities()
     c = cloud.covariances() / (scale * scale)
-    geom[:, 4:10] = c[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
-    geom[:, 10:13] = cloud.sh[:, 0, :]
+    rec["cov"] = c[:, [0, 0, 0, 1, 1, 2], [0, 1, 2, 1, 2, 2]]
+    rec["sh_dc"] = cloud.sh[:, 0, :]
     shortest = np.argmin(cloud.scales(), axis=1)          # the heat map's normal (2DGS: the third axis)
-    geom[:, 13:16] = cloud.rotation_matrices()[np.arange(n), :, shortest]
+    rec["normal"] = cloud.rotation_matrices()[np.arange(n), :, shortest]
+    geom = rec.view(np.float32).reshape(n, _GEOM_FLOATS)
     rest = np.ascontiguousarray(cloud.sh[:, 1:, :], np.float32).reshape(n, -1).astype(np.float16)
     if rest.shape[1] % 2:
         rest = np.concatenate([rest, np.zeros((n, 1), np.float16)], axis=1)

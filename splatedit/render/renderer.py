@@ -41,7 +41,7 @@ from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, 
                                            _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.targets import rp_resolve as _rp_resolve  # noqa: F401 - importable from here
-from splatedit.render.uniforms import FRAME_UBO
+from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MIN_WEIGHT,
@@ -221,8 +221,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         g = self._basis_groups
         bindings = (V.VertexBinding(0, _GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
                     V.VertexBinding(3, basis_stride))
-        attrs = [V.VertexAttribute(0, 0, "vec3", 0), V.VertexAttribute(1, 0, "vec3", 12),
-                 V.VertexAttribute(2, 0, "vec3", 24), V.VertexAttribute(3, 1, "unorm8x4", 0),
+        off = {f: SPLAT_GEOM.fields[f][1] for f in ("center", "u", "v")}    # splatedit/render/uniforms.py
+        attrs = [V.VertexAttribute(0, 0, "vec3", off["center"]), V.VertexAttribute(1, 0, "vec3", off["u"]),
+                 V.VertexAttribute(2, 0, "vec3", off["v"]), V.VertexAttribute(3, 1, "unorm8x4", 0),
                  V.VertexAttribute(4, 2, "uint", 0)]
         attrs += [V.VertexAttribute(5 + i, 3, "vec4", 16 * i) for i in range(4 * g)]
         return bindings, tuple(attrs)
@@ -284,7 +285,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if prepared:
             prep = self._prep_objects()
             dset, draws = prep.dset, prep.draws
-            n = np.array([prep.windows[window][1]], np.uint32)
+            n = np.array((prep.windows[window][1],), PREPARED_PUSH)
             for mode, offset in ((1, 0), (2, 16)):
                 pipeline = self._prepared_pipeline(kind, mode)
                 cb.bind_pipeline(pipeline)
@@ -424,7 +425,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             t.fb_points = t._fb(self.cache.render_pass(_RP_POINTS), [t.points_color, t.points_depth])
         desc = V.GraphicsDesc("points.vert", "points.frag", _RP_POINTS, V.LayoutDesc(sets=(_SPLAT_SET,)),
                               topology="point_list", bindings=(V.VertexBinding(0, _GEOM_STRIDE, per_instance=False),),
-                              attributes=(V.VertexAttribute(0, 0, "vec3", 0),), depth_test=True, depth_write=True)
+                              attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),
+                              depth_test=True, depth_write=True)
         pipe = self.cache.pipeline(desc)
 
         def rec(cb):

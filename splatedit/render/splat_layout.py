@@ -11,7 +11,7 @@ from __future__ import annotations
 from dataclasses import replace
 
 from splatedit.render import vk as V
-from splatedit.render.uniforms import FRAME_UBO
+from splatedit.render.uniforms import FRAME_UBO, SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B
 
 FLAG_SUPPORT = 1
 FLAG_HANDLE = 2
@@ -19,7 +19,7 @@ FLAG_DEFORMED = 4
 FLAG_INACTIVE = 8            # an inactive handle (the editor's several handles): darker
 
 _UBO_BYTES = FRAME_UBO.itemsize   # splatedit/render/uniforms.py, checked against frame.glsl
-_GEOM_STRIDE = 36           # centre, u, v as float32
+_GEOM_STRIDE = SPLAT_GEOM.itemsize   # centre, u, v as float32
 
 #: vertex path: frame UBO, deformation UBO
 _SPLAT_SET = (V.Binding(0, "uniform", "vert|frag"), V.Binding(1, "uniform", "vert"))
@@ -31,8 +31,8 @@ _PREP_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", 
              V.Binding(7, "storage", "comp"), V.Binding(8, "uniform", "comp"))
 #: the detail mode's pre-pass adds (n_b, lambda) per splat (shaders_glsl/detail.glsl)
 _PREP_SET_DETAIL = _PREP_SET + (V.Binding(9, "storage", "comp"),)
-_REC_A_BYTES = 48
-_REC_B_BYTES = 32
+_REC_A_BYTES = SPLAT_REC_A.itemsize
+_REC_B_BYTES = SPLAT_REC_B.itemsize
 _WORKGROUP = 64
 #: the pre-pass packs quad bounds as 12.4 fixed-point pixels
 _PREP_MAX_SIZE = 4095

@@ -20,6 +20,7 @@ from splatedit.render import vk as V
 from splatedit.render.gpu_units import (MAX_GROUPS, pack_basis_rows, pack_deform_block, selection_flags,
                                         unit_scale)
 from splatedit.render.splat_layout import FLAG_DEFORMED, _GEOM_STRIDE
+from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
 from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
                                   RENDER_VISIBILITY_EPS_RADII)
 
@@ -96,11 +97,11 @@ class SceneUploadsMixin:
             default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
             for lo in range(0, n, chunk):
                 m = min(chunk, n - lo)
-                geom = staging.view(np.float32)[:9 * m].reshape(m, 9)
-                np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom[:, 0:3],
+                geom = staging.view(np.uint8)[:m * _GEOM_STRIDE].view(SPLAT_GEOM)   # m records
+                np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom["center"],
                             casting="same_kind")
-                np.multiply(cloud.u[lo:lo + m], inv, out=geom[:, 3:6], casting="same_kind")
-                np.multiply(cloud.v[lo:lo + m], inv, out=geom[:, 6:9], casting="same_kind")
+                np.multiply(cloud.u[lo:lo + m], inv, out=geom["u"], casting="same_kind")
+                np.multiply(cloud.v[lo:lo + m], inv, out=geom["v"], casting="same_kind")
                 self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
                                                           lo * _GEOM_STRIDE))
                 col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
@@ -228,11 +229,11 @@ class SceneUploadsMixin:
             raise ParameterError("indices", f"must be in 0..{self.n - 1}")
         if self._detail_buf is None:
             self._free_prep()
-            self._detail_buf = V.Buffer(self.dev, self.n * 16, ("storage",), host_visible=True)
-        view = self._detail_buf.view(np.float32).reshape(self.n, 4)
-        view[:] = 0.0
-        view[idx, :3] = d[:, :3]
-        view[idx, 3] = d[:, 3] / self.scale
+            self._detail_buf = V.Buffer(self.dev, self.n * DETAIL_ROW.itemsize, ("storage",), host_visible=True)
+        view = self._detail_buf.view(np.uint8)[:self.n * DETAIL_ROW.itemsize].view(DETAIL_ROW)
+        view.view(np.float32)[:] = 0.0
+        view["normal"][idx] = d[:, :3]
+        view["lam"][idx] = d[:, 3] / self.scale
         # an offset swings by at most 2 |lambda| when its normal turns (clip bounds)
         self._detail_reach = 2.0 * float(np.abs(d[:, 3]).max(initial=0.0))
 
