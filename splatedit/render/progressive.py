@@ -10,14 +10,23 @@ each) so a window stays responsive and the image sharpens while it is drawn:
    targets against the complete depth buffer, and after every chunk the
    shading pass resolves what has been accumulated so far into an image.
 
+Each chunk goes through the compute pre-pass when the renderer uses it
+(:meth:`Renderer._use_prepass`): a step runs the pre-pass of the chunk's
+splats only (a whole number of workgroups inside one pre-pass window, so
+``chunk`` is rounded up to a multiple of 64 and a chunk never crosses a
+window) and then draws their records, in the same submit.  Otherwise (pre-pass
+off, images above 4095 pixels) the chunks are drawn on the vertex path.
+
 Every intermediate image of phase 2 is exact where it is covered: a pixel
 shows the normalised blend of the splats drawn so far that pass the final
 visibility test, and is transparent (alpha 0) where no splat has arrived
 yet, so the caller can composite it over its level-of-detail frame.  The
-last image equals :meth:`Renderer.render` with the vertex path
-(``prepass=False``) bit for bit: the chunks are drawn in splat order, as the
-single draw would.  Chunks are contiguous ranges of the cloud's order, so a
-spatially sorted cloud fills in region by region.
+last image equals :meth:`Renderer.render`: bit for bit on the vertex path
+(the chunks are drawn in splat order, as the single draw would); on the
+pre-pass path within the pre-pass tolerance (records are blended in the
+order the pre-pass's atomics hand out, which differs between runs).  Chunks
+are contiguous ranges of the cloud's order, so a spatially sorted cloud
+fills in region by region.
 
 The frame belongs to one renderer, camera, size and scene state: when the
 renderer draws any other frame in between (or the selection, basis or
