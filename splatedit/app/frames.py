@@ -238,7 +238,7 @@ class FrameScheduler:
         unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame's chunks
         go through the pre-pass, but per-step submits, shading passes and
         readbacks make full quality arrive 2-3x later than from the background
-        refiner: 3.5-3.9 s against about 1-2 s at 1M splats, see
+        refiner: 3-5 s against about 2 s at 1M splats, see
         docs/PERFORMANCE.md), and always in the detail mode (not tested there)."""
         if os.environ.get("SPLATEDIT_REFINE", "background") != "progressive":
             return False
