@@ -8,9 +8,9 @@ the background refiner (a whole frame on a second device, with the compute
 pre-pass, shown when done) or, with ``SPLATEDIT_REFINE=progressive``, refined
 progressively (:mod:`splatedit.app.progressive_refine`: a chunk of splats per
 idle frame on the same device, composited over the level-of-detail frame,
-dropped on any change: the image sharpens instead of switching, but without
-the pre-pass full quality comes 3-5x later; the detail mode always uses the
-refiner).
+dropped on any change: the image sharpens instead of switching, but with a
+submit, a shading pass and a readback per step full quality comes 2-3x later
+at 1M splats; the detail mode always uses the refiner).
 
 Two presentation paths: the GPU path (the editor has a GUI,
 :mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
@@ -235,10 +235,11 @@ class FrameScheduler:
     def _progressive_step(self, key, w: int, h: int) -> bool:
         """One step of the progressive refinement of ``key`` (started here); False
         where it is not used (the background refiner draws the frame instead):
-        unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame draws
-        without the compute pre-pass, so full quality arrives 3-5x later than
-        from the background refiner: 8 s against about 2 s at 1M splats, see
-        docs/PERFORMANCE.md), and always in the detail mode, which it cannot draw."""
+        unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame's chunks
+        go through the pre-pass, but per-step submits, shading passes and
+        readbacks make full quality arrive 2-3x later than from the background
+        refiner: 3-5 s against about 2 s at 1M splats, see
+        docs/PERFORMANCE.md), and always in the detail mode (not tested there)."""
         if os.environ.get("SPLATEDIT_REFINE", "background") != "progressive":
             return False
         ed, vp = self.ed, self.ed.viewport

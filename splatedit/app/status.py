@@ -86,6 +86,8 @@ def status_dict(ed) -> dict:
     fr = ed.frames
     pr = fr.progressive
     st["refining"] = None if pr is None else round(pr.frame.fraction, 3)
+    #: the shown frame is the full-quality one (not a level of detail / reduced size)
+    st["full_quality"] = not fr.scene_interactive
     last = fr.last_progressive
     st["last_refinement"] = None if last is None else {
         "first_chunk_s": _r(last.first_chunk_s, 3), "done_s": _r(last.done_s, 3), "steps": len(last.step_ms),

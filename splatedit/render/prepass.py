@@ -122,24 +122,10 @@ class PrepassMixin:
                 draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
                 objs.append(draws)
                 basis = self._basis_binding()
-                detail = self._detail_buf
                 windowed = len(spans) > 1
                 windows = []
                 for w0, wn in spans:
-                    def span(buf, stride):
-                        return (buf, w0 * stride, wn * stride) if windowed else buf
-                    chunks = []
-                    for base, cnt, off, rng in self._basis_chunks(basis, w0, wn):
-                        dset = V.DescriptorSet(self.dev, self.cache.set_layout(
-                            _PREP_SET if detail is None else _PREP_SET_DETAIL))
-                        objs.append(dset)
-                        writes = {0: self.ubo, 1: span(self._geom, _GEOM_STRIDE), 2: span(self._color, 4),
-                                  3: span(self._flags, 4), 4: (basis, off, rng),
-                                  5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
-                        if detail is not None:
-                            writes[9] = span(detail, 16)
-                        dset.write(writes)
-                        chunks.append((dset, base, cnt))
+                    chunks = self._prep_sets(objs, (rec_a, rec_b, draws), basis, w0, wn, w0, wn, windowed)
                     windows.append((w0, wn, chunks))
             except BaseException:
                 for o in reversed(objs):
@@ -148,13 +134,60 @@ class PrepassMixin:
             self._prep = _Prep(objs, windows[0][2][0][0], rec_a, rec_b, draws, windows)
         return self._prep
 
-    def _record_prepass(self, cb, window: int = 0):
+    def _prep_sets(self, objs: list, records: tuple, basis, w0: int, wn: int, first: int, count: int,
+                   windowed: bool) -> list:
+        """Descriptor sets (appended to ``objs``) that prepare splats ``first`` ..
+        ``first + count - 1`` of splat window (w0, wn) into ``records`` (records
+        A, B, indirect draws): one per basis window, as (set, first splat, count)."""
+        detail = self._detail_buf
+
+        def span(buf, stride):
+            return (buf, w0 * stride, wn * stride) if windowed else buf
+        rec_a, rec_b, draws = records
+        sets = []
+        for base, cnt, off, rng in self._basis_chunks(basis, first, count):
+            dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET if detail is None else _PREP_SET_DETAIL))
+            objs.append(dset)
+            writes = {0: self.ubo, 1: span(self._geom, _GEOM_STRIDE), 2: span(self._color, 4),
+                      3: span(self._flags, 4), 4: (basis, off, rng),
+                      5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
+            if detail is not None:
+                writes[9] = span(detail, 16)
+            dset.write(writes)
+            sets.append((dset, base, cnt))
+        return sets
+
+    def _prep_range(self, first: int, count: int) -> tuple[int, list, list]:
+        """Descriptor sets that prepare only splats ``first`` .. ``first + count - 1``
+        (inside one splat window; ``first`` a multiple of the workgroup size):
+        (window index, [(set, first splat, count)], the sets to destroy).
+        :mod:`splatedit.render.progressive` draws its chunks so."""
+        prep = self._prep_objects()
+        k = next(i for i, (w0, wn, _) in enumerate(prep.windows) if w0 <= first < w0 + wn)
+        w0, wn, _ = prep.windows[k]
+        if first % _WORKGROUP or first + count > w0 + wn:
+            raise ParameterError("chunk", f"splats {first}..{first + count - 1} do not start a workgroup "
+                                          f"inside pre-pass window {w0}..{w0 + wn - 1}")
+        objs = []
+        try:
+            sets = self._prep_sets(objs, (prep.rec_a, prep.rec_b, prep.draws), self._basis_binding(), w0, wn,
+                                   first, count, len(prep.windows) > 1)
+        except BaseException:
+            for o in reversed(objs):
+                o.destroy()
+            raise
+        return k, sets, objs
+
+    def _record_prepass(self, cb, window: int = 0, sets: list | None = None):
         """Compute pre-pass of splat window ``window``: records + indirect draw
-        counts for this frame's camera (one dispatch per basis window). Before
+        counts for this frame's camera (one dispatch per basis window); only
+        the splats of ``sets`` (from :meth:`_prep_range`) when given. Before
         any window but the first of a frame, it waits for the draws that read
         the previous window's records."""
         prep = self._prep_objects()
         w0, wn, chunks = prep.windows[window]
+        partial = sets is not None
+        chunks = sets if partial else chunks
         g = self._basis_groups
         detail = self._detail_buf is not None
         stem = "prepare_detail" if detail else "prepare"
@@ -162,10 +195,13 @@ class PrepassMixin:
         layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=16,
                               push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
-        if len(prep.windows) > 1:        # the previous window's draws read records and counts
+        if len(prep.windows) > 1 or partial:     # earlier draws read records and counts
             cb.memory_barrier("draw_indirect|vertex", "indirect_read|shader_read", "transfer|compute",
                               "transfer_write|shader_write")
         cb.fill_buffer(prep.draws, 0)
+        if partial:     # the shader sets the vertex counts at the window's first splat only
+            cb.fill_buffer(prep.draws, 4, 0, 4)
+            cb.fill_buffer(prep.draws, 1, 16, 4)
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
         for j, (dset, base, cnt) in enumerate(chunks):

@@ -10,14 +10,23 @@ each) so a window stays responsive and the image sharpens while it is drawn:
    targets against the complete depth buffer, and after every chunk the
    shading pass resolves what has been accumulated so far into an image.
 
+Each chunk goes through the compute pre-pass when the renderer uses it
+(:meth:`Renderer._use_prepass`): a step runs the pre-pass of the chunk's
+splats only (a whole number of workgroups inside one pre-pass window, so
+``chunk`` is rounded up to a multiple of 64 and a chunk never crosses a
+window) and then draws their records, in the same submit.  Otherwise (pre-pass
+off, images above 4095 pixels) the chunks are drawn on the vertex path.
+
 Every intermediate image of phase 2 is exact where it is covered: a pixel
 shows the normalised blend of the splats drawn so far that pass the final
 visibility test, and is transparent (alpha 0) where no splat has arrived
 yet, so the caller can composite it over its level-of-detail frame.  The
-last image equals :meth:`Renderer.render` with the vertex path
-(``prepass=False``) bit for bit: the chunks are drawn in splat order, as the
-single draw would.  Chunks are contiguous ranges of the cloud's order, so a
-spatially sorted cloud fills in region by region.
+last image equals :meth:`Renderer.render`: bit for bit on the vertex path
+(the chunks are drawn in splat order, as the single draw would); on the
+pre-pass path within the pre-pass tolerance (records are blended in the
+order the pre-pass's atomics hand out, which differs between runs).  Chunks
+are contiguous ranges of the cloud's order, so a spatially sorted cloud
+fills in region by region.
 
 The frame belongs to one renderer, camera, size and scene state: when the
 renderer draws any other frame in between (or the selection, basis or
@@ -39,6 +48,7 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
+from splatedit.render.splat_layout import _WORKGROUP
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 
@@ -94,8 +104,15 @@ class ProgressiveFrame:
             return 1.0
         return (self.next + (self.n if self.phase == "attr" else 0)) / (2.0 * self.n)
 
-    def _draw(self, cb, kind: str, first: int, count: int) -> None:
-        self.r._record_vertex_splats(cb, kind, first, count)
+    def _span(self, prepared: bool) -> tuple[int, int]:
+        """(first splat, count) of the next chunk: on the pre-pass path a whole
+        number of workgroups inside one pre-pass window."""
+        first = self.next
+        if not prepared:
+            return first, min(self.chunk, self.n - first)
+        end = next(w0 + wn for w0, wn, _ in self.r._prep_objects().windows if w0 <= first < w0 + wn)
+        size = -(-self.chunk // _WORKGROUP) * _WORKGROUP
+        return first, min(size, end - first)
 
     def step(self) -> np.ndarray | None:
         """Draw the next chunk.  Returns the (height, width, 4) uint8 image
@@ -109,37 +126,54 @@ class ProgressiveFrame:
             self.n = r.n
             self._restart()
         t = r._targets_for(self.width, self.height)
-        first, count = self.next, min(self.chunk, self.n - self.next)
-        if self.phase == "depth":
-            r._write_ubo(self.camera, self.width, self.height)
+        prepared = r._use_prepass()
+        #: the path of the last step: True for the compute pre-pass
+        self.prepared = prepared
+        first, count = self._span(prepared)
+        objs, sets, window = [], None, 0
+        if prepared:
+            window, sets, objs = r._prep_range(first, count)
 
-            def rec(cb):
-                rp = r.cache.render_pass(_RP_DEPTH if first == 0 else _RP_DEPTH_LOAD)
-                cb.begin_render_pass(rp, t.fb_depth, [1.0] if first == 0 else [None])
-                self._draw(cb, "depth", first, count)
-                cb.end_render_pass()
-            r.dev.submit(rec)
-            out = None
-        else:
-            alpha = r.background_alpha
-            r.background_alpha = 0.0
-            try:
+        def draw(cb, kind: str, desc: V.RenderPassDesc, fb, clears) -> None:
+            if prepared:
+                r._record_prepass(cb, window, sets)
+            cb.begin_render_pass(r.cache.render_pass(desc), fb, clears)
+            if prepared:
+                r._record_splats(cb, kind, True, window)
+            else:
+                r._record_vertex_splats(cb, kind, first, count)
+            cb.end_render_pass()
+
+        try:
+            if self.phase == "depth":
                 r._write_ubo(self.camera, self.width, self.height)
-            finally:
-                r.background_alpha = alpha
-            fmt = r.accum_format
 
-            def rec(cb):
-                rp = r.cache.render_pass(_rp_attr(fmt, "shader_read") if first == 0 else _rp_attr_load(fmt))
-                clear = [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None] if first == 0 else [None] * 3
-                cb.begin_render_pass(rp, t.fb_attr, clear)
-                self._draw(cb, "attr", first, count)
-                cb.end_render_pass()
-                r._record_resolve(cb, t, t.offscreen)
-                cb.copy_image_to_buffer(t.out, self._rb)
-                cb.host_read_barrier()
-            r.dev.submit(rec)
-            out = self._rb.read().reshape(self.height, self.width, 4)
+                def rec(cb):
+                    draw(cb, "depth", _RP_DEPTH if first == 0 else _RP_DEPTH_LOAD, t.fb_depth,
+                         [1.0] if first == 0 else [None])
+                r.dev.submit(rec)
+                out = None
+            else:
+                alpha = r.background_alpha
+                r.background_alpha = 0.0
+                try:
+                    r._write_ubo(self.camera, self.width, self.height)
+                finally:
+                    r.background_alpha = alpha
+                fmt = r.accum_format
+
+                def rec(cb):
+                    clear = [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None] if first == 0 else [None] * 3
+                    draw(cb, "attr", _rp_attr(fmt, "shader_read") if first == 0 else _rp_attr_load(fmt),
+                         t.fb_attr, clear)
+                    r._record_resolve(cb, t, t.offscreen)
+                    cb.copy_image_to_buffer(t.out, self._rb)
+                    cb.host_read_barrier()
+                r.dev.submit(rec)
+                out = self._rb.read().reshape(self.height, self.width, 4)
+        finally:
+            for o in reversed(objs):
+                o.destroy()
         self.next += count
         if self.next >= self.n:
             self.next = 0

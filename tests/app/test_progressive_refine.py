@@ -74,7 +74,8 @@ def test_still_view_sharpens_monotonically_and_ends_equal_to_the_full_frame(ed):
     """After motion stops on a slow model, each idle frame draws one chunk: the
     shown image keeps the LOD frame where nothing has arrived, the splats drawn
     grow every shown step, the area covered by full-quality splats never
-    shrinks, and the last shown image equals the one-submit full frame."""
+    shrinks, and the last shown image equals the one-submit full frame (within
+    the pre-pass tolerance: the chunks go through the compute pre-pass)."""
     fr, vp = ed.frames, ed.viewport
     _slow(ed)
     fr.motion()
@@ -102,15 +103,13 @@ def test_still_view_sharpens_monotonically_and_ends_equal_to_the_full_frame(ed):
     changed = [int((s != lod).any(axis=2).sum()) for s in shown]
     assert all(c <= k for c, k in zip(changed[:-1], covered[:-1]))
     assert changed[0] > 0
-    full = vp.full.r
     from splatedit.app.viewport import render_camera
-    prepass = full.prepass
-    full.prepass = False
-    try:
-        ref = full.render(render_camera(ed.cam), W, H)
-    finally:
-        full.prepass = prepass
-    assert np.array_equal(shown[-1][..., :3], ref[..., :3])
+    assert p.frame.prepared                         # the chunks went through the compute pre-pass
+    ref = vp.full.r.render(render_camera(ed.cam), W, H)
+    # the pre-pass tolerance (tests/render/test_paths.py): records blend in atomic order
+    diff = np.abs(shown[-1][..., :3].astype(int) - ref[..., :3].astype(int))
+    assert diff.mean() < 0.6, diff.mean()
+    assert (diff.max(axis=2) > 24).mean() < 0.003
     assert p.first_chunk_s is not None and p.first_chunk_s <= p.done_s
 
 

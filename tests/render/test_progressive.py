@@ -62,3 +62,75 @@ def test_progressive_frame_starts_over_when_another_frame_is_drawn(vertex_path):
         while not pf.done:
             img = pf.step()
     assert np.array_equal(img[..., :3], r.render(cam, W, H)[..., :3])
+
+
+def _close_to(img, ref):
+    """The pre-pass tolerance (tests/render/test_paths.py): records are blended
+    in the pre-pass's atomic order, not splat order."""
+    diff = np.abs(img.astype(int) - ref.astype(int))[..., :3]
+    assert diff.mean() < 0.6, diff.mean()
+    assert (diff.max(axis=2) > 24).mean() < 0.003
+
+
+def test_progressive_frame_draws_its_chunks_through_the_prepass(renderer):
+    """Default renderer (pre-pass on): chunks of 5000 splats are rounded up to
+    whole workgroups (5056), each chunk is prepared then drawn, the image fills
+    in and the last one matches the one-submit pre-pass frame."""
+    r = renderer
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    full = r.render(cam, W, H)
+    chunks = -(-bunny.n // 5056)
+    covered, steps = [], 0
+    with ProgressiveFrame(r, cam, W, H, 5000) as pf:
+        while not pf.done:
+            img = pf.step()
+            steps += 1
+            assert pf.prepared
+            if img is not None:
+                covered.append(img[..., 3] > 0)
+        assert pf.restarts == 0
+    assert steps == 2 * chunks and len(covered) == chunks
+    assert all((a <= b).all() for a, b in zip(covered, covered[1:]))
+    assert covered[0].sum() < 0.9 * covered[-1].sum()
+    _close_to(img, full)
+
+
+def test_progressive_frame_in_prepass_windows_of_a_deformed_cloud(renderer, monkeypatch):
+    """A deformed 60k-splat sphere in forced pre-pass windows of 16,384 splats
+    and 16-column basis windows of 3,072: chunks of 10,000 never cross a
+    window (so 2 per window, 8 per phase) and the last image matches the
+    one-submit windowed frame."""
+    from tests.render.deform_util import gaussian_basis
+    from tests.render.scenes import sphere
+    r = renderer
+    cloud = sphere(60000, overlap=1.0)
+    r.set_cloud(cloud)
+    idx = np.flatnonzero(cloud.positions[:, 2] > 0.2)
+    r.set_basis(idx, *gaussian_basis(cloud.positions[idx], k=16, seed=9))
+    r.set_displacement(np.random.default_rng(9).normal(scale=0.1, size=(16, 3)))
+    limits = r.dev.limits
+
+    class Small:
+        def __getattr__(self, name):
+            return getattr(limits, name)
+        maxStorageBufferRange = 48 * 16384
+
+    cam = Camera(eye=(0.2, 0.3, 1.9), target=(0, 0, 0), fov_deg=60)
+    monkeypatch.setattr(r.dev, "limits", Small())
+    r._free_prep()
+    try:
+        full = r.render(cam, W, H)
+        assert r.prepass_windows == 4
+        starts = []
+        with ProgressiveFrame(r, cam, W, H, 10000) as pf:
+            while not pf.done:
+                if pf.phase == "attr":
+                    starts.append(pf.next)
+                img = pf.step()
+    finally:
+        monkeypatch.undo()
+        r._free_prep()
+    assert starts == [0, 10048, 16384, 26432, 32768, 42816, 49152, 59200]
+    _close_to(img, full)
