@@ -23,6 +23,7 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.splat_layout import (_GEOM_STRIDE, _PREP_MAX_SIZE, _PREP_SET, _PREP_SET_DETAIL, _REC_A_BYTES,
                                            _REC_B_BYTES, _WORKGROUP, _rp_window, _splat_desc)
+from splatedit.render.uniforms import PREP_PUSH, PREPARED_PUSH
 from splatedit.tolerances import RENDER_PREPASS_WINDOW_SPLATS
 
 
@@ -192,7 +193,7 @@ class PrepassMixin:
         detail = self._detail_buf is not None
         stem = "prepare_detail" if detail else "prepare"
         comp = f"{stem}.comp" if g == 1 else f"{stem}_k{4 * g}.comp"
-        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=16,
+        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=PREP_PUSH.itemsize,
                               push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
         if len(prep.windows) > 1 or partial:     # earlier draws read records and counts
@@ -208,14 +209,14 @@ class PrepassMixin:
             if j:
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
             cb.bind_descriptor_set(pipe, dset)
-            cb.push_constants(pipe, np.array([base, cnt, wn, w0], np.uint32))
+            cb.push_constants(pipe, np.array((base, cnt, wn, w0), PREP_PUSH))
             cb.dispatch((cnt + _WORKGROUP - 1) // _WORKGROUP)
         cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
                           "indirect_read|shader_read")
 
     def _prepared_pipeline(self, kind: str, mode: int):
         layout = V.LayoutDesc(sets=(_PREP_SET if self._detail_buf is None else _PREP_SET_DETAIL,),
-                              push_bytes=4, push_stages="vert")
+                              push_bytes=PREPARED_PUSH.itemsize, push_stages="vert")
         return self.cache.pipeline(_splat_desc("prepared.vert", kind, self.accum_format, layout, spec=((0, mode),),
                                                topology="point_list" if mode == 2 else "triangle_strip"))
 
