@@ -10,8 +10,10 @@ Raw ``vk*`` calls live only in this package.  It provides
 * VkResult -> :class:`VulkanError` (a :class:`splatedit.errors.SplatEditError`),
   including success codes such as ``VK_TIMEOUT`` that the bindings raise;
 * :class:`Buffer` / :class:`Image` with staging uploads and readback;
-* render passes, descriptor sets, pipelines cached by their description
-  (:class:`PipelineCache`);
+* render passes and framebuffers (``passes``), descriptor sets and layouts
+  (``descriptors``), shaders (``shaders``), graphics pipelines
+  (``graphics``), all cached by their description in a
+  :class:`PipelineCache` (``pipelines``, which also builds compute pipelines);
 * :func:`live_handles` - a count of every live Vulkan object by kind, for leak
   tests.  Everything is destroyed explicitly, in reverse order of creation.
 """
@@ -19,11 +21,13 @@ Raw ``vk*`` calls live only in this package.  It provides
 from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError,
                                       drain_validation_messages, list_devices, live_handles,
                                       validation_enabled)
-from splatedit.render.vk.resources import Buffer, Image, readback_array
+from splatedit.render.vk.resources import Buffer, Image, Sampler, readback_array
 from splatedit.render.vk.commands import CommandBuffer, QueryPool
-from splatedit.render.vk.pipelines import (Attachment, Binding, ComputeDesc, DescriptorSet, Framebuffer,
-                                           GraphicsDesc, LayoutDesc, PipelineCache, RenderPassDesc, Sampler,
-                                           VertexAttribute, VertexBinding, spirv_path)
+from splatedit.render.vk.descriptors import Binding, DescriptorSet, LayoutDesc
+from splatedit.render.vk.passes import Attachment, Framebuffer, RenderPassDesc
+from splatedit.render.vk.shaders import spirv_path
+from splatedit.render.vk.graphics import GraphicsDesc, VertexAttribute, VertexBinding
+from splatedit.render.vk.pipelines import ComputeDesc, PipelineCache
 
 __all__ = [
     "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "drain_validation_messages",

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, VulkanError, call, track
+from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
 
 _LAYOUTS = {
     "undefined": vk.VK_IMAGE_LAYOUT_UNDEFINED,
@@ -91,26 +91,14 @@ class CommandBuffer:
 
     def copy_image_to_buffer(self, image, buf, rect=None, buf_offset=0):
         """Copy ``rect`` = (x, y, w, h) of an image in TRANSFER_SRC layout, tightly packed."""
-        x, y, w, h = rect if rect is not None else (0, 0, image.width, image.height)
-        sub = vk.VkImageSubresourceLayers(aspectMask=image.aspect, mipLevel=0, baseArrayLayer=0,
-                                          layerCount=1)
-        region = vk.VkBufferImageCopy(bufferOffset=buf_offset, bufferRowLength=0, bufferImageHeight=0,
-                                      imageSubresource=sub, imageOffset=vk.VkOffset3D(x, y, 0),
-                                      imageExtent=vk.VkExtent3D(w, h, 1))
         vk.vkCmdCopyImageToBuffer(self.handle, image.handle, vk.VK_IMAGE_LAYOUT_TRANSFER_SRC_OPTIMAL,
-                                  buf.handle, 1, [region])
+                                  buf.handle, 1, [_texel_region(image, rect, buf_offset)])
 
     def copy_buffer_to_image(self, buf, image, rect=None, buf_offset=0):
         """Copy tightly packed texels at ``buf_offset`` into ``rect`` = (x, y, w, h)
         of an image in TRANSFER_DST layout."""
-        x, y, w, h = rect if rect is not None else (0, 0, image.width, image.height)
-        sub = vk.VkImageSubresourceLayers(aspectMask=image.aspect, mipLevel=0, baseArrayLayer=0,
-                                          layerCount=1)
-        region = vk.VkBufferImageCopy(bufferOffset=buf_offset, bufferRowLength=0, bufferImageHeight=0,
-                                      imageSubresource=sub, imageOffset=vk.VkOffset3D(x, y, 0),
-                                      imageExtent=vk.VkExtent3D(w, h, 1))
         vk.vkCmdCopyBufferToImage(self.handle, buf.handle, image.handle,
-                                  vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, [region])
+                                  vk.VK_IMAGE_LAYOUT_TRANSFER_DST_OPTIMAL, 1, [_texel_region(image, rect, buf_offset)])
 
     def blit_image(self, src, dst, src_rect=None, dst_rect=None, nearest: bool = True):
         """Copy ``src_rect`` = (x, y, w, h) of ``src`` (TRANSFER_SRC layout) into
@@ -266,17 +254,21 @@ _ACCESS = {
 
 
 def _stage(names: str) -> int:
-    out = 0
-    for n in names.split("|"):
-        out |= _STAGES[n.strip()]
-    return out
+    return flag_bits(_STAGES, names, "pipeline stage")
 
 
 def _access(names: str) -> int:
-    out = 0
-    for n in names.split("|"):
-        out |= _ACCESS[n.strip()]
-    return out
+    return flag_bits(_ACCESS, names, "access")
+
+
+def _texel_region(image, rect, buf_offset: int):
+    """The VkBufferImageCopy of ``rect`` = (x, y, w, h) of ``image`` (default:
+    all of it) and tightly packed texels at ``buf_offset``."""
+    x, y, w, h = rect if rect is not None else (0, 0, image.width, image.height)
+    sub = vk.VkImageSubresourceLayers(aspectMask=image.aspect, mipLevel=0, baseArrayLayer=0, layerCount=1)
+    return vk.VkBufferImageCopy(bufferOffset=buf_offset, bufferRowLength=0, bufferImageHeight=0,
+                                imageSubresource=sub, imageOffset=vk.VkOffset3D(x, y, 0),
+                                imageExtent=vk.VkExtent3D(w, h, 1))
 
 
 class QueryPool:
@@ -297,7 +289,4 @@ class QueryPool:
         return (data.astype(np.float64) - float(data[0])) * self.dev.timestamp_period_ns
 
     def destroy(self):
-        if self.handle is not None:
-            vk.vkDestroyQueryPool(self.dev.device, self.handle, None)
-            track("query_pool", -1)
-            self.handle = None
+        release(self, "handle", vk.vkDestroyQueryPool, "query_pool")

@@ -83,6 +83,33 @@ def track(kind: str, delta: int) -> None:
             del _LIVE[kind]
 
 
+def release(owner, attr: str, destroy_fn, kind: str) -> None:
+    """Destroy ``owner.<attr>`` (a handle made on ``owner.dev``) with
+    ``destroy_fn(VkDevice, handle, None)``, count it out of :func:`live_handles`
+    as ``kind`` and set the attribute to None; nothing when it is None already
+    (destroy methods stay idempotent)."""
+    handle = getattr(owner, attr)
+    if handle is not None:
+        destroy_fn(owner.dev.device, handle, None)
+        track(kind, -1)
+        setattr(owner, attr, None)
+
+
+def flag_bits(table: dict, names, what: str) -> int:
+    """OR of ``table[name]`` over ``names``: an iterable of names, or one
+    string of names joined by ``|`` (``"vert|frag"``); an unknown name raises
+    ValueError naming ``what`` and the known names."""
+    if isinstance(names, str):
+        names = names.split("|")
+    out = 0
+    for n in names:
+        try:
+            out |= table[n.strip()]
+        except KeyError:
+            raise ValueError(f"unknown {what} {n!r}; known: {sorted(table)}") from None
+    return out
+
+
 def live_handles() -> dict[str, int]:
     """Number of live Vulkan objects created through this layer, by kind."""
     with _LIVE_LOCK:

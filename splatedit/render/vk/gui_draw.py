@@ -38,10 +38,11 @@ import numpy as np
 
 from splatedit.render.vk.commands import _LAYOUTS, CommandBuffer
 from splatedit.render.vk.core import Device
-from splatedit.render.vk.pipelines import (Attachment, Binding, DescriptorSet, Framebuffer, GraphicsDesc,
-                                           LayoutDesc, PipelineCache, RenderPass, RenderPassDesc, Sampler,
-                                           VertexAttribute, VertexBinding)
-from splatedit.render.vk.resources import Buffer, Image
+from splatedit.render.vk.descriptors import Binding, DescriptorSet, LayoutDesc
+from splatedit.render.vk.graphics import GraphicsDesc, VertexAttribute, VertexBinding
+from splatedit.render.vk.passes import Attachment, Framebuffer, RenderPass, RenderPassDesc
+from splatedit.render.vk.pipelines import PipelineCache
+from splatedit.render.vk.resources import Buffer, Image, Sampler
 
 #: bytes of one ImDrawVert (pos 8, uv 8, col 4)
 VERTEX_BYTES = 20

@@ -1,11 +1,11 @@
-"""Buffers and images with explicit destruction, staging uploads and readback."""
+"""Buffers, images and samplers with explicit destruction, staging uploads and readback."""
 
 from __future__ import annotations
 
 import numpy as np
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, VulkanError, call, track
+from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
 
 _BUFFER_USAGE = {
     "vertex": vk.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,
@@ -46,16 +46,6 @@ _IMAGE_USAGE = {
 }
 
 
-def _flags(table, names) -> int:
-    out = 0
-    for n in names:
-        try:
-            out |= table[n]
-        except KeyError:
-            raise ValueError(f"unknown usage {n!r}; known: {sorted(table)}") from None
-    return out
-
-
 class Buffer:
     """A VkBuffer with its own memory.
 
@@ -76,7 +66,7 @@ class Buffer:
         self._mapped = None
         usage = set(usage) | ({"transfer_dst", "transfer_src"} if not host_visible else set())
         d = device.device
-        info = vk.VkBufferCreateInfo(size=self.size, usage=_flags(_BUFFER_USAGE, usage),
+        info = vk.VkBufferCreateInfo(size=self.size, usage=flag_bits(_BUFFER_USAGE, usage, "buffer usage"),
                                      sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE)
         self.handle = call(vk.vkCreateBuffer, d, info, None)
         track("buffer", 1)
@@ -151,14 +141,8 @@ class Buffer:
         if self._mapped is not None:
             vk.vkUnmapMemory(d, self.memory)
             self._mapped = None
-        if self.handle is not None:
-            vk.vkDestroyBuffer(d, self.handle, None)
-            track("buffer", -1)
-            self.handle = None
-        if self.memory is not None:
-            vk.vkFreeMemory(d, self.memory, None)
-            track("memory", -1)
-            self.memory = None
+        release(self, "handle", vk.vkDestroyBuffer, "buffer")
+        release(self, "memory", vk.vkFreeMemory, "memory")
 
 
 class Image:
@@ -182,7 +166,7 @@ class Image:
             imageType=vk.VK_IMAGE_TYPE_2D, format=self.vk_format,
             extent=vk.VkExtent3D(self.width, self.height, 1), mipLevels=1, arrayLayers=1,
             samples=vk.VK_SAMPLE_COUNT_1_BIT, tiling=vk.VK_IMAGE_TILING_OPTIMAL,
-            usage=_flags(_IMAGE_USAGE, usage), sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE,
+            usage=flag_bits(_IMAGE_USAGE, usage, "image usage"), sharingMode=vk.VK_SHARING_MODE_EXCLUSIVE,
             initialLayout=vk.VK_IMAGE_LAYOUT_UNDEFINED)
         self.handle = call(vk.vkCreateImage, d, info, None)
         track("image", 1)
@@ -209,19 +193,30 @@ class Image:
         return FORMAT_INFO[self.format][0]
 
     def destroy(self) -> None:
-        d = self.dev.device
-        if self.view is not None:
-            vk.vkDestroyImageView(d, self.view, None)
-            track("image_view", -1)
-            self.view = None
-        if self.handle is not None:
-            vk.vkDestroyImage(d, self.handle, None)
-            track("image", -1)
-            self.handle = None
-        if self.memory is not None:
-            vk.vkFreeMemory(d, self.memory, None)
-            track("memory", -1)
-            self.memory = None
+        release(self, "view", vk.vkDestroyImageView, "image_view")
+        release(self, "handle", vk.vkDestroyImage, "image")
+        release(self, "memory", vk.vkFreeMemory, "memory")
+
+
+class Sampler:
+    """Clamp-to-edge sampler: nearest-neighbour (the resolve pass uses texelFetch)
+    or, with ``linear=True``, bilinear (GUI textures)."""
+
+    def __init__(self, device: Device, linear: bool = False):
+        self.dev = device
+        filt = vk.VK_FILTER_LINEAR if linear else vk.VK_FILTER_NEAREST
+        info = vk.VkSamplerCreateInfo(
+            magFilter=filt, minFilter=filt,
+            mipmapMode=vk.VK_SAMPLER_MIPMAP_MODE_NEAREST,
+            addressModeU=vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            addressModeV=vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            addressModeW=vk.VK_SAMPLER_ADDRESS_MODE_CLAMP_TO_EDGE,
+            maxLod=0.0, borderColor=vk.VK_BORDER_COLOR_FLOAT_TRANSPARENT_BLACK)
+        self.handle = call(vk.vkCreateSampler, device.device, info, None)
+        track("sampler", 1)
+
+    def destroy(self):
+        release(self, "handle", vk.vkDestroySampler, "sampler")
 
 
 def readback_array(raw: np.ndarray, fmt: str, width: int, height: int) -> np.ndarray:

@@ -14,7 +14,7 @@ from __future__ import annotations
 import vulkan as vk
 
 from splatedit.render.vk.core import Device, call, track
-from splatedit.render.vk.pipelines import Framebuffer
+from splatedit.render.vk.passes import Framebuffer
 
 #: swapchain VkFormat -> name in resources.FORMATS
 FORMAT_NAMES = {vk.VK_FORMAT_B8G8R8A8_UNORM: "bgra8", vk.VK_FORMAT_R8G8B8A8_UNORM: "rgba8"}
