@@ -15,8 +15,8 @@ Declared the same way: the deformation block ``Deform`` of deform.glsl
 and pre-pass records (:data:`SPLAT_GEOM`, :data:`SPLAT_REC_A`,
 :data:`SPLAT_REC_B`, splat_records.glsl), the basis rows
 (:data:`BASIS_GROUP`, deform.glsl), the detail rows (:data:`DETAIL_ROW`,
-detail.glsl) and the push-constant blocks
-(``*_PUSH``).  A uniform/storage block is compared member by member
+detail.glsl), the push-constant blocks (``*_PUSH``) and the GUI's vertex
+(:data:`GUI_VERTEX`, Dear ImGui's ImDrawVert).  A uniform/storage block is compared member by member
 (:func:`check_glsl_block`: std140 / std430 offsets, vec3 alignment, array
 strides, block size); a buffer of flat ``float`` / ``vec4`` records is
 compared through the GLSL constants naming its stride and field offsets
@@ -157,6 +157,10 @@ PREP_PUSH = np.dtype([("base", "<u4"), ("count", "<u4"), ("n", "<u4"), ("wbase",
 PREPARED_PUSH = np.dtype([("n", "<u4")])
 #: push constants of gui.vert: pixels -> NDC scale and translation
 GUI_PUSH = np.dtype([("scale", "<f4", (2,)), ("translate", "<f4", (2,))])
+#: one vertex of the GUI's vertex buffer: Dear ImGui's ImDrawVert, copied
+#: verbatim from its draw lists (gui.vert inputs 0-2): position (framebuffer
+#: pixels), texture coordinate, RGBA8 unorm colour
+GUI_VERTEX = np.dtype([("pos", "<f4", (2,)), ("uv", "<f4", (2,)), ("col", "u1", (4,))])
 
 _BASES = {"f": "float", "u": "uint", "i": "int"}
 _VEC = {"float": "vec", "uint": "uvec", "int": "ivec"}

@@ -3,8 +3,9 @@ scissor per draw, drawn into an existing colour target.
 
 :class:`GuiPainter` knows nothing about Dear ImGui (that is
 :mod:`splatedit.render.gui`); it draws indexed triangles whose vertices have
-ImGui's ``ImDrawVert`` layout (20 bytes: ``pos`` 2 x float32 in framebuffer
-pixels, ``uv`` 2 x float32, ``col`` RGBA8 unorm) and 16- or 32-bit indices
+ImGui's ``ImDrawVert`` layout (:data:`~splatedit.render.uniforms.GUI_VERTEX`,
+20 bytes: ``pos`` 2 x float32 in framebuffer pixels, ``uv`` 2 x float32,
+``col`` RGBA8 unorm) and 16- or 32-bit indices
 (``ImDrawIdx`` is a compile-time choice; imgui-bundle 1.93 uses 32 bits):
 
 * textures (:meth:`~GuiPainter.create_texture`, :meth:`~GuiPainter.update_texture`,
@@ -20,7 +21,8 @@ pixels, ``uv`` 2 x float32, ``col`` RGBA8 unorm) and 16- or 32-bit indices
 * :meth:`~GuiPainter.record` begins a render pass on a given framebuffer
   (loading its contents, or clearing them), binds the pipeline (one per
   target format, cached in a :class:`PipelineCache`), pushes
-  ``scale``/``translate`` (16 bytes of push constants), and issues one
+  ``scale``/``translate`` (push constants
+  :data:`~splatedit.render.uniforms.GUI_PUSH`), and issues one
   ``vkCmdDrawIndexed`` per :class:`GuiDraw` with its scissor rectangle.
 
 Frame contract: :meth:`~GuiPainter.upload` rewrites the buffers the previous
@@ -36,6 +38,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from splatedit.render.uniforms import GUI_PUSH, GUI_VERTEX
 from splatedit.render.vk.commands import _LAYOUTS, CommandBuffer
 from splatedit.render.vk.core import Device
 from splatedit.render.vk.descriptors import Binding, DescriptorSet, LayoutDesc
@@ -45,15 +48,16 @@ from splatedit.render.vk.pipelines import PipelineCache
 from splatedit.render.vk.resources import Buffer, Image, Sampler
 
 #: bytes of one ImDrawVert (pos 8, uv 8, col 4)
-VERTEX_BYTES = 20
+VERTEX_BYTES = GUI_VERTEX.itemsize
 #: smallest vertex/index buffer allocated (bytes); later growth doubles
 MIN_BUFFER_BYTES = 64 * 1024
 
 _SET = (Binding(0, "sampled", "frag"),)
-_LAYOUT = LayoutDesc(sets=(_SET,), push_bytes=16, push_stages="vert")
+_LAYOUT = LayoutDesc(sets=(_SET,), push_bytes=GUI_PUSH.itemsize, push_stages="vert")
 _VERTEX_BINDINGS = (VertexBinding(0, VERTEX_BYTES, per_instance=False),)
-_VERTEX_ATTRIBUTES = (VertexAttribute(0, 0, "vec2", 0), VertexAttribute(1, 0, "vec2", 8),
-                      VertexAttribute(2, 0, "unorm8x4", 16))
+_VERTEX_ATTRIBUTES = tuple(VertexAttribute(location, 0, fmt, GUI_VERTEX.fields[name][1])
+                           for location, (name, fmt) in enumerate((("pos", "vec2"), ("uv", "vec2"),
+                                                                   ("col", "unorm8x4"))))
 _LAYOUT_NAMES = {v: k for k, v in _LAYOUTS.items()}
 
 
@@ -267,7 +271,7 @@ class GuiPainter:
             cmd.bind_pipeline(pipe)
             cmd.bind_vertex_buffers(0, [self._vertices.buffer])
             cmd.bind_index_buffer(self._indices.buffer, uint32=self._index_bytes == 4)
-            cmd.push_constants(pipe, np.array([scale[0], scale[1], translate[0], translate[1]], np.float32))
+            cmd.push_constants(pipe, gui_push(scale, translate))
             bound = None
             for d in draws:
                 x, y, w, h = d.clip
@@ -300,6 +304,16 @@ class GuiPainter:
         if self._own_cache and self.cache is not None:
             self.cache.destroy()
         self.cache = None
+
+
+def gui_push(scale, translate) -> np.ndarray:
+    """The push constants of gui.vert: a () record of
+    :data:`~splatedit.render.uniforms.GUI_PUSH` holding ``scale`` and
+    ``translate`` (2 floats each: framebuffer pixels -> clip space)."""
+    rec = np.zeros((), GUI_PUSH)
+    rec["scale"] = scale
+    rec["translate"] = translate
+    return rec
 
 
 def _check_rgba(rgba) -> np.ndarray:
