@@ -353,10 +353,10 @@ def _render_gaussians(args, cloud) -> int:
     edit script's single edit fitted on the Gaussians' splat proxy and applied
     on the GPU (centres, covariances, SH frames)."""
     import numpy as np
-    from splatedit.render.gs_headless import render_gaussians_to_png, splat_proxy
+    from splatedit.render.gs_headless import render_gaussians_to_png
     if args.buffers is not None:
         raise ParameterError("--buffers", "is not available for Gaussian splatting scenes")
-    proxy = splat_proxy(cloud)
+    proxy = cloud.proxy_splats()
     camera = _camera_from_args(args, proxy)
     basis_rows = d_c = None
     on_cpu = False

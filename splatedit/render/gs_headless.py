@@ -18,18 +18,12 @@ from splatedit.render.headless import _prepare_output, _size_and_basis, _write, 
 
 
 def splat_proxy(cloud: GaussianCloud) -> SplatCloud:
-    """A SplatCloud with one splat per Gaussian (same indices): centre = the
-    Gaussian's, axes u, v = its two largest principal axes times their
-    standard deviations (model units).  Supports, handles and bases fitted on
-    it apply to the Gaussians row for row."""
-    r = cloud.rotation_matrices()
-    s = cloud.scales()
-    order = np.argsort(-s, axis=1)
-    rows = np.arange(len(cloud))
-    a0, a1 = order[:, 0], order[:, 1]
-    u = r[rows, :, a0] * s[rows, a0][:, None]
-    v = r[rows, :, a1] * s[rows, a1][:, None]
-    return SplatCloud(cloud.positions.copy(), u, v, None, name=cloud.name, source=cloud.source)
+    """The Gaussians' splat proxy, :meth:`GaussianCloud.proxy_splats` (one
+    disc per Gaussian, same indices, spanned by its two largest axes at
+    ``GAUSSIAN_PROXY_SIGMAS`` standard deviations, DC colours): supports,
+    handles and bases fitted on it apply to the Gaussians row for row.  The
+    same proxy as the editor's and ``splatedit deform``'s."""
+    return cloud.proxy_splats()
 
 
 def default_camera(cloud: GaussianCloud, width: int, height: int) -> Camera:

@@ -10,7 +10,6 @@ from splatedit.app.camera_control import OrbitCamera
 from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.data import default_model_path
 from splatedit.io import read
-from splatedit.render.gs_headless import splat_proxy
 from splatedit.tolerances import GS_PICK_MIN_OPACITY
 
 pytestmark = pytest.mark.gpu
@@ -23,7 +22,7 @@ def scene():
     sub = cloud.subset(np.random.default_rng(1).choice(cloud.n, 4000, replace=False))
     grow = np.sqrt(cloud.n / sub.n) * 0.8
     g = gaussians_from_splats(sub.replace(u=sub.u * grow, v=sub.v * grow), seed=4)
-    proxy = splat_proxy(g)
+    proxy = g.proxy_splats()
     vp = Viewport()
     vp.set_cloud(proxy)
     cam = OrbitCamera(scene_radius=proxy.diagonal / 2)
