@@ -331,21 +331,24 @@ class GaussianRenderer:
         self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
         self._near_far = (near * sc, far * sc)
 
-    def _record_prepass(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_PREP_PUSH.itemsize, push_stages="comp")
-        pipe = self.cache.pipeline(V.ComputeDesc("gs_prepare.comp", layout))
+    def _bind_compute(self, cb, shader: str, push: np.dtype):
+        """Bind compute shader ``shader`` with the scene's set (``_GS_SET``) and
+        push constants of layout ``push``; returns the pipeline."""
+        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=push.itemsize, push_stages="comp")
+        pipe = self.cache.pipeline(V.ComputeDesc(shader, layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
+        return pipe
+
+    def _record_prepass(self, cb):
+        pipe = self._bind_compute(cb, "gs_prepare.comp", GS_PREP_PUSH)
         groups = self._groups if len(self._basis_idx) else 1
         cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS), GS_PREP_PUSH))
         count = self._n2 if self.sort == "gpu" else self.n
         cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
 
     def _record_gpu_sort(self, cb):
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=GS_SORT_PUSH.itemsize, push_stages="comp")
-        pipe = self.cache.pipeline(V.ComputeDesc("gs_sort.comp", layout))
-        cb.bind_pipeline(pipe)
-        cb.bind_descriptor_set(pipe, self._dset)
+        pipe = self._bind_compute(cb, "gs_sort.comp", GS_SORT_PUSH)
         n2 = self._n2
         k = 2
         while k <= n2:

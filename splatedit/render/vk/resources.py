@@ -46,6 +46,16 @@ _IMAGE_USAGE = {
 }
 
 
+def _allocate(device: Device, req, flags: int):
+    """Device memory for requirements ``req`` (VkMemoryRequirements) in a
+    memory type with property ``flags``; counted in live_handles as "memory"."""
+    ainfo = vk.VkMemoryAllocateInfo(allocationSize=req.size,
+                                    memoryTypeIndex=device.memory_type(req.memoryTypeBits, flags))
+    memory = call(vk.vkAllocateMemory, device.device, ainfo, None)
+    track("memory", 1)
+    return memory
+
+
 class Buffer:
     """A VkBuffer with its own memory.
 
@@ -71,15 +81,11 @@ class Buffer:
         self.handle = call(vk.vkCreateBuffer, d, info, None)
         track("buffer", 1)
         try:
-            req = vk.vkGetBufferMemoryRequirements(d, self.handle)
             if host_visible:
                 flags = vk.VK_MEMORY_PROPERTY_HOST_VISIBLE_BIT | vk.VK_MEMORY_PROPERTY_HOST_COHERENT_BIT
             else:
                 flags = vk.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT
-            ainfo = vk.VkMemoryAllocateInfo(allocationSize=req.size,
-                                            memoryTypeIndex=device.memory_type(req.memoryTypeBits, flags))
-            self.memory = call(vk.vkAllocateMemory, d, ainfo, None)
-            track("memory", 1)
+            self.memory = _allocate(device, vk.vkGetBufferMemoryRequirements(d, self.handle), flags)
             call(vk.vkBindBufferMemory, d, self.handle, self.memory, 0)
             if host_visible:
                 self._mapped = call(vk.vkMapMemory, d, self.memory, 0, self.size, 0)
@@ -171,12 +177,8 @@ class Image:
         self.handle = call(vk.vkCreateImage, d, info, None)
         track("image", 1)
         try:
-            req = vk.vkGetImageMemoryRequirements(d, self.handle)
-            ainfo = vk.VkMemoryAllocateInfo(
-                allocationSize=req.size,
-                memoryTypeIndex=device.memory_type(req.memoryTypeBits, vk.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT))
-            self.memory = call(vk.vkAllocateMemory, d, ainfo, None)
-            track("memory", 1)
+            self.memory = _allocate(device, vk.vkGetImageMemoryRequirements(d, self.handle),
+                                    vk.VK_MEMORY_PROPERTY_DEVICE_LOCAL_BIT)
             call(vk.vkBindImageMemory, d, self.handle, self.memory, 0)
             sub = vk.VkImageSubresourceRange(aspectMask=self.aspect, baseMipLevel=0, levelCount=1,
                                              baseArrayLayer=0, layerCount=1)
