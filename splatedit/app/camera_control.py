@@ -42,6 +42,12 @@ class OrbitCamera:
     fov_deg: float = RENDER_FOV_DEG
     up_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
     scene_radius: float = 1.0
+    #: where the orbit pivot sits on screen, as (x, y) view-plane tangents
+    #: (right, up) off the view axis: (0, 0) is the window centre.  Framing into
+    #: a part of the window (beside a side panel) sets it to that part's
+    #: centre; orbit, the numpad views and the dolly drag turn / zoom about the
+    #: point at the target's depth there, so the framed model stays put
+    screen_offset: tuple = (0.0, 0.0)
 
     # -------------------------------------------------------------- frames
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,10 +130,26 @@ class OrbitCamera:
         return o + d * (depth / max(cos, 1e-9))
 
     # --------------------------------------------------------------- motion
+    def pivot(self) -> np.ndarray:
+        """(3,) world point the camera orbits about: at the target's depth,
+        under :attr:`screen_offset` (the target itself when it is (0, 0))."""
+        r, u, _ = self.basis()
+        ox, oy = self.screen_offset
+        return np.asarray(self.target, float) + self.distance * (ox * r + oy * u)
+
+    def turn_to(self, yaw: float, pitch: float) -> None:
+        """Set the view angles (radians), keeping the :meth:`pivot` where it
+        is in the world and on screen."""
+        p = self.pivot()
+        self.yaw = float(yaw)
+        self.pitch = float(np.clip(pitch, -PITCH_LIMIT, PITCH_LIMIT))
+        r, u, _ = self.basis()
+        ox, oy = self.screen_offset
+        self.target = p - self.distance * (ox * r + oy * u)
+
     def orbit(self, dx_px: float, dy_px: float) -> None:
-        """Turntable orbit about ``target`` by a mouse motion in pixels."""
-        self.yaw -= dx_px * EDITOR_ORBIT_RAD_PER_PX
-        self.pitch = float(np.clip(self.pitch + dy_px * EDITOR_ORBIT_RAD_PER_PX, -PITCH_LIMIT, PITCH_LIMIT))
+        """Turntable orbit about the :meth:`pivot` by a mouse motion in pixels."""
+        self.turn_to(self.yaw - dx_px * EDITOR_ORBIT_RAD_PER_PX, self.pitch + dy_px * EDITOR_ORBIT_RAD_PER_PX)
 
     def pan(self, dx_px: float, dy_px: float, h: int) -> None:
         """Move the pivot in the view plane so the pivot plane follows the mouse."""
@@ -144,7 +166,9 @@ class OrbitCamera:
         new_dist = float(np.clip(self.distance * f, EDITOR_MIN_DIST_REL * self.scene_radius,
                                  EDITOR_MAX_DIST_REL * self.scene_radius))
         f = new_dist / self.distance
-        if x is None or y is None:
+        if x is None or y is None:        # about the pivot (it keeps its pixel)
+            p = self.pivot()
+            self.target = p + (np.asarray(self.target, float) - p) * f
             self.distance = new_dist
             return
         p = self.point_at_depth(x, y, w, h, self.distance if depth is None else depth)
@@ -152,21 +176,37 @@ class OrbitCamera:
         self.target = p + (np.asarray(self.target, float) - p) * f
         self.distance = new_dist
 
-    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN) -> None:
-        """Look at a sphere (``center``, ``radius``) so it fills the view."""
-        self.target = np.asarray(center, float).copy()
-        half_v = math.radians(self.fov_deg) / 2
-        half_h = math.atan(math.tan(half_v) * aspect)
-        half = min(half_v, half_h)
-        self.distance = max(radius, 1e-9) * margin / math.sin(half)
+    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN,
+              area: tuple | None = None) -> None:
+        """Look at a sphere (``center``, ``radius``) so it fills the view, or,
+        with ``area`` = (x0, y0, x1, y1) fractions of the window (0..1, y
+        down), that part of it: the sphere's outline (exact under the
+        perspective) touches the area's nearer sides, centred between them in
+        angle, and the :meth:`pivot` goes to the sphere's centre."""
+        x0, y0, x1, y1 = (0.0, 0.0, 1.0, 1.0) if area is None else (float(v) for v in area)
+        tv = math.tan(math.radians(self.fov_deg) / 2)
+        th = tv * aspect
+        # the area's sides as angles off the view axis (right, up)
+        ax = (math.atan((2 * x0 - 1) * th), math.atan((2 * x1 - 1) * th))
+        ay = (math.atan((1 - 2 * y1) * tv), math.atan((1 - 2 * y0) * tv))
+        cx, cy = (ax[0] + ax[1]) / 2, (ay[0] + ay[1]) / 2          # centre directions
+        hx, hy = (ax[1] - ax[0]) / 2, (ay[1] - ay[0]) / 2          # half-angles
+        rad = max(radius, 1e-9) * margin
+        # the sphere seen in the x-z (y-z) plane is a disc at distance depth / cos(c):
+        # its tangents from the eye are +-asin(rad cos(c) / depth) about c
+        depth = max(rad * math.cos(cx) / math.sin(max(hx, 1e-9)), rad * math.cos(cy) / math.sin(max(hy, 1e-9)))
+        self.screen_offset = (math.tan(cx), math.tan(cy))
+        self.distance = depth
+        r, u, _ = self.basis()
+        self.target = np.asarray(center, float) - depth * (self.screen_offset[0] * r + self.screen_offset[1] * u)
 
-    def frame_points(self, points: np.ndarray, aspect: float = 1.0) -> None:
-        """Frame the bounding sphere of ``points`` (n, 3)."""
+    def frame_points(self, points: np.ndarray, aspect: float = 1.0, area: tuple | None = None) -> None:
+        """Frame the bounding sphere of ``points`` (n, 3) (into ``area``, see :meth:`frame`)."""
         pts = np.atleast_2d(np.asarray(points, float))
         lo, hi = pts.min(0), pts.max(0)
         c = (lo + hi) / 2
         r = float(np.sqrt(((pts - c) ** 2).sum(1)).max()) if len(pts) else 1.0
-        self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect)
+        self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect, area=area)
 
     def state(self) -> tuple:
         """A hashable snapshot (used to detect camera motion)."""

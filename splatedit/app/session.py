@@ -117,6 +117,8 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.manip: Manipulation | None = None
         self.manip_target = None      # ("handle", i) or ("curve", j)
         self.brush_target = SUPPORT
+        #: the picked curve point the transform fields edit (last added / dragged / chosen)
+        self.curve_active = 0
         self.version = 0          # bumps whenever cloud or selection changes
         self.last_commit_seconds = 0.0
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)

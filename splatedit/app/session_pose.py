@@ -97,6 +97,7 @@ class PoseEditing:
             return False
         self.manip = Manipulation(GRAB, self.curve_points[j] + self.curve_moves[j], view, mouse)
         self.manip_target = ("curve", int(j))
+        self.curve_active = int(j)
         return True
 
     def current_matrix(self) -> np.ndarray:

@@ -101,6 +101,7 @@ class RigEditing:
                 raise SplatEditError("this point is the curve's last point: pick another one")
         self.curve_points.append(p)
         self.curve_moves = np.vstack([self.curve_moves, np.zeros((1, 3))])
+        self.curve_active = len(self.curve_points) - 1
         self.push("curve point")
         return True
 
@@ -118,6 +119,21 @@ class RigEditing:
             return False
         self.rig.clear_curve()
         self.push("clear curve")
+        return True
+
+    def active_curve_point(self) -> int | None:
+        """Index of the picked point the transform fields edit (the last one
+        added, dragged or chosen), None without curve points."""
+        if not self.curve_points:
+            return None
+        return min(max(int(self.curve_active), 0), len(self.curve_points) - 1)
+
+    def select_curve_point(self, j: int) -> bool:
+        """Make picked point ``j`` (modulo the count) the active one (not an undo step)."""
+        if not self.curve_points:
+            return False
+        self.curve_active = int(j) % len(self.curve_points)
+        self.on_change()
         return True
 
     def curve_point_positions(self, live: bool = True) -> np.ndarray:
