@@ -20,12 +20,13 @@ pytest.importorskip("imgui_bundle")
 FOREGROUND_MAX = 230
 #: the framed bounding sphere is EDITOR_FRAME_MARGIN x the model's half
 #: diagonal; the bunny's silhouette spans at least this fraction of the free
-#: part's binding side (measured 0.6-0.7 at 960x600 from the front view)
+#: part's binding side (its height: measured 0.55 at 960x600, beside the panel
+#: and in the whole window alike)
 MIN_FILL = 0.45
-#: pixels: the model's box centre from the free part's centre (the bunny is not
-#: symmetric in its bounding box: measured 10-30 px at 960x600)
-MAX_CENTRE_OFFSET_REL = 0.12
-
+#: the model's box centre from the free part's centre, as a fraction of the
+#: part's side (the bunny is not symmetric in its bounding sphere: measured
+#: -14 / +12 px beside the panel, -4 / +12 px in the whole window, <= 0.025)
+MAX_CENTRE_OFFSET_REL = 0.06
 
 def _model_box(ed, top: float) -> tuple[int, int, int, int]:
     """(x0, y0, x1, y1) of the model's pixels in a screenshot of the window
