@@ -178,27 +178,36 @@ class OrbitCamera:
 
     def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN,
               area: tuple | None = None) -> None:
-        """Look at a sphere (``center``, ``radius``) so it fills the view, or,
-        with ``area`` = (x0, y0, x1, y1) fractions of the window (0..1, y
-        down), that part of it: the sphere's outline (exact under the
-        perspective) touches the area's nearer sides, centred between them in
-        angle, and the :meth:`pivot` goes to the sphere's centre."""
+        """Look at a sphere (``center``, ``radius`` x ``margin``) so it fills
+        the view, or, with ``area`` = (x0, y0, x1, y1) fractions of the window
+        (0..1, y down), that part of it: the sphere's outline (exact under the
+        perspective) is centred in the area and touches its nearer pair of
+        sides; the :meth:`pivot` goes to the sphere's centre.
+
+        In the x-z plane the tangents from the eye to a sphere at (X, z) (depth
+        z) have the slopes (X z +- R sqrt(X^2 + z^2 - R^2)) / (z^2 - R^2): the
+        outline's middle is X z / (z^2 - R^2) and, with X putting that middle at
+        the area's middle m, its half-width is R sqrt(m^2 / z^2 + 1 / (z^2 - R^2)),
+        which falls with z: the depth is where it equals the area's half-width
+        (a quadratic in z^2), the larger of the x and y ones."""
         x0, y0, x1, y1 = (0.0, 0.0, 1.0, 1.0) if area is None else (float(v) for v in area)
         tv = math.tan(math.radians(self.fov_deg) / 2)
         th = tv * aspect
-        # the area's sides as angles off the view axis (right, up)
-        ax = (math.atan((2 * x0 - 1) * th), math.atan((2 * x1 - 1) * th))
-        ay = (math.atan((1 - 2 * y1) * tv), math.atan((1 - 2 * y0) * tv))
-        cx, cy = (ax[0] + ax[1]) / 2, (ay[0] + ay[1]) / 2          # centre directions
-        hx, hy = (ax[1] - ax[0]) / 2, (ay[1] - ay[0]) / 2          # half-angles
-        rad = max(radius, 1e-9) * margin
-        # the sphere seen in the x-z (y-z) plane is a disc at distance depth / cos(c):
-        # its tangents from the eye are +-asin(rad cos(c) / depth) about c
-        depth = max(rad * math.cos(cx) / math.sin(max(hx, 1e-9)), rad * math.cos(cy) / math.sin(max(hy, 1e-9)))
-        self.screen_offset = (math.tan(cx), math.tan(cy))
-        self.distance = depth
+        # the area's middle and half-width as view-plane slopes (right, up)
+        mx, hx = (x0 + x1 - 1) * th, max((x1 - x0) * th, 1e-9)
+        my, hy = (1 - y0 - y1) * tv, max((y1 - y0) * tv, 1e-9)
+        r2 = max(radius, 1e-9) ** 2 * margin ** 2
+
+        def depth2(m: float, hw: float) -> float:
+            b = r2 * (hw * hw + m * m + 1)
+            return (b + math.sqrt(max(b * b - 4 * hw * hw * r2 * r2 * m * m, 0.0))) / (2 * hw * hw)
+
+        z2 = max(depth2(mx, hx), depth2(my, hy))
+        z = math.sqrt(z2)
+        self.screen_offset = (mx * (z2 - r2) / z2, my * (z2 - r2) / z2)
+        self.distance = z
         r, u, _ = self.basis()
-        self.target = np.asarray(center, float) - depth * (self.screen_offset[0] * r + self.screen_offset[1] * u)
+        self.target = np.asarray(center, float) - z * (self.screen_offset[0] * r + self.screen_offset[1] * u)
 
     def frame_points(self, points: np.ndarray, aspect: float = 1.0, area: tuple | None = None) -> None:
         """Frame the bounding sphere of ``points`` (n, 3) (into ``area``, see :meth:`frame`)."""

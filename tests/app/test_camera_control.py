@@ -118,6 +118,8 @@ def test_frame_into_an_area_touches_its_nearer_sides_and_stays_inside(area):
     gaps = np.array([lo[0] - x0, x1 - hi[0], lo[1] - y0, y1 - hi[1]])
     # one pair of opposite sides is touched (to the sampling of the outline)
     assert min(gaps[:2].max(), gaps[2:].max()) < 1.0
+    # and the outline is centred in the area both ways
+    assert np.allclose((lo + hi) / 2, [(x0 + x1) / 2, (y0 + y1) / 2], atol=0.5)
     # the pivot is the sphere's centre
     assert np.allclose(cam.pivot(), c)
 

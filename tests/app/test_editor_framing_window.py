@@ -25,7 +25,7 @@ FOREGROUND_MAX = 230
 MIN_FILL = 0.45
 #: the model's box centre from the free part's centre, as a fraction of the
 #: part's side (the bunny is not symmetric in its bounding sphere: measured
-#: -14 / +12 px beside the panel, -4 / +12 px in the whole window, <= 0.025)
+#: -11 / +12 px beside the panel, -4 / +12 px in the whole window, <= 0.025)
 MAX_CENTRE_OFFSET_REL = 0.06
 
 def _model_box(ed, top: float) -> tuple[int, int, int, int]:

@@ -10,7 +10,8 @@ import numpy as np
 from splatedit.app.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.model.orientation import UpAxis, detect_up_axis, next_up
-from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION
+from splatedit.app.panel import PANEL_MARGIN
+from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
 
 
 def free_area(w: int, h: int, panel_box, top: float = 0.0) -> tuple[float, float, float, float]:
@@ -80,8 +81,12 @@ class CameraTool(Tool):
         ed = self.ed
         w, h = ed.size
         box = ed.panel_box if ed.panel_visible else None
+        if box is not None and tuple(box) == (0, 0, 0, 0):
+            # no frame laid out yet (a model opened before the first GUI frame): the GUI
+            # panel's first place, at the left; the CPU text panel's size is not known
+            box = (PANEL_MARGIN, 0, EDITOR_GUI_PANEL_WIDTH, 0) if ed.gui is not None else None
         top = ed.gui.menu_height if ed.gui is not None else 0.0
-        return free_area(w, h, box if box and box[2] > 0 else None, top)
+        return free_area(w, h, box, top)
 
     def frame_all(self) -> None:
         """Home: the whole model fills the free part of the window."""
