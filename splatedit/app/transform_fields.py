@@ -189,8 +189,8 @@ def apply_position(ed, position) -> bool:
         p = np.array(position, dtype=np.float64).reshape(3)
     except (TypeError, ValueError) as exc:
         raise SplatEditError(f"transform: position must be 3 numbers ({exc})") from None
-    if t.position is not None and t.problem is None and np.all(np.isfinite(p)):
-        if np.allclose(p, t.position, rtol=0.0, atol=0.0):
-            ed.say("transform: already at that position")
-            return False
-    return apply_transform(ed, TransformInput(translate=list(p - (t.position if t.position is not None else p))))
+    if t.position is not None and t.problem is None and np.array_equal(p, t.position):
+        ed.say("transform: already at that position")
+        return False
+    here = t.position if t.position is not None else p
+    return apply_transform(ed, TransformInput(translate=[float(x) for x in p - here]))

@@ -162,3 +162,17 @@ def test_the_target_is_the_curve_point_with_the_curve_tool_on_else_the_handle(ed
     assert t.kind is TargetKind.HANDLE and t.problem is None and np.allclose(t.position, s.handle_centroid())
     key(ed, glfw.KEY_G)
     assert "a move is running" in field_target(s).problem
+
+
+def test_position_field_moves_the_handle_centre_there_in_one_edit(ed):  # noqa: F811
+    s = ed.session
+    _rig(s)
+    t = field_target(s)
+    assert t.kind is TargetKind.HANDLE and t.rotates and np.allclose(t.position, s.handle_centroid())
+    assert not apply_position(ed, t.position) and "already" in ed.messages[-1]
+    goal = t.position + [0.05, -0.02, 0.2]
+    assert apply_position(ed, goal)
+    assert len(s.edits) == 1 and np.allclose(s.handle_centroid(), goal, atol=1e-9)
+    assert np.allclose(field_target(s).position, goal, atol=1e-9)
+    key(ed, glfw.KEY_Z, glfw.MOD_CONTROL)
+    assert len(s.edits) == 0 and np.allclose(field_target(s).position, t.position)

@@ -8,9 +8,9 @@ import math
 import numpy as np
 
 from splatedit.app.keymap import Action, Section
+from splatedit.app.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.model.orientation import UpAxis, detect_up_axis, next_up
-from splatedit.app.panel import PANEL_MARGIN
 from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
 
 
