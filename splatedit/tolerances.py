@@ -813,3 +813,13 @@ EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
 #: a step's chunk grows at most this factor at a time (the first steps' times
 #: include pipeline creation and are not representative of the cost per splat)
 EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
+
+# ---------------------------------------------------------------------------
+# Framing beside the side panel (Home / F into the free part of the window)
+# ---------------------------------------------------------------------------
+#: Home / F frame into the window minus the side panel's column when what is
+#: left is at least this fraction of the window's width (height: below the
+#: menu bar); narrower, the whole window.  At the default 1280x720 the panel
+#: (EDITOR_GUI_PANEL_WIDTH + margin) leaves ~0.75 of the width; at 640 px
+#: ~0.5; a quarter still shows a framed model about 160 px wide at 640 px
+EDITOR_FRAME_MIN_FREE_FRACTION = 0.25

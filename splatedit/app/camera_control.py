@@ -42,6 +42,12 @@ class OrbitCamera:
     fov_deg: float = RENDER_FOV_DEG
     up_axis: np.ndarray = field(default_factory=lambda: np.array([0.0, 1.0, 0.0]))
     scene_radius: float = 1.0
+    #: where the orbit pivot sits on screen, as (x, y) view-plane tangents
+    #: (right, up) off the view axis: (0, 0) is the window centre.  Framing into
+    #: a part of the window (beside a side panel) sets it to that part's
+    #: centre; orbit, the numpad views and the dolly drag turn / zoom about the
+    #: point at the target's depth there, so the framed model stays put
+    screen_offset: tuple = (0.0, 0.0)
 
     # -------------------------------------------------------------- frames
     def basis(self) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
@@ -124,10 +130,26 @@ class OrbitCamera:
         return o + d * (depth / max(cos, 1e-9))
 
     # --------------------------------------------------------------- motion
+    def pivot(self) -> np.ndarray:
+        """(3,) world point the camera orbits about: at the target's depth,
+        under :attr:`screen_offset` (the target itself when it is (0, 0))."""
+        r, u, _ = self.basis()
+        ox, oy = self.screen_offset
+        return np.asarray(self.target, float) + self.distance * (ox * r + oy * u)
+
+    def turn_to(self, yaw: float, pitch: float) -> None:
+        """Set the view angles (radians), keeping the :meth:`pivot` where it
+        is in the world and on screen."""
+        p = self.pivot()
+        self.yaw = float(yaw)
+        self.pitch = float(np.clip(pitch, -PITCH_LIMIT, PITCH_LIMIT))
+        r, u, _ = self.basis()
+        ox, oy = self.screen_offset
+        self.target = p - self.distance * (ox * r + oy * u)
+
     def orbit(self, dx_px: float, dy_px: float) -> None:
-        """Turntable orbit about ``target`` by a mouse motion in pixels."""
-        self.yaw -= dx_px * EDITOR_ORBIT_RAD_PER_PX
-        self.pitch = float(np.clip(self.pitch + dy_px * EDITOR_ORBIT_RAD_PER_PX, -PITCH_LIMIT, PITCH_LIMIT))
+        """Turntable orbit about the :meth:`pivot` by a mouse motion in pixels."""
+        self.turn_to(self.yaw - dx_px * EDITOR_ORBIT_RAD_PER_PX, self.pitch + dy_px * EDITOR_ORBIT_RAD_PER_PX)
 
     def pan(self, dx_px: float, dy_px: float, h: int) -> None:
         """Move the pivot in the view plane so the pivot plane follows the mouse."""
@@ -144,7 +166,9 @@ class OrbitCamera:
         new_dist = float(np.clip(self.distance * f, EDITOR_MIN_DIST_REL * self.scene_radius,
                                  EDITOR_MAX_DIST_REL * self.scene_radius))
         f = new_dist / self.distance
-        if x is None or y is None:
+        if x is None or y is None:        # about the pivot (it keeps its pixel)
+            p = self.pivot()
+            self.target = p + (np.asarray(self.target, float) - p) * f
             self.distance = new_dist
             return
         p = self.point_at_depth(x, y, w, h, self.distance if depth is None else depth)
@@ -152,21 +176,46 @@ class OrbitCamera:
         self.target = p + (np.asarray(self.target, float) - p) * f
         self.distance = new_dist
 
-    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN) -> None:
-        """Look at a sphere (``center``, ``radius``) so it fills the view."""
-        self.target = np.asarray(center, float).copy()
-        half_v = math.radians(self.fov_deg) / 2
-        half_h = math.atan(math.tan(half_v) * aspect)
-        half = min(half_v, half_h)
-        self.distance = max(radius, 1e-9) * margin / math.sin(half)
+    def frame(self, center, radius: float, aspect: float = 1.0, margin: float = EDITOR_FRAME_MARGIN,
+              area: tuple | None = None) -> None:
+        """Look at a sphere (``center``, ``radius`` x ``margin``) so it fills
+        the view, or, with ``area`` = (x0, y0, x1, y1) fractions of the window
+        (0..1, y down), that part of it: the sphere's outline (exact under the
+        perspective) is centred in the area and touches its nearer pair of
+        sides; the :meth:`pivot` goes to the sphere's centre.
 
-    def frame_points(self, points: np.ndarray, aspect: float = 1.0) -> None:
-        """Frame the bounding sphere of ``points`` (n, 3)."""
+        In the x-z plane the tangents from the eye to a sphere at (X, z) (depth
+        z) have the slopes (X z +- R sqrt(X^2 + z^2 - R^2)) / (z^2 - R^2): the
+        outline's middle is X z / (z^2 - R^2) and, with X putting that middle at
+        the area's middle m, its half-width is R sqrt(m^2 / z^2 + 1 / (z^2 - R^2)),
+        which falls with z: the depth is where it equals the area's half-width
+        (a quadratic in z^2), the larger of the x and y ones."""
+        x0, y0, x1, y1 = (0.0, 0.0, 1.0, 1.0) if area is None else (float(v) for v in area)
+        tv = math.tan(math.radians(self.fov_deg) / 2)
+        th = tv * aspect
+        # the area's middle and half-width as view-plane slopes (right, up)
+        mx, hx = (x0 + x1 - 1) * th, max((x1 - x0) * th, 1e-9)
+        my, hy = (1 - y0 - y1) * tv, max((y1 - y0) * tv, 1e-9)
+        r2 = max(radius, 1e-9) ** 2 * margin ** 2
+
+        def depth2(m: float, hw: float) -> float:
+            b = r2 * (hw * hw + m * m + 1)
+            return (b + math.sqrt(max(b * b - 4 * hw * hw * r2 * r2 * m * m, 0.0))) / (2 * hw * hw)
+
+        z2 = max(depth2(mx, hx), depth2(my, hy))
+        z = math.sqrt(z2)
+        self.screen_offset = (mx * (z2 - r2) / z2, my * (z2 - r2) / z2)
+        self.distance = z
+        r, u, _ = self.basis()
+        self.target = np.asarray(center, float) - z * (self.screen_offset[0] * r + self.screen_offset[1] * u)
+
+    def frame_points(self, points: np.ndarray, aspect: float = 1.0, area: tuple | None = None) -> None:
+        """Frame the bounding sphere of ``points`` (n, 3) (into ``area``, see :meth:`frame`)."""
         pts = np.atleast_2d(np.asarray(points, float))
         lo, hi = pts.min(0), pts.max(0)
         c = (lo + hi) / 2
         r = float(np.sqrt(((pts - c) ** 2).sum(1)).max()) if len(pts) else 1.0
-        self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect)
+        self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect, area=area)
 
     def state(self) -> tuple:
         """A hashable snapshot (used to detect camera motion)."""

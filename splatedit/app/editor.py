@@ -11,12 +11,13 @@ target) the overlay is composited on the CPU (:mod:`splatedit.app.overlay`).  Lo
 worker threads; the loop polls them and stays responsive.
 
 The :class:`Editor` is a thin loop: window events go to the tools
-(:mod:`splatedit.app.tools`: camera, brush, gizmo, curve), keys are looked
+(:mod:`splatedit.app.tools`: camera, brush, gizmo, curve) through the event
+routing (:mod:`splatedit.app.routing`), keys are looked
 up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
 help and README's controls list) and run the bound action; each tool draws
 its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
-dropped on the window opens the same way, and :meth:`Editor.open_dialog`,
+dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,
 :meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
 File menu calls; load / save errors stay in an error box until dismissed.
 Entry point: :func:`run_editor`.
@@ -29,18 +30,19 @@ import sys
 import time
 from pathlib import Path
 
-from splatedit.app import files
 from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
 from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
+from splatedit.app.file_actions import FileActions
 from splatedit.app.frames import FrameScheduler
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.jobs import Job
-from splatedit.app.keymap import Action, Context, lookup
+from splatedit.app.keymap import Action
 from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
 from splatedit.app.panel import HelpView, compose_overlay
 from splatedit.app.session import Session
 from splatedit.app.status import StatusWriter
 from splatedit.app.recent import RecentFiles
+from splatedit.app.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
 from splatedit.app.tools.base import DragMode
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
@@ -51,11 +53,8 @@ from splatedit.errors import ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
                                   IQR_DEFAULT_TOL)
 
-#: wheel notch -> help lines scrolled
-HELP_WHEEL_LINES = 3
 
-
-class Editor:
+class Editor(EventRouting, FileActions):
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
                  budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
@@ -202,202 +201,6 @@ class Editor:
                 and s.manip is None and not fr.scene_interactive and fr.scene_key == fr.state()
                 and not (fr.refiner is not None and fr.refiner.busy))
 
-    # -------------------------------------------------------------- loading
-    def start_load(self) -> None:
-        self.jobs["load"] = files.load_job(self.path, self.wake)
-
-    def on_loaded(self, cloud, path=None) -> None:
-        files.on_loaded(self, cloud, path)
-
-    # ------------------------------------------- opening (also the GUI's File menu)
-    def open_dialog(self, folder=None) -> None:
-        """Show the file browser (Ctrl+O) in ``folder`` (default: the model's);
-        a G/R/S move in progress is cancelled first."""
-        if self.session is not None and self.session.manip is not None:
-            self.gizmo.cancel_manip()
-        self.confirm_quit = False
-        self.prompt = None
-        self.browser.open(folder)
-
-    def open_path(self, path, confirmed: bool = False) -> bool:
-        """Open the model at ``path`` in place of the current one (asks first
-        with unsaved changes unless ``confirmed``); True when loading started."""
-        return files.open_path(self, path, confirmed=confirmed)
-
-    def recent_files(self) -> list[Path]:
-        """The recent models, most recent first (missing files dropped)."""
-        return [] if self.recent is None else self.recent.files()
-
-    def poll_jobs(self) -> None:
-        files.poll_jobs(self)
-
-    # ---------------------------------------------------------------- input
-    def handle_events(self, events) -> None:
-        for e in events:
-            try:
-                if self.gui is not None and self.gui.takes(e):
-                    continue
-                getattr(self, f"on_{e.kind}")(e)
-            except SplatEditError as exc:
-                self.say(str(exc))
-
-    def on_resize(self, e) -> None:
-        self.frames.invalidate()
-        self.motion()
-
-    def on_enter(self, e) -> None:
-        self.cursor_inside = bool(e.action)
-
-    def on_iconify(self, e) -> None:
-        self.frames.invalidate()
-
-    def on_close(self, e) -> None:
-        self.request_quit()
-
-    def on_drop(self, e) -> None:
-        files.on_drop(self, [Path(p) for p in e.paths])
-
-    def on_char(self, e) -> None:
-        if self.browser.shown and self.prompt is None and self.confirm_open is None:
-            self.browser.type_char(e.char)
-            return
-        if self.prompt is not None and e.char.isprintable():
-            self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
-            self.prompt_fresh = False
-
-    def on_scroll(self, e) -> None:
-        if self.browser.shown:
-            self.browser.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
-            return
-        b = self.help.box
-        if self.help.shown and b is not None and b.x <= e.x < b.right and b.y <= e.y < b.bottom:
-            self.help.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
-            return
-        if self.session is None:
-            return
-        if e.mods & self.g.MOD_CONTROL:
-            self.brush.scroll(e)
-        else:
-            self.camera.scroll(e)
-
-    def on_move(self, e) -> None:
-        x, y = e.x, e.y
-        last = self.drag_last
-        self.mouse = (x, y)
-        self.cursor_inside = True
-        s = self.session
-        if self.drag_tool is not None and s is not None:
-            self.drag_tool.drag(self.drag, x, y, x - last[0], y - last[1], last)
-        if s is not None and s.manip is not None:
-            s.manip.mouse = (x, y)
-            self.motion()
-        self.drag_last = (x, y)
-
-    def on_button(self, e) -> None:
-        g, s = self.g, self.session
-        self.mouse = (e.x, e.y)
-        if e.action == g.RELEASE:
-            tool, mode = self.drag_tool, self.drag
-            self.drag, self.drag_tool = DragMode.NONE, None
-            if tool is not None and s is not None:
-                tool.release(mode)
-            return
-        if e.action != g.PRESS:
-            return
-        if self.browser.shown and self.confirm_open is None:
-            if e.button == g.MOUSE_BUTTON_LEFT:
-                self.browser.click(e.x, e.y)
-            return
-        r = self.error_rect
-        if r is not None and r[0] <= e.x < r[0] + r[2] and r[1] <= e.y < r[1] + r[3]:
-            self.dismiss_error()
-            return
-        if s is None or self.modal():
-            return
-        self.drag_last = (e.x, e.y)
-        for tool in self.tools:
-            mode = tool.press_modal(e)
-            if mode is not None:
-                break
-        else:
-            for tool in self.tools:
-                mode = tool.press(e)
-                if mode is not None:
-                    break
-            else:
-                return
-        self.drag = mode
-        self.drag_tool = tool if mode is not DragMode.NONE else None
-
-    def on_key(self, e) -> None:
-        g = self.g
-        if e.action not in (g.PRESS, g.REPEAT):
-            return
-        k = e.key
-        ctrl, shift = bool(e.mods & g.MOD_CONTROL), bool(e.mods & g.MOD_SHIFT)
-        if self.prompt is not None:
-            self.prompt_key(k)
-            return
-        if self.confirm_quit:
-            if k in (g.KEY_Y, g.KEY_Q):
-                self.running = False
-            else:                      # N, Esc or anything else: stay
-                self.confirm_quit = False
-                self.say("quit cancelled")
-            return
-        if self.confirm_open is not None:
-            files.answer_open(self, k == g.KEY_Y)
-            return
-        if self.browser.shown:
-            action = lookup(k, ctrl, shift, [Context.BROWSER])
-            if action is not None:
-                self.actions[action]()
-            return
-        s = self.session
-        manip = s is not None and s.manip is not None
-        # a running move keeps its keys (Esc cancels it, digits type) even under the help
-        helping = [Context.HELP] if self.help.shown else []
-        if self.error_box is not None:
-            helping.insert(0, Context.ERROR)
-        if s is None:
-            contexts = helping + [Context.ANY]
-        elif manip:
-            contexts = [Context.MANIP] + helping + [Context.ANY]
-        else:
-            contexts = helping + [Context.IDLE, Context.ANY]
-        action = lookup(k, ctrl, shift, contexts)
-        if action is None:
-            if s is not None:
-                self.motion()
-            return
-        if action is Action.TYPE_VALUE:
-            self.gizmo.type_key(k)
-            self.motion()
-        else:
-            self.run_action(action)
-
-    def run_action(self, action: Action) -> None:
-        """Run the handler bound to ``action`` (keys and GUI buttons share it):
-        during a G/R/S move its own handler when it has one."""
-        s = self.session
-        manip = s is not None and s.manip is not None
-        table = self.manip_actions if manip and action in self.manip_actions else self.actions
-        table[action]()
-        if s is not None:
-            self.motion()
-
-    def prompt_key(self, k: int) -> None:
-        g = self.g
-        if k in (g.KEY_ENTER, g.KEY_KP_ENTER):
-            path, self.prompt = self.prompt.strip(), None
-            if path:
-                self.save(Path(path).expanduser())
-        elif k == g.KEY_ESCAPE:
-            self.prompt = None
-        elif k == g.KEY_BACKSPACE:
-            self.prompt = "" if self.prompt_fresh else self.prompt[:-1]
-            self.prompt_fresh = False
-
     # -------------------------------------------------------------- actions
     def _action_table(self) -> dict:
         t = {}
@@ -448,31 +251,6 @@ class Editor:
 
     def commit(self) -> None:
         self.gizmo.commit_pose()
-
-    def save_target(self) -> Path:
-        if self.save_as is not None:
-            return self.save_as
-        if self.saved_path is not None:
-            return self.saved_path
-        self.save_as = files.default_save_path(self.path, self.cloud_name, self.bundled)
-        return self.save_as
-
-    save = files.save
-
-    def ask_save_as(self) -> None:
-        self.prompt = str(self.save_target())
-        self.prompt_fresh = True
-
-    def export_script(self) -> None:
-        files.export_script(self, self.save_target())
-
-    def request_quit(self) -> None:
-        s = self.session
-        if s is not None and s.dirty and not self.confirm_quit:
-            self.confirm_quit = True
-            self.say("unsaved changes: press Y (or Q) to quit without saving, N or Esc to stay")
-        else:
-            self.running = False
 
     # -------------------------------------------------------------- overlay
     def overlay_patches(self, w: int, h: int) -> list:

@@ -135,7 +135,10 @@ def draw_curve(ed, dl, w: int, h: int) -> None:
         px[np.asarray(d) <= 0] = np.nan
         polyline(dl, px, CURVE_RGB, 3.0)
     active = s.manip_target[1] if (s.manip_target and s.manip_target[0] == "curve") else None
+    chosen = s.active_curve_point() if s.curve_mode else None     # the transform fields' point: ringed
     for j, q in enumerate(ed.curve.dots(w, h)):
+        if j == chosen and j != active:
+            dot(dl, q, (255, 255, 255), 7.0)
         dot(dl, q, (255, 255, 255) if j == active else CURVE_RGB, 7.0 if j == active else 5.0)
 
 

@@ -39,7 +39,7 @@ from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
 from splatedit.app.tools.base import DragMode
-from splatedit.app.transform_fields import TransformInput, apply_transform
+from splatedit.app.gui_transform import TransformSection
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
 from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
@@ -63,12 +63,6 @@ class MenuEntry:
     enabled: Callable[[], bool] | None = None
 
 
-def _entered() -> bool:
-    """The last input field was left with Enter this frame."""
-    return imgui.is_item_deactivated() and (imgui.is_key_pressed(imgui.Key.enter)
-                                            or imgui.is_key_pressed(imgui.Key.keypad_enter))
-
-
 class EditorGui:
     def __init__(self, ed, device):
         from splatedit.render.gui import Gui
@@ -82,7 +76,7 @@ class EditorGui:
             MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
             MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
             MenuEntry("Quit", lambda: ed.run_action(Action.QUIT), "Q")]
-        self.fields = TransformInput()
+        self.transform = TransformSection(ed)
         self.rects: dict[str, Box] = {}
         self.panel_box: Box | None = None
         self.help_box: Box | None = None
@@ -287,7 +281,7 @@ class EditorGui:
         if imgui.collapsing_header("Deformation", open_):
             self._deformation()
         if imgui.collapsing_header("Transform", open_):
-            self._transform()
+            self.transform.draw(self._rect)
         if imgui.collapsing_header("Display", open_):
             self._display()
         if imgui.collapsing_header("History", open_):
@@ -381,39 +375,6 @@ class EditorGui:
             imgui.same_line()
             if imgui.button("Discard (Esc)"):
                 ed.run_action(Action.CANCEL)
-
-    def _transform(self) -> None:
-        """Move / rotate / scale fields of the active handle; Enter in a field or Apply applies."""
-        f = self.fields
-        go = False
-        imgui.set_next_item_width(220)
-        _, v = imgui.input_float3("move", f.translate, "%.4g")
-        f.translate = list(v)
-        go |= _entered()
-        self._rect("field_translate")
-        imgui.set_next_item_width(220)
-        _, v = imgui.input_float3("axis", f.axis, "%.3g")
-        f.axis = list(v)
-        go |= _entered()
-        imgui.set_next_item_width(100)
-        _, f.degrees = imgui.input_float("degrees", f.degrees, 0.0, 0.0, "%.4g")
-        go |= _entered()
-        self._rect("field_degrees")
-        imgui.set_next_item_width(100)
-        _, f.factor = imgui.input_float("scale", f.factor, 0.0, 0.0, "%.4g")
-        go |= _entered()
-        self._rect("field_scale")
-        if imgui.button("Apply"):
-            go = True
-        self._rect("transform_apply")
-        imgui.same_line()
-        if imgui.button("Reset fields"):
-            f.reset()
-        bad = f.problem()
-        if bad:
-            imgui.text_colored(RED, bad)
-        if go and apply_transform(self.ed, f):
-            f.reset()
 
     def _display(self) -> None:
         ed, vp = self.ed, self.ed.viewport

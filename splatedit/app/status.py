@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from splatedit.app.gaussian_doc import gaussians_of
+from splatedit.app.transform_fields import field_target
 
 
 def _r(v, nd=1):
@@ -41,7 +42,10 @@ def status_dict(ed) -> dict:
           "window": list(ed.size), "panel_box": list(ed.panel_box) if ed.panel_box else [0, 0, 0, 0],
           "camera": {"distance": round(cam.distance, 6), "yaw": round(cam.yaw, 6), "pitch": round(cam.pitch, 6),
                      "target": [round(float(x), 6) for x in cam.target],
-                     "up": [round(float(x), 6) for x in cam.up_axis]},
+                     "up": [round(float(x), 6) for x in cam.up_axis],
+                     "screen_offset": [round(float(x), 6) for x in cam.screen_offset],
+                     "pivot": [round(float(x), 6) for x in cam.pivot()]},
+          "frame_area": [round(float(x), 6) for x in ed.camera.view_area()],
           "up_axis": ed.camera.up.label, "up_source": ed.camera.up.source.value,
           "grey": bool(vp.grey), "splat_scale": round(float(vp.splat_scale), 4),
           "moving_frame_ms_median": (round(float(np.median(ed.moving_frame_ms)), 1)
@@ -82,6 +86,10 @@ def status_dict(ed) -> dict:
               basis_kind=None if s.basis is None else type(s.basis).__name__,
               brush_mode=tools.mode, closure_added=tools.last_added,
               closure_highlight=tools.highlighted(s.cloud) is not None)
+    ft = field_target(s)
+    st["fields"] = {"kind": ft.kind.value, "index": ft.index, "problem": ft.problem,
+                    "position": None if ft.position is None else [round(float(x), 9) for x in ft.position]}
+    st["curve_positions"] = [[round(float(x), 9) for x in q] for q in s.curve_point_positions()]
     st["idle"] = bool(ed.idle())
     fr = ed.frames
     pr = fr.progressive

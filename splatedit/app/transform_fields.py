@@ -1,18 +1,27 @@
-"""Numeric transform of the active handle (the GUI's transform fields).
+"""Numeric transform of what is active: a handle or a picked curve point
+(the GUI's transform fields).
 
-:class:`TransformInput` holds what the fields show: a translation (model
-units), a rotation (axis + degrees) and a uniform scale factor, applied in
-that order *reversed* (scale, then rotate, both about the handle's posed
-centroid, then translate), so each field reads as a G / R / S typed into the
-keyboard.  :func:`apply_transform` runs it through the same path as a
-finished G/R/S move (:meth:`GizmoTool.finish_manip`: committed at once for a
-single handle, kept as a pending pose with several handles), by handing the
+:func:`field_target` says what the fields act on (:class:`TransformTarget`):
+the active picked point of the control curve while the curve tool is on (or
+when there is no handle), else the active handle; with its current
+position (the handle's posed centroid, the point's moved position) and why
+it cannot be edited now (nothing painted or picked, the fit still running,
+a move running).  :class:`TransformInput` holds the relative fields: a
+translation (model units), a rotation (axis + degrees) and a uniform scale
+factor, applied in that order *reversed* (scale, then rotate, both about
+the target's position, then translate), so each field reads as a G / R / S
+typed into the keyboard; a curve point only moves.  :func:`apply_transform`
+and :func:`apply_position` (the absolute "position" field) run it through
+the same path as a finished G/R/S move or a dragged curve dot
+(:meth:`GizmoTool.finish_manip`: committed at once for a single handle,
+kept as a pending pose otherwise; an undo step either way) by handing the
 session a :class:`FixedManipulation` whose matrix is the typed one.
 No window, no GPU.
 """
 
 from __future__ import annotations
 
+import enum
 import math
 from dataclasses import dataclass, field
 
@@ -20,6 +29,7 @@ import numpy as np
 
 from splatedit.app.manipulation import GRAB, Manipulation, ViewInfo
 from splatedit.deform.transform import compose, rotate, scale, translate
+from splatedit.errors import SplatEditError
 from splatedit.tolerances import EDITOR_GUI_MIN_AXIS_NORM
 
 
@@ -89,25 +99,98 @@ class FixedManipulation(Manipulation):
         return f"typed transform: {self._text}"
 
 
+class TargetKind(enum.Enum):
+    """What the transform fields act on (values: the session's ``manip_target`` kinds)."""
+    NONE = "none"
+    HANDLE = "handle"
+    CURVE_POINT = "curve"
+
+
+@dataclass(frozen=True)
+class TransformTarget:
+    """What the fields act on: ``kind``, ``index`` (handle / picked point),
+    ``position`` (3,) model units (the handle's posed centroid, the point's
+    moved position; None for NONE), ``label`` (for the panel) and ``problem``
+    (why it cannot be edited now; None when it can)."""
+    kind: TargetKind
+    index: int = -1
+    position: np.ndarray | None = None
+    label: str = ""
+    problem: str | None = None
+
+    @property
+    def rotates(self) -> bool:
+        """Rotate and scale apply (a handle; a curve point only moves)."""
+        return self.kind is TargetKind.HANDLE
+
+
+def field_target(s) -> TransformTarget:
+    """The fields' target in session ``s`` (see the module docstring)."""
+    if s is None:
+        return TransformTarget(TargetKind.NONE, problem="no model open")
+    j = s.active_curve_point()
+    has_handle = bool(s.selection.handle.any())
+    if j is not None and (s.curve_mode or not has_handle):
+        label = f"curve point {j + 1} of {len(s.curve_points)}"
+        bad = _busy(s)
+        if bad is None and (s.basis is None or s.basis_groups[1] is None):
+            bad = ("add a second curve point" if len(s.curve_points) < 2
+                   else "the deformation is still being fitted" if s.fitting
+                   else s.fit_error or "paint a support region first (1)")
+        return TransformTarget(TargetKind.CURVE_POINT, j, s.curve_point_positions(live=False)[j], label, bad)
+    if not has_handle:
+        return TransformTarget(TargetKind.NONE, problem="paint a support region (1) and a handle (2), "
+                               "or pick curve points (K), first")
+    k = s.selection.active
+    label = f"handle {k + 1}" + (f" of {len(s.selection.handles)}" if len(s.selection.handles) > 1 else "")
+    bad = _busy(s)
+    if bad is None and not s.active_fitted():
+        bad = ("paint a support region first (1)" if not s.selection.support.any()
+               else "the deformation is still being fitted" if s.fitting
+               else s.fit_error or "the active handle is not fitted")
+    return TransformTarget(TargetKind.HANDLE, k, s.handle_centroid(), label, bad)
+
+
+def _busy(s) -> str | None:
+    if s.manip is not None:
+        return "a move is running: finish it (Enter) or cancel it (Esc) first"
+    return None
+
+
 def apply_transform(ed, fields: TransformInput) -> bool:
-    """Apply ``fields`` to the active handle as a G/R/S move would be applied;
-    says why not (editor message) and returns False when it cannot."""
+    """Apply ``fields`` to the :func:`field_target` as a G/R/S move (or a
+    dragged curve dot) would be applied; says why not (editor message) and
+    returns False when it cannot."""
     s = ed.session
     if s is None:
         return False
-    bad = fields.problem()
-    if bad is None and s.manip is not None:
-        bad = "a move is running: finish it (Enter) or cancel it (Esc) first"
-    if bad is None and not s.active_fitted():
-        bad = ("paint a support region and a handle first" if not s.selection.handle.any()
-               else "the deformation is still being fitted" if s.fitting else "the active handle is not fitted")
+    t = field_target(s)
+    bad = fields.problem() or t.problem
+    if bad is None and not t.rotates and (fields.degrees != 0 or fields.factor != 1.0):
+        bad = "a curve point only moves: set degrees to 0 and scale to 1"
     if bad is None and fields.is_identity():
         bad = "nothing to apply (all fields are at their neutral values)"
     if bad is not None:
         ed.say(f"transform: {bad}")
         return False
-    pivot = s.handle_centroid()
-    s.manip = FixedManipulation(fields.matrix(pivot), pivot, fields.describe())
-    s.manip_target = ("handle", s.selection.active)
+    s.manip = FixedManipulation(fields.matrix(t.position), t.position, fields.describe())
+    s.manip_target = (t.kind.value, t.index)
     ed.gizmo.finish_manip()
     return True
+
+
+def apply_position(ed, position) -> bool:
+    """Move the :func:`field_target` so its position becomes ``position``
+    (3,) model units (the "position" field); False (and a message) when it
+    cannot, or when it is already there."""
+    s = ed.session
+    t = field_target(s)
+    try:
+        p = np.array(position, dtype=np.float64).reshape(3)
+    except (TypeError, ValueError) as exc:
+        raise SplatEditError(f"transform: position must be 3 numbers ({exc})") from None
+    if t.position is not None and t.problem is None and np.array_equal(p, t.position):
+        ed.say("transform: already at that position")
+        return False
+    here = t.position if t.position is not None else p
+    return apply_transform(ed, TransformInput(translate=[float(x) for x in p - here]))

@@ -95,3 +95,58 @@ def test_frame_points():
     cam.frame_points(pts, 1.0)
     px, _ = cam.project(pts, 500, 500)
     assert (px >= 0).all() and (px <= 500).all()
+
+
+def _sphere_outline_px(cam, c, r, w, h):
+    d = np.random.default_rng(1).normal(size=(40000, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    return cam.project(np.asarray(c) + r * d, w, h)[0]
+
+
+@pytest.mark.parametrize("area", [(0.33, 0.03, 1.0, 1.0), (0.0, 0.0, 0.6, 1.0), (0.1, 0.2, 0.5, 0.9)])
+def test_frame_into_an_area_touches_its_nearer_sides_and_stays_inside(area):
+    """A sphere framed into a part of the window: its perspective outline
+    lies inside that part and touches it on the binding pair of sides."""
+    cam = make_cam()
+    w, h = 960, 600
+    c, r = np.array([1.0, 2.0, -3.0]), 0.7
+    cam.frame(c, r, w / h, margin=1.0, area=area)
+    px = _sphere_outline_px(cam, c, r, w, h)
+    x0, y0, x1, y1 = area[0] * w, area[1] * h, area[2] * w, area[3] * h
+    lo, hi = px.min(0), px.max(0)
+    assert lo[0] >= x0 - 0.5 and hi[0] <= x1 + 0.5 and lo[1] >= y0 - 0.5 and hi[1] <= y1 + 0.5
+    gaps = np.array([lo[0] - x0, x1 - hi[0], lo[1] - y0, y1 - hi[1]])
+    # one pair of opposite sides is touched (to the sampling of the outline)
+    assert min(gaps[:2].max(), gaps[2:].max()) < 1.0
+    # and the outline is centred in the area both ways
+    assert np.allclose((lo + hi) / 2, [(x0 + x1) / 2, (y0 + y1) / 2], atol=0.5)
+    # the pivot is the sphere's centre
+    assert np.allclose(cam.pivot(), c)
+
+
+def test_frame_without_area_is_centred_and_resets_the_offset():
+    cam = make_cam()
+    cam.frame(np.zeros(3), 1.0, 1.6, area=(0.4, 0.0, 1.0, 1.0))
+    assert cam.screen_offset[0] > 0
+    cam.frame(np.zeros(3), 1.0, 1.6)
+    assert cam.screen_offset == (0.0, 0.0)
+    px, _ = cam.project(np.zeros(3), 800, 500)
+    assert np.allclose(px[0], [400, 250])
+
+
+def test_orbit_views_and_dolly_keep_an_offset_pivot_on_its_pixel():
+    """Framed beside a panel, orbiting, the numpad views and the dolly drag
+    turn / zoom about the framed centre: it keeps its pixel."""
+    cam = make_cam()
+    w, h = 960, 600
+    c = np.array([0.3, 0.1, -0.2])
+    cam.frame(c, 0.5, w / h, area=(0.35, 0.05, 1.0, 1.0))
+    p0 = cam.project(c, w, h)[0][0]
+    assert p0[0] > w * 0.6                         # right of the window centre
+    cam.orbit(80.0, -30.0)
+    assert np.allclose(cam.project(c, w, h)[0][0], p0, atol=1e-6)
+    cam.turn_to(math.pi / 2, 0.0)
+    assert np.allclose(cam.project(c, w, h)[0][0], p0, atol=1e-6)
+    d = cam.distance
+    cam.dolly(3.0)
+    assert cam.distance < d and np.allclose(cam.project(c, w, h)[0][0], p0, atol=1e-6)

@@ -160,8 +160,10 @@ def test_gaussian_scene_edit_rotate_save(xvfb, tmp_path):
     pngs = []
     for name, f in (("src", src_path), ("saved", out)):
         png = tmp_path / f"{name}.png"
-        r2 = run("render", f, "-o", png, "--size", "320x240", "--eye", ",".join(map(str, eye)),
-                 "--target", ",".join(map(str, cam["target"])), "--up", ",".join(map(str, cam["up"])))
+        # "--eye=X,Y,Z": a value starting with "-" is not taken for an option (the target,
+        # framed beside the panel, is off the model's centre, so any coordinate may be negative)
+        r2 = run("render", f, "-o", png, "--size", "320x240", "--eye=" + ",".join(map(str, eye)),
+                 "--target=" + ",".join(map(str, cam["target"])), "--up=" + ",".join(map(str, cam["up"])))
         assert r2.returncode == 0, r2.stderr
         pngs.append(png)
     from PIL import Image

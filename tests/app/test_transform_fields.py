@@ -8,11 +8,15 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.transform_fields import TransformInput, apply_transform
+from splatedit.app.transform_fields import TargetKind, TransformInput, apply_position, apply_transform, field_target
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.test_editor_routing import ed, key  # noqa: F401 (fixture)
 
 glfw = pytest.importorskip("glfw")
+#: model units: a committed curve move brings the splat its point was picked on
+#: to the typed position (the curve interpolates its moved points: measured
+#: 3e-14 on the 30 x 30 plane, grid step 0.069)
+CURVE_POINT_LANDING = 1e-9
 
 
 def _rig(s, handles=((0.0, 0.0),)):
@@ -92,3 +96,83 @@ def test_refused_while_a_move_runs_or_without_a_fitted_handle(ed):  # noqa: F811
     key(ed, glfw.KEY_ESCAPE)
     assert not apply_transform(ed, TransformInput())
     assert "nothing to apply" in ed.messages[-1] and len(s.edits) == 0
+
+
+def _curve(s, xs=(-0.5, 0.0, 0.5)):
+    """Support r < 0.9 and a curve through plane points at x = xs, y = 0 (fitted)."""
+    r = np.linalg.norm(s.cloud.positions[:, :2], axis=1)
+    s.brush_target = SUPPORT
+    s.end_stroke(s.paint(np.flatnonzero(r < 0.9)))
+    for x in xs:
+        i = int(np.argmin(np.linalg.norm(s.cloud.positions[:, :2] - [x, 0.0], axis=1)))
+        assert s.add_curve_point(s.cloud.positions[i])
+    assert s.wait_fit() and s.basis_groups[1] is not None
+
+
+def test_fields_move_the_active_curve_point_to_a_typed_position_with_undo(ed):  # noqa: F811
+    s = ed.session
+    _curve(s)
+    s.curve_mode = True
+    t = field_target(s)
+    assert t.kind is TargetKind.CURVE_POINT and t.index == 2 and t.problem is None and not t.rotates
+    assert np.allclose(t.position, s.curve_points[2])
+    # a relative move of the first point, one undo step
+    s.select_curve_point(0)
+    assert field_target(s).index == 0
+    assert apply_transform(ed, TransformInput(translate=[0.0, 0.0, -0.2]))
+    assert s.manip is None and s.pose_pending and len(s.edits) == 0
+    assert np.allclose(s.curve_point_positions()[0], s.curve_points[0] + [0.0, 0.0, -0.2])
+    key(ed, glfw.KEY_Z, glfw.MOD_CONTROL)
+    assert not s.pose_pending
+    # rotating or scaling a point is refused with the reason
+    assert not apply_transform(ed, TransformInput(axis=[0.0, 0.0, 1.0], degrees=20.0))
+    assert "only moves" in ed.messages[-1]
+    # the position field: the last point goes where it is typed, the others stay
+    s.select_curve_point(-1)
+    goal = s.curve_points[2] + [0.0, 0.1, 0.3]
+    assert apply_position(ed, goal)
+    assert np.allclose(s.curve_point_positions()[2], goal, atol=1e-12)
+    assert np.allclose(s.curve_point_positions()[:2], s.curve_points[:2])
+    assert np.allclose(field_target(s).position, goal)                         # the fields show it
+    # Enter commits: the splat the point was picked on lands on the typed position
+    i = int(np.argmin(np.linalg.norm(s.cloud.positions - s.curve_points[2], axis=1)))
+    assert s.commit() and len(s.edits) == 1
+    assert np.linalg.norm(s.cloud.positions[i] - goal) < CURVE_POINT_LANDING
+    key(ed, glfw.KEY_Z, glfw.MOD_CONTROL)
+    assert len(s.edits) == 0 and np.allclose(s.curve_point_positions()[2], goal)
+
+
+def test_the_target_is_the_curve_point_with_the_curve_tool_on_else_the_handle(ed):  # noqa: F811
+    s = ed.session
+    assert field_target(s).kind is TargetKind.NONE and "paint a support" in field_target(s).problem
+    _rig(s)
+    _curve(s, xs=(-0.6, 0.6))
+    assert field_target(s).kind is TargetKind.HANDLE
+    s.curve_mode = True
+    t = field_target(s)
+    assert t.kind is TargetKind.CURVE_POINT and t.index == 1
+    s.remove_curve_point()
+    s.wait_fit()
+    t = field_target(s)
+    assert t.kind is TargetKind.CURVE_POINT and "second curve point" in t.problem
+    assert not apply_position(ed, t.position + 0.1) and "second curve point" in ed.messages[-1]
+    s.curve_mode = False
+    s.wait_fit()
+    t = field_target(s)
+    assert t.kind is TargetKind.HANDLE and t.problem is None and np.allclose(t.position, s.handle_centroid())
+    key(ed, glfw.KEY_G)
+    assert "a move is running" in field_target(s).problem
+
+
+def test_position_field_moves_the_handle_centre_there_in_one_edit(ed):  # noqa: F811
+    s = ed.session
+    _rig(s)
+    t = field_target(s)
+    assert t.kind is TargetKind.HANDLE and t.rotates and np.allclose(t.position, s.handle_centroid())
+    assert not apply_position(ed, t.position) and "already" in ed.messages[-1]
+    goal = t.position + [0.05, -0.02, 0.2]
+    assert apply_position(ed, goal)
+    assert len(s.edits) == 1 and np.allclose(s.handle_centroid(), goal, atol=1e-9)
+    assert np.allclose(field_target(s).position, goal, atol=1e-9)
+    key(ed, glfw.KEY_Z, glfw.MOD_CONTROL)
+    assert len(s.edits) == 0 and np.allclose(field_target(s).position, t.position)

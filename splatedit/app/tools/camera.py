@@ -8,8 +8,32 @@ import math
 import numpy as np
 
 from splatedit.app.keymap import Action, Section
+from splatedit.app.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.model.orientation import UpAxis, detect_up_axis, next_up
+from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
+
+
+def free_area(w: int, h: int, panel_box, top: float = 0.0) -> tuple[float, float, float, float]:
+    """(x0, y0, x1, y1) fractions of a ``w`` x ``h`` pixel window (y down)
+    that no GUI covers: below a menu bar ``top`` pixels high and beside the
+    side panel's column (``panel_box`` (x, y, w, h) pixels or None): the
+    panel grows downwards as its sections open, so its whole column counts,
+    like Blender's side regions.  The whole window when what is left would be
+    narrower than ``EDITOR_FRAME_MIN_FREE_FRACTION`` of it."""
+    w, h = max(int(w), 1), max(int(h), 1)
+    x0, x1, y0 = 0.0, float(w), min(max(float(top), 0.0), float(h))
+    if panel_box is not None:
+        px, _, pw, _ = panel_box
+        if w - (px + pw) >= px:         # more room right of the panel
+            x0 = float(px + pw)
+        else:
+            x1 = float(px)
+    if x1 - x0 < EDITOR_FRAME_MIN_FREE_FRACTION * w:
+        x0, x1 = 0.0, float(w)
+    if h - y0 < EDITOR_FRAME_MIN_FREE_FRACTION * h:
+        y0 = 0.0
+    return x0 / w, y0 / h, x1 / w, 1.0
 
 
 class CameraTool(Tool):
@@ -51,16 +75,31 @@ class CameraTool(Tool):
         self.ed.say(f"up axis {self.up.label} (numpad 1 / 3 / 7 views turn about it)")
 
     # ------------------------------------------------------------ framing
+    def view_area(self) -> tuple[float, float, float, float]:
+        """The part of the window framing fills (:func:`free_area`): beside the
+        side panel when it is shown, below the GUI's menu bar."""
+        ed = self.ed
+        w, h = ed.size
+        box = ed.panel_box if ed.panel_visible else None
+        if box is not None and tuple(box) == (0, 0, 0, 0):
+            # no frame laid out yet (a model opened before the first GUI frame): the GUI
+            # panel's first place, at the left; the CPU text panel's size is not known
+            box = (PANEL_MARGIN, 0, EDITOR_GUI_PANEL_WIDTH, 0) if ed.gui is not None else None
+        top = ed.gui.menu_height if ed.gui is not None else 0.0
+        return free_area(w, h, box, top)
+
     def frame_all(self) -> None:
+        """Home: the whole model fills the free part of the window."""
         s = self.session
         if s is None:
             return
         w, h = self.ed.size
         lo, hi = s.cloud.bounds()
-        self.cam.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / max(h, 1))
+        self.cam.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / max(h, 1), area=self.view_area())
         self.ed.motion()
 
     def frame_selection(self) -> None:
+        """F: the active handle (else the support) fills the free part of the window."""
         s = self.session
         if s is None:
             return
@@ -69,11 +108,12 @@ class CameraTool(Tool):
             self.frame_all()
             return
         w, h = self.ed.size
-        self.cam.frame_points(s.cloud.positions[m], w / max(h, 1))
+        self.cam.frame_points(s.cloud.positions[m], w / max(h, 1), area=self.view_area())
         self.ed.motion()
 
     def view_preset(self, yaw: float, pitch: float) -> None:
-        self.cam.yaw, self.cam.pitch = yaw, pitch
+        """A numpad view: turn about the pivot (the framed model stays where it is on screen)."""
+        self.cam.turn_to(yaw, pitch)
         self.ed.motion()
 
     # -------------------------------------------------------------- mouse

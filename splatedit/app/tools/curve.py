@@ -91,8 +91,11 @@ class CurveTool(Tool):
             if p:
                 out.append(p)
         active = s.manip_target[1] if (s.manip_target and s.manip_target[0] == "curve") else None
+        chosen = s.active_curve_point() if s.curve_mode else None     # the transform fields' point: ringed
         for j, q in enumerate(self.dots(w, h)):
             if np.isfinite(q).all():
+                if j == chosen and j != active:
+                    out.append(ov.dot_patch(q, (255, 255, 255), 7))
                 out.append(ov.dot_patch(q, (255, 255, 255) if j == active else CURVE_RGB,
                                         7 if j == active else 5))
         return out

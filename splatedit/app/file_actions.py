@@ -1,0 +1,89 @@
+"""The editor's file actions: loading, opening (the file browser, a path,
+a dropped file, the recent files), the save-as prompt, saving, exporting the
+edit script and quitting with unsaved changes.
+
+A part of :class:`~splatedit.app.editor.Editor` (mixed into it; the state
+it uses -- ``path``, ``jobs``, ``prompt``, ``confirm_quit``, ``saved_path``
+... -- is the editor's, read by the panels and the status file).  The work
+itself (worker jobs, checks, error boxes) is in :mod:`splatedit.app.files`;
+these are the entry points keys, the GUI's File menu and drops call.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from splatedit.app import files
+
+
+class FileActions:
+    """Load / open / save / export / quit of the Editor (its File menu API)."""
+
+    # -------------------------------------------------------------- loading
+    def start_load(self) -> None:
+        self.jobs["load"] = files.load_job(self.path, self.wake)
+
+    def on_loaded(self, cloud, path=None) -> None:
+        files.on_loaded(self, cloud, path)
+
+    # ------------------------------------------- opening (also the GUI's File menu)
+    def open_dialog(self, folder=None) -> None:
+        """Show the file browser (Ctrl+O) in ``folder`` (default: the model's);
+        a G/R/S move in progress is cancelled first."""
+        if self.session is not None and self.session.manip is not None:
+            self.gizmo.cancel_manip()
+        self.confirm_quit = False
+        self.prompt = None
+        self.browser.open(folder)
+
+    def open_path(self, path, confirmed: bool = False) -> bool:
+        """Open the model at ``path`` in place of the current one (asks first
+        with unsaved changes unless ``confirmed``); True when loading started."""
+        return files.open_path(self, path, confirmed=confirmed)
+
+    def recent_files(self) -> list[Path]:
+        """The recent models, most recent first (missing files dropped)."""
+        return [] if self.recent is None else self.recent.files()
+
+    def poll_jobs(self) -> None:
+        files.poll_jobs(self)
+
+    # ------------------------------------------------------- save-as prompt
+    def prompt_key(self, k: int) -> None:
+        """A key while the save-as path is typed: Enter saves, Esc cancels."""
+        g = self.g
+        if k in (g.KEY_ENTER, g.KEY_KP_ENTER):
+            path, self.prompt = self.prompt.strip(), None
+            if path:
+                self.save(Path(path).expanduser())
+        elif k == g.KEY_ESCAPE:
+            self.prompt = None
+        elif k == g.KEY_BACKSPACE:
+            self.prompt = "" if self.prompt_fresh else self.prompt[:-1]
+            self.prompt_fresh = False
+
+    # ------------------------------------------------------------- saving
+    def save_target(self) -> Path:
+        if self.save_as is not None:
+            return self.save_as
+        if self.saved_path is not None:
+            return self.saved_path
+        self.save_as = files.default_save_path(self.path, self.cloud_name, self.bundled)
+        return self.save_as
+
+    save = files.save
+
+    def ask_save_as(self) -> None:
+        self.prompt = str(self.save_target())
+        self.prompt_fresh = True
+
+    def export_script(self) -> None:
+        files.export_script(self, self.save_target())
+
+    def request_quit(self) -> None:
+        s = self.session
+        if s is not None and s.dirty and not self.confirm_quit:
+            self.confirm_quit = True
+            self.say("unsaved changes: press Y (or Q) to quit without saving, N or Esc to stay")
+        else:
+            self.running = False

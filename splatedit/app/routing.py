@@ -1,0 +1,182 @@
+"""The editor's event routing: each window event (from
+:meth:`splatedit.render.vk.window.Window.poll`) goes to the GUI first, then
+to the modal question, the file browser, the help or the tools.
+
+A part of :class:`~splatedit.app.editor.Editor` (mixed into it).  Mouse
+presses go to the tools in press order (every tool's ``press_modal``
+first, then ``press``); the tool that takes a press gets the drag's moves
+and its release.  Keys are looked up in the one keymap
+(:func:`splatedit.app.keymap.lookup`) in the contexts the editor is in
+(save-as prompt, quit / open question, browser, error box, help, a running
+G/R/S move, idle) and run the bound action.
+"""
+
+from __future__ import annotations
+
+from pathlib import Path
+
+from splatedit.app import files
+from splatedit.app.keymap import Action, Context, lookup
+from splatedit.app.tools.base import DragMode
+from splatedit.errors import SplatEditError
+
+#: wheel notch -> help lines scrolled
+HELP_WHEEL_LINES = 3
+
+
+class EventRouting:
+    """The Editor's ``on_<kind>`` event handlers and action dispatch."""
+
+    def handle_events(self, events) -> None:
+        for e in events:
+            try:
+                if self.gui is not None and self.gui.takes(e):
+                    continue
+                getattr(self, f"on_{e.kind}")(e)
+            except SplatEditError as exc:
+                self.say(str(exc))
+
+    def on_resize(self, e) -> None:
+        self.frames.invalidate()
+        self.motion()
+
+    def on_enter(self, e) -> None:
+        self.cursor_inside = bool(e.action)
+
+    def on_iconify(self, e) -> None:
+        self.frames.invalidate()
+
+    def on_close(self, e) -> None:
+        self.request_quit()
+
+    def on_drop(self, e) -> None:
+        files.on_drop(self, [Path(p) for p in e.paths])
+
+    def on_char(self, e) -> None:
+        if self.browser.shown and self.prompt is None and self.confirm_open is None:
+            self.browser.type_char(e.char)
+            return
+        if self.prompt is not None and e.char.isprintable():
+            self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
+            self.prompt_fresh = False
+
+    def on_scroll(self, e) -> None:
+        if self.browser.shown:
+            self.browser.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
+            return
+        b = self.help.box
+        if self.help.shown and b is not None and b.x <= e.x < b.right and b.y <= e.y < b.bottom:
+            self.help.scroll(-int(round(e.dy * HELP_WHEEL_LINES)))
+            return
+        if self.session is None:
+            return
+        if e.mods & self.g.MOD_CONTROL:
+            self.brush.scroll(e)
+        else:
+            self.camera.scroll(e)
+
+    def on_move(self, e) -> None:
+        x, y = e.x, e.y
+        last = self.drag_last
+        self.mouse = (x, y)
+        self.cursor_inside = True
+        s = self.session
+        if self.drag_tool is not None and s is not None:
+            self.drag_tool.drag(self.drag, x, y, x - last[0], y - last[1], last)
+        if s is not None and s.manip is not None:
+            s.manip.mouse = (x, y)
+            self.motion()
+        self.drag_last = (x, y)
+
+    def on_button(self, e) -> None:
+        g, s = self.g, self.session
+        self.mouse = (e.x, e.y)
+        if e.action == g.RELEASE:
+            tool, mode = self.drag_tool, self.drag
+            self.drag, self.drag_tool = DragMode.NONE, None
+            if tool is not None and s is not None:
+                tool.release(mode)
+            return
+        if e.action != g.PRESS:
+            return
+        if self.browser.shown and self.confirm_open is None:
+            if e.button == g.MOUSE_BUTTON_LEFT:
+                self.browser.click(e.x, e.y)
+            return
+        r = self.error_rect
+        if r is not None and r[0] <= e.x < r[0] + r[2] and r[1] <= e.y < r[1] + r[3]:
+            self.dismiss_error()
+            return
+        if s is None or self.modal():
+            return
+        self.drag_last = (e.x, e.y)
+        for tool in self.tools:
+            mode = tool.press_modal(e)
+            if mode is not None:
+                break
+        else:
+            for tool in self.tools:
+                mode = tool.press(e)
+                if mode is not None:
+                    break
+            else:
+                return
+        self.drag = mode
+        self.drag_tool = tool if mode is not DragMode.NONE else None
+
+    def on_key(self, e) -> None:
+        g = self.g
+        if e.action not in (g.PRESS, g.REPEAT):
+            return
+        k = e.key
+        ctrl, shift = bool(e.mods & g.MOD_CONTROL), bool(e.mods & g.MOD_SHIFT)
+        if self.prompt is not None:
+            self.prompt_key(k)
+            return
+        if self.confirm_quit:
+            if k in (g.KEY_Y, g.KEY_Q):
+                self.running = False
+            else:                      # N, Esc or anything else: stay
+                self.confirm_quit = False
+                self.say("quit cancelled")
+            return
+        if self.confirm_open is not None:
+            files.answer_open(self, k == g.KEY_Y)
+            return
+        if self.browser.shown:
+            action = lookup(k, ctrl, shift, [Context.BROWSER])
+            if action is not None:
+                self.actions[action]()
+            return
+        s = self.session
+        manip = s is not None and s.manip is not None
+        # a running move keeps its keys (Esc cancels it, digits type) even under the help
+        helping = [Context.HELP] if self.help.shown else []
+        if self.error_box is not None:
+            helping.insert(0, Context.ERROR)
+        if s is None:
+            contexts = helping + [Context.ANY]
+        elif manip:
+            contexts = [Context.MANIP] + helping + [Context.ANY]
+        else:
+            contexts = helping + [Context.IDLE, Context.ANY]
+        action = lookup(k, ctrl, shift, contexts)
+        if action is None:
+            if s is not None:
+                self.motion()
+            return
+        if action is Action.TYPE_VALUE:
+            self.gizmo.type_key(k)
+            self.motion()
+        else:
+            self.run_action(action)
+
+    def run_action(self, action: Action) -> None:
+        """Run the handler bound to ``action`` (keys and GUI buttons share it):
+        during a G/R/S move its own handler when it has one."""
+        s = self.session
+        manip = s is not None and s.manip is not None
+        table = self.manip_actions if manip and action in self.manip_actions else self.actions
+        table[action]()
+        if s is not None:
+            self.motion()

@@ -1,0 +1,199 @@
+"""The session's pose and manipulation: pending matrices per handle and
+moves per curve point, a running G/R/S move, finishing it and committing
+the whole pose as one edit.
+
+A part of :class:`~splatedit.app.session.Session` (mixed into it).  Ending
+a manipulation of a single-handle rig without curve commits at once;
+otherwise it is kept in the pose until :meth:`PoseEditing.commit` (Enter).
+A commit records a script edit (``indices`` support and handles,
+``matrix`` transforms, ``curves``) so the saved cloud can be replayed.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+from splatedit.app.gaussian_doc import commit_cloud
+from splatedit.app.manipulation import GRAB, Manipulation, ViewInfo
+from splatedit.app.rig import _matrix_tuple
+from splatedit.errors import SplatEditError
+
+
+class PoseEditing:
+    """Pose, manipulation, finish and commit of a Session."""
+
+    # ------------------------------------------------------------------ pose
+    @property
+    def single_rig(self) -> bool:
+        """One handle and no curve: ending a manipulation commits at once."""
+        return len(self.selection.handles) == 1 and not self.curve_points
+
+    @property
+    def pose_pending(self) -> bool:
+        """Some handle or curve point has a pending (uncommitted) move."""
+        return self.rig.pending
+
+    def handle_matrix(self, k: int, live: bool = True) -> np.ndarray:
+        """Pending matrix of handle ``k`` (with the running manipulation when ``live``)."""
+        m = self.pose[k] if k < len(self.pose) else np.eye(4)
+        if live and self.manip is not None and self.manip_target == ("handle", k):
+            m = self.manip.matrix() @ m
+        return m
+
+    def live_curve_moves(self, live: bool = True) -> np.ndarray:
+        mv = self.curve_moves.copy()
+        if live and self.manip is not None and self.manip_target and self.manip_target[0] == "curve":
+            j = self.manip_target[1]
+            p = self.curve_points[j] + mv[j]
+            m = self.manip.matrix()
+            mv[j] = m[:3, :3] @ p + m[:3, 3] - self.curve_points[j]
+        return mv
+
+    def inputs(self, live: bool = True) -> list:
+        """Per-group inputs of ``basis.displacement`` (fitted handles, then the curve)."""
+        hidx, curve = self.basis_groups
+        out = [self.handle_matrix(k, live) for k in hidx]
+        if curve is not None:
+            out.append(self.live_curve_moves(live))  # the curve's controls are its picked points
+        return out
+
+    def reset_pose(self) -> bool:
+        """Discard the pending transforms and curve moves (an undo step)."""
+        if self.manip is not None:
+            self.cancel()
+        if not self.pose_pending:
+            return False
+        self.rig.reset_pose(len(self.selection.handles))
+        self.push("reset pose")
+        return True
+
+    # ---------------------------------------------------------- manipulation
+    def handle_centroid(self, k: int | None = None) -> np.ndarray:
+        """Centroid of handle ``k`` (default: the active one) moved by its pending matrix."""
+        k = self.selection.active if k is None else k
+        c = self.cloud.positions[self.selection.handles[k]].mean(axis=0)
+        m = self.pose[k] if k < len(self.pose) else np.eye(4)
+        return m[:3, :3] @ c + m[:3, 3]
+
+    def active_fitted(self) -> bool:
+        """The active handle is part of the fitted basis."""
+        return self.basis is not None and self.selection.active in self.basis_groups[0]
+
+    def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float]) -> bool:
+        """Start G/R/S of the active handle (needs a basis that includes it)."""
+        if self.manip is not None or not self.active_fitted():
+            return False
+        self.manip = Manipulation(mode, self.handle_centroid(), view, mouse)
+        self.manip_target = ("handle", self.selection.active)
+        return True
+
+    def begin_curve_point(self, j: int, view: ViewInfo, mouse: tuple[float, float]) -> bool:
+        """Start dragging picked curve point ``j`` (needs a basis with the curve)."""
+        if self.manip is not None or self.basis is None or self.basis_groups[1] is None:
+            return False
+        if not 0 <= j < len(self.curve_points):
+            return False
+        self.manip = Manipulation(GRAB, self.curve_points[j] + self.curve_moves[j], view, mouse)
+        self.manip_target = ("curve", int(j))
+        self.curve_active = int(j)
+        return True
+
+    def current_matrix(self) -> np.ndarray:
+        return np.eye(4) if self.manip is None else self.manip.matrix()
+
+    def current_dc(self):
+        """dC of the whole pose, live manipulation included (None without
+        basis), in the session's :attr:`deformation` mode (a
+        RotationDisplacement in rotation mode)."""
+        if self.basis is None:
+            return None
+        return self.basis.displacement(self.inputs(), mode=self.deformation)
+
+    def cancel(self) -> None:
+        self.manip = None
+        self.manip_target = None
+        self.on_change()
+
+    def _check_manip(self) -> None:
+        """Raise SplatEditError (state unchanged) when the running manipulation's
+        typed value cannot be applied (e.g. a scale factor <= 0)."""
+        bad = self.manip.problem() if self.manip is not None else None
+        if bad:
+            raise SplatEditError(bad)
+
+    def _bake(self) -> None:
+        """Store the running manipulation in the pose."""
+        t = self.manip_target
+        if t[0] == "handle":
+            self.pose[t[1]] = self.handle_matrix(t[1])
+        else:
+            self.curve_moves = self.live_curve_moves()
+        self.manip = None
+        self.manip_target = None
+
+    def finish(self) -> str:
+        """End the running manipulation: commit at once for a single-handle
+        rig ("commit", or "" when nothing moved); else keep it in the pose
+        ("pose") for a later :meth:`commit`."""
+        if self.manip is None:
+            return ""
+        self._check_manip()
+        if self.single_rig:
+            return "commit" if self.commit() else ""
+        moved = not np.array_equal(self.manip.matrix(), np.eye(4))
+        what = "move handle" if self.manip_target[0] == "handle" else "move curve point"
+        self._bake()
+        if moved:
+            self.push(what)
+        else:
+            self.on_change()
+        return "pose" if moved else ""
+
+    def commit(self) -> bool:
+        """Apply the pose (running manipulation included) as one edit: the
+        deformed cloud becomes the new base, the edit is recorded, support and
+        handles are kept, the curve is consumed.  Raises InputError (state
+        unchanged) when a splat degenerates."""
+        from splatedit.script import Curve, Edit, Matrix
+        from splatedit.select.regions import Indices
+        if self.basis is None:
+            return False
+        self._check_manip()
+        inputs = self.inputs(live=True)
+        moves = self.live_curve_moves(live=True)
+        hidx, curve = self.basis_groups
+        mats = inputs[:len(hidx)]
+        if all(np.array_equal(m, np.eye(4)) for m in mats) and not (curve is not None and moves.any()):
+            self.manip = None
+            self.manip_target = None
+            self.on_change()
+            return False
+        t0 = time.perf_counter()
+        dc = self.basis.displacement(inputs, mode=self.deformation)
+        # the same arrays and the same checks as ``splatedit deform`` and as reading the
+        # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
+        # length is relative to the *whole* cloud's diagonal, which the edit may change)
+        # a Gaussian document: the Gaussians deformed on the CPU (covariances, SH) and re-wrapped
+        new = commit_cloud(self.basis, self.cloud, dc)     # raises InputError on a degenerate splat
+        self.last_commit_seconds = time.perf_counter() - t0
+        sel = self.selection
+        idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+        curves = ()
+        if curve is not None:
+            curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.curve_points),
+                            tuple(tuple(float(x) for x in d) for d in moves), None),)
+        edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
+                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
+                    fill_holes=False,  # the editor's closed selection, replayed as is
+                    deformation=self.deformation)
+        self.manip = None
+        self.manip_target = None
+        self.cloud = new
+        self.edits = self.edits + (edit,)
+        self.fit.clear()
+        self.rig.reset_pose(len(sel.handles))
+        self.rig.clear_curve()
+        self.push("edit")
+        return True

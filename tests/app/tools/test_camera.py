@@ -1,0 +1,67 @@
+"""The camera tool's framing area: the window minus the side panel's column
+and the menu bar (Home / F frame into it)."""
+
+from __future__ import annotations
+
+import pytest
+
+from splatedit.app.tools.camera import free_area
+from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
+
+W, H = 960, 600
+
+
+def test_left_panel_leaves_the_window_right_of_its_column_below_the_menu():
+    x0, y0, x1, y1 = free_area(W, H, (8, 27, EDITOR_GUI_PANEL_WIDTH, 120), top=19)
+    assert (x0 * W, y0 * H, x1 * W, y1 * H) == pytest.approx((8 + EDITOR_GUI_PANEL_WIDTH, 19, W, H))
+
+
+def test_right_panel_leaves_the_window_left_of_it():
+    px = W - 8 - EDITOR_GUI_PANEL_WIDTH
+    x0, y0, x1, y1 = free_area(W, H, (px, 27, EDITOR_GUI_PANEL_WIDTH, 500))
+    assert (x0 * W, y0, x1 * W, y1) == pytest.approx((0, 0, px, 1))
+
+
+def test_no_panel_or_a_panel_leaving_too_little_is_the_whole_window():
+    assert free_area(W, H, None) == (0.0, 0.0, 1.0, 1.0)
+    narrow = int(W * (1 - EDITOR_FRAME_MIN_FREE_FRACTION)) + 4      # leaves under the minimum
+    assert free_area(W, H, (0, 20, narrow, 300))[::2] == (0.0, 1.0)
+
+
+def test_home_keeps_the_model_out_of_the_panel_column_and_uses_the_window_without_it():
+    """Home through the camera tool of a window-less editor: every splat
+    projects right of the panel's column and below the menu bar; with the
+    panel hidden the model is centred in the whole window."""
+    import types
+
+    import numpy as np
+
+    from splatedit.app.session import Session
+    from tests.app.test_editor_routing import StubEditor
+    from tests.app.sessions import plane_cloud
+
+    s = Session(plane_cloud(), fit_sync=True)
+    try:
+        ed = StubEditor(s)
+        w, h = ed.size
+        ed.gui = types.SimpleNamespace(menu_height=19.0)
+        ed.panel_box = (8, 27, EDITOR_GUI_PANEL_WIDTH, 300)
+        ed.camera.frame_all()
+        px, _ = ed.cam.project(s.cloud.positions, w, h)
+        assert px[:, 0].min() >= 8 + EDITOR_GUI_PANEL_WIDTH and px[:, 1].min() >= 19.0
+        assert px[:, 0].max() <= w and px[:, 1].max() <= h
+        lo, hi = s.cloud.bounds()
+        assert np.allclose(ed.cam.pivot(), (lo + hi) / 2)       # orbits about the model's centre
+        # before the first GUI frame the panel's first place is assumed
+        ed.panel_box = (0, 0, 0, 0)
+        ed.camera.frame_all()
+        assert ed.cam.project(s.cloud.positions, w, h)[0][:, 0].min() >= 8 + EDITOR_GUI_PANEL_WIDTH
+        # panel hidden (P): the whole window below the menu bar
+        ed.panel_visible = False
+        ed.camera.frame_all()
+        assert ed.cam.screen_offset[0] == 0 and ed.cam.screen_offset[1] < 0     # a little down
+        px, _ = ed.cam.project(s.cloud.positions, w, h)
+        assert px[:, 0].min() < 8 + EDITOR_GUI_PANEL_WIDTH and px[:, 1].min() >= 19.0
+        assert abs(ed.cam.project(ed.cam.pivot(), w, h)[0][0, 0] - w / 2) < 1e-6
+    finally:
+        s.close()
