@@ -829,14 +829,19 @@ ROTATION_PROBE_DEGREES = 120.0
 #: the percentile of the probe splats' stretch that is compared.  The largest
 #: splat stretch sits where the deformation folds (an axis shrunk to 0.009
 #: of its length in the bunny's ear turned 90 degrees about a pivot 8 handle
-#: radii away: 112x, next splat 13x) and flips with the sample; the 99th
-#: percentile kept every scan's 99th-percentile stretch within 1.26x
-#: (bunny), 1.46x (kitten), 1.55x (hippo) of linear's over the sweep, the
-#: largest within 1.51x / 1.46x / 1.59x (against orig 1.61 / 1.59 / 2.08)
+#: radii away: 112x, next splat 13x) and flips with the sample.  Sweep of
+#: pivots 1-20 handle radii, 60/120/180 degrees, 4 axes (worst ratio to the
+#: linear mode of the 99th-percentile / largest stretch): comparing 99th
+#: percentiles: bunny 1.26 / 2.96, kitten 1.46 / 1.49, hippo 1.55 / 2.89;
+#: comparing maxima: 1.51 / 2.83, 1.46 / 1.74, 1.59 / 4.3; pivot always:
+#: 1.61 / 3.28, 1.59 / 3.23, 2.08 / 4.3
 ROTATION_PROBE_PERCENTILE = 99.0
 #: free support splats (evenly strided) sampled at fit time to compare arc
 #: centres: (4 K + 2 K + 6) floats each (about 0.9 MB at K = 16).  Cost of
-#: one choice (two candidates, then cached for the axis line): N ms
+#: one choice (two candidates, then cached for the pivot line), bunny with
+#: 1,667 / 1,834 probe splats, load 9-15: 3.6-4.4 ms best, 18-19 ms median of
+#: 7 (the bunny's and the scans' one-view edits have fewer free splats than
+#: this: every one of them is probed)
 ROTATION_PROBE_SPLATS = 2048
 #: tests (tests/deform/test_rotation_centre.py): the bunny's ear painted from
 #: one view, turned 120 degrees about an axis 8 handle radii away (3 axis
