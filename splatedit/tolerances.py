@@ -821,10 +821,11 @@ EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
 #: (its pivot, its centroid; deform/rotation_centre.py) are compared.  One
 #: fixed angle, so the choice does not change while a rotation is dragged.
 #: Measured (bench/stretch.py sweep, bunny, kitten, hippo and the bench bar):
-#: deciding at 120 degrees keeps the pivot for the bar bent about its base
-#: (2.7x max stretch at 150 degrees, linear 27x) and 2 below it (4.7x,
-#: linear 32x); deciding at the max of 120 and 180 took the centroid there
-#: (27x); 120 alone or the max of 90 and 150 agree on the scans
+#: deciding at 120 degrees keeps the pivot for the bench bar bent 150
+#: degrees about the start of its support (max stretch 2.7x, linear 27x) and
+#: about a point 3 radii beyond it (4.7x, linear 32x); deciding on the worse
+#: of 90 and 180 degrees took the centroid there (7.0x and 27x); on the
+#: scans 120 alone and the worse of 90 and 150 pick nearly alike
 ROTATION_PROBE_DEGREES = 120.0
 #: the percentile of the probe splats' stretch that is compared.  The largest
 #: splat stretch sits where the deformation folds (an axis shrunk to 0.009

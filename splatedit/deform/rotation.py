@@ -14,7 +14,10 @@ map instead:
   handle's centroid ``g_h`` (``c_h = g_h + d``, d the minimum-norm solution of
   ``(R_h - I) d = g_h - T_h(g_h)``), so a rotation about a gizmo pivot anywhere
   on that axis is a pure rotation about ``c_h`` with only a translation along
-  the axis left over;
+  the axis left over; or, when that axis is far enough from the support that
+  its arcs stretch more, ``g_h`` itself (the handle turns about its middle and
+  the translation ``(R_h - I)(pivot - g_h)`` goes through the residual, along
+  the chord): :mod:`splatedit.deform.rotation_centre` measures both;
 * weight field ``s_h(p)``: the sum of the handle's 4 affine-coordinate columns
   of the basis (1 on the handle, 0 on the fixed band and on other handles,
   smooth between), gradient ``grad s_h`` = the sum of its 4 Bx/By/Bz columns.
@@ -85,8 +88,9 @@ class HandleRotation:
     Attributes:
         w: (3,) float64 rotation vector (unit axis times angle in radians,
             angle in [0, pi]); zeros when the handle does not rotate.
-        center: (3,) float64 model-space point on the rotation axis nearest the
-            handle's centroid.
+        center: (3,) float64 model-space arc centre: the point of the
+            rotation axis nearest the handle's centroid, or the centroid
+            (:func:`~splatedit.deform.rotation_centre.choose_centre`).
         offsets: (4, 3) float64 the handle's control frame minus ``center``
             (model units), times the arc share phi (:func:`arc_share`):
             ``v_h = B_h offsets``.
@@ -218,8 +222,9 @@ def handle_blocks(basis) -> list[slice]:
 
 def rotation_displacement(basis, transforms: list):
     """``DeformationBasis.displacement(transforms, mode=ROTATION)``: each
-    handle's (4, 4) map (None: identity) decomposed, the residual maps (and the
-    curves' inputs) through the linear ``displacement``.  Returns a
+    handle's (4, 4) map (None: identity) decomposed about the centre
+    :func:`~splatedit.deform.rotation_centre.choose_centre` picks, the
+    residual maps (and the curves' inputs) through the linear ``displacement``.  Returns a
     RotationDisplacement, or the plain (K, 3) dC when no handle rotates (then
     bitwise the linear mode's)."""
     rotations, inputs = [], []

@@ -15,13 +15,14 @@ same handle motion (the residual map carries the translation
   support: an arc of radius D about a far axis is ``angle / (2 sin(angle /
   2))`` times longer than its chord (1.21x at 120 degrees, 1.57x at 180),
   and the transition between the fixed band and the handle has to absorb the
-  whole arc: the pivot centre stretches those splats by exactly that factor
-  more than the linear mode (measured on the bunny, the kitten and the hippo,
-  ``python -m splatedit.bench.stretch``), and tears 3-6x more neighbours.
+  whole arc: the pivot centre stretches those splats by that factor more than
+  the linear mode (99th percentile, pivots 8 handle radii away on the bunny,
+  the kitten and the hippo: ``python -m splatedit.bench.stretch``) and tears
+  1.5-6.5x as many neighbours.
 
 Which one a handle takes is measured, not guessed: the splat stretch of both
-at a few hundred support splats (:class:`StretchProbe`, sampled once at fit
-time) under a rigid turn by :data:`~splatedit.tolerances.ROTATION_PROBE_DEGREES`
+at up to ROTATION_PROBE_SPLATS free support splats (:class:`StretchProbe`,
+sampled once at fit time) under a rigid turn by :data:`~splatedit.tolerances.ROTATION_PROBE_DEGREES`
 about the frame's axis; the handle centre wins when it stretches less.  The
 choice depends on the axis line only, not on the angle, so dragging a
 rotation about a fixed pivot never jumps between the two; it is cached per
