@@ -26,7 +26,9 @@ sampled once at fit time) under a rigid turn by :data:`~splatedit.tolerances.ROT
 about the frame's axis; the handle centre wins when it stretches less.  The
 choice depends on the axis line only, not on the angle, so dragging a
 rotation about a fixed pivot never jumps between the two; it is cached per
-axis line.  The GPU evaluates the same formula with the chosen centre (the
+axis line.  A line that moves during a drag (grabbing a turned handle moves
+its screw axis) passes smoothly from one to the other: near equal scores
+give a centre between them.  The GPU evaluates the same formula with the chosen centre (the
 centre only enters the per-frame uniforms).
 """
 
@@ -36,7 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.tolerances import ROTATION_PROBE_DEGREES, ROTATION_PROBE_PERCENTILE, ROTATION_PROBE_SPLATS
+from splatedit.tolerances import (ROTATION_PROBE_BLEND, ROTATION_PROBE_DEGREES, ROTATION_PROBE_PERCENTILE,
+                                  ROTATION_PROBE_SPLATS)
 
 #: cached choices per basis (axis lines rounded to this many significant
 #: digits relative to the handle's radius; a drag keeps the same line)
@@ -99,7 +102,8 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np
     line through ``pivot`` (3,) (its point nearest the handle's centroid)
     along the unit ``axis`` (3,): ``pivot`` or the handle's centroid, the
     one whose rigid turn by ROTATION_PROBE_DEGREES stretches the probe's
-    splats less (:meth:`StretchProbe.stretch`; ties: the pivot).  The probe
+    splats less (:meth:`StretchProbe.stretch`), or a point between them
+    while the two stretch within ROTATION_PROBE_BLEND of each other.  The probe
     turns the way ``axis`` points (bending a part forwards and backwards
     differ); a rotation vector's axis flips where the angle passes 180
     degrees, where the blend itself flips to the short way round.  Without a
@@ -128,7 +132,13 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np
         inputs[handle] = res
         rotations = tuple(rot if j == handle else still for j in range(len(blocks)))
         scores.append(probe.stretch(RotationDisplacement(basis.displacement(inputs), rotations), blocks))
-    best = g.copy() if scores[1] < scores[0] else pivot
+    # smooth switch: the two deformations blend (the result is affine in the
+    # centre) while the scores are within ROTATION_PROBE_BLEND of each other,
+    # so a pivot line that moves during a drag (a grab after a turn) never
+    # makes the surface jump
+    t = min(1.0, max(0.0, (scores[1] / scores[0] - 1.0 + ROTATION_PROBE_BLEND) / (2.0 * ROTATION_PROBE_BLEND)))
+    share = t * t * (3.0 - 2.0 * t)                  # of the pivot
+    best = pivot if share == 1.0 else g + share * (pivot - g)
     if len(cache) >= _CACHE_SIZE:
         cache.clear()
     cache[key] = best

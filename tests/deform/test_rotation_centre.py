@@ -21,6 +21,7 @@ from splatedit.tolerances import (
     ROTSTRETCH_FAR_TEARS_VS_LINEAR,
     ROTSTRETCH_EAR_FAR_MAX_VS_LINEAR,
     ROTSTRETCH_EAR_FAR_P99,
+    ROTSTRETCH_SLIDE_STEP_SHARE,
 )
 
 LIN, ROT = DeformationMode.LINEAR, DeformationMode.ROTATION
@@ -126,3 +127,30 @@ def test_far_axis_edit_of_a_scan_stretches_like_the_linear_mode(shared_data):
         lin, rot, piv = sc.figures(m, LIN), sc.figures(m, ROT), sc.figures(m, ROT, pivot_only=True)
         print(f"kitten {axis}: p99 linear {lin[2]:.2f}, rotation {rot[2]:.2f}, pivot centre {piv[2]:.2f}")
         assert rot[2] <= ROTSTRETCH_FAR_P99_VS_LINEAR * lin[2] < piv[2]
+
+
+def _pivot_path_steps(ear, distances):
+    """Largest change of the deformed positions between neighbouring pivot
+    distances, and the change from the first to the last (model units)."""
+    basis, cloud = ear.basis, ear.cloud
+    basis.__dict__.pop("_rotation_centres", None)
+    pos = [basis.apply(cloud, basis.displacement([pivot_transform(ear.edit, 120.0, d, "view")], mode=ROT)).positions
+           for d in distances]
+    steps = [np.abs(b - a).max() for a, b in zip(pos, pos[1:])]
+    return max(steps), np.abs(pos[-1] - pos[0]).max()
+
+
+def test_centre_slides_while_the_pivot_line_moves(ear, monkeypatch):
+    """Grabbing a turned handle moves its screw axis every frame: where the
+    choice passes from the centroid to the pivot (the bunny's view axis, 3.5
+    to 3.75 handle radii) the surface moves in small steps (largest 10% of
+    the whole change in 50 steps); a hard switch makes one jump of 85% of it."""
+    import splatedit.deform.rotation_centre as rc
+    distances = np.linspace(3.5, 3.75, 51)
+    step, total = _pivot_path_steps(ear, distances)
+    print(f"pivot 3.5 -> 3.75 radii: largest step {step:.4f}, whole change {total:.4f} model units")
+    assert step < ROTSTRETCH_SLIDE_STEP_SHARE * total
+    monkeypatch.setattr(rc, "ROTATION_PROBE_BLEND", 1e-9)
+    hard_step, hard_total = _pivot_path_steps(ear, distances)
+    print(f"hard switch: largest step {hard_step:.4f}, whole change {hard_total:.4f}")
+    assert hard_step > 0.5 * hard_total
