@@ -20,19 +20,18 @@ same handle motion (the residual map carries the translation
   the kitten and the hippo: ``python -m splatedit.bench.stretch``) and tears
   1.5-6.5x as many neighbours.
 
-Which one a handle takes is measured, not guessed: the splat stretch of both
+When neither arc stretches less than the paper's chord (the linear mode), the
+handle's arc share gives way to it (a far axis can make every arc worse than
+the chord).  Which one a handle takes is measured, not guessed: the splat stretch of both
 at up to ROTATION_PROBE_SPLATS free support splats (:class:`StretchProbe`,
-sampled once at fit time) under a rigid turn by
-:data:`~splatedit.tolerances.ROTATION_PROBE_DEGREES` about the frame's axis;
-the handle centre wins when it stretches less, and near equal scores give a
-centre between the two (a line that moves during a drag, as grabbing a
-turned handle moves its screw axis, passes smoothly from one to the other).
-When even the better arc stretches clearly more than the paper's chord (the
-same turn in the linear mode; a far axis can make every arc worse), the
-handle's arc share slides to 0: the linear mode.  The choice depends on the
-axis line only, not on the angle, so dragging a rotation about a fixed pivot
-never jumps; it is cached per line.  The GPU evaluates the same formula with
-the chosen centre and share (both only enter the per-frame uniforms).
+sampled once at fit time) under a rigid turn by :data:`~splatedit.tolerances.ROTATION_PROBE_DEGREES`
+about the frame's axis; the handle centre wins when it stretches less.  The
+choice depends on the axis line only, not on the angle, so dragging a
+rotation about a fixed pivot never jumps between the two; it is cached per
+axis line.  A line that moves during a drag (grabbing a turned handle moves
+its screw axis) passes smoothly from one to the other: near equal scores
+give a centre between them.  The GPU evaluates the same formula with the chosen centre (the
+centre only enters the per-frame uniforms).
 """
 
 from __future__ import annotations
