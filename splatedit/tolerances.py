@@ -831,8 +831,7 @@ ROTATION_PROBE_DEGREES = 120.0
 #: splat stretch sits where the deformation folds (an axis shrunk to 0.009
 #: of its length in the bunny's ear turned 90 degrees about a pivot 8 handle
 #: radii away: 112x, next splat 13x) and flips with the sample.  Sweep of
-#: pivots 1-20 handle radii, 60/120/180 degrees, 4 axes, measured before the
-#: slide and the linear fallback below were added (worst ratio to the
+#: pivots 1-20 handle radii, 60/120/180 degrees, 4 axes (worst ratio to the
 #: linear mode of the 99th-percentile / largest stretch): comparing 99th
 #: percentiles: bunny 1.26 / 2.96, kitten 1.46 / 1.49, hippo 1.55 / 2.89;
 #: comparing maxima: 1.51 / 2.83, 1.46 / 1.74, 1.59 / 4.3; pivot always:
@@ -841,9 +840,9 @@ ROTATION_PROBE_PERCENTILE = 99.0
 #: free support splats (evenly strided) sampled at fit time to compare arc
 #: centres: (4 K + 2 K + 6) floats each (about 0.9 MB at K = 16).  Cost of
 #: one choice (two candidates, then cached for the pivot line), bunny with
-#: 1,667 / 1,834 probe splats, load 10-15, pivot, centroid and linear:
-#: 3.7-11 ms best, 16-18 ms median of 7 (the bunny's and the scans' one-view
-#: edits have fewer free splats than this: every one of them is probed)
+#: 1,667 / 1,834 probe splats, load 9-15: 3.6-4.4 ms best, 18-19 ms median of
+#: 7 (the bunny's and the scans' one-view edits have fewer free splats than
+#: this: every one of them is probed)
 ROTATION_PROBE_SPLATS = 2048
 #: relative band of the two centres' probe scores in which the centre slides
 #: from one to the other (smoothstep of the score ratio over 1 -+ this), so
@@ -851,9 +850,9 @@ ROTATION_PROBE_SPLATS = 2048
 #: drag; between, the result is the blend of the two deformations.  0.1:
 #: the bunny's ear, pivot moved 0.25 handle radii across the switch, slides
 #: in steps of at most 10% of the change (ROTSTRETCH_SLIDE_STEP_SHARE); the
-#: sweep's figures moved by a few percent (bunny, kitten, hippo, before the
-#: linear fallback: the worst 99th-percentile ratio to linear 1.33 / 1.46 /
-#: 1.83 with it, 1.33 / 1.46 / 1.78 with a hard switch)
+#: sweep's figures moved by a few percent (bunny, kitten, hippo: the worst
+#: 99th-percentile ratio to linear 1.33 / 1.46 / 1.83 with it, 1.33 / 1.46 /
+#: 1.78 with a hard switch)
 ROTATION_PROBE_BLEND = 0.1
 #: the arc (at the chosen centre) may stretch the probe's splats this much
 #: more (relative) than the linear mode under the same 120-degree turn before
@@ -862,9 +861,8 @@ ROTATION_PROBE_BLEND = 0.1
 #: from 3 views, 120 degrees about the model's origin and centroid on the
 #: 3 axes: 18 edits): tears summed linear 3,502, arcs only 5,427, with the
 #: fallback 3,642 (0.2 / 0.3: 4,510); worst 99th-percentile ratio to linear
-#: 1.31 -> 1.01; sweeps (bench/stretch.py, 72 edits each) worst: kitten
-#: 1.46 -> 1.20, hippo 1.83 -> 1.80, bunny 1.33 -> 1.33; bench bar cases
-#: unchanged (middle ring 1.00-1.10 R, bend about the base 2.7x)
+#: 1.31 -> 1.01; kitten sweep worst 1.46 -> 1.20; bench bar cases unchanged
+#: (middle ring 1.00-1.10 R, bend about the base 2.7x)
 ROTATION_PROBE_LINEAR_MARGIN = 0.1
 ROTATION_PROBE_LINEAR_BAND = 0.2
 #: tests (tests/deform/test_rotation_centre.py): the bunny's ear painted from
