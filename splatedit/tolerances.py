@@ -854,17 +854,6 @@ ROTATION_PROBE_SPLATS = 2048
 #: 99th-percentile ratio to linear 1.33 / 1.46 / 1.83 with it, 1.33 / 1.46 /
 #: 1.78 with a hard switch)
 ROTATION_PROBE_BLEND = 0.1
-#: the arc (at the chosen centre) may stretch the probe's splats this much
-#: more (relative) than the linear mode under the same 120-degree turn before
-#: its share slides towards the linear mode, over a further
-#: ROTATION_PROBE_LINEAR_BAND (smoothstep).  Measured (bunny one-view edits
-#: from 3 views, 120 degrees about the model's origin and centroid on the
-#: 3 axes: 18 edits): tears summed linear 3,502, arcs only 5,427, with the
-#: fallback 3,642 (0.2 / 0.3: 4,510); worst 99th-percentile ratio to linear
-#: 1.31 -> 1.01; kitten sweep worst 1.46 -> 1.20; bench bar cases unchanged
-#: (middle ring 1.00-1.10 R, bend about the base 2.7x)
-ROTATION_PROBE_LINEAR_MARGIN = 0.1
-ROTATION_PROBE_LINEAR_BAND = 0.2
 #: tests (tests/deform/test_rotation_centre.py): the bunny's ear painted from
 #: one view, turned 120 degrees about an axis 8 handle radii away (3 axis
 #: directions), and the kitten likewise.  99th-percentile stretch against the

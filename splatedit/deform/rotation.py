@@ -153,7 +153,7 @@ def screw_axis(matrix: np.ndarray, controls: np.ndarray):
 
 
 def decompose(matrix: np.ndarray, controls: np.ndarray,
-              centre: np.ndarray | None = None, arc_factor: float = 1.0) -> tuple[HandleRotation, np.ndarray]:
+              centre: np.ndarray | None = None) -> tuple[HandleRotation, np.ndarray]:
     """Split a handle's (4, 4) affine map ``T`` into its blended rotation and
     the residual affine map ``T - G + identity`` (G the rigid rotation about
     the centre).
@@ -175,7 +175,7 @@ def decompose(matrix: np.ndarray, controls: np.ndarray,
     if pivot is None:
         return HandleRotation(np.zeros(3), g.copy(), ctl - g), m
     c = pivot if centre is None else np.asarray(centre, dtype=np.float64)
-    phi = arc_share(float(np.linalg.norm(w))) * arc_factor
+    phi = arc_share(float(np.linalg.norm(w)))
     lin = (1.0 - phi) * (r - np.eye(3))          # the linearly interpolated share of R - I
     res = m.copy()
     res[:3, :3] = m[:3, :3] - r + np.eye(3) + lin
@@ -233,8 +233,8 @@ def rotation_displacement(basis, transforms: list):
             m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
             ctl = basis.constraints.groups[i].controls
             _, w, pivot = screw_axis(m, ctl)
-            centre, factor = (None, 1.0) if pivot is None else choose_centre(basis, i, w / np.linalg.norm(w), pivot)
-            rot, res = decompose(m, ctl, centre, factor)
+            centre = None if pivot is None else choose_centre(basis, i, w / np.linalg.norm(w), pivot)
+            rot, res = decompose(m, ctl, centre)
             rotations.append(rot)
             t = None if t is None else res
         inputs.append(t)

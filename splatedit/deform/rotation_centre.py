@@ -20,9 +20,7 @@ same handle motion (the residual map carries the translation
   the kitten and the hippo: ``python -m splatedit.bench.stretch``) and tears
   1.5-6.5x as many neighbours.
 
-When neither arc stretches less than the paper's chord (the linear mode), the
-handle's arc share gives way to it (a far axis can make every arc worse than
-the chord).  Which one a handle takes is measured, not guessed: the splat stretch of both
+Which one a handle takes is measured, not guessed: the splat stretch of both
 at up to ROTATION_PROBE_SPLATS free support splats (:class:`StretchProbe`,
 sampled once at fit time) under a rigid turn by :data:`~splatedit.tolerances.ROTATION_PROBE_DEGREES`
 about the frame's axis; the handle centre wins when it stretches less.  The
@@ -40,8 +38,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.tolerances import (ROTATION_PROBE_BLEND, ROTATION_PROBE_DEGREES, ROTATION_PROBE_LINEAR_BAND,
-                                  ROTATION_PROBE_LINEAR_MARGIN, ROTATION_PROBE_PERCENTILE, ROTATION_PROBE_SPLATS)
+from splatedit.tolerances import (ROTATION_PROBE_BLEND, ROTATION_PROBE_DEGREES, ROTATION_PROBE_PERCENTILE,
+                                  ROTATION_PROBE_SPLATS)
 
 #: cached choices per basis (axis lines rounded to this many significant
 #: digits relative to the handle's radius; a drag keeps the same line)
@@ -99,22 +97,17 @@ def _key(handle: int, axis: np.ndarray, centre: np.ndarray, radius: float) -> tu
             tuple(np.round(centre / radius * scale).astype(np.int64)))
 
 
-def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> tuple[np.ndarray, float]:
+def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np.ndarray:
     """The arc centre of handle ``handle`` of ``basis`` turning about the
     line through ``pivot`` (3,) (its point nearest the handle's centroid)
-    along the unit ``axis`` (3,), and the factor (in [0, 1]) of its arc share.
-
-    The centre is ``pivot`` or the handle's centroid, the one whose rigid
-    turn by ROTATION_PROBE_DEGREES stretches the probe's splats less
-    (:meth:`StretchProbe.stretch`), or a point between them while the two
-    stretch within ROTATION_PROBE_BLEND of each other.  The factor is 1
-    unless that stretch exceeds the linear mode's (the same turn, no arc) by
-    more than ROTATION_PROBE_LINEAR_MARGIN; it slides to 0 (the linear mode)
-    over a further ROTATION_PROBE_LINEAR_BAND.  The probe
+    along the unit ``axis`` (3,): ``pivot`` or the handle's centroid, the
+    one whose rigid turn by ROTATION_PROBE_DEGREES stretches the probe's
+    splats less (:meth:`StretchProbe.stretch`), or a point between them
+    while the two stretch within ROTATION_PROBE_BLEND of each other.  The probe
     turns the way ``axis`` points (bending a part forwards and backwards
     differ); a rotation vector's axis flips where the angle passes 180
     degrees, where the blend itself flips to the short way round.  Without a
-    probe (a basis not built by ``fit``): ``(pivot, 1.0)``."""
+    probe (a basis not built by ``fit``): ``pivot``."""
     from splatedit.deform.rotation import HandleRotation, RotationDisplacement, decompose, handle_blocks
     from splatedit.deform.transform import rotate
 
@@ -123,7 +116,7 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> tu
     g = ctl[0]
     radius = float(np.linalg.norm(ctl[1] - ctl[0]))
     if probe is None or not np.linalg.norm(pivot - g) > 0.0:
-        return pivot, 1.0
+        return pivot
     axis = np.asarray(axis, dtype=np.float64)
     cache = basis.__dict__.setdefault("_rotation_centres", {})
     key = _key(handle, axis, pivot, radius)
@@ -146,13 +139,6 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> tu
     t = min(1.0, max(0.0, (scores[1] / scores[0] - 1.0 + ROTATION_PROBE_BLEND) / (2.0 * ROTATION_PROBE_BLEND)))
     share = t * t * (3.0 - 2.0 * t)                  # of the pivot
     best = pivot if share == 1.0 else g + share * (pivot - g)
-    # the linear mode as the fallback: an arc that stretches clearly more than
-    # the paper's chord gives way to it (its share of the rotation slides to 0)
-    inputs = [None] * basis.n_groups
-    inputs[handle] = m
-    linear = probe.stretch(RotationDisplacement(basis.displacement(inputs), tuple(still for _ in blocks)), blocks)
-    u = min(1.0, max(0.0, (min(scores) / linear - 1.0 - ROTATION_PROBE_LINEAR_MARGIN) / ROTATION_PROBE_LINEAR_BAND))
-    best = (best, 1.0 - u * u * (3.0 - 2.0 * u))
     if len(cache) >= _CACHE_SIZE:
         cache.clear()
     cache[key] = best
