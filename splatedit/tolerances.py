@@ -831,8 +831,9 @@ ROTATION_PROBE_DEGREES = 120.0
 #: splat stretch sits where the deformation folds (an axis shrunk to 0.009
 #: of its length in the bunny's ear turned 90 degrees about a pivot 8 handle
 #: radii away: 112x, next splat 13x) and flips with the sample.  Sweep of
-#: pivots 1-20 handle radii, 60/120/180 degrees, 4 axes (worst ratio to the
-#: linear mode of the 99th-percentile / largest stretch): comparing 99th
+#: pivots 1-20 handle radii, 60/120/180 degrees, 4 axes, measured before the
+#: slide below was added (worst ratio to the linear mode of the
+#: 99th-percentile / largest stretch): comparing 99th
 #: percentiles: bunny 1.26 / 2.96, kitten 1.46 / 1.49, hippo 1.55 / 2.89;
 #: comparing maxima: 1.51 / 2.83, 1.46 / 1.74, 1.59 / 4.3; pivot always:
 #: 1.61 / 3.28, 1.59 / 3.23, 2.08 / 4.3
