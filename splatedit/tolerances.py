@@ -839,7 +839,7 @@ ROTATION_PROBE_DEGREES = 120.0
 #: 1.61 / 3.28, 1.59 / 3.23, 2.08 / 4.3
 ROTATION_PROBE_PERCENTILE = 99.0
 #: free support splats (evenly strided) sampled at fit time to compare arc
-#: centres: (4 K + 2 K + 6) floats each (about 0.9 MB at K = 16).  Cost of
+#: centres: (4 K + 2 K + 6) floats each (1.7 MB at K = 16).  Cost of
 #: one choice (two candidates, then cached for the pivot line), bunny with
 #: 1,667 / 1,834 probe splats, load 9-15: 3.6-4.4 ms best, 18-19 ms median of
 #: 7 (the bunny's and the scans' one-view edits have fewer free splats than
