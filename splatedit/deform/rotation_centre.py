@@ -136,7 +136,8 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np
     # centre) while the scores are within ROTATION_PROBE_BLEND of each other,
     # so a pivot line that moves during a drag (a grab after a turn) never
     # makes the surface jump
-    t = min(1.0, max(0.0, (scores[1] / scores[0] - 1.0 + ROTATION_PROBE_BLEND) / (2.0 * ROTATION_PROBE_BLEND)))
+    ratio = scores[1] / scores[0] if np.isfinite(scores).all() else np.inf    # a degenerate probe: the pivot
+    t = min(1.0, max(0.0, (ratio - 1.0 + ROTATION_PROBE_BLEND) / (2.0 * ROTATION_PROBE_BLEND)))
     share = t * t * (3.0 - 2.0 * t)                  # of the pivot
     best = pivot if share == 1.0 else g + share * (pivot - g)
     if len(cache) >= _CACHE_SIZE:
