@@ -55,6 +55,7 @@ from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_blocks,
                                        rotation_displacement, split_displacement)
 from splatedit.deform.rotation_apply import apply_segments
+from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
@@ -180,6 +181,7 @@ class DeformationBasis:
         self.stats = stats
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
         self.closure = None  # the ClosureResult when fit() closed the selection
+        self.stretch_probe = None  # free splats where rotation centres are compared (fit() sets it)
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -269,6 +271,9 @@ class DeformationBasis:
         )
         out = cls(con, rbf, pack, stats)
         out.closure = closure
+        if len(free_rows):
+            out.stretch_probe = StretchProbe.sample(pack, free_rows, cloud.u[idx[free_rows]],
+                                                    cloud.v[idx[free_rows]])
         return out
 
     # ------------------------------------------------------------ accessors

@@ -14,7 +14,10 @@ map instead:
   handle's centroid ``g_h`` (``c_h = g_h + d``, d the minimum-norm solution of
   ``(R_h - I) d = g_h - T_h(g_h)``), so a rotation about a gizmo pivot anywhere
   on that axis is a pure rotation about ``c_h`` with only a translation along
-  the axis left over;
+  the axis left over; or, when that axis is far enough from the support that
+  its arcs stretch more, ``g_h`` itself (the handle turns about its middle and
+  the translation ``(R_h - I)(pivot - g_h)`` goes through the residual, along
+  the chord): :mod:`splatedit.deform.rotation_centre` measures both;
 * weight field ``s_h(p)``: the sum of the handle's 4 affine-coordinate columns
   of the basis (1 on the handle, 0 on the fixed band and on other handles,
   smooth between), gradient ``grad s_h`` = the sum of its 4 Bx/By/Bz columns.
@@ -73,6 +76,7 @@ from scipy.linalg import polar
 from scipy.spatial.transform import Rotation
 
 from splatedit.deform.modes import DeformationMode
+from splatedit.deform.rotation_centre import choose_centre
 from splatedit.deform.transform import as_affine
 from splatedit.tolerances import ROTATION_FULL_DEGREES, ROTATION_MIN_ANGLE
 
@@ -84,8 +88,9 @@ class HandleRotation:
     Attributes:
         w: (3,) float64 rotation vector (unit axis times angle in radians,
             angle in [0, pi]); zeros when the handle does not rotate.
-        center: (3,) float64 model-space point on the rotation axis nearest the
-            handle's centroid.
+        center: (3,) float64 model-space arc centre: the point of the
+            rotation axis nearest the handle's centroid, or the centroid
+            (:func:`~splatedit.deform.rotation_centre.choose_centre`).
         offsets: (4, 3) float64 the handle's control frame minus ``center``
             (model units), times the arc share phi (:func:`arc_share`):
             ``v_h = B_h offsets``.
@@ -125,7 +130,30 @@ def arc_share(angle: float) -> float:
     return t * t * (3.0 - 2.0 * t)
 
 
-def decompose(matrix: np.ndarray, controls: np.ndarray) -> tuple[HandleRotation, np.ndarray]:
+def screw_axis(matrix: np.ndarray, controls: np.ndarray):
+    """The rotation of a handle's map and the point of its axis nearest the
+    handle's centroid.
+
+    Args:
+        matrix: (4, 4) float64 affine map; controls: (4, 3) control frame.
+    Returns:
+        ``(r, w, pivot)``: (3, 3) polar rotation, (3,) rotation vector and
+        (3,) pivot ``g + d``, d the minimum-norm solution of
+        ``(R - I) d = g - T(g)``; pivot is None below ROTATION_MIN_ANGLE.
+    """
+    m = np.asarray(matrix, dtype=np.float64)
+    g = np.asarray(controls, dtype=np.float64)[0]
+    r = rotation_part(m)
+    w = Rotation.from_matrix(r).as_rotvec()
+    if not np.linalg.norm(w) >= ROTATION_MIN_ANGLE:
+        return r, w, None
+    tg = m[:3, :3] @ g + m[:3, 3]
+    d = np.linalg.lstsq(r - np.eye(3), g - tg, rcond=None)[0]
+    return r, w, g + d
+
+
+def decompose(matrix: np.ndarray, controls: np.ndarray,
+              centre: np.ndarray | None = None) -> tuple[HandleRotation, np.ndarray]:
     """Split a handle's (4, 4) affine map ``T`` into its blended rotation and
     the residual affine map ``T - G + identity`` (G the rigid rotation about
     the centre).
@@ -133,6 +161,9 @@ def decompose(matrix: np.ndarray, controls: np.ndarray) -> tuple[HandleRotation,
     Args:
         matrix: (4, 4) float64 affine map (acts on column vectors).
         controls: (4, 3) float64 the handle's control frame (row 0: its centroid).
+        centre: (3,) the arc centre (model units; any point: the residual
+            takes the rest of the motion).  None: the screw axis' point
+            nearest the centroid (:func:`screw_axis`).
     Returns:
         (HandleRotation, residual (4, 4) float64).  Below ROTATION_MIN_ANGLE
         the rotation is zero and the residual is ``matrix`` itself.
@@ -140,13 +171,10 @@ def decompose(matrix: np.ndarray, controls: np.ndarray) -> tuple[HandleRotation,
     m = np.asarray(matrix, dtype=np.float64)
     ctl = np.asarray(controls, dtype=np.float64)
     g = ctl[0]
-    r = rotation_part(m)
-    w = Rotation.from_matrix(r).as_rotvec()
-    if not np.linalg.norm(w) >= ROTATION_MIN_ANGLE:
+    r, w, pivot = screw_axis(m, ctl)
+    if pivot is None:
         return HandleRotation(np.zeros(3), g.copy(), ctl - g), m
-    tg = m[:3, :3] @ g + m[:3, 3]
-    d = np.linalg.lstsq(r - np.eye(3), g - tg, rcond=None)[0]
-    c = g + d
+    c = pivot if centre is None else np.asarray(centre, dtype=np.float64)
     phi = arc_share(float(np.linalg.norm(w)))
     lin = (1.0 - phi) * (r - np.eye(3))          # the linearly interpolated share of R - I
     res = m.copy()
@@ -194,15 +222,19 @@ def handle_blocks(basis) -> list[slice]:
 
 def rotation_displacement(basis, transforms: list):
     """``DeformationBasis.displacement(transforms, mode=ROTATION)``: each
-    handle's (4, 4) map (None: identity) decomposed, the residual maps (and the
-    curves' inputs) through the linear ``displacement``.  Returns a
+    handle's (4, 4) map (None: identity) decomposed about the centre
+    :func:`~splatedit.deform.rotation_centre.choose_centre` picks, the
+    residual maps (and the curves' inputs) through the linear ``displacement``.  Returns a
     RotationDisplacement, or the plain (K, 3) dC when no handle rotates (then
     bitwise the linear mode's)."""
     rotations, inputs = [], []
     for i, (t, kind) in enumerate(zip(transforms, basis.group_kinds)):
         if kind == "handle":
             m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
-            rot, res = decompose(m, basis.constraints.groups[i].controls)
+            ctl = basis.constraints.groups[i].controls
+            _, w, pivot = screw_axis(m, ctl)
+            centre = None if pivot is None else choose_centre(basis, i, w / np.linalg.norm(w), pivot)
+            rot, res = decompose(m, ctl, centre)
             rotations.append(rot)
             t = None if t is None else res
         inputs.append(t)
