@@ -8,7 +8,8 @@ import pytest
 from scipy.interpolate import RBFInterpolator
 
 from splatedit.bench.solve import sample_transform, sphere_cloud, wavy_plane_cloud
-from splatedit.deform.basis import DeformationBasis, _run_plan
+from splatedit.deform.apply_plan import _run_plan
+from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.transform import (
     apply_affine,
@@ -381,9 +382,9 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
     """The CPU apply computes through short gaps of fixed splats between long
     runs of support splats (one long GEMM instead of a call per run) and then
     restores them: they must come out bitwise identical, -0.0 included."""
-    import splatedit.deform.basis as basis_module
-    from splatedit.deform.basis import _fill_small_gaps
-    monkeypatch.setattr(basis_module, "_RUN_MIN", 64)   # runs of 112 count as long here
+    import splatedit.deform.apply_plan as apply_plan
+    from splatedit.deform.apply_plan import _fill_small_gaps
+    monkeypatch.setattr(apply_plan, "_RUN_MIN", 64)   # runs of 112 count as long here
     cloud = wavy_plane_cloud(120)
     p = cloud.positions.copy()
     n = len(p)
@@ -407,7 +408,7 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
 
 
 def test_gap_filling_leaves_scattered_indices_alone():
-    from splatedit.deform.basis import _fill_small_gaps
+    from splatedit.deform.apply_plan import _fill_small_gaps
     idx = np.sort(np.random.default_rng(0).choice(100_000, 30_000, replace=False))
     span, member = _fill_small_gaps(idx)
     assert member.all() and np.array_equal(span, idx)
