@@ -813,3 +813,11 @@ EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
 #: a step's chunk grows at most this factor at a time (the first steps' times
 #: include pipeline creation and are not representative of the cost per splat)
 EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
+
+# ---------------------------------------------------------------------------
+# Deformation at scan scale: 5M-splat support (issue 11 part 5)
+# ---------------------------------------------------------------------------
+#: most splats per GEMM of the linear CPU apply (splatedit.deform.apply_plan;
+#: (c, K + 3) @ (K + 3, 3), also kept below BLAS_SINGLE_THREAD_MNK: 24,966
+#: rows for one handle).  Measured: see docs/PERFORMANCE.md
+LINEAR_APPLY_CHUNK = 8192

@@ -26,12 +26,14 @@ from __future__ import annotations
 import numpy as np
 
 from splatedit.deform.rotation_apply import apply_segments
+from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK
 
-#: rows per GEMM in the CPU apply: small enough that OpenBLAS runs it on
-#: one thread (its threads only add contention for so thin a product; measured
-#: 2-4x slower at 16384 rows on a loaded 2-core machine) and the chunk stays
-#: in L2; large enough that the Python loop is negligible
+#: most plan rows per run-plan segment (the linear apply works through a
+#: segment in sub-chunks of :func:`apply_chunk_rows`; the detail mode in its own)
 _APPLY_CHUNK = 65536
+#: plan rows per block while building the hot-path arrays (bounds the
+#: gathered copies of basis rows and cloud arrays to a few MB)
+_BUILD_BLOCK = 65536
 #: a gap of non-support splats between two runs of support splats is computed
 #: through (with zero basis rows, then restored bitwise) when it is at most this
 #: fraction of the shorter neighbouring run: one long GEMM instead of one call
@@ -110,8 +112,21 @@ def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CH
     return order, segments
 
 
+def apply_chunk_rows(n_columns: int) -> int:
+    """Splats per GEMM of the linear apply, ``(c, K + 3) @ (K + 3, 3)``: at
+    most LINEAR_APPLY_CHUNK, and m n k below BLAS_SINGLE_THREAD_MNK so that
+    OpenBLAS keeps every product on one thread (at least 256 rows: the
+    per-call overhead)."""
+    fit = (BLAS_SINGLE_THREAD_MNK - 1) // (3 * (n_columns + 3))
+    return int(max(256, min(LINEAR_APPLY_CHUNK, fit)))
+
+
 def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:
     """Hot-path arrays ``[B|p], [Wu|u], [Wv|v]`` in run-plan order.
+
+    Built in blocks of _BUILD_BLOCK plan rows: besides the arrays it returns
+    (3 (K + 3) 8 bytes per plan row) it needs only a few (M,) index arrays
+    and one block's gathered rows.
 
     Args:
         pack: (N, 4, K) float64 basis rows B, Bx, By, Bz of the support splats.
@@ -122,40 +137,46 @@ def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:
     ``segments`` (the run plan), ``comp_segments`` (the complement's runs or
     None) and ``filler`` (the fixed splats computed through).
     """
-    idx = indices
     # computing through small gaps of fixed splats (restored afterwards) turns
     # many short runs into a few long GEMMs
-    span, member = _fill_small_gaps(idx)
+    span, member = _fill_small_gaps(indices)
     order, segments = _run_plan(span)
-    rows = span[order]
-    sel = member[order]                               # plan rows that are support splats
-    pack_rows = (np.cumsum(member) - 1)[order][sel]   # their rows in pack
-    pk = pack[pack_rows]
+    rank = np.cumsum(member) - 1                      # plan position -> row in pack
     k = pack.shape[2]
-    arrays = []
-    for name in ("positions", "u", "v"):
-        src = getattr(cloud, name)[rows]
-        a = np.zeros((len(rows), k + 3))
-        if name == "positions":
-            a[sel, :k] = pk[:, 0, :]
-        else:
-            a[sel, :k] = np.einsum("nj,njk->nk", src[sel], pk[:, 1:, :])
-        a[:, k:] = src
-        arrays.append(a)
+    srcs = (cloud.positions, cloud.u, cloud.v)
+    arrays = [np.empty((len(order), k + 3)) for _ in srcs]
+    for s in range(0, len(order), _BUILD_BLOCK):
+        blk = order[s:s + _BUILD_BLOCK]
+        rows = span[blk]
+        sel = member[blk]                             # block rows that are support splats
+        pk = pack[rank[blk[sel]]]                     # (b, 4, K) gathered basis rows
+        for j, (src, a) in enumerate(zip(srcs, arrays)):
+            ab = a[s:s + len(blk)]
+            x = src[rows]
+            ab[:, k:] = x
+            if j == 0:
+                ab[sel, :k] = pk[:, 0, :]
+            else:
+                ab[sel, :k] = np.einsum("nj,njk->nk", x[sel], pk[:, 1:, :])
+            ab[~sel, :k] = 0.0
     filler = span[~member]
     # when the support is most of the cloud, copy only its complement
     # (long runs by slice, the rest by index); otherwise one plain copy
     comp_segments = None
     n_all = len(cloud.positions)
     if 2 * len(span) > n_all:
-        comp = np.setdiff1d(np.arange(n_all), span, assume_unique=True)
-        comp_segments = [d for _, _, d in _run_plan(comp, chunk=1 << 30)[1]]
+        comp = np.ones(n_all, dtype=bool)
+        comp[span] = False
+        comp_segments = [d for _, _, d in _run_plan(np.flatnonzero(comp), chunk=1 << 30)[1]]
     return dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
                 segments=segments, comp_segments=comp_segments, filler=filler)
 
 
 def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
     """Deformed ``(positions, u, v)`` (n, 3) float64 from the hot path ``c``.
+
+    Needs the three outputs and one sub-chunk's products (index-array
+    segments) besides them.
 
     Args:
         c: :func:`build_hot_path` of the base cloud whose arrays are ``srcs``.
@@ -176,12 +197,18 @@ def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
         apply_segments(c["arrays"], c["segments"], outs, d, rot, blocks)
     else:
         mx = np.vstack([d, np.eye(3)])
+        step = apply_chunk_rows(d.shape[0])
         for lo, hi, dest in c["segments"]:
-            for a, o in zip(c["arrays"], outs):
+            for cs in range(lo, hi, step):
+                ce = min(hi, cs + step)
                 if isinstance(dest, slice):
-                    np.matmul(a[lo:hi], mx, out=o[dest])
+                    rows = slice(dest.start + cs - lo, dest.start + ce - lo)
+                    for a, o in zip(c["arrays"], outs):
+                        np.matmul(a[cs:ce], mx, out=o[rows])
                 else:
-                    o[dest] = a[lo:hi] @ mx
+                    rows = dest[cs - lo:ce - lo]
+                    for a, o in zip(c["arrays"], outs):
+                        o[rows] = a[cs:ce] @ mx
     if len(c["filler"]):  # fixed splats computed through: restore them bitwise
         for s, o in zip(srcs, outs):
             o[c["filler"]] = s[c["filler"]]

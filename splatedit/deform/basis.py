@@ -52,7 +52,7 @@ from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 PROGRESS_STAGE = "precomputing deformation basis"
 #: progress stage name of the selection closure
 CLOSURE_STAGE = "closing the selection"
-#: support splats per chunk when evaluating the RBF for the basis
+#: support splats per chunk when evaluating the RBF for the basis and the Jacobians
 _BASIS_CHUNK = 65536
 
 
@@ -322,11 +322,16 @@ class DeformationBasis:
         (dC: (K, 3) or a RotationDisplacement)."""
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
-        jt = np.einsum("njk,ki->nji", self._pack[:, 1:, :], d)  # jt[n, j, i] = (J - I)[i, j]
-        out = jt.transpose(0, 2, 1).copy()
-        out += np.eye(3)
-        if rot is not None:
-            out += blend_jacobians(rot, self._pack, handle_blocks(self))
+        blocks = None if rot is None else handle_blocks(self)
+        n = self._pack.shape[0]
+        out = np.empty((n, 3, 3))
+        # in chunks: besides the (N, 3, 3) result only one chunk's temporaries
+        for s in range(0, n, _BASIS_CHUNK):
+            o = out[s:s + _BASIS_CHUNK]
+            np.einsum("njk,ki->nij", self._pack[s:s + _BASIS_CHUNK, 1:, :], d, out=o)
+            o += np.eye(3)
+            if rot is not None:
+                o += blend_jacobians(rot, self._pack[s:s + _BASIS_CHUNK], blocks)
         return out
 
     def _check_cloud(self, cloud):
