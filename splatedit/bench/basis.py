@@ -24,7 +24,7 @@ Fields of one case (times in seconds, memory in MB):
   (``constraints``, ``fit``, ``basis``: the basis rows it keeps,
   ``basis_kept_mb``, are part of its peak), with ``*_over_kept`` /
   ``*_over_output`` the ratios to what the stage keeps or returns;
-* up to ``scipy_max`` support splats, the obvious alternative on the same
+* up to ``scipy_max`` requested support splats, the obvious alternative on the same
   points: ``scipy_eval_s`` / ``scipy_peak_mb``, scipy's
   ``RBFInterpolator(kernel="cubic", degree=2)`` fitted to the same
   constraints and evaluated (values only, it has no gradients) at every free
@@ -177,7 +177,7 @@ def basis_case(support_splats: int, *, scipy_max: int = 1_000_000, repeats: int 
     out.update(jacobians_s=round(jac.seconds, 2), jacobians_peak_mb=round(jac.mb, 1),
                jacobians_peak_over_output=round(jac.mb / (j.nbytes / 2**20), 2))
     del j
-    if support.sum() <= scipy_max:
+    if support_splats <= scipy_max:
         from scipy.interpolate import RBFInterpolator
         con, rbf = basis.constraints, basis.rbf
         pts = cloud.positions[con.free_index]
@@ -203,6 +203,7 @@ def bench_basis(counts=(1_000_000, 2_000_000, 5_000_000), *, scipy_max: int = 1_
     # a fixed mmap threshold: glibc's dynamic one would keep freed arrays of
     # earlier stages on its heap, and RSS would then miss later stages' peaks
     env.setdefault("MALLOC_MMAP_THRESHOLD_", str(_MMAP_THRESHOLD))
+    env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")      # as `splatedit` itself runs
     for n in counts:
         cmd = [sys.executable, "-m", "splatedit.bench.basis", str(int(n)),
                "--scipy-max", str(int(scipy_max)), "--repeats", str(int(repeats))]
