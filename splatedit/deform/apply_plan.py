@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 from splatedit.deform.rotation_apply import apply_segments
-from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK
+from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
 
 #: most plan rows per run-plan segment (the linear apply works through a
 #: segment in sub-chunks of :func:`apply_chunk_rows`; the detail mode in its own)
@@ -115,10 +115,10 @@ def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CH
 def apply_chunk_rows(n_columns: int) -> int:
     """Splats per GEMM of the linear apply, ``(c, K + 3) @ (K + 3, 3)``: at
     most LINEAR_APPLY_CHUNK, and m n k below BLAS_SINGLE_THREAD_MNK so that
-    OpenBLAS keeps every product on one thread (at least 256 rows: the
-    per-call overhead)."""
+    OpenBLAS keeps every product on one thread (at least
+    ROTATION_APPLY_MIN_CHUNK rows, the same per-call overhead)."""
     fit = (BLAS_SINGLE_THREAD_MNK - 1) // (3 * (n_columns + 3))
-    return int(max(256, min(LINEAR_APPLY_CHUNK, fit)))
+    return int(max(ROTATION_APPLY_MIN_CHUNK, min(LINEAR_APPLY_CHUNK, fit)))
 
 
 def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:

@@ -75,7 +75,7 @@ def scattered():
 
 @pytest.mark.parametrize("which", [0, 1], ids=["grid-order", "shuffled"])
 def test_chunked_apply_equals_the_unchunked_one(scattered, which, monkeypatch):
-    """Sub-chunks of 256 splats and build blocks of 100 plan rows against one
+    """Sub-chunks of 256 splats (the smallest) and build blocks of 100 plan rows against one
     GEMM per segment and one build block: the same deformed cloud (within
     1e-15 of the model size: only BLAS's blocking of the same sums differs)."""
     cloud, basis = scattered[which]
@@ -100,10 +100,10 @@ def test_apply_sub_chunks_stay_on_one_blas_thread():
     """For 1-4 handles and curves' extra columns, every linear-apply product
     (c, K + 3) @ (K + 3, 3) is below the m n k where OpenBLAS starts a second
     thread, and c is at most LINEAR_APPLY_CHUNK."""
-    from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK
+    from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
     for k in (4, 8, 12, 16, 22, 40):
         c = apply_plan.apply_chunk_rows(k)
-        assert 256 <= c <= LINEAR_APPLY_CHUNK
+        assert ROTATION_APPLY_MIN_CHUNK <= c <= LINEAR_APPLY_CHUNK
         assert c * (k + 3) * 3 < BLAS_SINGLE_THREAD_MNK, k
 
 
