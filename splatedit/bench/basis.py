@@ -7,12 +7,15 @@ Morton order like a scan's coherent file order); the edit holds the feet (the
 bottom 10% of the height) fixed and drags a handle ball at the ear tip (5%
 of the diagonal, lifted and tilted by
 :func:`~splatedit.bench.solve.sample_transform`): about 79% of the cloud
-moves.  Every case runs in a fresh Python process (:func:`bench_basis`) so
-that its peak resident memory is its own; each stage's peak is read from
+moves.  The selection is used as painted (``fill_holes=False``; the closure
+has its own bench, ``splatedit bench closure``).  Every case runs in a fresh
+Python process (:func:`bench_basis`) so that its peak resident memory is its
+own; each stage's peak is read from
 ``VmHWM`` after resetting it (``/proc/self/clear_refs``) at the stage's start.
 Fields of one case (times in seconds, memory in MB):
 
 * ``splats``, ``support``, ``m`` (constraints), ``centers``, ``method``;
+  ``blas_threads`` (the OpenBLAS thread setting of the environment);
 * ``cloud_mb``: the cloud's positions and axes; ``kept_mb``: what the basis
   keeps (its (N, 4, K) rows plus the CPU apply's cached arrays);
 * ``constraints_s`` / ``fit_s`` / ``basis_s`` (the RBF values and gradients
@@ -125,6 +128,8 @@ def basis_case(support_splats: int, *, scipy_max: int = 1_000_000, repeats: int 
 
     cloud, support, handle = support_scene(support_splats)
     out = {"bench": "basis", "splats": int(cloud.n), "support": int(support.sum()),
+           "blas_threads": os.environ.get("OPENBLAS_NUM_THREADS") or os.environ.get("OMP_NUM_THREADS")
+           or "default",
            "cloud_mb": round(sum(a.nbytes for a in (cloud.positions, cloud.u, cloud.v)) / 2**20, 1)}
     stages = _Stages()
 
