@@ -888,3 +888,14 @@ ROTSTRETCH_BAR_BASE_MAX_STRETCH = 3.0
 #: against the whole change, measured 0.10 (0.0103 of 0.101 model units)
 #: with ROTATION_PROBE_BLEND, 0.85 with a hard switch (0.092 of 0.108)
 ROTSTRETCH_SLIDE_STEP_SHARE = 0.25
+# Deformation at scan scale: 5M-splat support (issue 11 part 5)
+# ---------------------------------------------------------------------------
+#: most splats per GEMM of the linear CPU apply (splatedit.deform.apply_plan:
+#: (c, K + 3) @ (K + 3, 3); also kept below BLAS_SINGLE_THREAD_MNK, 24,966
+#: rows for one handle).  The old 65,536 rows crossed that threshold: one handle,
+#: bunny scene of `splatedit bench basis`, 1M / 200k support, load 11, 11 / 15
+#: interleaved runs, median: 65,536 (2 threads) 1407 / 270 ms; 24,576 99 / 30;
+#: 16,384 112 / 30; 8,192 108 / 35; 4,096 121 / 38 (a copy of the cloud: 93 / 25).
+#: On one thread the size is within the noise; 8,192 keeps three chunks of
+#: (K + 3) float64 rows in L2 like ROTATION_APPLY_CHUNK and DETAIL_APPLY_CHUNK
+LINEAR_APPLY_CHUNK = 8192

@@ -5,7 +5,7 @@ plus 10 side-condition rows; 10 polynomial columns plus m kernel columns in
 farthest-point order) for m points sampled on a bumpy closed surface (not a
 quadric, so the polynomial is kept) and times
 
-* ``iqr_blocked_s``   -- :func:`splatedit.deform.rbf.blocked_qr` on the
+* ``iqr_blocked_s``   -- :func:`splatedit.deform.qr.blocked_qr` on the
   prebuilt matrix, all columns (factorisation + Q^T b + all prefix residuals),
 * ``iqr_fit_s``       -- ``TriharmonicRBF.fit(method="iqr", tol=0)``, i.e. the
   same plus building the columns lazily and the triangular solve,

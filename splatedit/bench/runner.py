@@ -102,6 +102,13 @@ def _estimate(quick: bool, progress=None, counts=None) -> Iterator[dict]:
         yield {"bench": "estimate", **line}
 
 
+def _basis(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.basis import bench_basis
+    counts = counts or ((100_000, 200_000) if quick else (1_000_000, 2_000_000, 5_000_000))
+    yield from bench_basis(counts=counts, scipy_max=100_000 if quick else 1_000_000,
+                           repeats=1 if quick else 3)
+
+
 def _io(quick: bool, progress=None, counts=None, large: bool = False) -> Iterator[dict]:
     from splatedit.bench.io import bench_io
     yield from bench_io(quick=quick, large=large)
@@ -110,6 +117,7 @@ def _io(quick: bool, progress=None, counts=None, large: bool = False) -> Iterato
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
+    "basis": _basis,
     "groups": _groups,
     "qr": _qr,
     "accuracy": _accuracy,
@@ -128,7 +136,8 @@ BENCHES = {
 def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
               large: bool = False) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
-    ``counts``: splat/point counts for ``estimate``, ``render`` and ``editor``
+    ``counts``: splat/point counts for ``estimate``, ``render``, ``editor`` and
+    support splats for ``basis``
     (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:

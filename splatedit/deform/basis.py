@@ -19,21 +19,8 @@ splats outside the support are not in the basis (``indices`` lists the
 support splats, sorted) and are copied bitwise.  Curves have no member splats:
 their samples are constraint points only.
 
-CPU hot path (``apply``).  Per frame a splat needs only linear combinations of
-``dC``: ``p' = [B | p] @ [dC; I]``, ``u' = [Wu | u] @ [dC; I]`` with
-``Wu = u_x Bx + u_y By + u_z Bz`` (the tangent-axis basis) and likewise for
-``v``.  These three (N, 4h + 3) float64 arrays are built once per base cloud
-(lazily, on the first ``apply``), stored in the order of a run plan of the
-support indices (long runs of consecutive splat indices are written with a
-slice, the rest gathered into chunks and scattered), and each frame is then
-three chunked GEMMs written straight into the output arrays; the splats
-outside the support are copied bitwise (one plain copy of the cloud, or only
-the complement's runs when the support is most of the cloud).  float64 is kept:
-float32 would lose positional accuracy (p is part of the GEMM) and showed no
-reliable gain in measurements here (the product is memory- and call-bound).
-A rotating frame (:class:`~splatedit.deform.rotation.RotationDisplacement`)
-uses the same arrays and run plan with extra output columns
-(:mod:`splatedit.deform.rotation_apply`).
+CPU hot path (``apply``): :mod:`splatedit.deform.apply_plan` (three cached
+(N, K + 3) arrays in run-plan order, three chunked GEMMs per frame).
 """
 
 from __future__ import annotations
@@ -43,6 +30,7 @@ import time
 
 import numpy as np
 
+from splatedit.deform.apply_plan import apply_hot_path, build_hot_path
 from splatedit.deform.constraints import (
     Constraints,
     affine_coordinate_gradients,
@@ -54,7 +42,6 @@ from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_blocks,
                                        rotation_displacement, split_displacement)
-from splatedit.deform.rotation_apply import apply_segments
 from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
@@ -66,89 +53,8 @@ from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 PROGRESS_STAGE = "precomputing deformation basis"
 #: progress stage name of the selection closure
 CLOSURE_STAGE = "closing the selection"
-#: support splats per chunk when evaluating the RBF for the basis
+#: support splats per chunk when evaluating the RBF for the basis and the Jacobians
 _BASIS_CHUNK = 65536
-#: rows per GEMM in the CPU apply: small enough that OpenBLAS runs it on
-#: one thread (its threads only add contention for so thin a product; measured
-#: 2-4x slower at 16384 rows on a loaded 2-core machine) and the chunk stays
-#: in L2; large enough that the Python loop is negligible
-_APPLY_CHUNK = 65536
-#: a gap of non-support splats between two runs of support splats is computed
-#: through (with zero basis rows, then restored bitwise) when it is at most this
-#: fraction of the shorter neighbouring run: one long GEMM instead of one call
-#: per run (a 1M-splat support made of 1000 grid rows: 35 ms -> see PERFORMANCE.md)
-_GAP_FILL_REL = 0.25
-#: runs of consecutive splat indices at least this long are written by slice
-_RUN_MIN = 512
-
-
-def _fill_small_gaps(index: np.ndarray, rel: float = _GAP_FILL_REL, run_min: int | None = None):
-    """Sorted splat indices plus the rows of the small gaps between their runs.
-
-    Returns ``(span, member)``: ``span`` (M,) sorted indices (``index`` and
-    the filled gap rows), ``member`` (M,) bool, True where ``span`` is in
-    ``index``.  A gap is filled when it is at most ``rel`` times the shorter of
-    its two neighbouring runs and both runs have at least ``run_min`` splats,
-    so scattered indices (short runs) are left alone.
-    """
-    index = np.asarray(index)
-    run_min = _RUN_MIN if run_min is None else run_min
-    n = len(index)
-    if n < 2:
-        return index, np.ones(n, dtype=bool)
-    gaps = np.diff(index) - 1
-    breaks = np.flatnonzero(gaps > 0)
-    if len(breaks) == 0:
-        return index, np.ones(n, dtype=bool)
-    starts = np.concatenate([[0], breaks + 1])
-    ends = np.concatenate([breaks + 1, [n]])
-    run_len = ends - starts
-    shorter = np.minimum(run_len[:-1], run_len[1:])
-    fill = (gaps[breaks] <= rel * shorter) & (shorter >= run_min)
-    if not fill.any():
-        return index, np.ones(n, dtype=bool)
-    lo = index[breaks[fill]] + 1
-    hi = index[breaks[fill] + 1]
-    extra = np.concatenate([np.arange(a, b) for a, b in zip(lo, hi)])
-    span = np.concatenate([index, extra])
-    member = np.concatenate([np.ones(n, dtype=bool), np.zeros(len(extra), dtype=bool)])
-    order = np.argsort(span, kind="stable")
-    return span[order], member[order]
-
-
-def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
-    """Split sorted splat indices into segments ``(order_lo, order_hi, dest)``.
-
-    ``order`` (returned) permutes positions of ``index`` so that every segment
-    is a contiguous block ``order[order_lo:order_hi]``; ``dest`` is a slice of
-    splat rows (long runs of consecutive indices) or an index array (the
-    remaining splats, in chunks).
-    """
-    n = len(index)
-    if n == 0:
-        return np.zeros(0, np.intp), []
-    breaks = np.flatnonzero(np.diff(index) != 1) + 1
-    starts = np.concatenate([[0], breaks])
-    ends = np.concatenate([breaks, [n]])
-    long_mask = (ends - starts) >= run_min
-    segments, order_parts, pos = [], [], 0
-    for s, e in zip(starts[long_mask], ends[long_mask]):
-        for cs in range(s, e, chunk):
-            ce = min(e, cs + chunk)
-            order_parts.append(np.arange(cs, ce))
-            segments.append((pos, pos + ce - cs, slice(int(index[cs]), int(index[cs]) + ce - cs)))
-            pos += ce - cs
-    short = np.ones(n, dtype=bool)
-    for s, e in zip(starts[long_mask], ends[long_mask]):
-        short[s:e] = False
-    rest = np.flatnonzero(short)
-    for cs in range(0, len(rest), chunk):
-        part = rest[cs:cs + chunk]
-        order_parts.append(part)
-        segments.append((pos, pos + len(part), index[part]))
-        pos += len(part)
-    order = np.concatenate(order_parts) if order_parts else np.zeros(0, np.intp)
-    return order, segments
 
 
 class DeformationBasis:
@@ -421,11 +327,16 @@ class DeformationBasis:
         (dC: (K, 3) or a RotationDisplacement)."""
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
-        jt = np.einsum("njk,ki->nji", self._pack[:, 1:, :], d)  # jt[n, j, i] = (J - I)[i, j]
-        out = jt.transpose(0, 2, 1).copy()
-        out += np.eye(3)
-        if rot is not None:
-            out += blend_jacobians(rot, self._pack, handle_blocks(self))
+        blocks = None if rot is None else handle_blocks(self)
+        n = self._pack.shape[0]
+        out = np.empty((n, 3, 3))
+        # in chunks: besides the (N, 3, 3) result only one chunk's temporaries
+        for s in range(0, n, _BASIS_CHUNK):
+            o = out[s:s + _BASIS_CHUNK]
+            np.einsum("njk,ki->nij", self._pack[s:s + _BASIS_CHUNK, 1:, :], d, out=o)
+            o += np.eye(3)
+            if rot is not None:
+                o += blend_jacobians(rot, self._pack[s:s + _BASIS_CHUNK], blocks)
         return out
 
     def _check_cloud(self, cloud):
@@ -435,42 +346,13 @@ class DeformationBasis:
                                  f"built for {n}")
 
     def _cpu_arrays(self, cloud):
-        """Hot-path arrays ``[B|p], [Wu|u], [Wv|v]`` in run-plan order, cached
-        per base cloud (the cache holds the arrays it was built from)."""
+        """Hot-path arrays of :mod:`splatedit.deform.apply_plan`, cached per
+        base cloud (the cache holds the arrays it was built from)."""
         c = self._cpu
         if (c is not None and c["positions"] is cloud.positions and c["u"] is cloud.u
                 and c["v"] is cloud.v):
             return c
-        idx = self.indices
-        # computing through small gaps of fixed splats (restored afterwards) turns
-        # many short runs into a few long GEMMs
-        span, member = _fill_small_gaps(idx)
-        order, segments = _run_plan(span)
-        rows = span[order]
-        sel = member[order]                               # plan rows that are support splats
-        pack_rows = (np.cumsum(member) - 1)[order][sel]   # their rows in self._pack
-        pk = self._pack[pack_rows]
-        k = self.n_columns
-        arrays = []
-        for name in ("positions", "u", "v"):
-            src = getattr(cloud, name)[rows]
-            a = np.zeros((len(rows), k + 3))
-            if name == "positions":
-                a[sel, :k] = pk[:, 0, :]
-            else:
-                a[sel, :k] = np.einsum("nj,njk->nk", src[sel], pk[:, 1:, :])
-            a[:, k:] = src
-            arrays.append(a)
-        filler = span[~member]
-        # when the support is most of the cloud, copy only its complement
-        # (long runs by slice, the rest by index); otherwise one plain copy
-        comp_segments = None
-        n_all = len(cloud.positions)
-        if 2 * len(span) > n_all:
-            comp = np.setdiff1d(np.arange(n_all), span, assume_unique=True)
-            comp_segments = [d for _, _, d in _run_plan(comp, chunk=1 << 30)[1]]
-        self._cpu = dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
-                         segments=segments, comp_segments=comp_segments, filler=filler)
+        self._cpu = build_hot_path(self._pack, self.indices, cloud)
         return self._cpu
 
     def release_cpu_cache(self) -> None:
@@ -488,28 +370,8 @@ class DeformationBasis:
         if not d.any() and rot is None:
             return tuple(s.copy() for s in srcs)
         c = self._cpu_arrays(cloud)
-        # splats outside the support: bitwise copies (never recomputed)
-        if c["comp_segments"] is None:
-            outs = tuple(s.copy() for s in srcs)
-        else:
-            outs = tuple(np.empty_like(s) for s in srcs)
-            for dest in c["comp_segments"]:
-                for s, o in zip(srcs, outs):
-                    o[dest] = s[dest]
-        if rot is not None:   # rotating handles: extra GEMM columns (splatedit.deform.rotation_apply)
-            apply_segments(c["arrays"], c["segments"], outs, d, rot, handle_blocks(self))
-        else:
-            mx = np.vstack([d, np.eye(3)])
-            for lo, hi, dest in c["segments"]:
-                for a, o in zip(c["arrays"], outs):
-                    if isinstance(dest, slice):
-                        np.matmul(a[lo:hi], mx, out=o[dest])
-                    else:
-                        o[dest] = a[lo:hi] @ mx
-        if len(c["filler"]):  # fixed splats computed through: restore them bitwise
-            for s, o in zip(srcs, outs):
-                o[c["filler"]] = s[c["filler"]]
-        return outs
+        blocks = None if rot is None else handle_blocks(self)
+        return apply_hot_path(c, srcs, d, rot, blocks)
 
     def apply(self, cloud, dC, *, validate: bool = False):
         """The deformed cloud (a new :class:`SplatCloud`; colours, faces and

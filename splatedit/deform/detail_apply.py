@@ -31,7 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.basis import _fill_small_gaps, _run_plan
+from splatedit.deform.apply_plan import _fill_small_gaps, _run_plan
 from splatedit.deform.rotation import arc_coefficients, handle_blocks
 from splatedit.deform.rotation_apply import _skew
 from splatedit.tolerances import DETAIL_APPLY_CHUNK

@@ -19,304 +19,43 @@ evaluates in the original coordinates; gradients carry the chain-rule factor
 
 from __future__ import annotations
 
-import math
-import numbers
 import time
 from concurrent.futures import ThreadPoolExecutor
-from dataclasses import dataclass, field
 from typing import Optional
 
 import numpy as np
-from scipy.linalg import lapack
 
-from splatedit.deform.centers import FarthestPointSampler
 from splatedit.deform.kernels import (
-    N_POLY,
     augmented_centers,
-    poly_gradient_coefficients,
     evaluation_squared_distances,
-    kernel_matrix,
-    poly_gradient,
+    poly_gradient_coefficients,
     poly_matrix,
-    squared_distances,
 )
-from splatedit.errors import ParameterError, SolverError
-from splatedit.progress import ProgressFn, report
+from splatedit.deform.qr import IncrementalQR, blocked_qr
+from splatedit.deform.rbf_fit import (
+    METHODS,
+    PROGRESS_STAGE,
+    FitSolution,
+    _as_float_array,
+    _FitInfo,
+    _relative_residuals,
+    solve_constraints,
+)
+from splatedit.errors import ParameterError
+from splatedit.progress import ProgressFn
 from splatedit.tolerances import (
-    AUTO_EXACT_MAX_CONSTRAINTS,
-    DUPLICATE_POINT_REL,
-    DUPLICATE_VALUE_RTOL,
     EVAL_CHUNK_MAX_BYTES,
     EVAL_CHUNK_ROWS,
     EVAL_THREADS,
     IQR_DEFAULT_TOL,
-    IQR_PANEL_COLUMNS,
-    IQR_R_DIAG_RTOL,
-    LU_MAX_CONSTRAINTS,
     RESIDUAL_NOTE_FACTOR,
     RESIDUAL_NOTE_MIN,
-    LU_MIN_RCOND,
-    POLY_RANK_RTOL,
 )
 
-METHODS = ("auto", "iqr", "lu")
-PROGRESS_STAGE = "fitting deformation"
-
-
-# ---------------------------------------------------------------------------
-# input validation and preprocessing
-# ---------------------------------------------------------------------------
-
-def _as_float_array(name: str, value) -> np.ndarray:
-    try:
-        arr = np.asarray(value, dtype=np.float64)
-    except (TypeError, ValueError) as exc:
-        raise ParameterError(name, f"not a numeric array ({exc})") from None
-    return arr
-
-
-def _validate(points, values, method, tol, max_centers, progress):
-    pts = _as_float_array("points", points)
-    if pts.ndim != 2 or pts.shape[1] != 3:
-        raise ParameterError("points", f"expected shape (m, 3), got {pts.shape}")
-    m = pts.shape[0]
-    if m < 1:
-        raise ParameterError("points", "need at least one constraint point")
-    if not np.all(np.isfinite(pts)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(pts), axis=1))[0])
-        raise ParameterError("points", f"row {bad} is not finite")
-    vals = _as_float_array("values", values)
-    if vals.ndim != 2:
-        raise ParameterError(
-            "values", f"expected shape (m, k), got {vals.shape} (use values[:, None] for one column)")
-    if vals.shape[0] != m:
-        raise ParameterError("values", f"has {vals.shape[0]} rows but points has {m}")
-    if vals.shape[1] < 1:
-        raise ParameterError("values", "needs at least one column")
-    if not np.all(np.isfinite(vals)):
-        bad = int(np.flatnonzero(~np.all(np.isfinite(vals), axis=1))[0])
-        raise ParameterError("values", f"row {bad} is not finite")
-    if not isinstance(method, str) or method not in METHODS:
-        raise ParameterError("method", f"must be one of {METHODS}, got {method!r}")
-    if isinstance(tol, bool) or not isinstance(tol, numbers.Real) or not math.isfinite(tol) or tol < 0:
-        raise ParameterError("tol", f"must be a finite number >= 0, got {tol!r}")
-    if max_centers is not None:
-        if isinstance(max_centers, bool) or not isinstance(max_centers, numbers.Integral) \
-                or max_centers < 1:
-            raise ParameterError("max_centers", f"must be None or an integer >= 1, got {max_centers!r}")
-        max_centers = int(max_centers)
-    if progress is not None and not callable(progress):
-        raise ParameterError("progress", "must be callable or None")
-    return pts, vals, float(tol), max_centers
-
-
-def _merge_duplicates(pts_n: np.ndarray, vals: np.ndarray, radius: float):
-    """Indices of the constraints to keep after merging (near-)duplicates.
-
-    Points closer than ``radius`` (normalised units) form a group; a group
-    whose values agree (DUPLICATE_VALUE_RTOL) is replaced by its first member,
-    a group with conflicting values raises SolverError.
-    """
-    m = pts_n.shape[0]
-    if m < 2:
-        return np.arange(m), 0
-    from scipy.spatial import cKDTree  # local: only needed here
-
-    pairs = cKDTree(pts_n).query_pairs(radius, output_type="ndarray")
-    if len(pairs) == 0:
-        return np.arange(m), 0
-    from scipy.sparse import coo_matrix
-    from scipy.sparse.csgraph import connected_components
-
-    graph = coo_matrix((np.ones(len(pairs)), (pairs[:, 0], pairs[:, 1])), shape=(m, m))
-    _, labels = connected_components(graph, directed=False)
-    # first member of every group, in input order
-    _, first = np.unique(labels, return_index=True)
-    first.sort()
-    rep_of_label = np.empty(labels.max() + 1, dtype=np.intp)
-    rep_of_label[labels[first]] = first
-    rep_of_point = rep_of_label[labels]
-    vmax = float(np.max(np.abs(vals))) if vals.size else 0.0
-    diff = np.max(np.abs(vals - vals[rep_of_point]), axis=1)
-    bad = np.flatnonzero(diff > DUPLICATE_VALUE_RTOL * vmax)
-    if bad.size:
-        i = int(bad[0])
-        j = int(rep_of_point[i])
-        raise SolverError(
-            f"constraint points {j} and {i} coincide but have different values "
-            f"(max difference {diff[i]:.3g}); a function cannot interpolate both "
-            f"({bad.size} such conflicting point(s))")
-    return first, m - first.size
-
-
-# ---------------------------------------------------------------------------
-# the incremental (blocked) Householder QR of Sect. 5
-# ---------------------------------------------------------------------------
-
-class IncrementalQR:
-    """Householder QR of a tall matrix grown panel by panel (left-looking).
-
-    Implements Sect. 5 of the paper with BLAS-3 panels instead of single
-    columns.  For every new panel of columns:
-
-    1. the reflectors of every previous panel are applied to it, one blocked
-       ``dgemqrt`` call per previous panel (compact WY form ``I - V T V^T``
-       with the ``T`` stored at factorisation time, so it is never recomputed);
-    2. the panel's lower part is factored by ``dgeqrt`` (recursive, BLAS-3);
-    3. its reflectors are applied to the right-hand sides, so ``Q^T b`` is
-       always current;
-    4. the residual of *every* prefix column count inside the panel follows
-       for free: ``||b - A[:, :n] x*|| = ||(Q^T b)[n:]||``.  Rows ``n:`` are
-       only ever touched by orthogonal reflectors from column ``n`` on, so the
-       tail norm is the same whether read right after column ``n`` or later.
-
-    The working panel is kept as a C-ordered (n_rows, w) array: its transpose
-    is Fortran-ordered and every row block ``[off:]`` of the panel is a
-    Fortran-contiguous column block of the transpose, so step 1 runs
-    ``dgemqrt(side="R")`` on the transpose in place, without copies.
-
-    Storage: the reflector blocks ``V_p`` (trapezoidal, the used columns of
-    A below the diagonal), their ``T`` factors, and R as per-panel column
-    blocks ``R[:j1, j0:j1]``; nothing is allocated for columns never used, so
-    memory is O(n_rows * n) for n used columns.
-    """
-
-    def __init__(self, n_rows: int, max_cols: int, rhs: np.ndarray):
-        if max_cols > n_rows:
-            raise ValueError("IncrementalQR needs max_cols <= n_rows")
-        self.n_rows = n_rows
-        self.max_cols = max_cols
-        self.r_blocks = []  # column blocks R[:j1, j0:j1] of the upper triangle
-        self.qtb = np.array(rhs, dtype=np.float64, order="F", copy=True)
-        if self.qtb.ndim != 2 or self.qtb.shape[0] != n_rows:
-            raise ValueError("rhs must have shape (n_rows, k)")
-        self.panels = []  # (offset, V (n_rows - offset, w) Fortran, T (w, w))
-        self.n_cols = 0
-        self._panel = None
-
-    def panel(self, width: int) -> np.ndarray:
-        """A writable (n_rows, w) block for the next ``w <= width`` columns."""
-        width = min(width, self.max_cols - self.n_cols)
-        self._panel = np.empty((self.n_rows, width), dtype=np.float64, order="C")
-        return self._panel
-
-    def add_panel(self) -> np.ndarray:
-        """Factor the columns written into the last :meth:`panel` block.
-
-        Returns ``tails`` of shape (w + 1, k): ``tails[i] = ||(Q^T b)[j0+i:]||``
-        for the prefixes ``n = j0 .. j0 + w`` columns.
-        """
-        c = self._panel
-        if c is None:
-            raise ValueError("call panel() first")
-        self._panel = None
-        j0 = self.n_cols
-        width = c.shape[1]
-        j1 = j0 + width
-        ct = c.T  # Fortran-ordered (w, n_rows) view of the same memory
-        # 1. previous reflectors: C[off:] <- Q_p^T C[off:]  <=>  Ct[:, off:] <- Ct[:, off:] Q_p
-        for off, v, t in self.panels:
-            blk = ct[:, off:]
-            out, info = lapack.dgemqrt(v, t, blk, side="R", trans="N", overwrite_c=1)
-            if info != 0:  # pragma: no cover - argument error, a bug
-                raise SolverError(f"LAPACK dgemqrt failed (info={info})")
-            if not np.shares_memory(out, blk):  # pragma: no cover - f2py copied
-                blk[...] = out
-        # 2. factor the part on and below the diagonal
-        v, t, info = lapack.dgeqrt(width, np.asfortranarray(c[j0:]), overwrite_a=1)
-        if info != 0:  # pragma: no cover
-            raise SolverError(f"LAPACK dgeqrt failed (info={info})")
-        self.r_blocks.append(np.vstack([c[:j0], np.triu(v[:width])]))
-        self.panels.append((j0, v, t))
-        # 3. update Q^T b
-        y = np.asfortranarray(self.qtb[j0:])
-        y, info = lapack.dgemqrt(v, t, y, side="L", trans="T", overwrite_c=1)
-        self.qtb[j0:] = y
-        self.n_cols = j1
-        # 4. tail norms ||(Q^T b)[n:]|| for n = j0..j1: reverse cumulative sums
-        #    (summed from the bottom, so small tails keep their accuracy)
-        sq = y * y
-        tails_sq = np.zeros((sq.shape[0] + 1, sq.shape[1]))  # last row: empty tail
-        tails_sq[:-1] = np.cumsum(sq[::-1], axis=0)[::-1]
-        return np.sqrt(tails_sq[: width + 1])
-
-    def r_factor(self, n: Optional[int] = None) -> np.ndarray:
-        """The upper-triangular n x n factor R (a new Fortran array)."""
-        n = self.n_cols if n is None else n
-        if not 0 <= n <= self.n_cols:
-            raise ValueError(f"n must be in [0, {self.n_cols}]")
-        r = np.zeros((n, n), order="F")
-        for (j0, _, _), blk in zip(self.panels, self.r_blocks):
-            if j0 >= n:
-                break
-            w = min(blk.shape[1], n - j0)
-            r[: min(blk.shape[0], n), j0:j0 + w] = blk[:n, :w]
-        return r
-
-    def r_diagonal(self, n: Optional[int] = None) -> np.ndarray:
-        """The first ``n`` diagonal entries of R."""
-        n = self.n_cols if n is None else n
-        d = [np.diag(blk[j0:]) for (j0, _, _), blk in zip(self.panels, self.r_blocks)]
-        return np.concatenate(d)[:n] if d else np.zeros(0)
-
-    def solve(self, n: int) -> np.ndarray:
-        """Least-squares solution using the first ``n`` columns: R x = (Q^T b)[:n]."""
-        if n == 0:
-            return np.zeros((0, self.qtb.shape[1]))
-        x, info = lapack.dtrtrs(self.r_factor(n), self.qtb[:n])
-        if info > 0:
-            raise SolverError(
-                f"the least-squares system is singular: R[{info - 1},{info - 1}] = 0 "
-                f"(linearly dependent basis functions)")
-        if info < 0:  # pragma: no cover
-            raise SolverError(f"LAPACK dtrtrs failed (info={info})")
-        return x
-
-
-def blocked_qr(a: np.ndarray, b: np.ndarray, panel: int = IQR_PANEL_COLUMNS):
-    """Blocked incremental QR of a prebuilt matrix with all its columns.
-
-    Returns ``(qr, tails)`` where ``qr`` is the :class:`IncrementalQR` state and
-    ``tails[n] = ||(Q^T b)[n:]||`` for ``n = 0..ncols``.  Used by tests (oracle:
-    ``scipy.linalg.qr``) and the benchmark; the RBF fit builds its columns
-    lazily instead.
-    """
-    a = np.asarray(a, dtype=np.float64)
-    b = np.asarray(b, dtype=np.float64)
-    if b.ndim == 1:
-        b = b[:, None]
-    qr = IncrementalQR(a.shape[0], a.shape[1], b)
-    tails = [None]
-    j = 0
-    while j < a.shape[1]:
-        w = min(panel, a.shape[1] - j)
-        qr.panel(w)[...] = a[:, j:j + w]
-        t = qr.add_panel()
-        if tails[0] is None:
-            tails[0] = t[:1]
-        tails.append(t[1:])
-        j += w
-    if tails[0] is None:
-        tails[0] = np.sqrt(np.sum(b * b, axis=0))[None, :]
-    return qr, np.concatenate(tails, axis=0)
-
-
-# ---------------------------------------------------------------------------
-# the fitted function
-# ---------------------------------------------------------------------------
-
-@dataclass
-class _FitInfo:
-    method: str
-    polynomial: bool
-    residuals: np.ndarray
-    residual_history: Optional[np.ndarray]
-    notes: list = field(default_factory=list)
-    n_constraints: int = 0
-    n_input_constraints: int = 0
-    tol: float = IQR_DEFAULT_TOL
-    rcond: Optional[float] = None
-    seconds: float = 0.0
+#: the QR and the fit drivers live in splatedit.deform.qr / .rbf_fit; their
+#: public names stay importable from here
+__all__ = ["METHODS", "PROGRESS_STAGE", "IncrementalQR", "TriharmonicRBF", "achieved_residuals",
+           "blocked_qr"]
 
 
 class TriharmonicRBF:
@@ -461,89 +200,14 @@ class TriharmonicRBF:
         e.g. a single constraint point, whose kernel matrix is [0]).
         """
         t_start = time.perf_counter()
-        pts, vals, tol, max_centers = _validate(points, values, method, tol, max_centers, progress)
-        m_in = pts.shape[0]
-        vals_in = vals
-        notes: list = []
-
-        # normalisation by the constraint bounding box
-        lo, hi = pts.min(axis=0), pts.max(axis=0)
-        shift = 0.5 * (lo + hi)
-        extent = float(np.max(hi - lo))
-        scale = 0.5 * extent if extent > 0 else 1.0
-        pts_n = (pts - shift) / scale
-        diag = float(np.linalg.norm(hi - lo))
-
-        # duplicates
-        keep, n_merged = _merge_duplicates(pts_n, vals, DUPLICATE_POINT_REL * diag / scale)
-        if n_merged:
-            pts_n = pts_n[keep]
-            vals = vals[keep]
-            notes.append(f"merged {n_merged} duplicate constraint point(s) with identical values")
-        m = pts_n.shape[0]
-
-        # polynomial or not
-        use_poly = True
-        if m < N_POLY:
-            use_poly = False
-            notes.append(f"polynomial dropped: {m} < {N_POLY} constraints cannot determine a quadratic")
-        else:
-            s = np.linalg.svd(poly_matrix(pts_n), compute_uv=False)
-            ratio = s[-1] / s[0]
-            if not ratio > POLY_RANK_RTOL:
-                use_poly = False
-                notes.append(f"polynomial dropped: constraints lie on a quadric "
-                             f"(monomial matrix s_min/s_max = {ratio:.1e} < {POLY_RANK_RTOL:g})")
-        if not use_poly and m == 1:
-            raise SolverError(
-                "a single (distinct) constraint point cannot be fitted: without the "
-                "polynomial the kernel matrix is [phi(0)] = [0]; give at least 2 distinct points")
-
-        # method
-        if method == "lu" and max_centers is not None and max_centers < m:
-            raise ParameterError(
-                "max_centers", f"method='lu' uses all {m} constraints as centers; "
-                f"max_centers={max_centers} needs method='iqr'")
-        if method == "lu" and m > LU_MAX_CONSTRAINTS:
-            raise ParameterError(
-                "method", f"method='lu' with {m} constraints needs a dense {m + N_POLY}^2 system "
-                f"(> {LU_MAX_CONSTRAINTS} constraints); use method='iqr' or 'auto'")
-        head: list = []
-        if method == "auto":
-            if m <= AUTO_EXACT_MAX_CONSTRAINTS and (max_centers is None or max_centers >= m):
-                used = "lu"
-                head.append(f"auto: exact LU solve since m = {m} <= {AUTO_EXACT_MAX_CONSTRAINTS}")
-            else:
-                used = "iqr"
-                why = (f"m = {m} > {AUTO_EXACT_MAX_CONSTRAINTS}" if m > AUTO_EXACT_MAX_CONSTRAINTS
-                       else f"max_centers = {max_centers} < m = {m}")
-                head.append(f"auto: incremental QR since {why}")
-        else:
-            used = method
-
-        report(progress, PROGRESS_STAGE, 0.0)
-        if used == "lu":
-            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, use_poly)
-            history = None
-            head.append(f"lu: exact solve with all {m} constraints as centers, "
-                        f"rcond {rcond:.1e}")
-        else:
-            rcond = None
-            w, q, idx, residuals, history, iqr_notes = _fit_iqr(
-                pts_n, vals, use_poly, tol, max_centers, progress)
-            head.extend(iqr_notes)
-        notes = head + notes
-        report(progress, PROGRESS_STAGE, 1.0)
-
-        info = _FitInfo(method=used, polynomial=use_poly, residuals=residuals,
-                        residual_history=history, notes=notes, n_constraints=m,
-                        n_input_constraints=m_in, tol=tol, rcond=rcond)
-        f = cls(centers_n=pts_n[idx], weights=w, poly_coeffs=q, shift=shift, scale=scale,
-                center_indices=keep[idx], info=info)
+        sol: FitSolution = solve_constraints(points, values, method, tol, max_centers, progress)
+        f = cls(centers_n=sol.centers_n, weights=sol.weights, poly_coeffs=sol.poly_coeffs,
+                shift=sol.shift, scale=sol.scale, center_indices=sol.center_indices,
+                info=sol.info)
         # the honest residual: what the returned weights achieve at every input
         # constraint (the solver's own figure is blind to rounding, e.g. when
         # near-duplicate points with different values make the system singular)
-        f._set_achieved(achieved_residuals(f, pts, vals_in), residuals)
+        f._set_achieved(achieved_residuals(f, sol.points, sol.values), sol.info.residuals)
         f.fit_seconds = time.perf_counter() - t_start
         return f
 
@@ -640,21 +304,6 @@ class TriharmonicRBF:
         return self._eval(x, True, True)
 
 
-# ---------------------------------------------------------------------------
-# the two solvers (normalised coordinates)
-# ---------------------------------------------------------------------------
-
-def _relative_residuals(res_norm: np.ndarray, b: np.ndarray) -> np.ndarray:
-    """Scale-free ``res_norm / ||b||`` per column (both 2-norms over the m
-    constraints, so a uniform error e on values of RMS size s gives e / s
-    whatever m); the absolute ``res_norm`` where ``b`` is identically 0."""
-    bn = np.linalg.norm(b, axis=0)
-    nz = bn > 0
-    out = np.array(res_norm, dtype=np.float64, copy=True)
-    out[..., nz] = out[..., nz] / bn[nz]
-    return out
-
-
 def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarray) -> np.ndarray:
     """(k,) ``||f(points) - values|| / ||values||`` per column: the residual
     the fitted weights really achieve, evaluated at every constraint point
@@ -671,107 +320,3 @@ def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarr
         d = f(points[s:s + step]) - values[s:s + step]
         res_sq += np.einsum("ij,ij->j", d, d)
     return _relative_residuals(np.sqrt(res_sq), values)
-
-
-def _fit_lu(pts_n, vals, use_poly):
-    m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
-    size = m + npoly
-    a = np.zeros((size, size), order="F")
-    kernel_matrix(pts_n, pts_n, out=a[:m, :m])
-    if use_poly:
-        p = poly_matrix(pts_n)
-        a[:m, m:] = p
-        a[m:, :m] = p.T
-    rhs = np.zeros((size, k))
-    rhs[:m] = vals
-    anorm = float(np.max(np.sum(np.abs(a), axis=0)))
-    lu, piv, info = lapack.dgetrf(a, overwrite_a=0)
-    if info > 0:
-        raise SolverError(
-            f"the exact RBF system is singular (zero pivot at {info - 1}); "
-            "use method='iqr' or remove degenerate constraints")
-    rcond, _ = lapack.dgecon(lu, anorm, norm="1")
-    if not rcond >= LU_MIN_RCOND:
-        raise SolverError(
-            f"the exact RBF system is numerically singular (rcond {rcond:.1e} < "
-            f"{LU_MIN_RCOND:g}); use method='iqr' or remove near-duplicate constraints")
-    x, info = lapack.dgetrs(lu, piv, rhs)
-    res = np.linalg.norm(a @ x - rhs, axis=0)
-    residuals = _relative_residuals(res, vals)
-    w = x[:m]
-    q = x[m:] if use_poly else None
-    return w, q, np.arange(m), residuals, float(rcond)
-
-
-def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
-    m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
-    n_rows = m + npoly
-    cap = m if max_centers is None else min(max_centers, m)
-    max_cols = npoly + cap
-    rhs = np.zeros((n_rows, k))
-    rhs[:m] = vals
-    qr = IncrementalQR(n_rows, max_cols, rhs)
-    sampler = FarthestPointSampler(pts_n)
-    p_all = poly_matrix(pts_n) if use_poly else None
-    order_parts = []
-    hist_parts = []  # residuals for center counts 0, 1, ...
-    bn = np.linalg.norm(vals, axis=0)
-    scale_c = np.where(bn > 0, 1.0 / np.where(bn > 0, bn, 1.0), 0.0)
-    panel_w = max(IQR_PANEL_COLUMNS, npoly + 1)
-    running_min = np.full(k, np.inf)
-    stop_cols = None
-    while qr.n_cols < max_cols:
-        j0 = qr.n_cols
-        block = qr.panel(panel_w)
-        width = block.shape[1]
-        c0 = 0
-        if j0 == 0 and use_poly:
-            block[:m, :npoly] = p_all
-            block[m:, :npoly] = 0.0
-            c0 = npoly
-        idx = sampler.take(width - c0)
-        order_parts.append(idx)
-        kernel_matrix(pts_n, pts_n[idx], out=block[:m, c0:])
-        if use_poly:
-            block[m:, c0:] = p_all[idx].T
-        tails = qr.add_panel()  # prefixes n = j0 .. j0 + width
-        res = tails * scale_c  # (width + 1, k)
-        first_n = max(j0 + (0 if j0 == 0 else 1), npoly)
-        res = res[first_n - j0:]
-        res = np.minimum.accumulate(np.vstack([running_min[None, :], res]), axis=0)[1:]
-        running_min = res[-1]
-        below = np.flatnonzero(np.all(res < tol, axis=1))
-        if below.size:
-            stop_cols = first_n + int(below[0])
-            hist_parts.append(res[: below[0] + 1])
-            break
-        hist_parts.append(res)
-        report(progress, PROGRESS_STAGE, qr.n_cols / max_cols)
-    notes = []
-    if stop_cols is None:
-        stop_cols = max_cols
-    n_centers = stop_cols - npoly
-    history = np.concatenate(hist_parts, axis=0)
-    residuals = history[-1].copy()
-    x = qr.solve(stop_cols)
-    order = np.concatenate(order_parts)[:n_centers] if order_parts else np.zeros(0, np.intp)
-    w = x[npoly:]
-    q = x[:npoly] if use_poly else None
-    summary = (f"iqr: {n_centers} of {m} constraints as centers, residual "
-               f"{np.max(residuals):.2g}")
-    if np.max(residuals) < tol:
-        summary += f" < tol {tol:g}"
-    notes.append(summary)
-    if np.max(residuals) >= tol:
-        if max_centers is not None and n_centers == max_centers < m:
-            notes.append(f"max_centers = {max_centers} reached before tol {tol:g}")
-        elif tol > 0:
-            notes.append(f"all {m} centers used and tol {tol:g} still not reached "
-                         "(rounding limits the residual)")
-    diag = np.abs(qr.r_diagonal(stop_cols))
-    if diag.size and diag.min() < IQR_R_DIAG_RTOL * diag.max():
-        notes.append(f"R is nearly singular (min/max |diag| = {diag.min() / diag.max():.1e}); "
-                     "weights may be inaccurate")
-    return w, q, order, residuals, history, notes

@@ -8,7 +8,8 @@ import pytest
 from scipy.interpolate import RBFInterpolator
 
 from splatedit.bench.solve import sample_transform, sphere_cloud, wavy_plane_cloud
-from splatedit.deform.basis import DeformationBasis, _run_plan
+from splatedit.deform.apply_plan import _run_plan
+from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.transform import (
     apply_affine,
@@ -381,9 +382,9 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
     """The CPU apply computes through short gaps of fixed splats between long
     runs of support splats (one long GEMM instead of a call per run) and then
     restores them: they must come out bitwise identical, -0.0 included."""
-    import splatedit.deform.basis as basis_module
-    from splatedit.deform.basis import _fill_small_gaps
-    monkeypatch.setattr(basis_module, "_RUN_MIN", 64)   # runs of 112 count as long here
+    import splatedit.deform.apply_plan as apply_plan
+    from splatedit.deform.apply_plan import _fill_small_gaps
+    monkeypatch.setattr(apply_plan, "_RUN_MIN", 64)   # runs of 112 count as long here
     cloud = wavy_plane_cloud(120)
     p = cloud.positions.copy()
     n = len(p)
@@ -407,7 +408,7 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
 
 
 def test_gap_filling_leaves_scattered_indices_alone():
-    from splatedit.deform.basis import _fill_small_gaps
+    from splatedit.deform.apply_plan import _fill_small_gaps
     idx = np.sort(np.random.default_rng(0).choice(100_000, 30_000, replace=False))
     span, member = _fill_small_gaps(idx)
     assert member.all() and np.array_equal(span, idx)
@@ -415,3 +416,39 @@ def test_gap_filling_leaves_scattered_indices_alone():
     span, member = _fill_small_gaps(runs)
     assert np.array_equal(span[member], runs)
     assert np.array_equal(span[~member], np.arange(1000, 1100))   # 100 <= 0.25 * 1000; the 10-run is short
+
+
+def test_basis_precompute_memory_does_not_grow_with_the_support(monkeypatch):
+    """The basis evaluation (values and gradients at every free splat) needs,
+    beyond the (N, 4, K) rows it fills, only chunk buffers: the same peak
+    (tracemalloc, from the stage's start) for a 31k- and a 125k-splat support
+    (4x), and below the two threads' two 4-MiB work matrices each (measured
+    11.4 MB at both).  A support-sized temporary (one (N, K, 3) gradient array
+    is 12 MB at 125k) would break both."""
+    import tracemalloc
+
+    import splatedit.deform.basis as basis_module
+    from splatedit.tolerances import EVAL_CHUNK_MAX_BYTES, EVAL_THREADS
+    monkeypatch.setattr(basis_module, "_BASIS_CHUNK", 8192)
+    extra = []
+    for n in (250, 500):
+        cloud = wavy_plane_cloud(n)
+        r = np.linalg.norm(cloud.positions[:, :2], axis=1)
+        base = {}
+
+        def progress(stage, fraction):
+            if stage == basis_module.PROGRESS_STAGE and fraction == 0.0:
+                tracemalloc.reset_peak()
+                base["bytes"] = tracemalloc.get_traced_memory()[0]
+
+        tracemalloc.start()
+        try:
+            b = DeformationBasis.fit(cloud, r < 0.8, [r < 0.2], method="iqr", max_centers=60,
+                                     fill_holes=False, progress=progress)
+            extra.append(tracemalloc.get_traced_memory()[1] - base["bytes"])
+        finally:
+            tracemalloc.stop()
+        assert len(b.constraints.free_index) > 3 * 8192
+    print(f"peak beyond the basis rows: {extra[0] / 2**20:.2f} / {extra[1] / 2**20:.2f} MB")
+    assert extra[1] <= 1.05 * extra[0]
+    assert max(extra) < 2 * EVAL_THREADS * EVAL_CHUNK_MAX_BYTES

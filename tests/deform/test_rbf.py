@@ -10,6 +10,7 @@ from hypothesis import strategies as st
 from scipy.interpolate import RBFInterpolator
 
 import splatedit.deform.rbf as rbf_mod
+import splatedit.deform.rbf_fit as fit_mod
 from splatedit.deform import TriharmonicRBF
 from splatedit.deform.kernels import kernel_gradient, kernel_matrix, poly_matrix
 from splatedit.deform.rbf import blocked_qr
@@ -315,7 +316,7 @@ def test_auto_threshold(monkeypatch):
     assert TriharmonicRBF.fit(pts, vals).method == "lu"
     f = TriharmonicRBF.fit(pts, vals, max_centers=20)
     assert f.method == "iqr" and "max_centers" in f.message
-    monkeypatch.setattr(rbf_mod, "AUTO_EXACT_MAX_CONSTRAINTS", 50)
+    monkeypatch.setattr(fit_mod, "AUTO_EXACT_MAX_CONSTRAINTS", 50)
     f = TriharmonicRBF.fit(pts, vals)
     assert f.method == "iqr" and f.message.startswith("auto: incremental QR")
 
@@ -345,7 +346,7 @@ def test_validation_names_the_parameter(kwargs, name):
 
 
 def test_lu_size_limit(monkeypatch):
-    monkeypatch.setattr(rbf_mod, "LU_MAX_CONSTRAINTS", 10)
+    monkeypatch.setattr(fit_mod, "LU_MAX_CONSTRAINTS", 10)
     with pytest.raises(ParameterError) as exc:
         TriharmonicRBF.fit(_cloud(11), np.ones((11, 1)), method="lu")
     assert exc.value.name == "method"
@@ -359,7 +360,7 @@ def test_evaluation_validates_x():
 
 
 def test_progress_reported_per_panel(monkeypatch):
-    monkeypatch.setattr(rbf_mod, "IQR_PANEL_COLUMNS", 32)
+    monkeypatch.setattr(fit_mod, "IQR_PANEL_COLUMNS", 32)
     pts = _cloud(200)
     calls = []
     TriharmonicRBF.fit(pts, _smooth_values(pts), method="iqr", tol=0.0,
