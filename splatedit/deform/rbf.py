@@ -41,6 +41,7 @@ from splatedit.deform.rbf_fit import (
     _relative_residuals,
     solve_constraints,
 )
+from splatedit.blas import single_blas_thread
 from splatedit.errors import ParameterError
 from splatedit.progress import ProgressFn
 from splatedit.tolerances import (
@@ -251,7 +252,9 @@ class TriharmonicRBF:
         # chunks are spread over EVAL_THREADS threads (each writes its own rows)
         workers = min(EVAL_THREADS, len(starts))
         if workers > 1:
-            with ThreadPoolExecutor(max_workers=workers) as pool:
+            # those threads already fill the cores: OpenBLAS's own threads on top
+            # of them oversubscribe (4.5-9x slower at a 1M support, see README)
+            with single_blas_thread(), ThreadPoolExecutor(max_workers=workers) as pool:
                 list(pool.map(one_chunk, starts))
         else:
             for s in starts:
