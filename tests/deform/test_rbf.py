@@ -376,6 +376,9 @@ def test_rbf_evaluation_threads_hold_blas_to_one_thread_and_restore_it(monkeypat
     it, the library's own setting is back."""
     from splatedit import blas
     from splatedit.deform import rbf as rbf_module
+    rng = np.random.default_rng(3)
+    pts = rng.normal(size=(60, 3))
+    f = rbf_module.TriharmonicRBF.fit(pts, rng.normal(size=(60, 2)), method="lu")
     seen = []
     original = rbf_module.TriharmonicRBF._eval_chunk
 
@@ -385,9 +388,6 @@ def test_rbf_evaluation_threads_hold_blas_to_one_thread_and_restore_it(monkeypat
 
     monkeypatch.setattr(rbf_module.TriharmonicRBF, "_eval_chunk", spy)
     monkeypatch.setattr(rbf_module, "EVAL_CHUNK_ROWS", 64)
-    rng = np.random.default_rng(3)
-    pts = rng.normal(size=(60, 3))
-    f = rbf_module.TriharmonicRBF.fit(pts, rng.normal(size=(60, 2)), method="lu")
     before = blas.blas_threads()
     f(rng.normal(size=(1000, 3)))
     assert len(seen) > 1 and set(seen) == {1}
