@@ -9,7 +9,6 @@ from __future__ import annotations
 import argparse
 import contextlib
 import json
-import math
 import os
 import signal
 import sys
@@ -26,6 +25,7 @@ os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
 from splatedit.app.options import parse_size, positive_float
 from splatedit.bench.runner import BENCHES
+from splatedit.commands.info import cmd_info
 from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
 #: the `splatedit bench` cases (one JSON line per case each)
@@ -85,113 +85,6 @@ def _positive_count(text: str) -> int:
 
 
 # ------------------------------------------------------------------ commands
-def _sig(x, digits: int = 7) -> float | None:
-    """``x`` rounded to ``digits`` significant digits (not decimals: a model
-    in units of 1e-20 keeps its figures); None for NaN or infinity, which
-    JSON cannot hold."""
-    x = float(x)
-    return float(f"{x:.{digits}g}") if math.isfinite(x) else None
-
-
-def _print_info(info: dict, as_json: bool) -> None:
-    if as_json:
-        print(json.dumps(info, allow_nan=False))     # strict JSON: no Infinity / NaN
-    else:
-        width = max(map(len, info))
-        for k, v in info.items():
-            print(f"{k:<{width}}  {v}")
-
-
-def _gaussian_info(args) -> dict:
-    """``info`` of a Gaussian splatting PLY: kind, count, SH degree, opacity and
-    scale percentiles, anisotropy, bounding box, kept extra properties."""
-    import numpy as np
-    from splatedit.io import read_gaussians
-    g = read_gaussians(args.file, progress=args.progress)
-    lo, hi = g.bounds()
-    pct = (5, 50, 95)
-    s = np.exp(g.log_scales.astype(np.float64))
-    srt = np.sort(s, axis=1)
-    return {
-        "file": str(args.file),
-        "kind": g.kind.value,
-        "gaussians": len(g),
-        "sh_degree": g.sh_degree,
-        "normals": g.normals is not None,
-        "extra_properties": list(g.extra),
-        "bounds_min": [_sig(x) for x in lo],
-        "bounds_max": [_sig(x) for x in hi],
-        "diagonal": _sig(np.linalg.norm(hi - lo)),
-        "opacity_p5_p50_p95": [_sig(x, 4) for x in np.percentile(g.opacities(), pct)],
-        "opacity_below_0.5": int((g.opacity_logits < 0).sum()),
-        "scale_max_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, -1], pct)],
-        "scale_min_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, 0], pct)],
-        "anisotropy_p5_p50_p95": [_sig(x, 4) for x in np.percentile(srt[:, -1] / srt[:, -2], pct)],
-    }
-
-
-def cmd_info(args) -> int:
-    """Counts, bounds and cleanliness figures.  Up to INFO_EXACT_MAX_POINTS
-    splats everything is exact; above, spacing, boundary splats and outliers
-    are estimated from spatial patches (listed under ``estimated``) and
-    stray clusters (a global graph property) are not computed (null)."""
-    import numpy as np
-    from splatedit.io import is_gaussian_file, read
-    if is_gaussian_file(args.file):
-        _print_info(_gaussian_info(args), args.json)
-        return 0
-    from splatedit.model.quality import assess, estimate_quality
-    from splatedit.model.spacing import point_spacing
-    from splatedit.tolerances import INFO_EXACT_MAX_POINTS
-    cloud = read(args.file, progress=args.progress)
-    lo, hi = cloud.bounds()
-    radii = cloud.radii
-    est = estimate_quality(cloud, lower=lo) if cloud.n > INFO_EXACT_MAX_POINTS else None
-    info = {
-        "file": str(args.file),
-        "splats": cloud.n,
-        "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
-        "colors": cloud.colors is not None,
-        "intensity": cloud.intensity is not None,
-        "classification": cloud.classification is not None,
-        "origin": [_sig(x, 15) for x in cloud.origin],
-        "bounds_min": [_sig(x) for x in lo],
-        "bounds_max": [_sig(x) for x in hi],
-        "diagonal": _sig(np.linalg.norm(hi - lo)),
-    }
-    med = np.median(radii)
-    if est is None:
-        quality = assess(cloud)
-        info.update({
-            "spacing": _sig(point_spacing(cloud.positions)),
-            "splat_radius_median": _sig(med),
-            "splat_radius_max": _sig(radii.max()),
-            "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
-            "boundary_splats": quality.boundary_count,
-            "outliers": quality.outliers.count,
-            "outliers_statistical": int(quality.outliers.statistical.sum()),
-            "outliers_isolated": int(quality.outliers.isolated.sum()),
-            "stray_cluster_points": int(quality.stray_clusters.sum()),
-        })
-    else:
-        info.update({
-            "spacing": _sig(est.spacing),
-            "splat_radius_median": _sig(med),
-            "splat_radius_max": _sig(radii.max()),
-            "splat_radius_max_rel_median": _sig(radii.max() / med, 4),
-            "boundary_splats": est.boundary,
-            "outliers": est.outliers,
-            "outliers_statistical": est.statistical,
-            "outliers_isolated": est.isolated,
-            "stray_cluster_points": None,
-            "estimated": ["spacing", "outliers", "outliers_statistical", "outliers_isolated"]
-                         + ([] if cloud.faces is not None else ["boundary_splats"]),
-            "sample_points": est.sample_points,
-        })
-    _print_info(info, args.json)
-    return 0
-
-
 def cmd_convert(args) -> int:
     from splatedit.io import check_output_path, is_gaussian_file, read, write
     check_output_path(args.output, overwrite=args.force, protect=args.input)

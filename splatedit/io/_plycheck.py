@@ -58,6 +58,35 @@ def read_head(path) -> PlyHead | None:
     return PlyHead(data, end, -1 if nl < 0 else nl + 1, size)
 
 
+#: the header comment of a PLY we write that carries the cloud's origin:
+#: ``comment splatedit origin X Y Z`` (17 significant digits: exact)
+ORIGIN_COMMENT = "splatedit origin"
+
+
+def origin_comment(origin) -> str:
+    """The comment text (without ``comment``) that stores ``origin`` (3,)."""
+    return ORIGIN_COMMENT + " " + " ".join(f"{float(x):.17g}" for x in origin)
+
+
+def stored_origin(path) -> np.ndarray | None:
+    """(3,) float64 origin of a PLY header's last ``comment splatedit origin
+    X Y Z`` line, or None (no such line, or not three finite numbers).
+    Whether it suits the data is :func:`splatedit.io._build.local_origin`'s
+    decision."""
+    head = read_head(path)
+    if head is None:
+        return None
+    found = None
+    for line in head.lines():
+        w = line.split()
+        if len(w) == 6 and w[0] == "comment" and " ".join(w[1:3]) == ORIGIN_COMMENT:
+            try:
+                found = np.array([float(x) for x in w[3:]])
+            except ValueError:
+                continue
+    return found if found is not None and np.isfinite(found).all() else None
+
+
 def warn_trailing(path, what: str, nv: int, nf: int | None) -> None:
     counts = f"'vertex {nv}'" + ("" if nf is None else f" and 'face {nf}'")
     warnings.warn(InputWarning(f"{path}: {what} after the rows the header declares ({counts}) "

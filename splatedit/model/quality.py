@@ -78,10 +78,12 @@ class QualityEstimate:
     sample_points: int
 
 
-def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
+def estimate_quality(cloud, target: int = INFO_SAMPLE_POINTS,
                      lower=None) -> QualityEstimate | None:
-    """:class:`QualityEstimate` of ``cloud`` without an all-points k-NN, or
-    None when the patches give no usable points (then use :func:`assess`).
+    """:class:`QualityEstimate` of ``cloud`` (a SplatCloud or a
+    :class:`~splatedit.model.summary.CloudSummary`: ``n``, ``positions``,
+    ``faces`` and ``normals_at(rows)``) without an all-points k-NN, or None
+    when the patches give no usable points (then use :func:`assess`).
     ``lower``: the bounding box's lower corner, if known."""
     from splatedit.model.sample import patch_sample
     n = cloud.n
@@ -105,9 +107,7 @@ def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
     if cloud.faces is not None and len(cloud.faces):
         boundary = int(mesh_boundary_vertices(n, cloud.faces).sum())
     else:
-        sel = ps.index
-        nrm = np.cross(cloud.u[sel], cloud.v[sel])
-        nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+        nrm = cloud.normals_at(ps.index)
         nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, len(pts)), neighbours=idx)
         bnd = boundary_points(pts, nrm, nb)
         boundary = int(round(bnd[exact].sum() * scale))
