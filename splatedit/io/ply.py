@@ -8,11 +8,15 @@ properties used: ``x y z`` (required), ``nx ny nz`` (or ``normal_x ...``),
 float), ``radius``, our ``ux uy uz vx vy vz``, and the scan attributes
 ``intensity`` and ``classification`` (kept, not turned into colours: a PLY
 without colours keeps the default material).  Other properties and
-elements are ignored.  A ``face`` element (``vertex_indices`` or
+elements are ignored.  A header line ``comment splatedit origin X Y Z`` (our
+writer's) is the cloud's local origin when it suits the points
+(:func:`splatedit.io._build.local_origin`).  A ``face`` element (``vertex_indices`` or
 ``vertex_index`` list) makes the file a mesh: polygons are fan-triangulated.
 
 Written file layout (binary little endian by default)::
 
+    comment written by splatedit from NAME
+    comment splatedit origin X Y Z                          (if the cloud has a local origin)
     element vertex n
       double x y z            positions, bit-exact
       float  nx ny nz         unit normals, for other tools
