@@ -113,10 +113,9 @@ def cmd_info(args) -> int:
 def _exact_figures(cloud, med: float, rmax: float) -> dict:
     """Spacing, splat-size and cleanliness figures of a whole cloud, exactly."""
     from splatedit.model.quality import assess
-    from splatedit.model.spacing import point_spacing
     quality = assess(cloud)
     return {
-        "spacing": _sig(point_spacing(cloud.positions)),
+        "spacing": _sig(quality.spacing),
         "splat_radius_median": _sig(med),
         "splat_radius_max": _sig(rmax),
         "splat_radius_max_rel_median": _sig(quality.radius_max_rel_median, 4),
