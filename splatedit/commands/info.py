@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import json
 import math
+import threading
 
 
 def _sig(x, digits: int = 7) -> float | None:
@@ -14,6 +15,25 @@ def _sig(x, digits: int = 7) -> float | None:
     JSON cannot hold."""
     x = float(x)
     return float(f"{x:.{digits}g}") if math.isfinite(x) else None
+
+
+def _import_in_background(module: str) -> threading.Thread:
+    """Start importing ``module`` on a thread and return it (join it before
+    using the module).  The figures need scipy (0.5-1 s of imports: Python
+    work holding the GIL); reading a binary PLY is file I/O and numpy loops
+    that release it, so on two cores the import and the read overlap.  A
+    failed import is raised again by the caller's own import."""
+    import importlib
+
+    def load():
+        try:
+            importlib.import_module(module)
+        except BaseException:       # the caller's import reports it
+            pass
+
+    thread = threading.Thread(target=load, name=f"import {module}", daemon=True)
+    thread.start()
+    return thread
 
 
 def _print_info(info: dict, as_json: bool) -> None:
@@ -65,10 +85,12 @@ def cmd_info(args) -> int:
     if is_gaussian_file(args.file):
         _print_info(_gaussian_info(args), args.json)
         return 0
-    from splatedit.model.quality import estimate_quality
     from splatedit.model.summary import CloudSummary
     from splatedit.tolerances import INFO_EXACT_MAX_POINTS
+    loading = _import_in_background("splatedit.model.quality")
     model = read_summary(args.file, progress=args.progress, lean_above=INFO_EXACT_MAX_POINTS)
+    loading.join()
+    from splatedit.model.quality import estimate_quality
     lo, hi = model.bounds()
     est = estimate_quality(model, lower=lo) if model.n > INFO_EXACT_MAX_POINTS else None
     if est is None and model.cloud is None:     # no usable patches: every figure exactly

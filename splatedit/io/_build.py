@@ -10,8 +10,6 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud, column_bounds
-from splatedit.model.estimate import estimate_splats
-from splatedit.model.mesh import cloud_from_mesh
 from splatedit.tolerances import (MAX_COORDINATE_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
                                   REBASE_STORED_REACH)
 
@@ -227,6 +225,10 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
             row = int(np.flatnonzero(bad)[0])
             raise InputError(f"radius must be > 0, got {radius[row]}", path=source,
                              element="vertex", row=row, prop="radius")
+    # estimation needs scipy (0.5-1 s to import): readers of files that carry
+    # their splats, and `info`'s lean path, never load it
+    from splatedit.model.estimate import estimate_splats
+    from splatedit.model.mesh import cloud_from_mesh
     if faces is not None and not (normals is not None and radius is not None):
         cloud = cloud_from_mesh(positions, faces, normals=normals, colors=colors, name=name,
                                 source=source, progress=progress)
