@@ -12,10 +12,11 @@ types).  Normals and splat sizes are estimated (LAS has none).
 Far coordinates are rebased to an origin on the file's own integer grid:
 ``origin = offset + X0 * scale``, the local coordinates are ``(X - X0) *
 scale``, so writing back with the same scale and offset gives back the same
-integers.  ``X0`` is 0 (the origin is the offset) when the points lie within
-``REBASE_MIN_ABS`` of the offset, as in every file splatedit writes (a cloud
-not read from LAS is written with its origin as the offset); else the
-coarse-grid origin of :func:`splatedit.io._build.local_origin`.  A cloud
+integers.  ``X0`` is 0 (the origin is the offset) when the offset suits the
+points (:func:`splatedit.io._build.fits_origin`: within twice their longest
+side), as in every file splatedit writes (a cloud not read from LAS is
+written with its origin as the offset); else the grid origin of
+:func:`splatedit.io._build.local_origin` moved onto the file's grid.  A cloud
 written back (same scale and offset) is read with the same origin: the
 offset again, or the same grid point unless an edit moved the box centre
 across half a grid step.
@@ -58,7 +59,7 @@ def grey_from_intensity(intensity: np.ndarray) -> np.ndarray | None:
 def _origin_step(world_lo, world_hi, scale, offset) -> np.ndarray:
     """(3,) int64 ``X0`` of the origin ``offset + X0 * scale`` of a far
     LAS file (world box ``world_lo``..``world_hi``): 0, the offset itself,
-    when the box lies within REBASE_MIN_ABS of it (files we write carry the
+    when it suits the box (:func:`fits_origin`; files we write carry the
     origin there), else the grid point of :func:`local_origin` moved onto the
     file's integer grid."""
     if fits_origin(offset, world_lo, world_hi):
