@@ -66,3 +66,16 @@ def test_ply_round_trip_keeps_an_origin_off_the_grid(tmp_path):
         back = read(path)
         assert np.array_equal(back.origin, origin), binary
         assert np.array_equal(back.world_positions(), cloud.world_positions()), binary
+
+
+def test_las_laz_and_e57_carry_the_origin_of_a_cloud_not_read_from_them(tmp_path):
+    """LAS/LAZ store it as the header offset, E57 as the scan's pose."""
+    world = _tile()
+    origin = np.array([512_360.5, 5_123_470.25, 300.0])
+    u = np.tile([0.05, 0.0, 0.0], (len(world), 1))
+    v = np.tile([0.0, 0.05, 0.0], (len(world), 1))
+    cloud = SplatCloud(world - origin, u, v, origin=origin)
+    for ext in (".las", ".laz", ".e57"):
+        path = tmp_path / f"o{ext}"
+        write(path, cloud)
+        assert np.array_equal(read(path).origin, origin), ext
