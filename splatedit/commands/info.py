@@ -4,6 +4,7 @@ splatting scene), as aligned text or one JSON object."""
 
 from __future__ import annotations
 
+import importlib
 import json
 import math
 import threading
@@ -23,8 +24,6 @@ def _import_in_background(module: str) -> threading.Thread:
     work holding the GIL); reading a binary PLY is file I/O and numpy loops
     that release it, so on two cores the import and the read overlap.  A
     failed import is raised again by the caller's own import."""
-    import importlib
-
     def load():
         try:
             importlib.import_module(module)
@@ -85,6 +84,8 @@ def cmd_info(args) -> int:
     if is_gaussian_file(args.file):
         _print_info(_gaussian_info(args), args.json)
         return 0
+    # the read's own modules first: the thread below then imports none of them
+    importlib.import_module("splatedit.io._plysummary")
     from splatedit.model.summary import CloudSummary
     from splatedit.tolerances import INFO_EXACT_MAX_POINTS
     loading = _import_in_background("splatedit.model.quality")
