@@ -178,10 +178,17 @@ def rebase(positions, origin) -> np.ndarray:
     float64 array (the readers' own), to keep the peak memory down."""
     if not origin.any():
         return positions
-    if isinstance(positions, np.ndarray) and positions.dtype == np.float64 and positions.flags.writeable:
-        positions -= origin
-        return positions
-    return np.asarray(positions, dtype=np.float64) - origin
+    if not (isinstance(positions, np.ndarray) and positions.dtype == np.float64
+            and positions.flags.writeable and positions.ndim == 2):
+        positions = np.array(positions, dtype=np.float64)
+    # block by block against the origin repeated per row: a (3,) row broadcast
+    # over (n, 3) runs numpy's length-3 inner loop n times, 3-4x slower
+    step = 1 << 16
+    rows = np.tile(np.asarray(origin, dtype=np.float64), (min(len(positions), step), 1))
+    for lo in range(0, len(positions), step):
+        blk = positions[lo:lo + step]
+        np.subtract(blk, rows[:len(blk)], out=blk)
+    return positions
 
 
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
