@@ -50,6 +50,11 @@ deformation (exact for translations, large rotations shrink the middle);
 offsets, deforms the base rotation-aware and re-attaches the offsets along
 the deformed normals (relief keeps its height and stays upright; see
 :mod:`splatedit.deform.detail`).  Curves are displacements in every mode.
+
+The package: :mod:`splatedit.script.model` (the dataclasses and the JSON
+output), :mod:`splatedit.script.parse` (reading and validation) and
+:mod:`splatedit.script.run` (running edits, reports); everything is
+exported here.
 """
 
 from splatedit.script.model import (METHODS, SCRIPT_VERSION, TRS, Curve, Edit, EditScript, Matrix,
