@@ -256,7 +256,7 @@ def bench_groups(cloud: SplatCloud | None = None, *, quick: bool = False, method
         t = time.perf_counter()
         b.apply(cloud, dc)  # first frame builds the hot-path arrays
         t_first = time.perf_counter() - t
-        t_apply = _best_of(lambda: b.apply(cloud, dc), apply_repeats)
+        t_apply = _best_of(lambda basis=b: basis.apply(cloud, dc), apply_repeats)
         yield dict(name=name, n_points=int(len(cloud)), n_support=st["n_support"],
                    n_free=st["n_free"], n_handles=len(hs), n_curves=len(curves),
                    curve_points=[c.n_controls for c in curves],

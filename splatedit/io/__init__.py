@@ -45,10 +45,12 @@ from splatedit.io.pts import read_pts, write_pts
 from splatedit.io.xyz import read_xyz, write_xyz
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
+from splatedit.model.summary import CloudSummary
 from splatedit.progress import report
 
 __all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "split_scan_index",
-           "READ_EXTENSIONS", "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians"]
+           "READ_EXTENSIONS", "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians",
+           "read_summary"]
 
 _READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_pts,
             ".off": read_off, ".las": read_las, ".laz": read_las, ".e57": read_e57,
@@ -91,6 +93,29 @@ def read(path, *, progress=None) -> SplatCloud:
     if ext == ".ply" and is_gaussian_ply(path):
         return read_gaussian_ply(path, progress=progress).proxy_splats()
     return reader(path, progress=progress)
+
+
+def read_summary(path, *, progress=None, lean_above: int = 0) -> CloudSummary:
+    """What ``splatedit info`` needs of a model (:class:`CloudSummary`).
+
+    A binary PLY of more than ``lean_above`` splats holding our splat axes
+    is read in one pass keeping only the centres and splat radii
+    (:mod:`splatedit.io._plysummary`; ``cloud`` is None); anything else, or
+    a file failing a check there, is read whole by :func:`read` (whose
+    errors name the row at fault).
+    """
+    src, scan = split_scan_index(path)
+    if scan is None and Path(src).suffix.lower() == ".ply":
+        check_readable_file(src)
+        from splatedit.io._plycheck import binary_layout, check_declared_sizes, stored_origin
+        check_declared_sizes(src)
+        layout = binary_layout(src)
+        if layout is not None and layout[1] > lean_above and not is_gaussian_ply(src):
+            from splatedit.io._plysummary import read_ply_summary
+            summary = read_ply_summary(src, layout, progress, stored_origin=stored_origin(src))
+            if summary is not None:
+                return summary
+    return CloudSummary.of_cloud(read(path, progress=progress))
 
 
 def is_gaussian_file(path) -> bool:

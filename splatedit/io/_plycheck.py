@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import os
 import warnings
+from typing import NamedTuple
 
 import numpy as np
 import plyfile
@@ -18,6 +19,72 @@ TYPES = {"char": "i1", "int8": "i1", "uchar": "u1", "uint8": "u1", "short": "i2"
           "int16": "i2", "ushort": "u2", "uint16": "u2", "int": "i4", "int32": "i4",
           "uint": "u4", "uint32": "u4", "float": "f4", "float32": "f4", "double": "f8",
           "float64": "f8"}
+
+
+#: how much of a file the header scans read: headers are a few hundred bytes
+HEADER_SCAN_BYTES = 1 << 16
+
+
+class PlyHead(NamedTuple):
+    """The start of a PLY file (:func:`read_head`)."""
+    #: the first HEADER_SCAN_BYTES of the file
+    data: bytes
+    #: offset of ``end_header``
+    end: int
+    #: offset of the body (after the newline ending ``end_header``); -1 when there is none
+    body: int
+    #: file size in bytes
+    size: int
+
+    def lines(self, errors: str = "replace") -> list[str]:
+        """The header lines before ``end_header``, ``ply`` first (UnicodeDecodeError
+        with ``errors="strict"`` for a header that is not ASCII)."""
+        return self.data[:self.end].decode("ascii", errors).splitlines()
+
+
+def read_head(path) -> PlyHead | None:
+    """The header of ``path``, or None when the file cannot be read or does
+    not start with ``ply`` and hold ``end_header`` in its first HEADER_SCAN_BYTES."""
+    try:
+        with open(path, "rb") as fh:
+            data = fh.read(HEADER_SCAN_BYTES)
+            size = os.fstat(fh.fileno()).st_size
+    except OSError:
+        return None
+    end = data.find(b"end_header")
+    if not data.startswith(b"ply") or end < 0:
+        return None
+    nl = data.find(b"\n", end)
+    return PlyHead(data, end, -1 if nl < 0 else nl + 1, size)
+
+
+#: the header comment of a PLY we write that carries the cloud's origin:
+#: ``comment splatedit origin X Y Z`` (17 significant digits: exact)
+ORIGIN_COMMENT = "splatedit origin"
+
+
+def origin_comment(origin) -> str:
+    """The comment text (without ``comment``) that stores ``origin`` (3,)."""
+    return ORIGIN_COMMENT + " " + " ".join(f"{float(x):.17g}" for x in origin)
+
+
+def stored_origin(path) -> np.ndarray | None:
+    """(3,) float64 origin of a PLY header's last ``comment splatedit origin
+    X Y Z`` line, or None (no such line, or not three finite numbers).
+    Whether it suits the data is :func:`splatedit.io._build.local_origin`'s
+    decision."""
+    head = read_head(path)
+    if head is None:
+        return None
+    found = None
+    for line in head.lines():
+        w = line.split()
+        if len(w) == 6 and w[0] == "comment" and " ".join(w[1:3]) == ORIGIN_COMMENT:
+            try:
+                found = np.array([float(x) for x in w[3:]])
+            except ValueError:
+                continue
+    return found if found is not None and np.isfinite(found).all() else None
 
 
 def warn_trailing(path, what: str, nv: int, nf: int | None) -> None:
@@ -74,18 +141,11 @@ def check_declared_sizes(path) -> None:
     take: ascii, one character and a separator per scalar property and per
     list length; binary, the scalar sizes and the list length fields.
     Headers this cannot parse are left to plyfile."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-            total = os.fstat(fh.fileno()).st_size
-    except OSError:
-        return
-    end = head.find(b"end_header")
-    nl = head.find(b"\n", end)
-    if not head.startswith(b"ply") or end < 0 or nl < 0:
+    head = read_head(path)
+    if head is None or head.body < 0:
         return
     fmt, elements = None, []
-    for line in head[:end].decode("ascii", "replace").splitlines()[1:]:
+    for line in head.lines()[1:]:
         w = line.split()
         if len(w) >= 2 and w[0] == "format":
             fmt = w[1]
@@ -95,7 +155,7 @@ def check_declared_sizes(path) -> None:
             elements[-1][2] += 2 if fmt == "ascii" else _SIZES[TYPES[w[1]]]
         elif elements and len(w) == 5 and w[0] == "property" and w[1] == "list" and w[2] in TYPES:
             elements[-1][2] += 2 if fmt == "ascii" else _SIZES[TYPES[w[2]]]
-    body = total - (nl + 1)
+    body = head.size - head.body
     need = 0
     for name, count, row in elements:
         need += count * row
@@ -116,17 +176,11 @@ def binary_layout(path):
     reports problems in its own words).  A property declared twice raises
     :class:`InputError`.
     """
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-    except OSError:
-        return None
-    end = head.find(b"end_header")
-    nl = head.find(b"\n", end)
-    if not head.startswith(b"ply") or end < 0 or nl < 0 or head[end:nl].strip() != b"end_header":
+    head = read_head(path)
+    if head is None or head.body < 0 or head.data[head.end:head.body].strip() != b"end_header":
         return None
     try:
-        lines = head[:end].decode("ascii").splitlines()
+        lines = head.lines("strict")
     except UnicodeDecodeError:
         return None
     fmt, elements = None, []
@@ -149,4 +203,4 @@ def binary_layout(path):
     if order is None or len(elements) != 1 or elements[0][0] != "vertex" or not elements[0][2]:
         return None
     dtype = np.dtype([(nm, order + code) for nm, code in elements[0][2]])
-    return nl + 1, elements[0][1], dtype
+    return head.body, elements[0][1], dtype

@@ -131,3 +131,50 @@ def read_bytes(path) -> bytes:
             return fh.read()
     except OSError as exc:
         raise InputError(f"cannot read file: {exc.strerror or exc}", path=str(path)) from None
+
+
+def line_error(message: str, path: str, row: int, line) -> InputError:
+    """An :class:`InputError` for data row ``row`` (0-based) ending in
+    ``(line N)`` (1-based file line), with ``line`` set on it."""
+    err = InputError(f"{message} (line {line})", path=path, row=row)
+    err.line = int(line)
+    return err
+
+
+def point_rows(path, *, columns: tuple[int, ...], expected: str, noun: str, check_count: bool,
+               progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """The rows of a text point file (XYZ, PTS): one point per line, every
+    line with the column count of the first (one of ``columns``).  A first
+    line holding one number equal to the count of the lines after it (the
+    PTS point-count line) is skipped; with ``check_count`` a first line of
+    one number that is not that count is an error.
+
+    Returns:
+        (values (n, ncol) float64, 1-based file line of each row (n,) int)
+    Raises:
+        InputError: an empty file (``zero {noun}``); ``expected {expected},
+            got {ncol}`` for a first row of another width; ``wrong column
+            count`` naming the first row that differs from it.
+    """
+    src = str(path)
+    tab = scan_numbers(read_bytes(path), src, progress=progress)
+    if len(tab) == 0:
+        raise InputError(f"empty file: no data lines (zero {noun})", path=src)
+    start = 0
+    if tab.count[0] == 1 and len(tab) > 1:
+        declared = tab.values[tab.start[0]]
+        if declared == len(tab) - 1:
+            start = 1
+        elif check_count:
+            raise line_error(f"the count line says {declared:g} points but {len(tab) - 1} follow",
+                             src, 0, tab.line[0])
+    count, line = tab.count[start:], tab.line[start:]
+    ncol = int(count[0])
+    if ncol not in columns:
+        raise line_error(f"expected {expected}, got {ncol}", src, 0, line[0])
+    bad = count != ncol
+    if bad.any():
+        row = int(np.flatnonzero(bad)[0])
+        raise line_error(f"wrong column count: expected {ncol} like line {line[0]}, got {count[row]}",
+                         src, row, line[row])
+    return tab.values[tab.start[start]:].reshape(-1, ncol), line

@@ -6,6 +6,9 @@ file's frame and merged; or one scan picked by index with ``file.e57#2``
 0..65535 from the scan's intensity limits, or from its values when the file
 gives none) are kept; without colours, grey from the intensity.  Points of
 invalid cartesian coordinates (``cartesianInvalidState`` != 0) are dropped.
+The first scan's pose translation is the local origin when the points lie
+within ``REBASE_MIN_ABS`` of it (as in the files written here), so a scan
+read, edited and written keeps its origin.
 
 Write: one scan whose pose is a pure translation by the cloud's origin, with
 the local coordinates as its points (pye57 writes the points in single
@@ -49,9 +52,15 @@ def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
     if scan is not None and not 0 <= scan < count:
         raise InputError(f"scan index {scan} out of range 0..{count - 1}", path=src)
     parts = []
+    stored = None           # the first scan's pose translation: the origin we wrote there
     for i in ([scan] if scan is not None else range(count)):
         header = e57.get_header(i)
         names = set(header.point_fields)
+        if stored is None:
+            try:
+                stored = np.asarray(header.translation, dtype=np.float64).reshape(3)
+            except Exception:       # a pose node of another shape: no stored origin
+                stored = np.zeros(3)
         try:
             d = e57.read_scan(i, colors="colorRed" in names, intensity="intensity" in names,
                               transform=True, ignore_missing_fields=True)
@@ -89,7 +98,7 @@ def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
     elif intensity is not None:
         colors = grey_from_intensity(intensity)
     return build_cloud(src if scan is None else f"{src}#{scan}", xyz, colors=colors,
-                       progress=progress, intensity=intensity)
+                       progress=progress, intensity=intensity, stored_origin=stored)
 
 
 def write_e57(fh, cloud: SplatCloud, directory) -> None:

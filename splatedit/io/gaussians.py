@@ -27,7 +27,7 @@ import numpy as np
 import plyfile
 
 from splatedit.errors import InputError
-from splatedit.io._plycheck import check_declared_sizes
+from splatedit.io._plycheck import check_declared_sizes, read_head
 from splatedit.model.gaussians import GaussianCloud, GaussianKind
 
 _DC = ("f_dc_0", "f_dc_1", "f_dc_2")
@@ -43,16 +43,11 @@ _PLY_TYPE = {"i1": "char", "u1": "uchar", "i2": "short", "u2": "ushort", "i4": "
 def _vertex_header(path) -> list[str] | None:
     """Scalar property names of the first ``vertex`` element of a PLY header, or
     None when the file is not a PLY (or its header cannot be parsed here)."""
-    try:
-        with open(path, "rb") as fh:
-            head = fh.read(1 << 16)
-    except OSError:
-        return None
-    end = head.find(b"end_header")
-    if not head.startswith(b"ply") or end < 0:
+    head = read_head(path)
+    if head is None:
         return None
     names, in_vertex = [], False
-    for line in head[:end].decode("ascii", "replace").splitlines():
+    for line in head.lines():
         w = line.split()
         if len(w) == 3 and w[0] == "element":
             if in_vertex:

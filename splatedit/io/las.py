@@ -10,9 +10,16 @@ written back by the LAS writer (same point format; extra bytes with their
 types).  Normals and splat sizes are estimated (LAS has none).
 
 Far coordinates are rebased to an origin on the file's own integer grid:
-``origin = offset + X0 * scale`` for an integer ``X0`` near the centre, and
-the local coordinates are ``(X - X0) * scale``, so writing back with the same
-scale and offset gives back the same integers.
+``origin = offset + X0 * scale``, the local coordinates are ``(X - X0) *
+scale``, so writing back with the same scale and offset gives back the same
+integers.  ``X0`` is 0 (the origin is the offset) when the offset suits the
+points (:func:`splatedit.io._build.fits_origin`: within twice their longest
+side), as in every file splatedit writes (a cloud not read from LAS is
+written with its origin as the offset); else the grid origin of
+:func:`splatedit.io._build.local_origin` moved onto the file's grid.  A cloud
+written back (same scale and offset) is read with the same origin: the
+offset again, or the same grid point unless an edit moved the box centre
+across half a grid step.
 
 Write: point format 3 (RGB) when the cloud has colours of its own, else 1,
 LAS 1.2; formats 7 / 6 and LAS 1.4 when the source file was LAS 1.4-style
@@ -25,7 +32,7 @@ from __future__ import annotations
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.io._build import build_cloud
+from splatedit.io._build import build_cloud, fits_origin, local_origin
 from splatedit.model.cloud import Quantization, SplatCloud, column_bounds
 from splatedit.progress import report
 from splatedit.tolerances import LAS_DEFAULT_SCALE, REBASE_MIN_ABS
@@ -49,6 +56,18 @@ def grey_from_intensity(intensity: np.ndarray) -> np.ndarray | None:
     return out
 
 
+def _origin_step(world_lo, world_hi, scale, offset) -> np.ndarray:
+    """(3,) int64 ``X0`` of the origin ``offset + X0 * scale`` of a far
+    LAS file (world box ``world_lo``..``world_hi``): 0, the offset itself,
+    when it suits the box (:func:`fits_origin`; files we write carry the
+    origin there), else the grid point of :func:`local_origin` moved onto the
+    file's integer grid."""
+    if fits_origin(offset, world_lo, world_hi):
+        return np.zeros(3, dtype=np.int64)
+    grid = local_origin(None, bounds=(world_lo, world_hi))
+    return np.round((grid - offset) / scale).astype(np.int64)
+
+
 def read_las(path, *, progress=None) -> SplatCloud:
     """Read a ``.las`` or ``.laz`` file (see the module docstring)."""
     import laspy
@@ -70,7 +89,7 @@ def read_las(path, *, progress=None) -> SplatCloud:
     lo_i, hi_i = column_bounds(ints)
     world_lo, world_hi = lo_i * scale + offset, hi_i * scale + offset
     if max(np.abs(world_lo).max(), np.abs(world_hi).max()) > REBASE_MIN_ABS:
-        ref = (lo_i + hi_i) // 2
+        ref = _origin_step(world_lo, world_hi, scale, offset)
         origin = offset + ref * scale
         ints -= ref
         positions = ints.astype(np.float64)

@@ -18,7 +18,6 @@ from splatedit.errors import InputError
 from splatedit.io._build import check_finite, colors_from_columns, local_origin, rebase, triangulate
 from splatedit.io._text import read_bytes, scan_numbers
 from splatedit.model.cloud import SplatCloud
-from splatedit.model.mesh import cloud_from_mesh
 
 _KEYWORD = re.compile(r"^(C?)(N?)OFF$")
 
@@ -141,6 +140,7 @@ def read_off(path, *, progress=None) -> SplatCloud:
                      element="face", row=row)
     faces = triangulate(flat, k, nv, src, "face", "vertex_indices", fline)
     origin = local_origin(positions)
+    from splatedit.model.mesh import cloud_from_mesh
     cloud = cloud_from_mesh(rebase(positions, origin), faces, normals=normals, colors=colors,
                             name=Path(path).name, source=src, progress=progress)
     cloud.origin = origin

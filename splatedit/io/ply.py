@@ -8,11 +8,15 @@ properties used: ``x y z`` (required), ``nx ny nz`` (or ``normal_x ...``),
 float), ``radius``, our ``ux uy uz vx vy vz``, and the scan attributes
 ``intensity`` and ``classification`` (kept, not turned into colours: a PLY
 without colours keeps the default material).  Other properties and
-elements are ignored.  A ``face`` element (``vertex_indices`` or
+elements are ignored.  A header line ``comment splatedit origin X Y Z`` (our
+writer's) is the cloud's local origin when it suits the points
+(:func:`splatedit.io._build.local_origin`).  A ``face`` element (``vertex_indices`` or
 ``vertex_index`` list) makes the file a mesh: polygons are fan-triangulated.
 
 Written file layout (binary little endian by default)::
 
+    comment written by splatedit from NAME
+    comment splatedit origin X Y Z                          (if the cloud has a local origin)
     element vertex n
       double x y z            positions, bit-exact
       float  nx ny nz         unit normals, for other tools
@@ -32,7 +36,8 @@ from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
 from splatedit.io._plybinary import _AXES, _COLORS, _NORMALS, read_binary_chunked, scan_columns
 from splatedit.io._plycheck import TYPES as _TYPES
-from splatedit.io._plycheck import binary_layout, check_declared_sizes, check_trailing, warn_trailing
+from splatedit.io._plycheck import (binary_layout, check_declared_sizes, check_trailing, origin_comment,
+                                   stored_origin, warn_trailing)
 from splatedit.io._text import scan_numbers
 from splatedit.model.cloud import SplatCloud
 from splatedit.progress import report
@@ -249,8 +254,9 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     report(progress, "reading", 0.0)
     check_declared_sizes(path)
     layout = binary_layout(path)
+    stored = stored_origin(path)
     if layout is not None:
-        return read_binary_chunked(path, layout, progress)
+        return read_binary_chunked(path, layout, progress, stored_origin=stored)
     fast = _read_ascii_fast(path, progress)
     if fast is not None:
         data, face_lists = fast
@@ -299,7 +305,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     report(progress, "reading", 1.0)
     return build_cloud(path, positions, normals=normals, radius=radius, u=u, v=v,
                        colors=colors, faces=faces, progress=progress, intensity=intensity,
-                       classification=classification)
+                       classification=classification, stored_origin=stored)
 
 
 # ----------------------------------------------------------------- writing
@@ -348,12 +354,15 @@ def _vertex_array(cloud: SplatCloud, dtype: np.dtype, rows: slice = slice(None))
 _PLY_TYPE = {"f8": "double", "f4": "float", "u1": "uchar", "u2": "ushort", "i4": "int"}
 
 
-def _header(dtype: np.dtype, n: int, n_faces: int | None, fmt: str, comment: str | None) -> bytes:
+def _header(dtype: np.dtype, n: int, n_faces: int | None, fmt: str, comment: str | None,
+            origin=None) -> bytes:
     lines = ["ply", f"format {fmt} 1.0"]
     if comment:
         # PLY headers are ASCII: escape anything else (e.g. a file name like été.ply)
         safe = comment.encode("ascii", "backslashreplace").decode("ascii")
         lines += [f"comment {c}" for c in safe.splitlines()]
+    if origin is not None and np.any(origin):
+        lines.append(f"comment {origin_comment(origin)}")     # the last one counts when read
     lines.append(f"element vertex {n}")
     for name in dtype.names:
         lines.append(f"property {_PLY_TYPE[dtype[name].str[1:]]} {name}")
@@ -374,11 +383,15 @@ def write_ply(fh, cloud: SplatCloud, *, binary: bool = True, axes: bool = True,
             writes only positions, colours and faces ("geometry only"); a
             reader then derives the splats again (from the mesh if there are
             faces).
+
+    Positions are world coordinates; a cloud with a local origin also gets
+    the header line ``comment splatedit origin X Y Z``, which the reader
+    takes as the origin again (:func:`splatedit.io._build.local_origin`).
     """
     dtype = _vertex_dtype(cloud, axes, "<")
     faces = cloud.faces
     fh.write(_header(dtype, cloud.n, None if faces is None else len(faces),
-                     "binary_little_endian" if binary else "ascii", comment))
+                     "binary_little_endian" if binary else "ascii", comment, cloud.origin))
     if binary:
         step = max(1, PLY_READ_CHUNK_BYTES // dtype.itemsize)
         for lo in range(0, cloud.n, step):

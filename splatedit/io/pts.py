@@ -11,9 +11,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns
-from splatedit.io._text import read_bytes, scan_numbers
+from splatedit.io._text import line_error, point_rows
 from splatedit.io.las import grey_from_intensity
 from splatedit.model.cloud import SplatCloud
 
@@ -21,37 +20,13 @@ _LAYOUTS = {3: ("x", "y", "z"), 4: ("x", "y", "z", "intensity"), 6: ("x", "y", "
             7: ("x", "y", "z", "intensity", "r", "g", "b")}
 
 
-def _err(msg, src, row, line):
-    err = InputError(f"{msg} (line {line})", path=src, row=row)
-    err.line = int(line)
-    return err
-
-
 def read_pts(path, *, progress=None) -> SplatCloud:
     """Read a ``.pts`` file (see the module docstring)."""
     src = str(path)
-    tab = scan_numbers(read_bytes(path), src, progress=progress)
-    if len(tab) == 0:
-        raise InputError("empty file: no data lines (zero points)", path=src)
-    start = 0
-    if tab.count[0] == 1 and len(tab) > 1:
-        start = 1
-        declared = tab.values[tab.start[0]]
-        if declared != len(tab) - 1:
-            raise _err(f"the count line says {declared:g} points but {len(tab) - 1} follow",
-                       src, 0, tab.line[0])
-    count, line = tab.count[start:], tab.line[start:]
-    ncol = int(count[0])
-    if ncol not in _LAYOUTS:
-        raise _err(f"expected 3, 4, 6 or 7 columns (x y z [intensity] [r g b]), got {ncol}",
-                   src, 0, line[0])
-    bad = count != ncol
-    if bad.any():
-        row = int(np.flatnonzero(bad)[0])
-        raise _err(f"wrong column count: expected {ncol} like line {line[0]}, got {count[row]}",
-                   src, row, line[row])
-    vals = tab.values[tab.start[start]:].reshape(-1, ncol)
-    names = _LAYOUTS[ncol]
+    vals, line = point_rows(path, columns=tuple(_LAYOUTS), noun="points", check_count=True,
+                            expected="3, 4, 6 or 7 columns (x y z [intensity] [r g b])",
+                            progress=progress)
+    names = _LAYOUTS[vals.shape[1]]
     cols = {nm: vals[:, j] for j, nm in enumerate(names)}
     check_finite(cols, src, None, line)
     intensity = colors = None
@@ -62,8 +37,8 @@ def read_pts(path, *, progress=None) -> SplatCloud:
         bad = (raw < 0) | (raw > 65535) | (raw != np.floor(raw))
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
-            raise _err(f"intensity {cols['intensity'][row]:g} is not an integer in -2048..65535",
-                       src, row, line[row])
+            raise line_error(f"intensity {cols['intensity'][row]:g} is not an integer in -2048..65535",
+                             src, row, line[row])
         intensity = raw.astype(np.uint16)
     if "r" in cols:
         rgb = [np.rint(cols[c]).astype(np.int64) for c in "rgb"]

@@ -215,6 +215,11 @@ class SplatCloud:
         nrm = np.cross(self.u, self.v)
         return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
+    def normals_at(self, rows) -> np.ndarray:
+        """(m, 3) float64 unit normals of the splats ``rows`` (indices or a mask)."""
+        nrm = np.cross(self.u[rows], self.v[rows])
+        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
     @property
     def radii(self) -> np.ndarray:
         """(n,) float64, the larger semi-axis of every splat (model units)."""

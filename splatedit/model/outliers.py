@@ -117,7 +117,7 @@ def detect_outliers(points, k: int = OUTLIER_NEIGHBOURS, ratio: float = OUTLIER_
 
 
 def stray_clusters(points, radius: float, *, k: int = OUTLIER_NEIGHBOURS,
-                   max_fraction: float = STRAY_CLUSTER_MAX_REL) -> np.ndarray:
+                   max_fraction: float = STRAY_CLUSTER_MAX_REL, neighbours=None) -> np.ndarray:
     """(n,) bool: points of small pieces of the cloud, far from the rest.
 
     Args:
@@ -128,6 +128,9 @@ def stray_clusters(points, radius: float, *, k: int = OUTLIER_NEIGHBOURS,
         k: neighbours per point.
         max_fraction: pieces with at most this fraction of the points are
             strays; the largest piece never is.
+        neighbours: optional (dist, idx), (n, >= k + 1) sorted distances and
+            indices of a k-NN query that includes the point itself
+            (:func:`splatedit.model.estimate.knn`); saves the query.
     """
     from scipy.sparse import coo_matrix
     from scipy.sparse.csgraph import connected_components
@@ -137,8 +140,11 @@ def stray_clusters(points, radius: float, *, k: int = OUTLIER_NEIGHBOURS,
     if n < 3 or not np.isfinite(radius):
         return out
     kk = int(min(k, n - 1))
-    d, j = cKDTree(pts).query(pts, k=kk + 1, workers=-1)
-    d, j = d[:, 1:].ravel(), j[:, 1:].ravel()
+    if neighbours is None:
+        d, j = cKDTree(pts).query(pts, k=kk + 1, workers=-1)
+    else:
+        d, j = neighbours
+    d, j = d[:, 1:kk + 1].ravel(), j[:, 1:kk + 1].ravel()
     i = np.repeat(np.arange(n), kk)
     keep = d <= radius
     graph = coo_matrix((np.ones(int(keep.sum()), np.int8), (i[keep], j[keep])), shape=(n, n))

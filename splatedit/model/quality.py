@@ -10,6 +10,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import knn
 from splatedit.model.outliers import OutlierFlags, detect_outliers, stray_clusters
 from splatedit.model.sizing import boundary_points, mesh_boundary_vertices, neighbour_indices
+from splatedit.model.spacing import point_spacing
 from splatedit.tolerances import INFO_SAMPLE_POINTS, OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS
 
 
@@ -25,12 +26,15 @@ class CloudQuality:
         radius_max_rel_median: the largest splat radius over the median radius.
         stray_clusters: (n,) bool, points of small far pieces that are not
             already outliers (see :func:`~splatedit.model.outliers.stray_clusters`).
+        spacing: :func:`~splatedit.model.spacing.point_spacing` of the
+            positions (from the same k-NN query).
     """
 
     outliers: OutlierFlags
     boundary: np.ndarray
     radius_max_rel_median: float
     stray_clusters: np.ndarray
+    spacing: float = 0.0
 
     @property
     def boundary_count(self) -> int:
@@ -44,8 +48,9 @@ def assess(cloud: SplatCloud) -> CloudQuality:
     radii = cloud.radii
     spread = float(radii.max() / np.median(radii))
     if n < 3:
-        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread, np.zeros(n, dtype=bool))
-    # one k-NN query serves the outlier test and the boundary test
+        return CloudQuality(detect_outliers(pts), np.zeros(n, dtype=bool), spread, np.zeros(n, dtype=bool),
+                            point_spacing(pts))
+    # one k-NN query serves the spacing, the outlier, boundary and stray-cluster tests
     dist, idx = knn(pts, max(SIZE_NEIGHBOURS, OUTLIER_NEIGHBOURS + 1))
     flags = detect_outliers(pts, distances=dist)
     if cloud.faces is not None and len(cloud.faces):
@@ -53,8 +58,8 @@ def assess(cloud: SplatCloud) -> CloudQuality:
     else:
         nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, n), neighbours=idx)
         boundary = boundary_points(pts, cloud.normals, nb)
-    strays = stray_clusters(pts, flags.isolation_radius) & ~flags.mask
-    return CloudQuality(flags, boundary, spread, strays)
+    strays = stray_clusters(pts, flags.isolation_radius, neighbours=(dist, idx)) & ~flags.mask
+    return CloudQuality(flags, boundary, spread, strays, point_spacing(pts, nearest=dist[:, 1]))
 
 
 @dataclass(frozen=True)
@@ -78,10 +83,12 @@ class QualityEstimate:
     sample_points: int
 
 
-def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
+def estimate_quality(cloud, target: int = INFO_SAMPLE_POINTS,
                      lower=None) -> QualityEstimate | None:
-    """:class:`QualityEstimate` of ``cloud`` without an all-points k-NN, or
-    None when the patches give no usable points (then use :func:`assess`).
+    """:class:`QualityEstimate` of ``cloud`` (a SplatCloud or a
+    :class:`~splatedit.model.summary.CloudSummary`: ``n``, ``positions``,
+    ``faces`` and ``normals_at(rows)``) without an all-points k-NN, or None
+    when the patches give no usable points (then use :func:`assess`).
     ``lower``: the bounding box's lower corner, if known."""
     from splatedit.model.sample import patch_sample
     n = cloud.n
@@ -105,9 +112,7 @@ def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
     if cloud.faces is not None and len(cloud.faces):
         boundary = int(mesh_boundary_vertices(n, cloud.faces).sum())
     else:
-        sel = ps.index
-        nrm = np.cross(cloud.u[sel], cloud.v[sel])
-        nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+        nrm = cloud.normals_at(ps.index)
         nb = neighbour_indices(pts, min(SIZE_NEIGHBOURS, len(pts)), neighbours=idx)
         bnd = boundary_points(pts, nrm, nb)
         boundary = int(round(bnd[exact].sum() * scale))

@@ -25,18 +25,20 @@ def nearest_neighbour_distances(points: np.ndarray, k: int = 1, tree: cKDTree | 
     return d[:, k]
 
 
-def point_spacing(points: np.ndarray, tree: cKDTree | None = None) -> float:
+def point_spacing(points: np.ndarray, tree: cKDTree | None = None, nearest=None) -> float:
     """Typical sample spacing: the median distance of every point to its
     nearest point at a *different* position (model units).
 
     Coincident points (an unwelded triangle soup stores every vertex several
     times) are looked through: the spacing is that of the distinct
-    positions.  Returns 0.0 for fewer than 2 distinct points.
+    positions.  Returns 0.0 for fewer than 2 distinct points.  ``nearest``:
+    the (n,) distances to the nearest other point if known (column 1 of a
+    k-NN query that includes the point itself; saves the query).
     """
     pts = np.asarray(points, dtype=np.float64)
     if len(pts) < 2:
         return 0.0
-    d = nearest_neighbour_distances(pts, 1, tree)
+    d = nearest_neighbour_distances(pts, 1, tree) if nearest is None else np.asarray(nearest)
     if (d > 0).mean() >= 0.5:       # the common case: few duplicates
         d = d[d > 0]
         return float(np.median(d)) if len(d) else 0.0

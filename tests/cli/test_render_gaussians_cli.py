@@ -30,8 +30,10 @@ def gs_file(scene, tmp_path, monkeypatch):
     """A path whose 'reading' gives the Gaussian scene (until the 3DGS reader lands)."""
     path = tmp_path / "scene.ply"
     path.write_bytes(b"stand-in")
-    real = cli._read_model
-    monkeypatch.setattr(cli, "_read_model", lambda p, progress: scene if str(p) == str(path) else real(p, progress))
+    from splatedit.commands import render
+    real = render._read_model
+    monkeypatch.setattr(render, "_read_model",
+                        lambda p, progress: scene if str(p) == str(path) else real(p, progress))
     return path
 
 

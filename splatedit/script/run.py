@@ -1,0 +1,242 @@
+"""Running edit scripts on a splat cloud (CPU path): each edit's regions
+resolved to masks and matrices, its deformation basis fitted and committed,
+and the :class:`EditReport` the CLI prints."""
+
+from __future__ import annotations
+
+import time
+from dataclasses import dataclass, field
+from typing import Callable
+
+import numpy as np
+
+from splatedit.deform.distortion import DistortionStats, distortion_from_axes
+from splatedit.deform.modes import DeformationMode
+from splatedit.errors import EditScriptError, InputError, SplatEditError
+from splatedit.script.model import Edit, EditScript, SolverSettings
+from splatedit.script.parse import _Ctx
+from splatedit.select.regions import Indices, Region
+
+
+@dataclass
+class EditReport:
+    """What one edit did (printed by the CLI)."""
+    index: int
+    support: int
+    handles: list[int]
+    constraints: int
+    centers: int
+    residual: float
+    method: str
+    fit_seconds: float
+    basis_seconds: float
+    max_displacement: float
+    notes: list[str] = field(default_factory=list)
+    #: per curve: (picked points, kept samples)
+    curves: list[tuple[int, int]] = field(default_factory=list)
+    #: splats the selection closure added (support and handles)
+    closure_added: int = 0
+    #: warnings for the user (conflicting constraints), one sentence each
+    warnings: list[str] = field(default_factory=list)
+    #: distortion of the support splats (splatedit.deform.distortion): per-splat
+    #: stretch max(s1, 1/s2) and area change s1 s2 of the committed axes
+    distortion: DistortionStats | None = None
+    #: the edit's deformation mode ("rotation", "linear", "detail")
+    mode: str = DeformationMode.ROTATION.value
+
+    def distortion_line(self) -> str:
+        """``  distortion: stretch max 1.84x, 0 > 3x, 0 > 4x, area change 0.71..2.30``."""
+        if self.distortion is None:
+            return ""
+        return f"  distortion: {self.distortion.summary()}"
+
+    def distortion_warning(self) -> str | None:
+        """The warning text when splats are stretched beyond the warn threshold, else None."""
+        d = self.distortion
+        if d is None or not d.exceeds_warn:
+            return None
+        return (f"edit {self.index} stretches {d.n_above_warn} of {d.n} support splats "
+                f"({100.0 * d.fraction_above_warn:.1f} %) more than {d.warn:g}x "
+                f"({d.n_above_broken} more than {d.broken:g}x, max {d.max_stretch:.2f}x): "
+                f"expect blurred detail and holes there; use a larger support or a milder transform")
+
+    def line(self) -> str:
+        hs = "+".join(map(str, self.handles))
+        notes = f" ({'; '.join(self.notes)})" if self.notes else ""
+        closed = f" (closure added {self.closure_added})" if self.closure_added else ""
+        groups = [f"handle {hs}"] if self.handles else []
+        groups += [f"curve {k} points/{n} samples" for k, n in self.curves]
+        return (f"edit {self.index}: {self.mode} deformation, support {self.support} splats{closed}, {', '.join(groups)}, "
+                f"{self.constraints} constraints, {self.method} with {self.centers} centers "
+                f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
+                f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
+
+
+def resolve_edit(cloud, edit: Edit, source: str | None = None):
+    """Masks and matrices of one edit on ``cloud``.
+
+    Returns:
+        (support (n,) bool, handles list of (n,) bool, matrices list of (4,4) float64)
+    Raises:
+        EditScriptError: a region selects nothing or indexes past the cloud.
+    """
+    ctx = _Ctx(source)
+    n = cloud.n
+
+    def mask(region: Region, jp: str) -> np.ndarray:
+        if isinstance(region, Indices) and max(region.indices) >= n:
+            bad = next(i for i, x in enumerate(region.indices) if x >= n)
+            raise ctx.fail(f"{jp}.indices[{bad}]", f"index {region.indices[bad]} is out of range (the model has {n} splats)")
+        return region.mask(cloud.positions)
+
+    support = mask(edit.support, f"{edit.json_path}.support")
+    if not support.any():
+        raise ctx.fail(f"{edit.json_path}.support", "selects no splat")
+    handles, matrices = [], []
+    single = len(edit.handles) == 1
+    for k, (h, t) in enumerate(zip(edit.handles, edit.transforms)):
+        jp = f"{edit.json_path}.handle" if single else f"{edit.json_path}.handles[{k}]"
+        hm = mask(h, jp) & support
+        if not hm.any():
+            raise ctx.fail(jp, "selects no splat inside the support")
+        handles.append(hm)
+        matrices.append(t.matrix(cloud.positions[hm].mean(axis=0)))
+    return support, handles, matrices
+
+
+@dataclass
+class ResolvedEdit:
+    """One edit resolved on a cloud: everything ``DeformationBasis.fit`` and
+    ``DeformationBasis.displacement`` need.
+
+    Attributes:
+        support: (n,) bool mask.
+        handles: list of (n,) bool masks (inside the support).
+        matrices: one (4, 4) affine matrix per handle.
+        curves: one :class:`~splatedit.deform.curves.ControlCurve` per curve.
+        curve_moves: per curve, the (k + 1, 3) control-point displacements
+            that move its picked points by the script's ``move``.
+    """
+    support: np.ndarray
+    handles: list
+    matrices: list
+    curves: list
+    curve_moves: list
+    fill_holes: bool = True
+    deformation: DeformationMode = DeformationMode.ROTATION
+
+    @property
+    def inputs(self) -> list:
+        """Per-group inputs of ``DeformationBasis.displacement`` (handles, then curves)."""
+        return list(self.matrices) + list(self.curve_moves)
+
+
+def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> ResolvedEdit:
+    """Masks, matrices and control curves of one edit on ``cloud``.
+
+    Raises:
+        EditScriptError: a region selects nothing or indexes past the cloud;
+            a bad curve (JSON path of the curve).
+    """
+    support, handles, matrices = resolve_edit(cloud, edit, source)
+    curves, moves = [], []
+    for j, c in enumerate(edit.curves):
+        try:
+            cc = c.control_curve()
+            moves.append(cc.control_displacement(np.array(c.move, dtype=np.float64)))
+        except SplatEditError as exc:
+            raise EditScriptError(str(exc), json_path=f"{edit.json_path}.curves[{j}]",
+                                  path=source) from None
+        curves.append(cc)
+    return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes, edit.deformation)
+
+
+def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
+             tol: float | None = None, source: str | None = None, progress=None):
+    """Resolve one edit on ``cloud`` and fit its deformation basis.
+
+    ``method``/``tol`` override ``solver`` when given.
+    Returns:
+        (ResolvedEdit, DeformationBasis, displacement): the displacement is what
+        ``DeformationBasis.displacement`` returns in the edit's mode (a (K, 3)
+        dC for "linear", a RotationDisplacement for "rotation")
+    Raises:
+        EditScriptError: bad regions/curves, or a fit that failed (JSON path of the edit).
+    """
+    from splatedit.deform.basis import DeformationBasis
+    from splatedit.deform.constraints import CurveSamplesError
+
+    r = resolve_edit_inputs(cloud, edit, source)
+    fit = DeformationBasis.fit
+    if r.deformation is DeformationMode.DETAIL:
+        from splatedit.deform.detail import DetailBasis
+        fit = DetailBasis.fit
+    try:
+        basis = fit(cloud, r.support, r.handles, curves=r.curves,
+                                     method=method or solver.method,
+                                     tol=solver.tol if tol is None else tol,
+                                     max_centers=solver.max_centers, fill_holes=r.fill_holes,
+                                     progress=progress)
+        d_c = basis.displacement(r.inputs, mode=edit.deformation)
+    except CurveSamplesError as exc:
+        jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")
+        raise EditScriptError(str(exc).split(": ", 1)[1], json_path=jp, path=source) from None
+    except SplatEditError as exc:
+        raise EditScriptError(str(exc), json_path=edit.json_path, path=source) from None
+    return r, basis, d_c
+
+
+def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
+    """Why committing an edit failed validation.  A splat inside the support
+    was squashed by the deformation; a splat outside it was not touched, so
+    the model as a whole became too large for it (splat axes must be longer
+    than MIN_AXIS_LENGTH_REL of the diagonal) or beyond MAX_COORDINATE_ABS:
+    say how far the edit moves things instead of blaming that splat."""
+    row = exc.row
+    if row is not None and row in set(np.asarray(basis.indices).tolist()):
+        return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
+                "use a milder transform")
+    d_c = getattr(d_c, "dC", d_c)    # a RotationDisplacement: its residual dC
+    move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
+    return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
+            f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
+            f"({exc.reason}); use a milder transform")
+
+
+def run_script(cloud, script: EditScript, *, method: str | None = None, tol: float | None = None,
+               source: str | None = None, progress=None,
+               on_edit: Callable[[EditReport], None] | None = None):
+    """Apply every edit of ``script`` to ``cloud`` in order (CPU path).
+
+    ``method``/``tol`` override the script's solver settings when given.
+    Returns:
+        (deformed SplatCloud, list of EditReport)
+    """
+    reports = []
+    for i, edit in enumerate(script.edits):
+        r, basis, d_c = fit_edit(cloud, edit, script.solver, method=method, tol=tol,
+                                 source=source, progress=progress)
+        t0 = time.perf_counter()
+        try:   # commit validates: an extreme edit must not write an unreadable model
+            new = basis.commit(cloud, d_c)
+        except InputError as exc:
+            raise EditScriptError(_degenerate_message(cloud, basis, d_c, exc), json_path=edit.json_path,
+                                  path=source) from None
+        disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
+        i_sup = basis.indices
+        dist = distortion_from_axes(cloud.u[i_sup], cloud.v[i_sup], new.u[i_sup], new.v[i_sup])
+        stats = basis.stats
+        con = basis.constraints
+        rep = EditReport(i, len(con.support_index), [len(h) for h in con.handle_index], stats["n_constraints"],
+                         stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
+                         stats["basis_seconds"] + (time.perf_counter() - t0), disp,
+                         [stats["message"]] if stats.get("message") else [],
+                         [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
+                         stats.get("closure_added", 0),
+                         [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts],
+                         dist, DeformationMode(edit.deformation).value)
+        reports.append(rep)
+        if on_edit is not None:
+            on_edit(rep)
+        cloud = new
+    return cloud, reports
