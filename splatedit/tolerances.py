@@ -813,3 +813,19 @@ EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
 #: a step's chunk grows at most this factor at a time (the first steps' times
 #: include pipeline creation and are not representative of the cost per splat)
 EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
+
+# ---------------------------------------------------------------------------
+# Tiled estimation of large raw clouds (issue 11 part 4)
+# ---------------------------------------------------------------------------
+#: points per k-d tree tile of splatedit.model.tiles.tiled_knn (its cells and
+#: their halo are queried against one small tree)
+TILE_POINTS = 65536
+#: mean points per occupied octree cell of the tiles (the halo is one cell wide)
+TILE_CELL_POINTS = 64
+#: a tiled k-th distance counts as exact only below (1 - this) times its bound
+#: (the bound comes from float64 grid coordinates, exact to ~1e-16 relative)
+TILE_EXACT_MARGIN_REL = 1e-9
+#: points per chunk of the orientation's forest and edge passes
+#: (splatedit.model.orient): its (m, k, 3) float64 normal gather is 100 MB at
+#: 2^19 points and k = 8
+ORIENT_CHUNK_POINTS = 1 << 19
