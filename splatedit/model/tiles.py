@@ -27,6 +27,8 @@ in cache (see docs/PERFORMANCE.md, "10M raw points").
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass
 
 import numpy as np
@@ -131,7 +133,7 @@ class TiledKnnStats:
 
 def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | None = None,
               tile_points: int = TILE_POINTS, cell_points: float = TILE_CELL_POINTS,
-              progress=None, stats: TiledKnnStats | None = None) -> tuple[np.ndarray, np.ndarray]:
+              threads: int = -1, progress=None, stats: TiledKnnStats | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Exact k nearest neighbours (the point itself included) of Morton-sorted points.
 
     Args:
@@ -141,6 +143,8 @@ def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | No
             there too: (3,) float64 grid corner, grid steps per model unit).
         k: neighbours per point, clamped to n.
         dist_columns: keep this many leading distance columns (default k).
+        threads: tiles processed at once (-1: one per CPU); each tile's tree
+            is built and queried without the GIL.
     Returns:
         dist (n, kd) float32 sorted distances (model units) and idx (n, k)
         int32 (int64 from 2^31 points) indices into ``points``: the same as
@@ -155,14 +159,15 @@ def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | No
     idx = np.empty((n, k), dtype=np.int32 if n < 2 ** 31 else np.int64)
     if n == 0:
         return dist, idx
+    threads = (os.cpu_count() or 1) if threads < 0 else threads
     level = fine_level(codes, cell_points) if scale > 0 else 0
     stats.level = level
     todo = None                                  # None: every point
     while True:
         grid = cell_grid(codes, level, scale) if level > 0 else \
             CellGrid(0, np.zeros(1, np.uint64), np.array([0, n], np.int64), np.inf)
-        todo = _level_pass(pts, np.asarray(lo, np.float64), scale, grid, k, kd, todo, tile_points, dist, idx, stats,
-                           progress if todo is None else None)
+        todo = _level_pass(pts, np.asarray(lo, np.float64), scale, grid, k, kd, todo, tile_points,
+                           dist, idx, stats, threads, progress if todo is None else None)
         if len(todo) == 0:
             return dist, idx
         stats.retried += len(todo)
@@ -170,7 +175,7 @@ def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | No
 
 
 def _level_pass(pts, lo, scale, grid: CellGrid, k, kd, todo, tile_points, dist, idx,
-                stats: TiledKnnStats, progress) -> np.ndarray:
+                stats: TiledKnnStats, threads: int, progress) -> np.ndarray:
     """Query ``todo`` (sorted (m,) int64 point indices, None for all) on
     ``grid``'s tiles; return those whose answer is not provably exact."""
     n = len(pts)
@@ -185,34 +190,43 @@ def _level_pass(pts, lo, scale, grid: CellGrid, k, kd, todo, tile_points, dist, 
     # tiles: runs of query cells holding about tile_points points in all
     tile_of = np.cumsum(counts[qcells]) // max(int(tile_points), 1)
     cut = np.concatenate([[0], np.flatnonzero(np.diff(tile_of)) + 1, [len(qcells)]])
-    failed = []
     steps = 2 ** (_BITS - grid.level)
-    for t in range(len(cut) - 1):
+
+    def tile(t):
         tc = qcells[cut[t]:cut[t + 1]]
         if todo is None:
-            q = np.arange(grid.start[tc[0]], grid.start[tc[-1] + 1])
+            q = slice(int(grid.start[tc[0]]), int(grid.start[tc[-1] + 1]))
+            qi = np.arange(q.start, q.stop)
         else:
-            q = todo[qstart[cut[t]]:qstart[cut[t + 1]]]
+            q = qi = todo[qstart[cut[t]]:qstart[cut[t + 1]]]
         cand = _ranges(grid.start, grid.neighbourhood(tc)) if grid.level > 0 else np.arange(n)
-        stats.tiles += 1
-        stats.tree_points += len(cand)
-        local = pts[cand]
         kk = min(k, len(cand))
-        d, i = cKDTree(local, balanced_tree=False).query(pts[q], k=kk, workers=-1)
-        d, i = d.reshape(len(q), kk), i.reshape(len(q), kk)
+        d, i = cKDTree(pts[cand], balanced_tree=False).query(pts[q], k=kk, workers=inner)
+        d, i = d.reshape(len(qi), kk), i.reshape(len(qi), kk)
         if kk < k:                               # too few points around: not exact
-            d = np.concatenate([d, np.full((len(q), k - kk), np.inf)], axis=1)
-            i = np.concatenate([i, np.zeros((len(q), k - kk), i.dtype)], axis=1)
+            d = np.concatenate([d, np.full((len(qi), k - kk), np.inf)], axis=1)
+            i = np.concatenate([i, np.zeros((len(qi), k - kk), i.dtype)], axis=1)
         dist[q] = d[:, :kd]
         idx[q] = cand[i]
+        bad = None
         if grid.level > 0:
             g = (pts[q] - lo) * scale / steps
             frac = g - np.floor(g)
             wall = np.minimum(frac, 1.0 - frac).min(axis=1)
             bound = (1.0 + wall) * grid.width * (1.0 - TILE_EXACT_MARGIN_REL)
-            bad = ~(d[:, k - 1] < bound)
-            if bad.any():
-                failed.append(q[bad])
-        report(progress, "finding neighbours", float(q[-1] + 1) / n if todo is None else 1.0)
+            bad = qi[~(d[:, k - 1] < bound)]
+        return len(cand), int(qi[-1]) + 1, bad
+
+    ntiles = len(cut) - 1
+    threads = min(max(int(threads), 1), ntiles)
+    inner = 1 if threads > 1 else -1             # threads over tiles, or over one tile's queries
+    failed = []
+    with ThreadPoolExecutor(threads) as pool:
+        for ncand, end, bad in pool.map(tile, range(ntiles)):
+            stats.tiles += 1
+            stats.tree_points += ncand
+            if bad is not None and len(bad):
+                failed.append(bad)
+            report(progress, "finding neighbours", end / n if todo is None else 1.0)
     return np.concatenate(failed) if failed else np.zeros(0, np.int64)
 
