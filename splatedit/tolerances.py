@@ -825,7 +825,17 @@ TILE_CELL_POINTS = 64
 #: a tiled k-th distance counts as exact only below (1 - this) times its bound
 #: (the bound comes from float64 grid coordinates, exact to ~1e-16 relative)
 TILE_EXACT_MARGIN_REL = 1e-9
-#: points per chunk of the orientation's forest and edge passes
-#: (splatedit.model.orient): its (m, k, 3) float64 normal gather is 100 MB at
-#: 2^19 points and k = 8
-ORIENT_CHUNK_POINTS = 1 << 19
+#: points per chunk of the orientation's forest pass (splatedit.model.orient;
+#: a piece of the safe-edge forest ends at a chunk border).  1M bunny points,
+#: CPU seconds / pieces / piece-graph edges: 2^16 0.90 / 783 / 1475, 2^17 0.97
+#: / 609, 2^18 0.97 / 472, 2^19 1.14 / 373, one chunk 1.26 / 264 (all 100%
+#: outward): the MST over a few thousand pieces costs nothing and a chunk's
+#: temporaries (~200 bytes a point) stay ~13 MB
+ORIENT_CHUNK_POINTS = 1 << 16
+#: tests/model/test_tiles.py: traced numpy peak of estimate_splats on 1M raw
+#: bunny points, above the input, per point.  Measured (tracemalloc, same
+#: session): 245 bytes on this branch (156 of them the sorted points, k-NN
+#: table and distances, normals and order; 48 the output u and v; ~70 a
+#: fixed ~70 MB of per-chunk temporaries, so the figure falls with n)
+#: against 494 before the tiled estimation
+ESTIMATE_PEAK_EXTRA_BYTES_PER_POINT = 300

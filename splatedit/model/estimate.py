@@ -220,7 +220,9 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     # only a splat above the boundary cap can be changed by it: test just those
     test = np.flatnonzero(r > BOUNDARY_CAP_REL_NEIGHBOURS * local)
     boundary = np.zeros(n, dtype=bool)
-    boundary[test] = boundary_points(pts, normals, nb, query=test)
+    for lo in range(0, len(test), ESTIMATE_CHUNK_POINTS):     # its (m, k, 3) gathers in chunks
+        part = test[lo:lo + ESTIMATE_CHUNK_POINTS]
+        boundary[part] = boundary_points(pts, normals, nb, query=part)
     r = limit_radii(r, nb, boundary, local=local)
     return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
 
@@ -321,14 +323,16 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
     del codes
     if normals is None:
         nrm = estimate_normals(sp, neighbours=nb, progress=progress)
-        nrm = orient_normals(sp, nrm, neighbours=nb, progress=progress)
+        nrm = orient_normals(sp, nrm, neighbours=nb, progress=progress, inplace=True)
     else:
         nrm = np.asarray(normals, dtype=np.float64)
         if nrm.shape != pts.shape:
             raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
         nrm = fill_missing_normals(sp, nrm[order])
     report(progress, "sizing splats", 0.0)
-    nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
+    for lo_i in range(0, n, ESTIMATE_CHUNK_POINTS):
+        part = nrm[lo_i:lo_i + ESTIMATE_CHUNK_POINTS]
+        part /= np.linalg.norm(part, axis=1, keepdims=True)
     if radius is None:
         r = robust_splat_radii(sp, nrm, distances=dist, neighbours=nb)
     elif np.ndim(radius) == 1:

@@ -36,19 +36,27 @@ from scipy.sparse.csgraph import breadth_first_order, connected_components, mini
 from splatedit.errors import ParameterError
 from splatedit.model.sizing import neighbour_indices
 from splatedit.progress import report
-from splatedit.tolerances import (ORIENT_CHUNK_POINTS, ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS,
+from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, ORIENT_CHUNK_POINTS, ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS,
                                   ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS)
 
 
 def _edges(nrm, nb, lo, hi):
     """Weights ``1 + eps - |cos|`` ((m, k) float32) and negative-dot flags
-    ((m, k) bool) of the k-NN edges of points ``lo:hi``."""
-    dot = np.einsum("ikj,ij->ik", nrm[nb[lo:hi]], nrm[lo:hi])
-    return (1.0 + ORIENT_WEIGHT_EPS - np.abs(dot)).astype(np.float32), dot < 0
+    ((m, k) bool) of the k-NN edges of points ``lo:hi`` (the (m, k, 3)
+    normal gather in sub-chunks of ESTIMATE_CHUNK_POINTS rows)."""
+    w = np.empty((hi - lo, nb.shape[1]), dtype=np.float32)
+    neg = np.empty(w.shape, dtype=bool)
+    for a in range(lo, hi, ESTIMATE_CHUNK_POINTS):
+        b = min(a + ESTIMATE_CHUNK_POINTS, hi)
+        dot = np.einsum("ikj,ij->ik", nrm[nb[a:b]], nrm[a:b])
+        w[a - lo:b - lo] = 1.0 + ORIENT_WEIGHT_EPS - np.abs(dot)
+        neg[a - lo:b - lo] = dot < 0
+    return w, neg
 
 
 def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
-                   neighbours=None, progress=None, chunk: int = ORIENT_CHUNK_POINTS) -> np.ndarray:
+                   neighbours=None, progress=None, chunk: int = ORIENT_CHUNK_POINTS,
+                   inplace: bool = False) -> np.ndarray:
     """Consistently orient normals (see the module docstring).
 
     Args:
@@ -59,6 +67,8 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
         neighbours: optional (n, >= k + 1) integer indices from
             :func:`splatedit.model.estimate.knn` (the point itself included).
         chunk: points per chunk of the forest and edge passes.
+        inplace: flip the rows of ``normals`` itself (a C-contiguous float64
+            array) instead of a copy.
     Returns:
         (n, 3) float64 normals, each equal to ``+-normals[i]``; every
         connected component of the k-NN graph is seeded at its highest point
@@ -66,14 +76,16 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
         the seed normal is nearly horizontal).
     """
     pts = np.ascontiguousarray(points, dtype=np.float64)
-    nrm = np.array(normals, dtype=np.float64)
+    nrm = normals if inplace else np.array(normals, dtype=np.float64)
     n = len(pts)
     if nrm.shape != pts.shape or pts.ndim != 2 or pts.shape[1:] != (3,):
         raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
     if n == 0:
         return nrm
     if n == 1:
-        return -nrm if _seed_flips(pts, nrm, np.zeros(1, np.int64), 1)[1][0] else nrm
+        if _seed_flips(pts, nrm, np.zeros(1, np.int64), 1)[1][0]:
+            nrm *= -1.0
+        return nrm
     report(progress, "orienting normals", 0.0)
     k = int(min(max(k, 1), n - 1))
     if neighbours is None or neighbours.shape[1] < k + 1:
@@ -112,8 +124,8 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
         report(progress, "orienting normals", 0.4 * hi / n)
     # 2. the lightest edge between every pair of pieces, chunk by chunk
     keys, ws, gs = [], [], []
-    for lo in range(0, n, chunk):
-        hi = min(lo + chunk, n)
+    for lo in range(0, n, ESTIMATE_CHUNK_POINTS):
+        hi = min(lo + ESTIMATE_CHUNK_POINTS, n)
         w, neg = _edges(nrm, nb, lo, hi)
         a = np.broadcast_to(lab[lo:hi, None], w.shape)
         b = lab[nb[lo:hi]]

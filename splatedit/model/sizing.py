@@ -181,7 +181,7 @@ def neighbour_median(radii, neighbours) -> np.ndarray:
     ((n, m) int64 indices, m >= 1)."""
     r = np.asarray(radii, dtype=np.float64)
     local = np.empty(len(r))
-    step = 8 * ESTIMATE_CHUNK_POINTS
+    step = ESTIMATE_CHUNK_POINTS
     for lo in range(0, len(r), step):
         local[lo:lo + step] = _row_median(r[neighbours[lo:lo + step]])
     return local
