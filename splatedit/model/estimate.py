@@ -18,6 +18,9 @@
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 from scipy.spatial import cKDTree
 
@@ -106,11 +109,18 @@ def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None
     if neighbours is None or neighbours.shape[1] < k:
         _, neighbours = knn(pts, k, tree=tree, query=idx_q, progress=progress)
     step = ESTIMATE_CHUNK_POINTS
-    for lo in range(0, len(idx_q), step):
+
+    def chunk(lo):
         nbi = neighbours[lo:lo + step, :k]
         cov = neighbourhood_covariances(pts, nbi, centres=pts[idx_q[lo:lo + step]])
         out[lo:lo + step] = smallest_eigenvectors(cov)
-        report(progress, "estimating normals", (lo + len(nbi)) / len(idx_q))
+        return lo + len(nbi)
+
+    # chunks on a thread pool: numpy's gathers and loops run without the GIL
+    starts = range(0, len(idx_q), step)
+    with ThreadPoolExecutor(min(os.cpu_count() or 1, len(starts))) as pool:
+        for end in pool.map(chunk, starts):
+            report(progress, "estimating normals", end / len(idx_q))
     return out
 
 
