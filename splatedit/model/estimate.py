@@ -267,7 +267,8 @@ def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
     return t1 * r[:, None], t2 * r[:, None]
 
 
-def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.ndarray:
+def fill_missing_normals(points, normals, *, tree: cKDTree | None = None,
+                         neighbours=None) -> np.ndarray:
     """Normalise ``normals`` and replace zero-length or non-finite rows by PCA
     normals (:func:`estimate_normals`) turned to agree with the nearest point
     that has a valid normal (when no row is valid, all are estimated and
@@ -275,6 +276,9 @@ def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.
 
     Args:
         points: (n, 3) float64 positions; normals: (n, 3) float64.
+        neighbours: optional (n, >= NORMAL_NEIGHBOURS) k-NN indices of
+            ``points`` (the point itself included), e.g. from
+            :func:`splatedit.model.tiles.tiled_knn`: no k-d tree over all points.
     Returns:
         a new (n, 3) float64 array of unit normals.
     """
@@ -286,10 +290,14 @@ def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.
     out[good] /= ln[good, None]
     if good.all():
         return out
+    if neighbours is not None and neighbours.shape[1] < NORMAL_NEIGHBOURS:
+        neighbours = None
     if not good.any():
-        return orient_normals(pts, estimate_normals(pts, tree=tree), tree=tree)
+        return orient_normals(pts, estimate_normals(pts, tree=tree, neighbours=neighbours),
+                              tree=tree, neighbours=neighbours)
     bad = np.flatnonzero(~good)
-    est = estimate_normals(pts, tree=tree, query=bad)
+    est = estimate_normals(pts, tree=tree, query=bad,
+                           neighbours=None if neighbours is None else neighbours[bad])
     gidx = np.flatnonzero(good)
     _, j = cKDTree(pts[gidx]).query(pts[bad], workers=-1)
     ref = out[gidx[j]]
@@ -338,7 +346,7 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
         nrm = np.asarray(normals, dtype=np.float64)
         if nrm.shape != pts.shape:
             raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
-        nrm = fill_missing_normals(sp, nrm[order])
+        nrm = fill_missing_normals(sp, nrm[order], neighbours=nb)
     report(progress, "sizing splats", 0.0)
     for lo_i in range(0, n, ESTIMATE_CHUNK_POINTS):
         part = nrm[lo_i:lo_i + ESTIMATE_CHUNK_POINTS]
