@@ -206,8 +206,11 @@ def _level_pass(pts, lo, scale, grid: CellGrid, k, kd, todo, tile_points, dist, 
             q = qi = todo[qstart[cut[t]]:qstart[cut[t + 1]]]
         cand = _ranges(grid.start, grid.neighbourhood(tc)) if grid.level > 0 else np.arange(n)
         kk = min(k, len(cand))
-        d, i = cKDTree(pts[cand], balanced_tree=False).query(pts[q], k=kk, workers=inner)
+        # no exact answer lies beyond two cells (the bound below): the search may stop there
+        d, i = cKDTree(pts[cand], balanced_tree=False).query(
+            pts[q], k=kk, workers=inner, distance_upper_bound=2.0 * grid.width)
         d, i = d.reshape(len(qi), kk), i.reshape(len(qi), kk)
+        i[i >= len(cand)] = 0                    # missing neighbours (d = inf): retried below
         if kk < k:                               # too few points around: not exact
             d = np.concatenate([d, np.full((len(qi), k - kk), np.inf)], axis=1)
             i = np.concatenate([i, np.zeros((len(qi), k - kk), i.dtype)], axis=1)
