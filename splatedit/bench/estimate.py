@@ -9,7 +9,8 @@ from (``oriented``: 1.0 is every normal outward), and on Linux the process's
 peak resident memory during the estimation (``peak_rss_gb``, the sampled
 points and their face normals included: the peak is reset after sampling)
 and its rise above the resident memory before it, per point
-(``rss_rise_bytes_per_point``).  When Open3D is installed (the
+(``rss_rise_bytes_per_point``; memory the process had freed before is
+reused without a rise: meaningful in a fresh process, as from the CLI).  When Open3D is installed (the
 optional ``bench`` extra) its ``estimate_normals`` runs on the same points in
 the same run, with its default neighbourhood (30 nearest) and with ours (16),
 and ``ratio_to_open3d`` is our whole estimation over its k = 16 normals alone.

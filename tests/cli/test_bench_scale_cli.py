@@ -24,7 +24,9 @@ def test_bench_estimate_reports_stages_and_full_orientation(capsys):
     assert all(s >= 0 for s in stages) and sum(stages) <= line["total_s"] + 0.05
     assert "open3d_normals_k16_s" in line or "not installed" in line.get("open3d", "")
     if sys.platform == "linux":                  # peak RSS from /proc/self/status
-        assert line["peak_rss_gb"] > 0 and line["rss_rise_bytes_per_point"] > 0
+        assert line["peak_rss_gb"] > 0
+        # a process that freed memory before (this test session) reuses it: the rise can be 0
+        assert line["rss_rise_bytes_per_point"] >= 0
 
 
 def test_bench_render_scale_line_has_upload_frame_and_lod(capsys):
