@@ -17,9 +17,11 @@ whole cloud while everything around it (tree build, gathers) is serial.
    is not in the tree lies outside the 3x3x3 cells around the query's own
    cell, at least ``cell + wall`` away (``wall``: the distance to the nearest
    face of its own cell), so a k-th distance below that bound is exact (ties
-   aside).  The few points that fail (outliers, sparse regions) are queried
-   again on the next coarser octree level (cells twice as large), down to the
-   root, where the tree holds every point.
+   aside).  The few points that fail (points near a cell wall, sparse
+   regions) are queried again on the next coarser octree level (cells twice
+   as large); what is still left after ``TILE_RETRY_LEVELS`` levels (strays
+   far from the surface, whose coarse 3x3x3 blocks would hold most of the
+   surface) is queried against one tree over all points.
 
 Memory is the (n, k) int32 index table and the (n, kd) float32 distance
 columns asked for, plus one small tree per thread; the tiles run on a thread
@@ -41,7 +43,7 @@ from scipy.spatial import cKDTree
 
 from splatedit.model.pca import interleave
 from splatedit.progress import report
-from splatedit.tolerances import TILE_CELL_POINTS, TILE_EXACT_MARGIN_REL, TILE_POINTS
+from splatedit.tolerances import TILE_CELL_POINTS, TILE_EXACT_MARGIN_REL, TILE_POINTS, TILE_RETRY_LEVELS
 
 _BITS = 21
 #: the 27 offsets of a cell's 3x3x3 block
@@ -129,15 +131,18 @@ def _ranges(start: np.ndarray, cells: np.ndarray) -> np.ndarray:
 class TiledKnnStats:
     """What :func:`tiled_knn` did: ``level`` of the fine cells, ``tiles``,
     ``tree_points`` (points in all trees, halos included: the tiles' overhead
-    is ``tree_points / n - 1``), ``retried`` (queries redone on coarser levels)."""
+    is ``tree_points / n - 1``), ``retried`` (queries redone on coarser
+    levels), ``global_queries`` (those left to one tree over all points)."""
     level: int = 0
     tiles: int = 0
     tree_points: int = 0
     retried: int = 0
+    global_queries: int = 0
 
 
 def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | None = None,
               tile_points: int = TILE_POINTS, cell_points: float = TILE_CELL_POINTS,
+              retry_levels: int = TILE_RETRY_LEVELS,
               threads: int = -1, progress=None, stats: TiledKnnStats | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Exact k nearest neighbours (the point itself included) of Morton-sorted points.
 
@@ -150,6 +155,8 @@ def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | No
         dist_columns: keep this many leading distance columns (default k).
         threads: tiles processed at once (-1: one per CPU); each tile's tree
             is built and queried without the GIL.
+        retry_levels: coarser octree levels on which inexact answers are
+            retried before the rest go to one tree over all points.
     Returns:
         dist (n, kd) float32 sorted distances (model units) and idx (n, k)
         int32 (int64 from 2^31 points) indices into ``points``: the same as
@@ -168,15 +175,23 @@ def tiled_knn(points, codes, lo, scale: float, k: int, *, dist_columns: int | No
     level = fine_level(codes, cell_points) if scale > 0 else 0
     stats.level = level
     todo = None                                  # None: every point
-    while True:
-        grid = cell_grid(codes, level, scale) if level > 0 else \
+    for retry in range(retry_levels + 1):
+        grid = cell_grid(codes, level - retry, scale) if level - retry > 0 else \
             CellGrid(0, np.zeros(1, np.uint64), np.array([0, n], np.int64), np.inf)
         todo = _level_pass(pts, np.asarray(lo, np.float64), scale, grid, k, kd, todo, tile_points,
                            dist, idx, stats, threads, progress if todo is None else None)
         if len(todo) == 0:
             return dist, idx
         stats.retried += len(todo)
-        level -= 1
+        if grid.level == 0:
+            break
+    # what is left (strays far from everything: the 3x3x3 blocks of coarse cells
+    # around them hold far more points than their k-NN balls): one tree over all
+    d, i = cKDTree(pts).query(pts[todo], k=k, workers=-1)
+    dist[todo] = d.reshape(len(todo), k)[:, :kd]
+    idx[todo] = i.reshape(len(todo), k)
+    stats.global_queries += len(todo)
+    return dist, idx
 
 
 def _level_pass(pts, lo, scale, grid: CellGrid, k, kd, todo, tile_points, dist, idx,
