@@ -915,3 +915,42 @@ REBASE_GRID_MIN = 1.0
 #: twice the grid origin's reach (one float32 bit), and far enough that an
 #: edit moving the model by a fraction of its size keeps the stored origin
 REBASE_STORED_REACH = 2.0
+# Tiled estimation of large raw clouds (issue 11 part 4)
+# ---------------------------------------------------------------------------
+#: points per k-d tree tile of splatedit.model.tiles.tiled_knn (its cells and
+#: their halo are queried against one small tree).  1M bunny points, k = 16,
+#: CPU seconds / tree points per point (halo overhead), load 6.5: 2^14 2.61 /
+#: 1.34, 2^16 2.74 / 1.18, 2^18 2.98 / 1.07 (one global tree: 2.59 s); 2^16
+#: keeps a tile's tree (~80k points) cache-sized with a small halo
+TILE_POINTS = 65536
+#: mean points per occupied octree cell of the tiles (the halo is one cell
+#: wide, so a cell must be wider than most k-th neighbour distances).  Same
+#: cloud: 64 -> level 7, 1.18 tree points per point, 0 retried queries; 16 ->
+#: level 8, 2.10 and 25,654 retried (cells narrower than the 16-NN radius)
+TILE_CELL_POINTS = 64
+#: a tiled k-th distance counts as exact only below (1 - this) times its bound
+#: (the bound comes from float64 grid coordinates, exact to ~1e-16 relative)
+TILE_EXACT_MARGIN_REL = 1e-9
+#: points per chunk of the orientation's forest pass (splatedit.model.orient;
+#: a piece of the safe-edge forest ends at a chunk border).  1M bunny points,
+#: CPU seconds / pieces / piece-graph edges: 2^16 0.90 / 783 / 1475, 2^17 0.97
+#: / 609, 2^18 0.97 / 472, 2^19 1.14 / 373, one chunk 1.26 / 264 (all 100%
+#: outward): the MST over a few thousand pieces costs nothing and a chunk's
+#: temporaries (~200 bytes a point) stay ~13 MB
+ORIENT_CHUNK_POINTS = 1 << 16
+#: tests/model/test_tiles.py: traced numpy peak of estimate_splats on 1M raw
+#: bunny points, above the input, per point.  Measured (tracemalloc, same
+#: session): 245 bytes on this branch (156 of them the sorted points, k-NN
+#: table and distances, normals and order; 48 the output u and v; ~70 a
+#: fixed ~70 MB of per-chunk temporaries, so the figure falls with n)
+#: against 494 before the tiled estimation
+ESTIMATE_PEAK_EXTRA_BYTES_PER_POINT = 300
+#: coarser octree levels tiled_knn retries inexact answers on before it
+#: queries the rest against one tree over all points.  1M bunny points + 1%
+#: uniform noise + 50 far strays, CPU s / tree points per point / left to the
+#: global tree (one global tree alone: 3.3 s): 0 levels 3.33 / 1.56 / 8,664;
+#: 1: 3.60 / 2.90 / 7,340; 2: 4.30 / 5.4 / 119; retrying all the way to the
+#: root: 5.79 / 13.6 (coarse 3x3x3 blocks around strays hold most of the
+#: surface).  One level resolves the points near a cell wall without a tree
+#: over the whole cloud (poste_france.xyz: 105 retried, 39 left)
+TILE_RETRY_LEVELS = 1

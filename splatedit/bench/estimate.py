@@ -5,8 +5,12 @@ on the bundled bunny mesh (no normals), then
 :func:`splatedit.model.estimate.estimate_splats` with the time of each stage
 (from its progress reports: k-NN, PCA normals, orientation, sizing), the
 share of normals that agree with the normal of the face they were sampled
-from (``oriented``: 1.0 is every normal outward; peak memory: run it under
-``/usr/bin/time -v``).  When Open3D is installed (the
+from (``oriented``: 1.0 is every normal outward), and on Linux the process's
+peak resident memory during the estimation (``peak_rss_gb``, the sampled
+points and their face normals included: the peak is reset after sampling)
+and its rise above the resident memory before it, per point
+(``rss_rise_bytes_per_point``; memory the process had freed before is
+reused without a rise: meaningful in a fresh process, as from the CLI).  When Open3D is installed (the
 optional ``bench`` extra) its ``estimate_normals`` runs on the same points in
 the same run, with its default neighbourhood (30 nearest) and with ours (16),
 and ``ratio_to_open3d`` is our whole estimation over its k = 16 normals alone.
@@ -42,6 +46,28 @@ def bunny_points(n: int, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     return p, cr[tri] / area[tri, None]
 
 
+def _rss_bytes(field: str) -> int | None:
+    """``VmRSS`` / ``VmHWM`` (peak) of this process in bytes (Linux), else None."""
+    try:
+        with open("/proc/self/status") as f:
+            for line in f:
+                if line.startswith(field + ":"):
+                    return int(line.split()[1]) * 1024
+    except OSError:
+        pass
+    return None
+
+
+def _reset_peak_rss() -> bool:
+    """Reset this process's ``VmHWM`` to its current RSS (Linux >= 4.0)."""
+    try:
+        with open("/proc/self/clear_refs", "w") as f:
+            f.write("5")
+        return True
+    except OSError:
+        return False
+
+
 def _open3d_normals(points: np.ndarray, knn: int) -> float | None:
     try:
         import open3d as o3d
@@ -63,15 +89,21 @@ def bench_estimate(counts=(1_000_000,), open3d: bool = True) -> Iterator[dict]:
         def progress(stage, fraction, first=first):
             first.setdefault(stage, time.perf_counter())
 
+        reset = _reset_peak_rss()
+        before = _rss_bytes("VmRSS")
         t0 = time.perf_counter()
         cloud = estimate_splats(pts, progress=progress)
         total = time.perf_counter() - t0
+        peak = _rss_bytes("VmHWM") if reset else None
         marks = [t0] + [first.get(s, t0) for s in _STAGES[1:]] + [t0 + total]
         stages = {f"{s.split()[0]}_s": round(b - a, 2) for s, a, b in zip(_STAGES, marks, marks[1:])}
         oriented = float(np.mean(np.einsum("ij,ij->i", np.cross(cloud.u, cloud.v), face_n) > 0))
         del cloud
         line = {"case": "estimate", "points": n, "total_s": round(total, 2), **stages,
                 "oriented": oriented}
+        if peak is not None and before is not None:
+            line["peak_rss_gb"] = round(peak / 1e9, 2)
+            line["rss_rise_bytes_per_point"] = round((peak - before) / n)
         if open3d:
             o16 = _open3d_normals(pts, NORMAL_NEIGHBOURS)
             if o16 is None:

@@ -5,23 +5,12 @@
   the normal is the eigenvector of the smallest eigenvalue of the 3x3
   neighbourhood covariance, solved in closed form for all points at once
   (:mod:`splatedit.model.pca`; 5x faster than batched ``np.linalg.eigh``).
-* :func:`orient_normals` makes the signs consistent by propagating along the
-  minimum spanning tree of the k-nearest-neighbour "Riemannian graph" with edge
-  weight ``1 - |n_i . n_j|`` (Hoppe et al.): nearly parallel normals are
-  traversed first.  In two levels, which Kruskal's order makes nearly the
-  same tree: edges to the ``ORIENT_FOREST_NEIGHBOURS`` nearest neighbours
-  whose normals are within ``ORIENT_SAFE_ANGLE_DEG`` (whose relative sign is
-  unambiguous) are joined first by a BFS forest, O(n), and the MST runs only
-  over the pieces that forest leaves, on the remaining edges between them
-  (the MST over all n k edges was 2 of the 3 seconds at 1M points).  Each
-  connected component is seeded at its highest point
-  (largest z) whose normal is turned towards +z; on a closed surface the
-  outward normal at the highest point *is* +z, so closed shapes come out
-  outward-facing.  When that seed normal is nearly horizontal
-  (``|n_z| < ORIENT_SEED_MIN_NZ``) it is turned away from the component's
-  centroid instead.  The propagation is vectorised: the flip of a point is the
-  XOR of the edge flips on its tree path to the seed, computed by pointer
-  jumping in O(n log depth).
+* :func:`orient_normals` (:mod:`splatedit.model.orient`) makes the signs
+  consistent by propagating along Hoppe's minimum spanning tree of the k-NN
+  graph with edge weight ``1 - |n_i . n_j|``, in chunks of bounded memory.
+* :func:`estimate_splats` finds all neighbours at once with the exact tiled
+  k-NN of :mod:`splatedit.model.tiles` (small k-d trees per tile instead of
+  one over the whole cloud).
 * :func:`splat_axes` builds an orthonormal tangent frame scaled to a radius
   that closes the surface (see :func:`splat_radii`), capped relative to the
   neighbours' radii and at boundaries (:mod:`splatedit.model.sizing`).
@@ -29,20 +18,25 @@
 
 from __future__ import annotations
 
+import os
+from concurrent.futures import ThreadPoolExecutor
+
 import numpy as np
 from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
+from splatedit.model.orient import orient_normals
 from splatedit.model.outliers import detect_outliers
-from splatedit.model.pca import morton_order, neighbourhood_covariances, smallest_eigenvectors
+from splatedit.model.pca import morton_codes, neighbourhood_covariances, smallest_eigenvectors
 from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
                                     neighbour_indices, neighbour_median)
 from splatedit.model.spacing import nearest_neighbour_distances
+from splatedit.model.tiles import tiled_knn
 from splatedit.progress import report
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
                                   FALLBACK_SPLAT_RADIUS, MIN_SPLAT_RADIUS_REL_MEDIAN, NORMAL_NEIGHBOURS,
-                                  ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS, ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS,
+                                  ORIENT_NEIGHBOURS,
                                   OUTLIER_NEIGHBOURS, SIZE_NEIGHBOURS, SPACING_NEIGHBOUR,
                                   SPLAT_RADIUS_FACTOR)
 
@@ -115,167 +109,19 @@ def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None
     if neighbours is None or neighbours.shape[1] < k:
         _, neighbours = knn(pts, k, tree=tree, query=idx_q, progress=progress)
     step = ESTIMATE_CHUNK_POINTS
-    for lo in range(0, len(idx_q), step):
+
+    def chunk(lo):
         nbi = neighbours[lo:lo + step, :k]
         cov = neighbourhood_covariances(pts, nbi, centres=pts[idx_q[lo:lo + step]])
         out[lo:lo + step] = smallest_eigenvectors(cov)
-        report(progress, "estimating normals", (lo + len(nbi)) / len(idx_q))
+        return lo + len(nbi)
+
+    # chunks on a thread pool: numpy's gathers and loops run without the GIL
+    starts = range(0, len(idx_q), step)
+    with ThreadPoolExecutor(min(os.cpu_count() or 1, len(starts))) as pool:
+        for end in pool.map(chunk, starts):
+            report(progress, "estimating normals", end / len(idx_q))
     return out
-
-
-def _seed_flips(pts, nrm, labels, ncomp):
-    """Seed (highest point) of every component and whether its normal flips."""
-    order = np.lexsort((pts[:, 2], labels))
-    last = np.r_[np.flatnonzero(np.diff(labels[order])), len(order) - 1]
-    seeds = order[last]                                 # component c -> seed, c = 0..ncomp-1
-    nz = nrm[seeds, 2]
-    flip = nz < 0
-    flat = np.abs(nz) < ORIENT_SEED_MIN_NZ
-    if flat.any():
-        cnt = np.bincount(labels, minlength=ncomp).astype(np.float64)
-        centroid = np.stack([np.bincount(labels, pts[:, j], minlength=ncomp) for j in range(3)], 1)
-        centroid /= cnt[:, None]
-        out = np.einsum("ij,ij->i", nrm[seeds], pts[seeds] - centroid)
-        flip = np.where(flat, out < 0, flip)
-    return seeds, flip
-
-
-def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree: cKDTree | None = None,
-                   neighbours=None, progress=None) -> np.ndarray:
-    """Consistently orient normals by MST propagation (Hoppe et al. 1992),
-    after a BFS forest over the safe edges (see the module docstring).
-
-    Args:
-        points: (n, 3) float64 positions (model units).
-        normals: (n, 3) float64 unit normals with arbitrary signs.
-        k: neighbours per point in the Riemannian graph.
-        tree: optional prebuilt ``cKDTree(points)``.
-        neighbours: optional (n, >= k + 1) integer indices from :func:`knn`.
-    Returns:
-        (n, 3) float64 normals, each equal to ``+-normals[i]``; every
-        connected component of the k-NN graph is seeded at its highest point
-        with the normal turned to +z (or away from the component centroid when
-        the seed normal is nearly horizontal).
-    """
-    # scipy.sparse costs 0.2-0.4 s to import: only paths that orient normals pay it
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import connected_components, minimum_spanning_tree
-    pts = _points(points)
-    nrm = np.array(normals, dtype=np.float64)
-    n = len(pts)
-    if nrm.shape != pts.shape:
-        raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
-    if n == 0:
-        return nrm
-    if n == 1:
-        labels = np.zeros(1, dtype=np.int64)
-        _, flip = _seed_flips(pts, nrm, labels, 1)
-        return np.where(flip[:, None], -nrm, nrm)
-    report(progress, "orienting normals", 0.0)
-    k = int(min(max(k, 1), n - 1))
-    if neighbours is None or neighbours.shape[1] < k + 1:
-        _, neighbours = knn(pts, k + 1, tree=tree)
-    nb = neighbour_indices(pts, k + 1, neighbours=neighbours)      # (n, k), self left out
-    w = np.empty(nb.shape, dtype=np.float32)      # 1 - |cos|: float32 resolves 1e-7
-    neg = np.empty(nb.shape, dtype=bool)
-    step = 8 * ESTIMATE_CHUNK_POINTS
-    for lo in range(0, n, step):
-        dot = np.einsum("ikj,ij->ik", nrm[nb[lo:lo + step]], nrm[lo:lo + step])
-        w[lo:lo + step] = 1.0 + ORIENT_WEIGHT_EPS - np.abs(dot)
-        neg[lo:lo + step] = dot < 0
-    report(progress, "orienting normals", 0.2)
-    # 1. "safe" edges (normals within ORIENT_SAFE_ANGLE_DEG): any spanning
-    #    forest of them orients its components; a BFS forest costs O(n).
-    low = w < 1.0 - np.cos(np.radians(ORIENT_SAFE_ANGLE_DEG))
-    low[:, ORIENT_FOREST_NEIGHBOURS:] = False    # the farther safe edges go to the MST phase
-    # the safe graph as CSR straight from the row-major k-NN table, with a
-    # virtual root row n appended later (no COO sort)
-    indptr = np.zeros(n + 2, dtype=np.int64)
-    np.cumsum(low.sum(axis=1), out=indptr[1:n + 1])
-    safe_idx = nb[low]
-    ncl, lab = connected_components(
-        csr_matrix((np.ones(len(safe_idx), np.int8), safe_idx, indptr[:n + 1]), shape=(n, n)),
-        directed=False)
-    rep = np.empty(ncl, dtype=np.int64)
-    rep[lab[::-1]] = np.arange(n - 1, -1, -1)          # first point of every piece
-    indptr[n + 1] = indptr[n] + ncl
-    parent = _forest_parents(n, np.concatenate([safe_idx, rep]), indptr)
-    del safe_idx, indptr
-    body = parent != np.arange(n)
-    rel = np.zeros(n, dtype=bool)                       # flip relative to the piece's root
-    rel[body] = np.einsum("ij,ij->i", nrm[body], nrm[parent[body]]) < 0
-    rel = _path_xor(parent, rel)
-    report(progress, "orienting normals", 0.5)
-    # 2. Hoppe's MST over the pieces, on the remaining edges between them
-    #    (Kruskal over all n k edges is what took 2 s of 3 at 1M points).
-    hi = np.flatnonzero(~low.ravel())
-    hr, hc = hi // k, nb.ravel()[hi]
-    a, b = lab[hr], lab[hc]
-    keep = a != b
-    a, b, hw = a[keep], b[keep], w.ravel()[hi][keep].astype(np.float64)
-    g = neg.ravel()[hi][keep] ^ rel[hr[keep]] ^ rel[hc[keep]]   # flip between the two roots
-    del w, neg, low, hi, hr, hc
-    a, b = np.minimum(a, b), np.maximum(a, b)
-    key = a * ncl + b
-    o = np.lexsort((hw, key))                          # the lightest edge of every pair first
-    first = np.r_[True, key[o][1:] != key[o][:-1]] if len(o) else np.zeros(0, bool)
-    o = o[first]
-    key, a, b, hw, g = key[o], a[o], b[o], hw[o], g[o]
-    qtree = minimum_spanning_tree(csr_matrix((hw, (a, b)), shape=(ncl, ncl))).tocoo()
-    ncomp, qlab = connected_components(qtree, directed=False)
-    labels = qlab[lab]
-    seeds, seed_flip = _seed_flips(pts, nrm, labels, ncomp)
-    qparent = _rooted_forest(ncl, qtree.row, qtree.col, lab[seeds])
-    qbody = np.flatnonzero(qparent != np.arange(ncl))
-    qflip = np.zeros(ncl, dtype=bool)
-    if len(qbody):
-        pa, pb = np.minimum(qbody, qparent[qbody]), np.maximum(qbody, qparent[qbody])
-        qflip[qbody] = g[np.searchsorted(key, pa * ncl + pb)]
-    qflip = _path_xor(qparent, qflip)
-    flip = rel ^ qflip[lab]
-    flip ^= (flip[seeds] ^ seed_flip)[labels]
-    report(progress, "orienting normals", 1.0)
-    nrm[flip] *= -1.0
-    return nrm
-
-
-def _rooted_forest(n: int, rows, cols, roots) -> np.ndarray:
-    """Parent of every node of the forest with edges ``rows``-``cols`` (any
-    direction, (e,) int64) when every tree is hung from its node in
-    ``roots`` ((c,) int64, one per tree); a root is its own parent.  (n,) int64."""
-    order = np.argsort(rows, kind="stable")
-    indptr = np.zeros(n + 2, dtype=np.int64)
-    np.cumsum(np.bincount(rows, minlength=n), out=indptr[1:n + 1])
-    indptr[n + 1] = indptr[n] + len(roots)
-    return _forest_parents(n, np.concatenate([np.asarray(cols)[order], roots]), indptr)
-
-
-def _forest_parents(n: int, indices, indptr) -> np.ndarray:
-    """BFS parents in the undirected graph of CSR ``indices``/``indptr`` over
-    n + 1 nodes whose last row (the virtual root n) lists one root per
-    component; roots (and nodes not reached) are their own parents."""
-    from scipy.sparse import csr_matrix
-    from scipy.sparse.csgraph import breadth_first_order
-    adj = csr_matrix((np.ones(len(indices), np.int8), indices, indptr), shape=(n + 1, n + 1))
-    _, pred = breadth_first_order(adj, n, directed=False, return_predecessors=True)
-    parent = pred[:n].astype(np.int64)
-    own = (parent == n) | (parent < 0)
-    parent[own] = np.flatnonzero(own)
-    return parent
-
-
-def _path_xor(parent: np.ndarray, flag: np.ndarray) -> np.ndarray:
-    """XOR of ``flag`` along every node's path to its root (``parent`` as from
-    :func:`_rooted_forest`), by pointer jumping: O(n log depth)."""
-    flag = flag.copy()
-    parent = parent.copy()
-    while True:
-        grand = parent[parent]
-        if np.array_equal(grand, parent):
-            break
-        flag ^= flag[parent]
-        parent = grand
-    return flag
 
 
 def tangent_frame(normals) -> tuple[np.ndarray, np.ndarray]:
@@ -384,7 +230,9 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     # only a splat above the boundary cap can be changed by it: test just those
     test = np.flatnonzero(r > BOUNDARY_CAP_REL_NEIGHBOURS * local)
     boundary = np.zeros(n, dtype=bool)
-    boundary[test] = boundary_points(pts, normals, nb, query=test)
+    for lo in range(0, len(test), ESTIMATE_CHUNK_POINTS):     # its (m, k, 3) gathers in chunks
+        part = test[lo:lo + ESTIMATE_CHUNK_POINTS]
+        boundary[part] = boundary_points(pts, normals, nb, query=part)
     r = limit_radii(r, nb, boundary, local=local)
     return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
 
@@ -419,7 +267,8 @@ def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,
     return t1 * r[:, None], t2 * r[:, None]
 
 
-def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.ndarray:
+def fill_missing_normals(points, normals, *, tree: cKDTree | None = None,
+                         neighbours=None) -> np.ndarray:
     """Normalise ``normals`` and replace zero-length or non-finite rows by PCA
     normals (:func:`estimate_normals`) turned to agree with the nearest point
     that has a valid normal (when no row is valid, all are estimated and
@@ -427,6 +276,9 @@ def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.
 
     Args:
         points: (n, 3) float64 positions; normals: (n, 3) float64.
+        neighbours: optional (n, >= NORMAL_NEIGHBOURS) k-NN indices of
+            ``points`` (the point itself included), e.g. from
+            :func:`splatedit.model.tiles.tiled_knn`: no k-d tree over all points.
     Returns:
         a new (n, 3) float64 array of unit normals.
     """
@@ -438,10 +290,14 @@ def fill_missing_normals(points, normals, *, tree: cKDTree | None = None) -> np.
     out[good] /= ln[good, None]
     if good.all():
         return out
+    if neighbours is not None and neighbours.shape[1] < NORMAL_NEIGHBOURS:
+        neighbours = None
     if not good.any():
-        return orient_normals(pts, estimate_normals(pts, tree=tree), tree=tree)
+        return orient_normals(pts, estimate_normals(pts, tree=tree, neighbours=neighbours),
+                              tree=tree, neighbours=neighbours)
     bad = np.flatnonzero(~good)
-    est = estimate_normals(pts, tree=tree, query=bad)
+    est = estimate_normals(pts, tree=tree, query=bad,
+                           neighbours=None if neighbours is None else neighbours[bad])
     gidx = np.flatnonzero(good)
     _, j = cKDTree(pts[gidx]).query(pts[bad], workers=-1)
     ref = out[gidx[j]]
@@ -470,33 +326,63 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
     n = len(pts)
     # Work in Morton order (cache-local queries and gathers: 2x faster k-NN
     # at 1M points); the results go back to the caller's order at the end.
-    order = morton_order(pts) if n > 1 else np.arange(n)
+    codes, lo, scale = morton_codes(pts)
+    order = np.argsort(codes, kind="stable") if n > 1 else np.arange(n)
+    codes = codes[order]
     sp = pts[order]
-    tree = cKDTree(sp) if n > 1 else None
     dist = nb = None
-    if n > 1:
+    if n > 1 and (radius is None or normals is None):
         kmax = max(SPACING_NEIGHBOUR + 1, SIZE_NEIGHBOURS)
         if normals is None:
             kmax = max(NORMAL_NEIGHBOURS, ORIENT_NEIGHBOURS + 1, kmax)
-        if radius is None or normals is None:
-            dist, nb = knn(sp, kmax, tree=tree, progress=progress, compact=True,
-                           dist_columns=max(SPACING_NEIGHBOUR, OUTLIER_NEIGHBOURS) + 1)
+        dist, nb = tiled_knn(sp, codes, lo, scale, kmax, progress=progress,
+                             dist_columns=max(SPACING_NEIGHBOUR, OUTLIER_NEIGHBOURS) + 1)
+        _self_first(nb)
+    del codes
     if normals is None:
-        nrm = estimate_normals(sp, tree=tree, neighbours=nb, progress=progress)
-        nrm = orient_normals(sp, nrm, tree=tree, neighbours=nb, progress=progress)
+        nrm = estimate_normals(sp, neighbours=nb, progress=progress)
+        nrm = orient_normals(sp, nrm, neighbours=nb, progress=progress, inplace=True)
     else:
         nrm = np.asarray(normals, dtype=np.float64)
         if nrm.shape != pts.shape:
             raise ParameterError("normals", f"expected shape {pts.shape}, got {nrm.shape}")
-        nrm = fill_missing_normals(sp, nrm[order], tree=tree)
-    rad = radius
-    if radius is not None and np.ndim(radius) == 1:
-        rad = np.asarray(radius, dtype=np.float64)[order]
-    us, vs = splat_axes(sp, nrm, radius=rad, tree=tree, distances=dist, neighbours=nb,
-                        progress=progress)
-    del dist, nb, tree
-    u = np.empty_like(us)
-    v = np.empty_like(vs)
-    u[order] = us
-    v[order] = vs
+        nrm = fill_missing_normals(sp, nrm[order], neighbours=nb)
+    report(progress, "sizing splats", 0.0)
+    for lo_i in range(0, n, ESTIMATE_CHUNK_POINTS):
+        part = nrm[lo_i:lo_i + ESTIMATE_CHUNK_POINTS]
+        part /= np.linalg.norm(part, axis=1, keepdims=True)
+    if radius is None:
+        r = robust_splat_radii(sp, nrm, distances=dist, neighbours=nb)
+    elif np.ndim(radius) == 1:
+        r = np.asarray(radius, dtype=np.float64)[order]
+    else:
+        r = np.broadcast_to(np.asarray(radius, dtype=np.float64), (n,))
+    del dist, nb, sp
+    # the frames chunk by chunk, straight into the caller's order
+    u = np.empty((n, 3))
+    v = np.empty((n, 3))
+    step = 8 * ESTIMATE_CHUNK_POINTS
+    for lo_i in range(0, n, step):
+        t1, t2 = tangent_frame(nrm[lo_i:lo_i + step])
+        rr = r[lo_i:lo_i + step, None]
+        u[order[lo_i:lo_i + step]] = t1 * rr
+        v[order[lo_i:lo_i + step]] = t2 * rr
+    report(progress, "sizing splats", 1.0)
     return SplatCloud(pts, u, v, colors, faces, name=name, source=source)
+
+
+def _self_first(nb: np.ndarray) -> None:
+    """Make every row of a k-NN index table ((n, k) int, from a query that
+    includes the point itself) start with its own point, in place: with
+    duplicate points a duplicate may come first (both at distance 0); the
+    two swap, or, when the point is missing from its row (more than k
+    copies), the first duplicate is replaced by it."""
+    odd = np.flatnonzero(nb[:, 0] != np.arange(len(nb)))
+    if len(odd) == 0:
+        return
+    sub = nb[odd]
+    is_self = sub == odd[:, None]
+    col = np.where(is_self.any(axis=1), is_self.argmax(axis=1), 0)
+    sub[np.arange(len(odd)), col] = sub[:, 0]
+    sub[:, 0] = odd
+    nb[odd] = sub

@@ -37,22 +37,45 @@ def _spread_bits(x: np.ndarray) -> np.ndarray:
     return x
 
 
-def morton_order(points) -> np.ndarray:
-    """Permutation sorting ``points`` ((n, 3) float) along a Z-order curve
-    on a 2^21 grid over their bounding cube; (n,) int64."""
+def morton_codes(points) -> tuple[np.ndarray, np.ndarray, float]:
+    """Z-order (Morton) code of every point on a 2^21 grid over the bounding
+    cube of ``points`` ((n, 3) float).
+
+    Returns:
+        codes (n,) uint64 (bits ``z y x`` interleaved, x lowest), the cube's
+        corner ``lo`` (3,) float64 and ``scale`` (grid steps per model unit):
+        a point's grid coordinates are ``floor((p - lo) * scale)``.
+    """
     pts = np.asarray(points)
     n = len(pts)
-    if n < 2:
-        return np.arange(n, dtype=np.int64)
-    lo = pts.min(axis=0)
+    if n == 0:
+        return np.zeros(0, np.uint64), np.zeros(3), 0.0
+    lo = pts.min(axis=0).astype(np.float64)
     ext = float((pts.max(axis=0) - lo).max())
     scale = (2 ** _MORTON_BITS - 1) / ext if ext > 0 else 0.0
     code = np.zeros(n, dtype=np.uint64)
     step = 16 * ESTIMATE_CHUNK_POINTS
     for lo_i in range(0, n, step):
         q = ((pts[lo_i:lo_i + step] - lo) * scale).astype(np.uint64)
-        code[lo_i:lo_i + step] = (_spread_bits(q[:, 0]) | _spread_bits(q[:, 1]) << np.uint64(1)
-                                  | _spread_bits(q[:, 2]) << np.uint64(2))
+        code[lo_i:lo_i + step] = interleave(q)
+    return code, lo, scale
+
+
+def interleave(q: np.ndarray) -> np.ndarray:
+    """Morton codes of (m, 3) non-negative integer grid coordinates below
+    2^21: (m,) uint64."""
+    q = np.asarray(q).astype(np.uint64, copy=False)
+    return (_spread_bits(q[:, 0]) | _spread_bits(q[:, 1]) << np.uint64(1)
+            | _spread_bits(q[:, 2]) << np.uint64(2))
+
+
+def morton_order(points) -> np.ndarray:
+    """Permutation sorting ``points`` ((n, 3) float) along a Z-order curve
+    on a 2^21 grid over their bounding cube; (n,) int64."""
+    n = len(points)
+    if n < 2:
+        return np.arange(n, dtype=np.int64)
+    code, _, _ = morton_codes(points)
     return np.argsort(code, kind="stable").astype(np.int64, copy=False)
 
 

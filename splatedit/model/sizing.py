@@ -46,8 +46,9 @@ def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None 
             includes the point itself (:func:`splatedit.model.estimate.knn`).
     Returns:
         (n, k - 1) integer indices (int64, or the dtype of ``neighbours``:
-        int32 from a compact :func:`knn`); the point itself is left out even
-        when duplicates of it came first.
+        int32 from a compact :func:`knn`; a view of ``neighbours``
+        when every row starts with its own point); the point itself is left
+        out even when duplicates of it came first.
     """
     pts = np.asarray(points, dtype=np.float64)
     n = len(pts)
@@ -61,8 +62,10 @@ def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None 
     idx = np.asarray(neighbours[:, :k])
     if idx.dtype.kind not in "iu":
         idx = idx.astype(np.int64)
-    out = idx[:, 1:].copy()                      # the usual case: the point itself comes first
     odd = np.flatnonzero(idx[:, 0] != np.arange(n))
+    if len(odd) == 0:                            # the usual case: the point itself comes first
+        return idx[:, 1:]                        # a view: no (n, k - 1) copy
+    out = idx[:, 1:].copy()
     if len(odd):                                 # a duplicate came first: drop the point's own entry
         sub = idx[odd]
         is_self = sub == odd[:, None]
@@ -178,7 +181,7 @@ def neighbour_median(radii, neighbours) -> np.ndarray:
     ((n, m) int64 indices, m >= 1)."""
     r = np.asarray(radii, dtype=np.float64)
     local = np.empty(len(r))
-    step = 8 * ESTIMATE_CHUNK_POINTS
+    step = ESTIMATE_CHUNK_POINTS
     for lo in range(0, len(r), step):
         local[lo:lo + step] = _row_median(r[neighbours[lo:lo + step]])
     return local

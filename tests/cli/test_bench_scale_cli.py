@@ -3,6 +3,7 @@
 from __future__ import annotations
 
 import json
+import sys
 
 import pytest
 
@@ -22,6 +23,10 @@ def test_bench_estimate_reports_stages_and_full_orientation(capsys):
     stages = [line[k] for k in ("finding_s", "estimating_s", "orienting_s", "sizing_s")]
     assert all(s >= 0 for s in stages) and sum(stages) <= line["total_s"] + 0.05
     assert "open3d_normals_k16_s" in line or "not installed" in line.get("open3d", "")
+    if sys.platform == "linux":                  # peak RSS from /proc/self/status
+        assert line["peak_rss_gb"] > 0
+        # a process that freed memory before (this test session) reuses it: the rise can be 0
+        assert line["rss_rise_bytes_per_point"] >= 0
 
 
 def test_bench_render_scale_line_has_upload_frame_and_lod(capsys):
