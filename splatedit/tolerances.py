@@ -813,3 +813,16 @@ EDITOR_PROGRESSIVE_MIN_CHUNK = 20_000
 #: a step's chunk grows at most this factor at a time (the first steps' times
 #: include pipeline creation and are not representative of the cost per splat)
 EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
+
+# ---------------------------------------------------------------------------
+# Progressive refinement by default: chunks composed on the device (issue 10 "one device", issue 11 part 5)
+# ---------------------------------------------------------------------------
+#: chunk steps the work budget of one presented frame is split into (the chunk is
+#: sized to budget / this): several steps per presented frame keep the frame near
+#: its budget when the per-splat cost changes (a colour step costs ~1.6x a visibility
+#: step: 53 vs 32 ms per 100k splats at 1280x720, 1M splats, 2 loaded cores), and
+#: a step's fixed cost (submit, pre-pass dispatch) is small next to 100k splats
+EDITOR_PROGRESSIVE_STEPS_PER_FRAME = 3
+#: share of the frame interval left to the steps at least, however slow presenting
+#: is (the rest is the measured present + GUI cost and the composition pass)
+EDITOR_PROGRESSIVE_MIN_WORK_SHARE = 0.5

@@ -35,7 +35,8 @@ from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS,
-                                  EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_REFINE_DELAY_S)
+                                  EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_PROGRESSIVE_STEPS_PER_FRAME,
+                                  EDITOR_REFINE_DELAY_S)
 
 
 @dataclass(frozen=True)
@@ -148,7 +149,7 @@ class FrameScheduler:
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
         if self._stepped is not None:
-            self._stepped.frame_ms.append(self.frame_ms)
+            self._stepped.frame_done(self.frame_ms)
             self._stepped = None
         if self._rendered_interactive:
             self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
@@ -233,56 +234,56 @@ class FrameScheduler:
                 ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
 
     def _progressive_step(self, key, w: int, h: int) -> bool:
-        """One step of the progressive refinement of ``key`` (started here); False
-        where it is not used (the background refiner draws the frame instead):
-        unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame's chunks
-        go through the pre-pass, but per-step submits, shading passes and
-        readbacks make full quality arrive 2-3x later than from the background
-        refiner: 3-5 s against about 2 s at 1M splats, see
-        docs/PERFORMANCE.md), and always in the detail mode (not tested there)."""
-        if os.environ.get("SPLATEDIT_REFINE", "background") != "progressive":
+        """Advance the progressive refinement of ``key`` (started here) by one
+        presented frame's worth of chunks; False where it is not used (the
+        background refiner draws the frame instead): with
+        ``SPLATEDIT_REFINE=background`` (the fallback), and for a Gaussian
+        document (no progressive frame)."""
+        if os.environ.get("SPLATEDIT_REFINE", "progressive") == "background":
             return False
         ed, vp = self.ed, self.ed.viewport
         p = self.progressive
+        if self.gpu:
+            ed.presenter.wait_previous()     # the shown frame may be the image composed now
         if p is None:
             if key == self._refine_failed_key:
                 return True
-            chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK, int(vp.budget_ms / max(vp.ms_per_splat, 1e-9)))
-            if self.gpu:
-                ed.presenter.wait_previous()     # the shown frame may be the full renderer's image
+            chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK,
+                        int(self.budget_ms / EDITOR_PROGRESSIVE_STEPS_PER_FRAME / max(vp.ms_per_splat, 1e-9)))
+            # the level-of-detail frame, shown under the chunks: on the GPU path
+            # the LOD renderer's image (not redrawn while this view refines)
+            under = self.scene
+            if isinstance(under, ResidentFrame):
+                under = (under.image, (under.width, under.height))
+            elif under is None or under.shape[:2] != (h, w):
+                under = vp.render(ed.cam, w, h, interactive=True, resident=self.gpu)
+                under = (under.image, (under.width, under.height)) if self.gpu else under
             try:
                 frame = vp.progressive(ed.cam, w, h, chunk)
+                if frame is None:
+                    return False
+                p = self.progressive = ProgressiveRefinement(frame, key, under, self.budget_ms, self.gpu)
             except SplatEditError as exc:
                 ed.say(f"full-quality frame failed: {exc}")
                 self._refine_failed_key = key
                 return True
-            if frame is None:
-                return False
-            # the level-of-detail frame as pixels, under the chunks
-            under = self.scene if isinstance(self.scene, np.ndarray) else None
-            if under is None or under.shape[:2] != (h, w):
-                under = vp.render(ed.cam, w, h, interactive=True)
-            p = self.progressive = ProgressiveRefinement(frame, key, under, vp.budget_ms)
-            # shown until the first chunk arrives: pixels, not the renderers' images (a
-            # ResidentFrame of the full renderer is destroyed when the steps resize its targets)
-            self.scene = under
         self._stepped = p
         try:
-            img = p.step()
+            img = p.advance()
         except SplatEditError as exc:
             ed.say(f"full-quality frame failed: {exc}")
             self._refine_failed_key = key
             self.drop_progressive()
             return True
-        if img is not None:
-            self.scene = img
+        self.scene = ResidentFrame(img, w, h) if self.gpu else img
         if p.done:
             self.scene_interactive = False
             n = ed.session.cloud.n
             vp.last_info = FrameInfo(p.total_ms, n, 1, False, False)
             vp.ms_per_splat = p.total_ms / max(n, 1)
             self.last_progressive = p
-            self.drop_progressive()
+            self.progressive = None
+            p.close()
         return True
 
     def render_scene(self, key, interactive: bool) -> None:

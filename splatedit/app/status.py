@@ -89,11 +89,7 @@ def status_dict(ed) -> dict:
     #: the shown frame is the full-quality one (not a level of detail / reduced size)
     st["full_quality"] = not fr.scene_interactive
     last = fr.last_progressive
-    st["last_refinement"] = None if last is None else {
-        "first_chunk_s": _r(last.first_chunk_s, 3), "done_s": _r(last.done_s, 3), "steps": len(last.step_ms),
-        "step_ms_max": _r(max(last.step_ms)), "shown": len(last.shown_splats),
-        "frame_ms_median": _r(np.median(last.frame_ms)) if last.frame_ms else None,
-        "frame_ms_max": _r(max(last.frame_ms)) if last.frame_ms else None}
+    st["last_refinement"] = None if last is None else last.timings()
     w, h = ed.size
     gz = ed.gizmo
     if not (w and h):

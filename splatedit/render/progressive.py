@@ -48,9 +48,14 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
-from splatedit.render.splat_layout import _WORKGROUP
+from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
+#: the shading pass over the shown image: loads it, writes covered pixels ("over":
+#: the intermediate uniforms give uncovered pixels alpha 0, so they keep what is there)
+_RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
+_OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(_RESOLVE_SET,)),
+                            topology="triangle_list", blend_alpha=True)
 
 
 def _rp_attr_load(fmt: str) -> V.RenderPassDesc:
@@ -85,12 +90,17 @@ class ProgressiveFrame:
         self.chunk = int(chunk)
         self.n = renderer.n
         self._rb = V.Buffer(renderer.dev, width * height * 4, ("transfer_dst",), host_visible=True)
+        self._shown = self._fb_over = None      # the composed image (set_under / show)
+        self._under = None
+        self._unshown = False                   # attribute chunks drawn since the last shading pass
         self._restart()
 
     def _restart(self) -> None:
         self.phase = "depth"
         self.next = 0
         self.restarts = getattr(self, "restarts", -1) + 1
+        self._unshown = False
+        self._final = False                     # the last image shaded with the real background
         self._serial = self.r.frames_recorded
 
     @property
@@ -114,10 +124,12 @@ class ProgressiveFrame:
         size = -(-self.chunk // _WORKGROUP) * _WORKGROUP
         return first, min(size, end - first)
 
-    def step(self) -> np.ndarray | None:
+    def step(self, readback: bool = True) -> np.ndarray | None:
         """Draw the next chunk.  Returns the (height, width, 4) uint8 image
         so far after an attribute chunk (alpha 0 where nothing is drawn yet),
-        None after a visibility chunk or when already done."""
+        None after a visibility chunk or when already done.  With
+        ``readback=False`` the chunk is only drawn (no shading pass, no
+        readback; None): :meth:`show` composes what has been drawn."""
         r = self.r
         r._check_open()
         if self.done:
@@ -154,23 +166,20 @@ class ProgressiveFrame:
                 r.dev.submit(rec)
                 out = None
             else:
-                alpha = r.background_alpha
-                r.background_alpha = 0.0
-                try:
-                    r._write_ubo(self.camera, self.width, self.height)
-                finally:
-                    r.background_alpha = alpha
+                self._write_ubo(0.0)
                 fmt = r.accum_format
 
                 def rec(cb):
                     clear = [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None] if first == 0 else [None] * 3
                     draw(cb, "attr", _rp_attr(fmt, "shader_read") if first == 0 else _rp_attr_load(fmt),
                          t.fb_attr, clear)
-                    r._record_resolve(cb, t, t.offscreen)
-                    cb.copy_image_to_buffer(t.out, self._rb)
-                    cb.host_read_barrier()
+                    if readback:
+                        r._record_resolve(cb, t, t.offscreen)
+                        cb.copy_image_to_buffer(t.out, self._rb)
+                        cb.host_read_barrier()
                 r.dev.submit(rec)
-                out = self._rb.read().reshape(self.height, self.width, 4)
+                out = self._rb.read().reshape(self.height, self.width, 4) if readback else None
+                self._unshown = not readback
         finally:
             for o in reversed(objs):
                 o.destroy()
@@ -180,10 +189,114 @@ class ProgressiveFrame:
             self.phase = "attr" if self.phase == "depth" else "done"
         return out
 
+    def _write_ubo(self, background_alpha: float) -> None:
+        """The frame uniforms with this alpha for background pixels (0: the
+        intermediate images, uncovered pixels told apart; the renderer's own
+        for the last)."""
+        r = self.r
+        alpha = r.background_alpha
+        r.background_alpha = background_alpha
+        try:
+            r._write_ubo(self.camera, self.width, self.height)
+        finally:
+            r.background_alpha = alpha
+
+    # ------------------------------------------------------ on the device
+    def set_under(self, under) -> None:
+        """What shows where no full-quality splat has arrived yet: an (h, w, 4)
+        uint8 frame (uploaded once), or ``(image, (sw, sh))``: the top-left
+        ``sw`` x ``sh`` part of an rgba8 device image of this renderer's device
+        in TRANSFER_SRC layout (e.g. a level-of-detail frame, a half-resolution
+        one included), scaled onto the frame (nearest) by one blit.  It is
+        copied at the next :meth:`show`, so ``image`` must stay unchanged until then."""
+        self._under = under
+        if self._shown is None:
+            self._shown = V.Image(self.r.dev, self.width, self.height, "rgba8",
+                                  ("color", "transfer_src", "transfer_dst"))
+            self._fb_over = V.Framebuffer(self.r.dev, self.r.cache.render_pass(_RP_OVER), [self._shown],
+                                          self.width, self.height)
+
+    def show(self, readback: bool = False):
+        """The image to show now, composed on the device: the full-quality
+        frame once :attr:`done` (the renderer's output image, as
+        :meth:`Renderer.render_resident` leaves it: its last image equals the
+        one-submit frame), else the attribute chunks drawn so far shaded over
+        the :meth:`set_under` image (one shading pass over the pixels they
+        cover, only when chunks were drawn since the last call; before the
+        first attribute chunk the under image alone).  Returns the device image
+        (rgba8, TRANSFER_SRC layout, ``width`` x ``height``; valid until the
+        next step or show) or, with ``readback``, its (h, w, 4) uint8 pixels."""
+        r = self.r
+        r._check_open()
+        if self.done:
+            t = r._targets_for(self.width, self.height)
+            if not self._final:
+                self._write_ubo(r.background_alpha)
+
+                def rec(cb):
+                    r._record_resolve(cb, t, t.offscreen)
+                r.dev.submit(rec)
+                self._unshown, self._final = False, True
+            return self._read(t.out) if readback else t.out
+        if self._shown is None:
+            raise ParameterError("under", "set_under() before show()")
+        under, self._under = self._under, None
+        shade = self._unshown
+        staging = None
+        if under is None and not shade:
+            return self._read(self._shown) if readback else self._shown
+        if isinstance(under, np.ndarray):
+            if under.shape != (self.height, self.width, 4) or under.dtype != np.uint8:
+                raise ParameterError("under", f"must be a ({self.height}, {self.width}, 4) uint8 frame, "
+                                              f"got {under.shape} {under.dtype}")
+            staging = V.Buffer(r.dev, under.nbytes, ("transfer_src",), host_visible=True)
+            staging.write(np.ascontiguousarray(under))
+        t = r._targets_for(self.width, self.height)
+        if shade:
+            self._write_ubo(0.0)
+        img = self._shown
+        try:
+            def rec(cb):
+                if under is not None:
+                    cb.memory_barrier("color_output", "color_write", "transfer", "transfer_read")
+                    cb.image_barrier(img, "transfer_dst", "transfer", "none", "transfer", "transfer_write")
+                    if staging is not None:
+                        cb.copy_buffer_to_image(staging, img)
+                    else:
+                        src, (sw, sh) = under
+                        cb.blit_image(src, img, (0, 0, sw, sh), (0, 0, self.width, self.height))
+                    cb.image_barrier(img, "transfer_src", "transfer", "transfer_write",
+                                     "color_output", "color_read|color_write")
+                if shade:
+                    pipe = r.cache.pipeline(_OVER_DESC)
+                    cb.begin_render_pass(r.cache.render_pass(_RP_OVER), self._fb_over, [None])
+                    cb.bind_pipeline(pipe)
+                    cb.bind_descriptor_set(pipe, t.resolve_set)
+                    cb.draw(3)
+                    cb.end_render_pass()
+            r.dev.submit(rec)
+        finally:
+            if staging is not None:
+                staging.destroy()
+        if shade:
+            self._unshown = False
+        return self._read(img) if readback else img
+
+    def _read(self, image) -> np.ndarray:
+        def rec(cb):
+            cb.copy_image_to_buffer(image, self._rb)
+            cb.host_read_barrier()
+        self.r.dev.submit(rec)
+        return self._rb.read().reshape(self.height, self.width, 4).copy()
+
     def close(self) -> None:
-        if self._rb is not None:
-            self._rb.destroy()
-            self._rb = None
+        if self._fb_over is not None or self._shown is not None:
+            self.r.dev.wait_idle()          # a presented frame may still read the shown image
+        for name in ("_fb_over", "_shown", "_rb"):
+            obj = getattr(self, name)
+            if obj is not None:
+                obj.destroy()
+                setattr(self, name, None)
 
     def __enter__(self):
         return self
