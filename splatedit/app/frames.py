@@ -250,20 +250,21 @@ class FrameScheduler:
                 return True
             chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK,
                         int(self.budget_ms / EDITOR_PROGRESSIVE_STEPS_PER_FRAME / max(vp.ms_per_splat, 1e-9)))
-            # the level-of-detail frame, shown under the chunks: on the GPU path
-            # the LOD renderer's image (not redrawn while this view refines)
-            under = self.scene
-            if isinstance(under, ResidentFrame):
-                under = (under.image, (under.width, under.height))
-            elif under is None or under.shape[:2] != (h, w):
-                under = vp.render(ed.cam, w, h, interactive=True, resident=self.gpu)
-                under = (under.image, (under.width, under.height)) if self.gpu else under
             try:
                 frame = vp.progressive(ed.cam, w, h, chunk)
                 if frame is None:
                     return False
-                p = self.progressive = ProgressiveRefinement(frame, key, under, self.budget_ms, self.gpu)
             except SplatEditError as exc:
+                ed.say(f"full-quality frame failed: {exc}")
+                self._refine_failed_key = key
+                return True
+            try:
+                under = self._under(w, h)
+                p = self.progressive = ProgressiveRefinement(frame, key, under, self.budget_ms, self.gpu)
+            except BaseException as exc:
+                frame.close()
+                if not isinstance(exc, SplatEditError):
+                    raise
                 ed.say(f"full-quality frame failed: {exc}")
                 self._refine_failed_key = key
                 return True
@@ -285,6 +286,20 @@ class FrameScheduler:
             self.progressive = None
             p.close()
         return True
+
+    def _under(self, w: int, h: int):
+        """The level-of-detail frame shown under the progressive chunks: on the
+        GPU path the LOD renderer's image (not redrawn while the view refines:
+        any change drops the refinement), on the CPU path its pixels.  A frame
+        the full renderer drew at reduced size (no LOD pyramid yet) is drawn
+        again as pixels: the steps re-size that renderer's images."""
+        ed, vp = self.ed, self.ed.viewport
+        sc = self.scene
+        if isinstance(sc, ResidentFrame) and not vp.owns_full_image(sc.image):
+            return sc.image, (sc.width, sc.height)
+        if isinstance(sc, np.ndarray) and sc.shape[:2] == (h, w):
+            return sc
+        return vp.render(ed.cam, w, h, interactive=True)
 
     def render_scene(self, key, interactive: bool) -> None:
         ed = self.ed

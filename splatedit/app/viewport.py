@@ -330,6 +330,12 @@ class Viewport:
             return None
         return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)
 
+    def owns_full_image(self, image) -> bool:
+        """``image`` is the full renderer's output image (re-created when that
+        renderer draws another size)."""
+        t = self.full.r._targets if self.full is not None else None
+        return t is not None and image is t.out
+
     def pick(self, cam: OrbitCamera, w: int, h: int):
         """(index map (h, w) int64, -1 background; depth (h, w)) of the full cloud."""
         if self.gaussians is not None:
