@@ -33,10 +33,24 @@ from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
 from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
-from splatedit.errors import SplatEditError
+from splatedit.errors import ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS,
                                   EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_PROGRESSIVE_STEPS_PER_FRAME,
                                   EDITOR_REFINE_DELAY_S)
+
+
+def _refine_above_ms() -> float:
+    """``SPLATEDIT_REFINE_ABOVE_MS`` (milliseconds > 0), default ``EDITOR_ASYNC_REFINE_MS``."""
+    text = os.environ.get("SPLATEDIT_REFINE_ABOVE_MS", "")
+    if not text:
+        return EDITOR_ASYNC_REFINE_MS
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not value > 0 or value == float("inf"):
+        raise ParameterError("SPLATEDIT_REFINE_ABOVE_MS", f"must be a number of milliseconds > 0, got {text!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -62,6 +76,8 @@ class FrameScheduler:
         self.progressive = None          # ProgressiveRefinement of the current view
         #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
         self.last_progressive = None
+        #: progressive refinements finished (status file, tests)
+        self.refinements = 0
         self._stepped = None             # the refinement stepped in the frame being drawn
         self._refine_failed_key = None   # view whose background frame failed (not retried)
         self.last_motion = 0.0
@@ -69,6 +85,8 @@ class FrameScheduler:
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
         self._rendered_interactive = False
         self.budget_ms = float(budget_ms)
+        #: full-quality frames predicted slower than this (ms) are refined after motion stops
+        self.refine_above_ms = _refine_above_ms()
         self.frame_overhead_ms = 10.0
         self.frames = 0
         self._sel_version_seen = -1
@@ -108,7 +126,7 @@ class FrameScheduler:
     def async_refine(self) -> bool:
         """True when full-quality frames are slow enough to be drawn in the background."""
         vp = self.ed.viewport
-        return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > EDITOR_ASYNC_REFINE_MS
+        return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > self.refine_above_ms
 
     def pending(self) -> bool:
         """A frame must be drawn now (the scene is stale or still interactive)."""
@@ -283,6 +301,7 @@ class FrameScheduler:
             vp.last_info = FrameInfo(p.total_ms, n, 1, False, False)
             vp.ms_per_splat = p.total_ms / max(n, 1)
             self.last_progressive = p
+            self.refinements += 1
             self.progressive = None
             p.close()
         return True

@@ -10,6 +10,7 @@ import os
 import numpy as np
 
 from splatedit.app.gaussian_doc import gaussians_of
+from splatedit.render.vk import devices_created
 
 
 def _r(v, nd=1):
@@ -90,6 +91,8 @@ def status_dict(ed) -> dict:
     st["full_quality"] = not fr.scene_interactive
     last = fr.last_progressive
     st["last_refinement"] = None if last is None else last.timings()
+    st["refinements"] = fr.refinements
+    st["vulkan_devices_created"] = devices_created()
     w, h = ed.size
     gz = ed.gizmo
     if not (w and h):

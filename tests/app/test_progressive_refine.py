@@ -112,8 +112,6 @@ def test_still_view_sharpens_monotonically_and_ends_equal_to_the_full_frame(ed):
     diff = np.abs(shown[-1][..., :3].astype(int) - ref[..., :3].astype(int))
     assert diff.mean() < 0.6, diff.mean()
     assert (diff.max(axis=2) > 24).mean() < 0.003
-    # every intermediate image is the LOD frame outside the refined pixels: where the
-    # full frame is background and the LOD frame is not, the LOD frame shows
     assert p.first_chunk_s is not None and p.first_chunk_s <= p.done_s
     assert len(p.frame_ms) == len(p.work_ms) == len(p.show_ms)
 

@@ -13,10 +13,10 @@ Raw ``vk*`` calls live only in this package.  It provides
 * render passes, descriptor sets, pipelines cached by their description
   (:class:`PipelineCache`);
 * :func:`live_handles` - a count of every live Vulkan object by kind, for leak
-  tests.  Everything is destroyed explicitly, in reverse order of creation.
+  tests; :func:`devices_created` - devices created so far in this process.  Everything is destroyed explicitly, in reverse order of creation.
 """
 
-from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError,
+from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError, devices_created,
                                       drain_validation_messages, list_devices, live_handles,
                                       validation_enabled)
 from splatedit.render.vk.resources import Buffer, Image, readback_array
@@ -26,7 +26,7 @@ from splatedit.render.vk.pipelines import (Attachment, Binding, ComputeDesc, Des
                                            VertexAttribute, VertexBinding, spirv_path)
 
 __all__ = [
-    "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "drain_validation_messages",
+    "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "devices_created", "drain_validation_messages",
     "list_devices", "live_handles", "validation_enabled", "Buffer", "Image", "readback_array",
     "CommandBuffer", "QueryPool", "Attachment", "Binding", "ComputeDesc", "DescriptorSet", "Framebuffer",
     "GraphicsDesc", "LayoutDesc", "PipelineCache", "RenderPassDesc", "Sampler", "VertexAttribute",

@@ -83,6 +83,16 @@ def track(kind: str, delta: int) -> None:
             del _LIVE[kind]
 
 
+_CREATED: Counter = Counter()
+
+
+def devices_created() -> int:
+    """Vulkan devices (``vkCreateDevice``) this process has created so far (the
+    editor creates one for rendering, refinement and presentation)."""
+    with _LIVE_LOCK:
+        return _CREATED["device"]
+
+
 def live_handles() -> dict[str, int]:
     """Number of live Vulkan objects created through this layer, by kind."""
     with _LIVE_LOCK:
@@ -259,6 +269,8 @@ class Device:
                                      ppEnabledExtensionNames=extensions or None)
         self.device = call(vk.vkCreateDevice, self.physical, info, None)
         track("device", 1)
+        with _LIVE_LOCK:
+            _CREATED["device"] += 1
         self.queue = vk.vkGetDeviceQueue(self.device, self.queue_family, 0)
         pinfo = vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
