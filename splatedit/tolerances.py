@@ -826,3 +826,10 @@ EDITOR_PROGRESSIVE_STEPS_PER_FRAME = 3
 #: share of the frame interval left to the steps at least, however slow presenting
 #: is (the rest is the measured present + GUI cost and the composition pass)
 EDITOR_PROGRESSIVE_MIN_WORK_SHARE = 0.5
+#: pixels added around the projected boxes of the splats drawn since the last shown
+#: image: the shading pass of :meth:`ProgressiveFrame.show` covers only that rect.  A
+#: splat's quad bounds its ellipse and the low-pass disc (RENDER_LOWPASS_RADIUS_PX =
+#: 0.71 px); point splats are at most a few pixels wide but centred on the splat;
+#: 2 px covers both and the rounding (tests/render/test_progressive.py compares the
+#: composed images with the whole-image CPU composite bit for bit)
+PROGRESSIVE_SHADE_PAD_PX = 2.0

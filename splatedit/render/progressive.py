@@ -49,6 +49,10 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
 from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
+from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
+
+#: splats per box of the shading rect (:meth:`ProgressiveFrame._chunk_rect`)
+_BOX_BLOCK = 4096
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 #: the shading pass over the shown image: loads it, writes covered pixels ("over":
@@ -62,6 +66,15 @@ def _rp_attr_load(fmt: str) -> V.RenderPassDesc:
     col = V.Attachment(fmt, "load", initial="shader_read", final="shader_read")
     return V.RenderPassDesc(colors=(col, col),
                             depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
+
+
+def _union(a, b):
+    """The smallest (x, y, w, h) rect holding rects ``a`` and ``b`` (None: empty)."""
+    if a is None or b is None:
+        return a if b is None else b
+    x0, y0 = min(a[0], b[0]), min(a[1], b[1])
+    x1, y1 = max(a[0] + a[2], b[0] + b[2]), max(a[1] + a[3], b[1] + b[3])
+    return x0, y0, x1 - x0, y1 - y0
 
 
 def composite(image: np.ndarray, under: np.ndarray) -> np.ndarray:
@@ -91,6 +104,8 @@ class ProgressiveFrame:
         self.n = renderer.n
         self._rb = V.Buffer(renderer.dev, width * height * 4, ("transfer_dst",), host_visible=True)
         self._shown = self._fb_over = None      # the composed image (set_under / show)
+        self._boxes = None                      # (n, lo, hi, axis) of blocks of _BOX_BLOCK splats
+        self.shaded_rect = None
         self._under = None
         self._unshown = False                   # attribute chunks drawn since the last shading pass
         self._restart()
@@ -100,6 +115,7 @@ class ProgressiveFrame:
         self.next = 0
         self.restarts = getattr(self, "restarts", -1) + 1
         self._unshown = False
+        self._dirty = None                      # pixel rect (x, y, w, h) the unshown chunks can touch
         self._final = False                     # the last image shaded with the real background
         self._serial = self.r.frames_recorded
 
@@ -180,6 +196,7 @@ class ProgressiveFrame:
                 r.dev.submit(rec)
                 out = self._rb.read().reshape(self.height, self.width, 4) if readback else None
                 self._unshown = not readback
+                self._dirty = None if readback else _union(self._dirty, self._chunk_rect(first, count))
         finally:
             for o in reversed(objs):
                 o.destroy()
@@ -243,8 +260,6 @@ class ProgressiveFrame:
         under, self._under = self._under, None
         shade = self._unshown
         staging = None
-        if under is None and not shade:
-            return self._read(self._shown) if readback else self._shown
         if isinstance(under, np.ndarray):
             if under.shape != (self.height, self.width, 4) or under.dtype != np.uint8:
                 raise ParameterError("under", f"must be a ({self.height}, {self.width}, 4) uint8 frame, "
@@ -252,9 +267,16 @@ class ProgressiveFrame:
             staging = V.Buffer(r.dev, under.nbytes, ("transfer_src",), host_visible=True)
             staging.write(np.ascontiguousarray(under))
         t = r._targets_for(self.width, self.height)
+        rect = self._dirty
+        if shade and rect is None:        # the chunks since the last image are all off screen
+            shade = self._unshown = False
         if shade:
             self._write_ubo(0.0)
+            #: the pixel rect (x, y, w, h) the last shading pass covered
+            self.shaded_rect = rect
         img = self._shown
+        if under is None and not shade:
+            return self._read(img) if readback else img
         try:
             def rec(cb):
                 if under is not None:
@@ -270,6 +292,7 @@ class ProgressiveFrame:
                 if shade:
                     pipe = r.cache.pipeline(_OVER_DESC)
                     cb.begin_render_pass(r.cache.render_pass(_RP_OVER), self._fb_over, [None])
+                    cb.set_scissor(*rect)
                     cb.bind_pipeline(pipe)
                     cb.bind_descriptor_set(pipe, t.resolve_set)
                     cb.draw(3)
@@ -279,8 +302,45 @@ class ProgressiveFrame:
             if staging is not None:
                 staging.destroy()
         if shade:
-            self._unshown = False
+            self._unshown, self._dirty = False, None
         return self._read(img) if readback else img
+
+    def _chunk_rect(self, first: int, count: int) -> tuple[int, int, int, int] | None:
+        """A pixel rect (x, y, w, h) holding every pixel splats ``first`` ..
+        ``first + count - 1`` can cover (from boxes of blocks of splats, grown by
+        the largest splat axis times the splat scale and by the deformation's
+        reach; ``PROGRESSIVE_SHADE_PAD_PX`` for the low-pass disc and point
+        splats); the whole image when a box reaches the camera plane; None
+        when the chunk is off screen."""
+        r = self.r
+        if self._boxes is None or self._boxes[0] != r.n:
+            c = r.cloud
+            starts = np.arange(0, r.n, _BOX_BLOCK)
+            reach = np.sqrt(np.maximum(np.einsum("ij,ij->i", c.u, c.u), np.einsum("ij,ij->i", c.v, c.v)))
+            rad = np.maximum.reduceat(reach, starts)
+            self._boxes = (r.n, np.minimum.reduceat(c.positions, starts, axis=0) - rad[:, None],
+                           np.maximum.reduceat(c.positions, starts, axis=0) + rad[:, None], rad)
+        _, lo, hi, rad = self._boxes
+        b0, b1 = first // _BOX_BLOCK, -(-(first + count) // _BOX_BLOCK)
+        grow = rad[b0:b1, None] * max(r.splat_scale - 1.0, 0.0) + r._displacement_reach()
+        lo, hi = lo[b0:b1] - grow, hi[b0:b1] + grow
+        corners = np.stack([np.where(np.array([i & 1, i & 2, i & 4], bool), hi, lo) for i in range(8)], axis=1)
+        view = self.camera.view_matrix()
+        e = corners.reshape(-1, 3) @ view[:3, :3].T + view[:3, 3]
+        depth = -e[:, 2]
+        near = self.r._near_far[0]
+        if (depth <= 0.5 * near).any():
+            return 0, 0, self.width, self.height
+        f = 1.0 / np.tan(np.radians(self.camera.fov_deg) / 2.0)
+        w, h = self.width, self.height
+        x = 0.5 * w * (1.0 + f * (h / w) * e[:, 0] / depth)
+        y = 0.5 * h * (1.0 - f * e[:, 1] / depth)
+        pad = PROGRESSIVE_SHADE_PAD_PX
+        x0, x1 = max(int(np.floor(x.min() - pad)), 0), min(int(np.ceil(x.max() + pad)), w)
+        y0, y1 = max(int(np.floor(y.min() - pad)), 0), min(int(np.ceil(y.max() + pad)), h)
+        if x1 <= x0 or y1 <= y0:
+            return None
+        return x0, y0, x1 - x0, y1 - y0
 
     def _read(self, image) -> np.ndarray:
         def rec(cb):

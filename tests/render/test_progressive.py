@@ -53,7 +53,8 @@ def test_images_composed_on_the_device_equal_the_cpu_composite(vertex_path):
     """Chunks drawn without readback and composed on the device (:meth:`show`)
     over a level-of-detail frame give, at every shown step, exactly the CPU
     composite of the read-back image so far over that frame (vertex path:
-    deterministic); visibility steps show the frame under unchanged; the last
+    deterministic) although each shading pass covers only the projected boxes
+    of its chunks; visibility steps show the frame under unchanged; the last
     one is the single frame with its background (alpha 255)."""
     r = vertex_path
     bunny = read(default_model_path())
@@ -68,7 +69,7 @@ def test_images_composed_on_the_device_equal_the_cpu_composite(vertex_path):
             img = pf.step()
             if img is not None:
                 expected.append(composite(img, under))
-    shown = []
+    shown, rects = [], []
     with ProgressiveFrame(r, cam, W, H, 7000) as pf:
         pf.set_under(under)
         while not pf.done:
@@ -79,11 +80,16 @@ def test_images_composed_on_the_device_equal_the_cpu_composite(vertex_path):
                 assert np.array_equal(out, under)
             else:
                 shown.append(out)
+                rects.append(pf.shaded_rect)
         last = pf.show(readback=True)
     assert len(shown) == len(expected) >= 5
     for got, want in zip(shown[:-1], expected[:-1]):
         assert np.array_equal(got[..., :3], want[..., :3])
     assert np.array_equal(last, full)
+    # each shading pass covered only the rect its chunks can reach (the bunny file is not
+    # spatially sorted: every chunk spans the model, whose box is ~53% of the image)
+    areas = [w * h for _, _, w, h in rects]
+    assert max(areas) < 0.6 * W * H, areas
 
 
 def test_under_a_half_size_device_image_is_pixel_doubled(renderer):
