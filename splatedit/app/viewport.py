@@ -320,14 +320,12 @@ class Viewport:
     def progressive(self, cam: OrbitCamera, w: int, h: int, chunk: int):
         """A :class:`~splatedit.render.progressive.ProgressiveFrame` of the full
         cloud (``chunk`` splats per step) on the full renderer, synced with the
-        document; None where it cannot draw the frame (a Gaussian document, or
-        the detail mode, which has no vertex-path variant)."""
+        document (the detail mode included: its chunks go through its pre-pass);
+        None where it cannot draw the frame (a Gaussian document)."""
         if self.gaussians is not None or self.cloud is None:
             return None
         from splatedit.render.progressive import ProgressiveFrame
         self._sync(self.full)
-        if self.full.r._detail_buf is not None:
-            return None
         return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)
 
     def owns_full_image(self, image) -> bool:

@@ -28,17 +28,17 @@ class _Presenter:
         self.frames.append(frame.copy())
 
 
-def _editor(n=60000):
+def _editor(n=60000, cloud=None, budgets=(8000, 2000), **session):
     from splatedit.app.session import Session
     from splatedit.app.viewport import Viewport
-    cloud = bunny_surface_cloud(n)
+    cloud = bunny_surface_cloud(n) if cloud is None else cloud
     vp = Viewport(budget_ms=100.0)
-    vp.set_pyramid(LodPyramid(cloud, budgets=(8000, 2000)))
+    vp.set_pyramid(LodPyramid(cloud, budgets=budgets))
     cam = OrbitCamera(scene_radius=cloud.diagonal / 2, yaw=0.3, pitch=0.2)
     lo, hi = cloud.bounds()
     cam.frame((lo + hi) / 2, cloud.diagonal / 2, W / H)
     ed = types.SimpleNamespace(
-        session=Session(cloud), viewport=vp, cam=cam, size=(W, H), drag=DragMode.NONE, gui=None,
+        session=Session(cloud, **session), viewport=vp, cam=cam, size=(W, H), drag=DragMode.NONE, gui=None,
         presenter=_Presenter(), said=[], overlay_patches=lambda w, h: [], wake=lambda: None,
         window=types.SimpleNamespace(iconified=lambda: False),
         brush=types.SimpleNamespace(picker=None, tools=types.SimpleNamespace(prepare=lambda c: None),
@@ -165,3 +165,48 @@ def test_several_chunks_per_presented_frame_up_to_the_budget(ed, monkeypatch):
     assert len(p.step_ms) > len(p.work_ms) >= 2
     # a frame stops once the next step would pass the budget: at most one step over it
     assert all(w <= 40.0 + max(p.step_ms) + 1.0 for w in p.work_ms), (p.work_ms, max(p.step_ms))
+
+
+def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
+    """A bent bumpy plane in the detail mode (its own pre-pass shader): after
+    motion stops the view is refined progressively on the editor's device (no
+    background refiner) and ends equal to the one-submit detail frame."""
+    from splatedit.deform.modes import DeformationMode
+    from tests.deform.detail_scene import bend, bumpy_plane
+    import splatedit.app.progressive_refine as pr
+    monkeypatch.delenv("SPLATEDIT_REFINE", raising=False)
+    monkeypatch.setattr(pr.ProgressiveRefinement, "budget_ms", lambda self: 0.0)
+    monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 1000)
+    monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
+    sc = bumpy_plane(nx=90, ny=30)
+    ed = _editor(cloud=sc.cloud, budgets=(800, 300), fit_sync=True)
+    ed.frames = FrameScheduler(ed, 100.0)
+    try:
+        s, fr, vp = ed.session, ed.frames, ed.viewport
+        s.set_selection(sc.support, sc.handle)
+        assert s.wait_fit()
+        while s.deformation is not DeformationMode.DETAIL:
+            s.cycle_deformation()
+            assert s.wait_fit()
+        s.pose[0] = bend(sc)
+        _slow(ed)
+        fr.motion()
+        fr.draw()
+        assert vp.last_info.lod and fr.scene_interactive
+        fr.last_motion -= 1.0
+        for _ in range(100):
+            fr.draw()
+            if fr.last_progressive is not None:
+                break
+        p = fr.last_progressive
+        assert p is not None and p.done and len(p.step_ms) >= 4 and fr.refiner is None
+        assert vp.full.r._detail_buf is not None and p.frame.prepared
+        from splatedit.app.viewport import render_camera
+        ref = vp.full.r.render(render_camera(ed.cam), W, H)
+        diff = np.abs(ed.presenter.frames[-1][..., :3].astype(int) - ref[..., :3].astype(int))
+        assert diff.mean() < 0.6 and (diff.max(axis=2) > 24).mean() < 0.003
+        assert (ref[..., :3] < 250).any()
+    finally:
+        ed.frames.close()
+        ed.session.close()
+        ed.viewport.close()
