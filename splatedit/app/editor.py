@@ -578,6 +578,8 @@ def run_editor(path=None, **options) -> int:
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
+    from splatedit.app.frames import refine_settings
+    refine_settings()           # so is a bad SPLATEDIT_REFINE / SPLATEDIT_REFINE_ABOVE_MS
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
                              "saves never replace it: choose another path")

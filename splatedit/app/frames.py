@@ -3,14 +3,13 @@ when the full-quality one, presenting it with the overlay, and the
 frame-time bookkeeping that sizes the interactive budget.
 
 Full quality: drawn at once when it is cheap; when it is slow (a large model,
-drawn at a level of detail while moving) it is drawn after motion stops by
-the background refiner (a whole frame on a second device, with the compute
-pre-pass, shown when done) or, with ``SPLATEDIT_REFINE=progressive``, refined
-progressively (:mod:`splatedit.app.progressive_refine`: a chunk of splats per
-idle frame on the same device, composited over the level-of-detail frame,
-dropped on any change: the image sharpens instead of switching, but with a
-submit, a shading pass and a readback per step full quality comes 2-3x later
-at 1M splats; the detail mode always uses the refiner).
+drawn at a level of detail while moving) it is refined progressively after
+motion stops (:mod:`splatedit.app.progressive_refine`: a few chunks of splats
+per presented frame on the editor's one device, composed over the
+level-of-detail frame on the device, dropped on any change: the image
+sharpens instead of switching).  ``SPLATEDIT_REFINE=background`` keeps the
+previous fallback: the background refiner draws the whole frame on a second
+device (with the compute pre-pass) and it is shown when done.
 
 Two presentation paths: the GPU path (the editor has a GUI,
 :mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
@@ -39,18 +38,25 @@ from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFI
                                   EDITOR_REFINE_DELAY_S)
 
 
-def _refine_above_ms() -> float:
-    """``SPLATEDIT_REFINE_ABOVE_MS`` (milliseconds > 0), default ``EDITOR_ASYNC_REFINE_MS``."""
+def refine_settings() -> tuple[str, float]:
+    """(mode, threshold ms) of the full-quality refinement from the environment:
+    ``SPLATEDIT_REFINE`` ``progressive`` (default) or ``background`` (the
+    second-device fallback), and ``SPLATEDIT_REFINE_ABOVE_MS`` (full-quality
+    frames predicted slower than this are refined after motion stops; default
+    ``EDITOR_ASYNC_REFINE_MS``).  ParameterError names a bad value."""
+    mode = os.environ.get("SPLATEDIT_REFINE", "") or "progressive"
+    if mode not in ("progressive", "background"):
+        raise ParameterError("SPLATEDIT_REFINE", f"must be 'progressive' or 'background', got {mode!r}")
     text = os.environ.get("SPLATEDIT_REFINE_ABOVE_MS", "")
     if not text:
-        return EDITOR_ASYNC_REFINE_MS
+        return mode, EDITOR_ASYNC_REFINE_MS
     try:
         value = float(text)
     except ValueError:
         value = float("nan")
-    if not value > 0 or value == float("inf"):
+    if not 0 < value < float("inf"):
         raise ParameterError("SPLATEDIT_REFINE_ABOVE_MS", f"must be a number of milliseconds > 0, got {text!r}")
-    return value
+    return mode, value
 
 
 @dataclass(frozen=True)
@@ -85,8 +91,8 @@ class FrameScheduler:
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
         self._rendered_interactive = False
         self.budget_ms = float(budget_ms)
-        #: full-quality frames predicted slower than this (ms) are refined after motion stops
-        self.refine_above_ms = _refine_above_ms()
+        #: "progressive" (default) or "background" (the second-device fallback), see refine_settings
+        self.refine_mode, self.refine_above_ms = refine_settings()
         self.frame_overhead_ms = 10.0
         self.frames = 0
         self._sel_version_seen = -1
@@ -257,7 +263,7 @@ class FrameScheduler:
         background refiner draws the frame instead): with
         ``SPLATEDIT_REFINE=background`` (the fallback), and for a Gaussian
         document (no progressive frame)."""
-        if os.environ.get("SPLATEDIT_REFINE", "progressive") == "background":
+        if self.refine_mode == "background":
             return False
         ed, vp = self.ed, self.ed.viewport
         p = self.progressive

@@ -33,11 +33,14 @@ renderer draws any other frame in between (or the selection, basis or
 displacement change), start a new one; :meth:`step` detects another frame
 (:attr:`Renderer.frames_recorded`) and starts over by itself.
 
-Editor use (:mod:`splatedit.app.progressive_refine`): when motion stops, create
-``ProgressiveFrame(full_renderer, camera, w, h, chunk)`` with ``chunk`` sized
-to the frame budget (``budget_ms / ms_per_splat``), call :meth:`step` once
-per idle frame and show ``composite(image, lod_frame)`` until :attr:`done`;
-drop it on any camera or scene change.
+Without readback (the editor, :mod:`splatedit.app.progressive_refine`):
+:meth:`set_under` gives the level-of-detail frame (a device image, scaled by
+one blit, or pixels), ``step(readback=False)`` only draws chunks (several per
+presented frame, the chunk sized to the frame budget), and :meth:`show`
+composes on the device: one shading pass over the rect the new chunks can
+reach, blended over the shown image (uncovered pixels keep the frame under),
+and once :attr:`done` the renderer's own output image (the one-submit frame).
+Drop the frame on any camera or scene change.
 """
 
 from __future__ import annotations
