@@ -12,8 +12,11 @@ refining (whole presented frames), the number of steps, and the input
 latency (wheel event sent during refinement -> the new camera in the status
 file), and the time from that event to the status showing the full-quality
 frame of the new view (``wheel_to_full_quality_s``, for
-the progressive refinement (the default) and the background refiner
-(``--modes background``, i.e. ``SPLATEDIT_REFINE=background``) alike; with the
+the progressive refinement and the background refiner alike.  The
+background refiner (a second Vulkan device) is gone since the progressive
+refinement became the default; ``--modes background`` (it sets
+``SPLATEDIT_REFINE=background`` for the editor) measures it on an older
+revision (``PYTHONPATH`` of a checkout before branch progdefault).  With the
 background refiner a status written before the level-of-detail frame can
 still say full quality: a figure near 0.1 s is that race, not a frame).  Needs Xvfb and
 xdotool.

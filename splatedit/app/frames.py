@@ -5,11 +5,9 @@ frame-time bookkeeping that sizes the interactive budget.
 Full quality: drawn at once when it is cheap; when it is slow (a large model,
 drawn at a level of detail while moving) it is refined progressively after
 motion stops (:mod:`splatedit.app.progressive_refine`: a few chunks of splats
-per presented frame on the editor's one device, composed over the
+per presented frame on the editor's one Vulkan device, composed over the
 level-of-detail frame on the device, dropped on any change: the image
-sharpens instead of switching).  ``SPLATEDIT_REFINE=background`` keeps the
-previous fallback: the background refiner draws the whole frame on a second
-device (with the compute pre-pass) and it is shown when done.
+sharpens instead of switching).
 
 Two presentation paths: the GPU path (the editor has a GUI,
 :mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
@@ -28,35 +26,29 @@ import numpy as np
 
 from splatedit.app import overlay as ov
 from splatedit.app import revision
-from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
 from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
 from splatedit.errors import ParameterError, SplatEditError
-from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS,
+from splatedit.tolerances import (EDITOR_ASYNC_REFINE_MS,
                                   EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_PROGRESSIVE_STEPS_PER_FRAME,
                                   EDITOR_REFINE_DELAY_S)
 
 
-def refine_settings() -> tuple[str, float]:
-    """(mode, threshold ms) of the full-quality refinement from the environment:
-    ``SPLATEDIT_REFINE`` ``progressive`` (default) or ``background`` (the
-    second-device fallback), and ``SPLATEDIT_REFINE_ABOVE_MS`` (full-quality
-    frames predicted slower than this are refined after motion stops; default
-    ``EDITOR_ASYNC_REFINE_MS``).  ParameterError names a bad value."""
-    mode = os.environ.get("SPLATEDIT_REFINE", "") or "progressive"
-    if mode not in ("progressive", "background"):
-        raise ParameterError("SPLATEDIT_REFINE", f"must be 'progressive' or 'background', got {mode!r}")
+def refine_above_ms() -> float:
+    """Full-quality frames predicted slower than this (ms) are refined
+    progressively after motion stops: ``SPLATEDIT_REFINE_ABOVE_MS``, default
+    ``EDITOR_ASYNC_REFINE_MS``.  ParameterError names a bad value."""
     text = os.environ.get("SPLATEDIT_REFINE_ABOVE_MS", "")
     if not text:
-        return mode, EDITOR_ASYNC_REFINE_MS
+        return EDITOR_ASYNC_REFINE_MS
     try:
         value = float(text)
     except ValueError:
         value = float("nan")
     if not 0 < value < float("inf"):
         raise ParameterError("SPLATEDIT_REFINE_ABOVE_MS", f"must be a number of milliseconds > 0, got {text!r}")
-    return mode, value
+    return value
 
 
 @dataclass(frozen=True)
@@ -78,21 +70,20 @@ class FrameScheduler:
         self.scene = None
         self.scene_key: SceneKey | None = None
         self.scene_interactive = False
-        self.refiner = None
         self.progressive = None          # ProgressiveRefinement of the current view
         #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
         self.last_progressive = None
         #: progressive refinements finished (status file, tests)
         self.refinements = 0
         self._stepped = None             # the refinement stepped in the frame being drawn
-        self._refine_failed_key = None   # view whose background frame failed (not retried)
+        self._refine_failed_key = None   # view whose refinement failed (not retried)
         self.last_motion = 0.0
         self.frame_ms = 0.0
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
         self._rendered_interactive = False
         self.budget_ms = float(budget_ms)
-        #: "progressive" (default) or "background" (the second-device fallback), see refine_settings
-        self.refine_mode, self.refine_above_ms = refine_settings()
+        #: full-quality frames predicted slower than this (ms) are refined progressively
+        self.refine_above_ms = refine_above_ms()
         self.frame_overhead_ms = 10.0
         self.frames = 0
         self._sel_version_seen = -1
@@ -130,7 +121,7 @@ class FrameScheduler:
                         (vp.distortion_map, vp.grey, vp.splat_scale, vp.background))
 
     def async_refine(self) -> bool:
-        """True when full-quality frames are slow enough to be drawn in the background."""
+        """True when full-quality frames are slow enough to be refined progressively."""
         vp = self.ed.viewport
         return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > self.refine_above_ms
 
@@ -142,10 +133,9 @@ class FrameScheduler:
                 or (s is not None and self.scene_key != self.state()))
 
     def busy(self) -> bool:
-        """Waiting for a background refinement (or its start)."""
+        """A slow view waits for its refinement to start (motion just stopped)."""
         s = self.ed.session
-        refining = self.refiner is not None and self.refiner.busy
-        return refining or (self.scene_interactive and s is not None and self.async_refine())
+        return self.scene_interactive and s is not None and self.async_refine()
 
     # --------------------------------------------------------------- draw
     @property
@@ -186,7 +176,7 @@ class FrameScheduler:
 
     def _draw_gpu(self, w: int, h: int) -> None:
         """One presented frame on the GPU: the scene (a device-resident frame
-        blitted, or pixels from the background refiner uploaded), then the GUI
+        blitted, or pixels uploaded), then the GUI
         pass (panels, help, the tools' overlays) into the swapchain image."""
         ed = self.ed
         src = None
@@ -219,7 +209,7 @@ class FrameScheduler:
         return frame
 
     def _update_scene(self, w: int, h: int) -> None:
-        """Render (or take from the background refiner) the scene when it is stale."""
+        """Render the scene when it is stale, or advance its progressive refinement."""
         ed = self.ed
         sc = self.scene
         if isinstance(sc, ResidentFrame) and getattr(sc.image, "handle", None) is None:
@@ -233,38 +223,18 @@ class FrameScheduler:
             self.drop_progressive()          # any change: camera, selection, pose, display
         if stale or (self.scene_interactive and not moving):
             if not moving and self.async_refine():
-                # a slow full-quality frame: refined progressively, a chunk per frame
+                # a slow full-quality frame: refined progressively, a few chunks per frame
                 if stale:
                     self.render_scene(key, interactive=True)
-                if self.scene_interactive and self._progressive_step(key, w, h):
-                    pass
-                # the detail mode: drawn by the background refiner, once the view
-                # has been still for a while (a started frame cannot be aborted)
-                elif (self.scene_interactive and key != self._refine_failed_key
-                        and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S):
-                    self.request_refine(key)
+                if self.scene_interactive and not self._progressive_step(key, w, h):
+                    self.render_scene(key, interactive=False)    # no progressive frame: drawn at once
             else:
                 self.render_scene(key, interactive=moving)
-        if self.refiner is not None and self.refiner.error is not None:
-            # a failed full-quality frame is reported once and not retried for this view
-            failed_key, exc = self.refiner.error
-            ed.say(f"full-quality frame failed: {exc}")
-            self.refiner.error = None
-            self._refine_failed_key = failed_key
-        if self.refiner is not None and self.scene_interactive:
-            img = self.refiner.take(key)
-            if img is not None and img.shape[:2] == (h, w):
-                self.scene, self.scene_interactive = img, False
-                ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
 
     def _progressive_step(self, key, w: int, h: int) -> bool:
         """Advance the progressive refinement of ``key`` (started here) by one
-        presented frame's worth of chunks; False where it is not used (the
-        background refiner draws the frame instead): with
-        ``SPLATEDIT_REFINE=background`` (the fallback), and for a Gaussian
-        document (no progressive frame)."""
-        if self.refine_mode == "background":
-            return False
+        presented frame's worth of chunks; False where there is no progressive
+        frame (a Gaussian document: the caller draws the frame at once)."""
         ed, vp = self.ed, self.ed.viewport
         p = self.progressive
         if self.gpu:
@@ -337,25 +307,5 @@ class FrameScheduler:
         info = ed.viewport.last_info
         self.scene_interactive = bool(interactive and info is not None and (info.lod or info.div > 1))
 
-    def request_refine(self, key) -> None:
-        from splatedit.app.viewport import BackgroundRefiner
-        ed = self.ed
-        vp = ed.viewport
-        if self.refiner is None:
-            self.refiner = BackgroundRefiner(ed.wake, vp.budget_ms)
-        s = ed.session
-        w, h = ed.size
-        c = ed.cam
-        cam = OrbitCamera(np.array(c.target, float), c.distance, c.yaw, c.pitch, c.fov_deg,
-                          np.array(c.up_axis, float), c.scene_radius)
-        self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
-                                       handle=s.selection.handle.copy(), sel_version=s.version,
-                                       inactive=s.selection.others(), basis=s.basis, dc=vp.dc, camera=cam,
-                                       w=w, h=h, distortion_map=vp.distortion_map, grey=vp.grey,
-                                       splat_scale=vp.splat_scale, background=vp.background, pick_key=ed.brush.pick_key()))
-
     def close(self) -> None:
         self.drop_progressive()
-        if self.refiner is not None:
-            self.refiner.close()
-            self.refiner = None

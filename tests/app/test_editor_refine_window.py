@@ -24,7 +24,6 @@ def test_refinement_after_motion_uses_the_editors_one_device(xvfb, tmp_path, mon
     model = tmp_path / "refine.ply"
     write(model, bunny_surface_cloud(EDITOR_LOD_MIN_SPLATS), overwrite=True)
     monkeypatch.setenv("SPLATEDIT_REFINE_ABOVE_MS", "1")
-    monkeypatch.delenv("SPLATEDIT_REFINE", raising=False)
     ed = EditorProcess(xvfb, tmp_path, str(model), "--budget-ms", "5")
     try:
         s = ed.idle(lambda s: s["loaded"] and s["full_quality"] and s["refinements"] >= 1,

@@ -52,7 +52,6 @@ def ed(monkeypatch):
     # chunks of 8000 splats (about 8 steps per phase) whatever this machine's speed
     import splatedit.app.frames as frames
     import splatedit.app.progressive_refine as pr
-    monkeypatch.delenv("SPLATEDIT_REFINE", raising=False)   # progressive: the default
     monkeypatch.setattr(frames, "EDITOR_PROGRESSIVE_MIN_CHUNK", 8000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 8000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
@@ -169,12 +168,11 @@ def test_several_chunks_per_presented_frame_up_to_the_budget(ed, monkeypatch):
 
 def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
     """A bent bumpy plane in the detail mode (its own pre-pass shader): after
-    motion stops the view is refined progressively on the editor's device (no
-    background refiner) and ends equal to the one-submit detail frame."""
+    motion stops the view is refined progressively on the editor's device and
+    ends equal to the one-submit detail frame."""
     from splatedit.deform.modes import DeformationMode
     from tests.deform.detail_scene import bend, bumpy_plane
     import splatedit.app.progressive_refine as pr
-    monkeypatch.delenv("SPLATEDIT_REFINE", raising=False)
     monkeypatch.setattr(pr.ProgressiveRefinement, "budget_ms", lambda self: 0.0)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 1000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
@@ -199,7 +197,7 @@ def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
             if fr.last_progressive is not None:
                 break
         p = fr.last_progressive
-        assert p is not None and p.done and len(p.step_ms) >= 4 and fr.refiner is None
+        assert p is not None and p.done and len(p.step_ms) >= 4
         assert vp.full.r._detail_buf is not None and p.frame.prepared
         from splatedit.app.viewport import render_camera
         ref = vp.full.r.render(render_camera(ed.cam), W, H)
