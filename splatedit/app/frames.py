@@ -93,8 +93,11 @@ class FrameScheduler:
         self.drop_progressive()
 
     def drop_progressive(self) -> None:
-        if self.progressive is not None:
-            self.progressive.close()
+        p = self.progressive
+        if p is not None:
+            if isinstance(self.scene, ResidentFrame) and self.scene.image is p.image:
+                self.scene = self.scene_key = None      # its image goes with it: drawn again
+            p.close()
             self.progressive = None
 
     def motion(self) -> None:
@@ -218,9 +221,9 @@ class FrameScheduler:
         key = self.state()
         now = time.perf_counter()
         moving = now - self.last_motion < EDITOR_REFINE_DELAY_S or ed.drag is not DragMode.NONE
-        stale = self.scene is None or key != self.scene_key
         if self.progressive is not None and (moving or self.progressive.key != key):
             self.drop_progressive()          # any change: camera, selection, pose, display
+        stale = self.scene is None or key != self.scene_key
         if stale or (self.scene_interactive and not moving):
             if not moving and self.async_refine():
                 # a slow full-quality frame: refined progressively, a few chunks per frame
