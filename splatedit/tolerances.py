@@ -817,11 +817,18 @@ EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
 # Progressive refinement by default: chunks composed on the device (issue 10 "one device", issue 11 part 5)
 # ---------------------------------------------------------------------------
 #: chunk steps the work budget of one presented frame is split into (the chunk is
-#: sized to budget / this): several steps per presented frame keep the frame near
-#: its budget when the per-splat cost changes (a colour step costs ~1.6x a visibility
-#: step: 53 vs 32 ms per 100k splats at 1280x720, 1M splats, 2 loaded cores), and
-#: a step's fixed cost (submit, pre-pass dispatch) is small next to 100k splats
-EDITOR_PROGRESSIVE_STEPS_PER_FRAME = 3
+#: sized to budget / this; a step that leaves room for another is followed by one).
+#: One: every step pays a fixed cost (a render pass loading and storing the full-size
+#: depth and accumulation targets, the pre-pass dispatch, a submit): 1M splats at
+#: 1280x720 drawn in 20k-splat chunks took 2.9-4.0 s, in 250k chunks 1.16 s
+#: (docs/PERFORMANCE.md, 2 loaded cores), i.e. ~20-30 ms per step; 3 steps per
+#: frame gave 66-77 steps per 1M refinement in the window
+EDITOR_PROGRESSIVE_STEPS_PER_FRAME = 1
+#: a colour step's cost per splat over a visibility step's (the chunk is divided by
+#: it when the colour half starts), 100k-splat steps of 1M splats at 1280x720, draw
+#: only: 35 vs 32 ms at load 0.5 (53 ms with the old per-step shading pass of 16 ms
+#: and readback), 128 vs 106 and 184 vs 170 ms at load 10 (2 cores): 1.1-1.2
+EDITOR_PROGRESSIVE_ATTR_COST = 1.15
 #: share of the frame interval left to the steps at least, however slow presenting
 #: is (the rest is the measured present + GUI cost and the composition pass)
 EDITOR_PROGRESSIVE_MIN_WORK_SHARE = 0.5

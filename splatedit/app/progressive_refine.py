@@ -12,10 +12,12 @@ is handled between presented frames (any change drops the refinement,
 
 Per presented frame :meth:`ProgressiveRefinement.advance` draws chunks until
 the work budget is used (the frame interval ``frame_ms`` minus the measured
-cost of presenting, at least ``EDITOR_PROGRESSIVE_MIN_WORK_SHARE`` of it),
-then composes the image once.  The chunk size follows the budget: it starts
-at ``work / steps / ms_per_splat`` and is rescaled after every step by the
-ratio of the step budget to the step's measured time.
+cost of presenting and composing, at least ``EDITOR_PROGRESSIVE_MIN_WORK_SHARE``
+of it), then composes the image once.  The chunk size follows the budget: it
+starts at ``work / EDITOR_PROGRESSIVE_STEPS_PER_FRAME / ms_per_splat`` and is
+rescaled after every step by the ratio of the step budget to the step's
+measured time (and by ``1 / EDITOR_PROGRESSIVE_ATTR_COST`` when the colour
+half starts); a step that leaves room for another is followed by one.
 """
 
 from __future__ import annotations
@@ -25,7 +27,8 @@ import time
 import numpy as np
 
 from splatedit.render.progressive import ProgressiveFrame
-from splatedit.tolerances import (EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH, EDITOR_PROGRESSIVE_MIN_CHUNK,
+from splatedit.tolerances import (EDITOR_PROGRESSIVE_ATTR_COST, EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH,
+                                  EDITOR_PROGRESSIVE_MIN_CHUNK,
                                   EDITOR_PROGRESSIVE_MIN_WORK_SHARE, EDITOR_PROGRESSIVE_STEPS_PER_FRAME)
 
 
@@ -95,12 +98,15 @@ class ProgressiveRefinement:
         target = budget / EDITOR_PROGRESSIVE_STEPS_PER_FRAME
         t0 = time.perf_counter()
         while not f.done:
+            phase = f.phase
             ts = time.perf_counter()
             f.step(readback=False)
             ms = (time.perf_counter() - ts) * 1e3
             self.step_ms.append(ms)
             if not f.done and ms > 0:
                 scale = min(target / ms, EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH)
+                if f.phase != phase:        # visibility done: colour steps cost more per splat
+                    scale /= EDITOR_PROGRESSIVE_ATTR_COST
                 f.chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK, int(f.chunk * scale))
             if (time.perf_counter() - t0) * 1e3 + min(ms, target) > budget:
                 break

@@ -7,8 +7,9 @@ each) so a window stays responsive and the image sharpens while it is drawn:
 1. visibility: ``ceil(n / chunk)`` steps draw the splats' depth into the
    renderer's depth target (the first step clears it, the others load it);
 2. attributes: the same chunks are accumulated into the colour/normal
-   targets against the complete depth buffer, and after every chunk the
-   shading pass resolves what has been accumulated so far into an image.
+   targets against the complete depth buffer; ``step()`` then resolves what
+   has been accumulated so far into an image and reads it back, or (without
+   readback, below) :meth:`show` composes it on the device when asked.
 
 Each chunk goes through the compute pre-pass when the renderer uses it
 (:meth:`Renderer._use_prepass`): a step runs the pre-pass of the chunk's
