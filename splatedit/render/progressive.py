@@ -108,7 +108,6 @@ class ProgressiveFrame:
         self.n = renderer.n
         self._rb = V.Buffer(renderer.dev, width * height * 4, ("transfer_dst",), host_visible=True)
         self._shown = self._fb_over = None      # the composed image (set_under / show)
-        self._boxes = None                      # (n, lo, hi, axis) of blocks of _BOX_BLOCK splats
         self.shaded_rect = None
         self._under = None
         self._unshown = False                   # attribute chunks drawn since the last shading pass
@@ -317,14 +316,15 @@ class ProgressiveFrame:
         splats); the whole image when a box reaches the camera plane; None
         when the chunk is off screen."""
         r = self.r
-        if self._boxes is None or self._boxes[0] != r.n:
+        cached = getattr(r, "_progressive_boxes", None)     # per cloud: shared by its refinements
+        if cached is None or cached[0] is not r.cloud:
             c = r.cloud
-            starts = np.arange(0, r.n, _BOX_BLOCK)
+            starts = np.arange(0, c.n, _BOX_BLOCK)
             reach = np.sqrt(np.maximum(np.einsum("ij,ij->i", c.u, c.u), np.einsum("ij,ij->i", c.v, c.v)))
             rad = np.maximum.reduceat(reach, starts)
-            self._boxes = (r.n, np.minimum.reduceat(c.positions, starts, axis=0) - rad[:, None],
-                           np.maximum.reduceat(c.positions, starts, axis=0) + rad[:, None], rad)
-        _, lo, hi, rad = self._boxes
+            cached = r._progressive_boxes = (c, np.minimum.reduceat(c.positions, starts, axis=0) - rad[:, None],
+                                             np.maximum.reduceat(c.positions, starts, axis=0) + rad[:, None], rad)
+        _, lo, hi, rad = cached
         b0, b1 = first // _BOX_BLOCK, -(-(first + count) // _BOX_BLOCK)
         grow = rad[b0:b1, None] * max(r.splat_scale - 1.0, 0.0) + r._displacement_reach()
         lo, hi = lo[b0:b1] - grow, hi[b0:b1] + grow
