@@ -52,13 +52,15 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
-from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
+from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP, RP_PICK
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
 
 #: splats per box of the shading rect (:meth:`ProgressiveFrame._chunk_rect`)
 _BOX_BLOCK = 4096
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
+_RP_PICK_LOAD = V.RenderPassDesc(colors=(V.Attachment("r32ui", "load", initial="transfer_src", final="transfer_src"),),
+                                 depth=V.Attachment("d32f", "load", initial="transfer_src", final="transfer_src"))
 #: the shading pass over the shown image: loads it, writes covered pixels ("over":
 #: the intermediate uniforms give uncovered pixels alpha 0, so they keep what is there)
 _RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
@@ -117,6 +119,7 @@ class ProgressiveFrame:
         self.phase = "depth"
         self.next = 0
         self.restarts = getattr(self, "restarts", -1) + 1
+        self._pick_next = 0
         self._unshown = False
         self._dirty = None                      # pixel rect (x, y, w, h) the unshown chunks can touch
         self._final = False                     # the last image shaded with the real background
@@ -133,10 +136,11 @@ class ProgressiveFrame:
             return 1.0
         return (self.next + (self.n if self.phase == "attr" else 0)) / (2.0 * self.n)
 
-    def _span(self, prepared: bool) -> tuple[int, int]:
-        """(first splat, count) of the next chunk: on the pre-pass path a whole
-        number of workgroups inside one pre-pass window."""
-        first = self.next
+    def _span(self, prepared: bool, first: int | None = None) -> tuple[int, int]:
+        """(first splat, count) of the next chunk (from ``first``, default
+        :attr:`next`): on the pre-pass path a whole number of workgroups inside
+        one pre-pass window."""
+        first = self.next if first is None else first
         if not prepared:
             return first, min(self.chunk, self.n - first)
         end = next(w0 + wn for w0, wn, _ in self.r._prep_objects().windows if w0 <= first < w0 + wn)
@@ -208,6 +212,55 @@ class ProgressiveFrame:
             self.next = 0
             self.phase = "attr" if self.phase == "depth" else "done"
         return out
+
+    # ------------------------------------------------------------ pick map
+    @property
+    def pick_done(self) -> bool:
+        """The pick map of the view is complete (:meth:`pick_step`)."""
+        return self._pick_next >= self.n
+
+    def pick_step(self) -> None:
+        """Once :attr:`done`: draw the next chunk (``chunk`` splats) of the view's
+        pick map (splat index and depth of the nearest splat per pixel, as
+        :meth:`Renderer.pick` draws it whole); :meth:`pick_result` once
+        :attr:`pick_done`."""
+        r = self.r
+        r._check_open()
+        if not self.done or self.pick_done:
+            raise ParameterError("pick", "the frame is not done, or its pick map is")
+        t = r._targets_for(self.width, self.height)
+        t.ensure_pick()
+        prepared = r._use_prepass()
+        first, count = self._span(prepared, self._pick_next)
+        objs, sets, window = [], None, 0
+        if prepared:
+            window, sets, objs = r._prep_range(first, count)
+        try:
+            r._write_ubo(self.camera, self.width, self.height)
+
+            def rec(cb):
+                if prepared:
+                    r._record_prepass(cb, window, sets)
+                cb.begin_render_pass(r.cache.render_pass(RP_PICK if first == 0 else _RP_PICK_LOAD), t.fb_pick,
+                                     [(0, 0, 0, 0), 1.0] if first == 0 else [None, None])
+                if prepared:
+                    r._record_splats(cb, "pick", True, window)
+                else:
+                    r._record_vertex_splats(cb, "pick", first, count)
+                cb.end_render_pass()
+            r.dev.submit(rec)
+        finally:
+            for o in reversed(objs):
+                o.destroy()
+        self._pick_next = first + count
+
+    def pick_result(self):
+        """(index (h, w) int64, -1 background; view-axis depth (h, w) float64,
+        NaN background) of the complete pick map, as :meth:`Renderer.pick`."""
+        if not (self.done and self.pick_done):
+            raise ParameterError("pick", "the pick map is not complete")
+        self.r._write_ubo(self.camera, self.width, self.height)      # its near/far decode the depth
+        return self.r._targets_for(self.width, self.height).read_pick(None, lambda cb: None)
 
     def _write_ubo(self, background_alpha: float) -> None:
         """The frame uniforms with this alpha for background pixels (0: the

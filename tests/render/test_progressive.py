@@ -235,3 +235,27 @@ def test_progressive_frame_in_the_detail_mode_matches_the_single_frame(renderer)
         img = pf.show(readback=True)
     _close_to(img, full)
     assert (full[..., :3] < 250).any() and not np.array_equal(full, under)
+
+
+def test_pick_map_in_chunks_equals_the_single_pick(vertex_path):
+    """After the frame, the view's pick map drawn in chunks of 7,000 splats
+    (6 steps) equals :meth:`Renderer.pick` of the same view (vertex path:
+    deterministic), index and depth."""
+    r = vertex_path
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    idx, depth = r.pick(cam, W, H)
+    with ProgressiveFrame(r, cam, W, H, 7000) as pf:
+        while not pf.done:
+            pf.step(readback=False)
+        steps = 0
+        while not pf.pick_done:
+            pf.pick_step()
+            steps += 1
+        got_idx, got_depth = pf.pick_result()
+    assert steps == -(-bunny.n // 7000)
+    assert (idx >= 0).mean() > 0.1
+    assert np.array_equal(got_idx, idx)
+    assert np.array_equal(np.isnan(got_depth), np.isnan(depth))
+    assert np.allclose(got_depth[idx >= 0], depth[idx >= 0], rtol=1e-6)
