@@ -71,6 +71,9 @@ class FrameScheduler:
         self.scene_key: SceneKey | None = None
         self.scene_interactive = False
         self.progressive = None          # ProgressiveRefinement of the current view
+        #: (ProgressiveRefinement done, brush pick key): its pick map drawn in chunks while still
+        self.picking = None
+        self._pick_ready = None          # (brush pick key, index map, depth) of the last still view
         #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
         self.last_progressive = None
         #: progressive refinements finished (status file, tests)
@@ -92,7 +95,21 @@ class FrameScheduler:
         self.scene_key = None
         self.drop_progressive()
 
+    def drop_picking(self) -> None:
+        if self.picking is not None:
+            self.picking[0].close()
+            self.picking = None
+
+    def take_pick(self, key):
+        """(index map, depth) of the view with brush pick key ``key``, drawn in
+        chunks after its refinement (the brush's pick map), or None."""
+        ready = self._pick_ready
+        if ready is not None and ready[0] == key:
+            return ready[1], ready[2]
+        return None
+
     def drop_progressive(self) -> None:
+        self.drop_picking()
         p = self.progressive
         if p is not None:
             if isinstance(self.scene, ResidentFrame) and self.scene.image is p.image:
@@ -132,6 +149,7 @@ class FrameScheduler:
         """A frame must be drawn now (the scene is stale or still interactive)."""
         s = self.ed.session
         return (self.scene_key is None or self.ed.drag is not DragMode.NONE or self.progressive is not None
+                or self.picking is not None
                 or (self.scene_interactive and not (s is not None and self.async_refine()))
                 or (s is not None and self.scene_key != self.state()))
 
@@ -223,6 +241,8 @@ class FrameScheduler:
         moving = now - self.last_motion < EDITOR_REFINE_DELAY_S or ed.drag is not DragMode.NONE
         if self.progressive is not None and (moving or self.progressive.key != key):
             self.drop_progressive()          # any change: camera, selection, pose, display
+        if self.picking is not None:
+            self._pick_step(key, moving)
         stale = self.scene is None or key != self.scene_key
         if stale or (self.scene_interactive and not moving):
             if not moving and self.async_refine():
@@ -282,8 +302,30 @@ class FrameScheduler:
             self.last_progressive = p
             self.refinements += 1
             self.progressive = None
-            p.close()
+            pick_key = ed.brush.pick_key()
+            if pick_key is not None and (self._pick_ready is None or self._pick_ready[0] != pick_key):
+                self.picking = (p, pick_key)     # the brush's pick map next, while the view is still
+            else:
+                p.close()
         return True
+
+    def _pick_step(self, key, moving: bool) -> None:
+        """One chunk of the still view's pick map (started when its refinement
+        ended), dropped on any change; kept for the brush when complete."""
+        p, pick_key = self.picking
+        if moving or p.key != key or self.ed.brush.pick_key() != pick_key:
+            self.drop_picking()
+            return
+        f = p.frame
+        try:
+            f.pick_step()
+            if f.pick_done:
+                idx, depth = f.pick_result()
+                self._pick_ready = (pick_key, idx, depth)
+                self.drop_picking()
+        except SplatEditError as exc:
+            self.ed.say(f"pick map failed: {exc}")
+            self.drop_picking()
 
     def _under(self, w: int, h: int):
         """The level-of-detail frame shown under the progressive chunks: on the

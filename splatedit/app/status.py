@@ -92,6 +92,8 @@ def status_dict(ed) -> dict:
     last = fr.last_progressive
     st["last_refinement"] = None if last is None else last.timings()
     st["refinements"] = fr.refinements
+    #: the brush's pick map of this view was drawn after its refinement (no pick on first use)
+    st["pick_map_ready"] = fr.take_pick(ed.brush.pick_key()) is not None
     st["vulkan_devices_created"] = devices_created()
     w, h = ed.size
     gz = ed.gizmo

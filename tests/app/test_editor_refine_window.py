@@ -4,8 +4,9 @@ A 150,000-splat model (the smallest that gets levels of detail,
 ``EDITOR_LOD_MIN_SPLATS``) opened with a 5 ms motion budget (moving frames
 are levels of detail) and ``SPLATEDIT_REFINE_ABOVE_MS=1`` (every still view
 is refined): after a wheel step the view is refined progressively to full
-quality on the editor's own device, and the process has created exactly one
-Vulkan device (rendering, refinement and presentation share it)."""
+quality on the editor's own device, then the brush's pick map of the view is
+drawn in chunks, and the process has created exactly one Vulkan device
+(rendering, refinement, picking and presentation share it)."""
 
 from __future__ import annotations
 
@@ -38,6 +39,8 @@ def test_refinement_after_motion_uses_the_editors_one_device(xvfb, tmp_path, mon
                     "the new view refined", 120)
         lr = s["last_refinement"]
         assert lr["done_s"] is not None and lr["steps"] >= 2 and lr["frames"] >= 1
+        # then the brush's pick map of the still view, in chunks on the same device
+        s = ed.idle(lambda s: s["pick_map_ready"], "the pick map of the view", 60)
         assert s["vulkan_devices_created"] == 1, s["vulkan_devices_created"]
     finally:
         ed.close()

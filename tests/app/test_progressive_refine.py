@@ -208,3 +208,50 @@ def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
         ed.frames.close()
         ed.session.close()
         ed.viewport.close()
+
+
+def test_the_brush_pick_map_is_drawn_in_chunks_after_the_refinement(ed):
+    """Once the still view is refined, the scheduler keeps drawing (pending)
+    until the view's pick map is complete, a chunk per frame, then hands it to
+    the brush (take_pick of its key): equal to a whole pick of the view; a
+    camera change drops a pick map under way."""
+    fr, vp = ed.frames, ed.viewport
+    key = ("view", 1)
+    ed.brush.pick_key = lambda: key
+    _slow(ed)
+    fr.motion()
+    fr.draw()
+    fr.last_motion -= 1.0
+    for _ in range(100):
+        fr.draw()
+        if fr.last_progressive is not None:
+            break
+    assert fr.picking is not None and fr.pending() and fr.take_pick(key) is None
+    frames = 0
+    while fr.picking is not None and frames < 50:
+        fr.draw()
+        frames += 1
+    assert frames >= 2 and not fr.pending()
+    idx, depth = fr.take_pick(key)
+    ref_idx, ref_depth = vp.pick(ed.cam, W, H)
+    assert (ref_idx >= 0).mean() > 0.1
+    # the pre-pass path: nearest-splat ties may resolve differently
+    assert (idx == ref_idx).mean() > 0.99
+    assert fr.take_pick(("view", 2)) is None
+    # a new view: its pick map is dropped when the camera moves again
+    ed.cam.yaw += 0.3
+    key = ("view", 2)
+    _slow(ed)                                       # the refinement measured the real (fast) cost
+    fr.motion()
+    fr.draw()
+    fr.last_motion -= 1.0
+    for _ in range(100):
+        fr.draw()
+        if fr.picking is not None:
+            break
+    assert fr.picking is not None
+    p = fr.picking[0]
+    ed.cam.yaw += 0.3
+    fr.motion()
+    fr.draw()
+    assert fr.picking is None and p.frame._rb is None and fr.take_pick(key) is None
