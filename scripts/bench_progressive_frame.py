@@ -3,7 +3,7 @@
     PYTHONPATH=$PWD python scripts/bench_progressive_frame.py 1000000 [--size 1280x720] [--chunks 20000,100000]
 
 In one process, alternating, on the bunny-surface cloud of ``bench_editor``:
-the one-submit pre-pass frame (what the background refiner draws), and a
+the one-submit pre-pass frame (what the former background refiner drew), and a
 progressive frame per chunk size stepped to the end (sum of the step wall
 times = its time to full quality).  One JSON line per count.
 """

@@ -1,6 +1,7 @@
 """Progressive refinement in the real editor window (Xvfb, lavapipe).
 
     PYTHONPATH=$PWD python scripts/bench_refine_window.py 1000000 4000000 [--size 1280x720] [--dir /tmp]
+        [--modes progressive,background] [--repeats 2]
 
 For each count: writes a bunny-surface model (``bench_editor``'s cloud) as
 binary PLY, opens it in the editor under a private Xvfb with a status file,
@@ -11,7 +12,11 @@ refining (whole presented frames), the number of steps, and the input
 latency (wheel event sent during refinement -> the new camera in the status
 file), and the time from that event to the status showing the full-quality
 frame of the new view (``wheel_to_full_quality_s``, for
-``SPLATEDIT_REFINE=progressive`` and the background refiner alike; with the
+the progressive refinement and the background refiner alike.  The
+background refiner (a second Vulkan device) is gone since the progressive
+refinement became the default; ``--modes background`` (it sets
+``SPLATEDIT_REFINE=background`` for the editor) measures it on an older
+revision (``PYTHONPATH`` of a checkout before branch progdefault).  With the
 background refiner a status written before the level-of-detail frame can
 still say full quality: a figure near 0.1 s is that race, not a frame).  Needs Xvfb and
 xdotool.
@@ -63,7 +68,7 @@ def _wait(path: Path, cond, timeout: float, proc=None) -> dict:
     raise TimeoutError(f"last status: { {k: _status(path).get(k) for k in ('idle', 'refining', 'last_refinement')} }")
 
 
-def measure(n: int, size: tuple[int, int], folder: Path, display: str) -> dict:
+def measure(n: int, size: tuple[int, int], folder: Path, display: str, mode: str) -> dict:
     from splatedit.app.bench import bunny_surface_cloud
     from splatedit.io import write
     model = folder / f"refine_bench_{n}.ply"
@@ -71,8 +76,8 @@ def measure(n: int, size: tuple[int, int], folder: Path, display: str) -> dict:
         write(model, bunny_surface_cloud(n), overwrite=True)
     st = folder / f"refine_status_{n}.json"
     st.unlink(missing_ok=True)
-    env = dict(os.environ, DISPLAY=display)
-    progressive = os.environ.get("SPLATEDIT_REFINE") == "progressive"
+    env = dict(os.environ, DISPLAY=display, SPLATEDIT_REFINE=mode)
+    progressive = mode == "progressive"
     log = open(folder / f"refine_editor_{n}.log", "w")
     ed = subprocess.Popen([sys.executable, "-m", "splatedit.app.editor", str(model), "--status-file", str(st),
                            "--size", f"{size[0]}x{size[1]}"], env=env, stdout=log, stderr=subprocess.STDOUT)
@@ -119,12 +124,19 @@ def main() -> None:
     ap.add_argument("counts", type=int, nargs="+")
     ap.add_argument("--size", default="1280x720")
     ap.add_argument("--dir", default=tempfile.gettempdir())
+    ap.add_argument("--modes", default=os.environ.get("SPLATEDIT_REFINE", "progressive"),
+                    help="comma-separated refinement modes run in turn (progressive, background)")
+    ap.add_argument("--repeats", type=int, default=1, help="rounds over the modes")
     a = ap.parse_args()
     size = tuple(int(x) for x in a.size.split("x"))
     proc, display = _xvfb()
     try:
         for n in a.counts:
-            print(json.dumps(measure(n, size, Path(a.dir), display)), flush=True)
+            for _ in range(a.repeats):
+                for mode in a.modes.split(","):
+                    out = measure(n, size, Path(a.dir), display, mode)
+                    out["load_average"] = [round(x, 2) for x in os.getloadavg()]
+                    print(json.dumps(out), flush=True)
     finally:
         proc.terminate()
         proc.wait(5)

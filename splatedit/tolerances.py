@@ -299,10 +299,9 @@ EDITOR_BRUSH_WHEEL_STEP = 1.15
 EDITOR_BRUSH_KEY_STEP = 1.2
 #: seconds without motion after which the full-quality frame is drawn
 EDITOR_REFINE_DELAY_S = 0.2
-#: full-quality frames predicted slower than this (ms) are drawn in the background
+#: full-quality frames predicted slower than this (ms) are refined progressively after
+#: motion stops (app/progressive_refine.py; SPLATEDIT_REFINE_ABOVE_MS overrides it)
 EDITOR_ASYNC_REFINE_MS = 400.0
-#: seconds without motion before such a background frame is started
-EDITOR_ASYNC_REFINE_DELAY_S = 0.6
 #: assumed full-quality cost (ms per splat at the window size) before the first measurement
 EDITOR_GUESS_MS_PER_SPLAT = 6e-4
 #: models with more splats than this get a level-of-detail pyramid
@@ -954,3 +953,28 @@ ESTIMATE_PEAK_EXTRA_BYTES_PER_POINT = 300
 #: surface).  One level resolves the points near a cell wall without a tree
 #: over the whole cloud (poste_france.xyz: 105 retried, 39 left)
 TILE_RETRY_LEVELS = 1
+# Progressive refinement by default: chunks composed on the device (issue 10 "one device", issue 11 part 5)
+# ---------------------------------------------------------------------------
+#: chunk steps the work budget of one presented frame is split into (the chunk is
+#: sized to budget / this; a step that leaves room for another is followed by one).
+#: One: every step pays a fixed cost (a render pass loading and storing the full-size
+#: depth and accumulation targets, the pre-pass dispatch, a submit): 1M splats at
+#: 1280x720 drawn in 20k-splat chunks took 2.9-4.0 s, in 250k chunks 1.16 s
+#: (docs/PERFORMANCE.md, 2 loaded cores), i.e. ~20-30 ms per step; 3 steps per
+#: frame gave 66-77 steps per 1M refinement in the window
+EDITOR_PROGRESSIVE_STEPS_PER_FRAME = 1
+#: a colour step's cost per splat over a visibility step's (the chunk is divided by
+#: it when the colour half starts), 100k-splat steps of 1M splats at 1280x720, draw
+#: only: 35 vs 32 ms at load 0.5 (53 ms with the old per-step shading pass of 16 ms
+#: and readback), 128 vs 106 and 184 vs 170 ms at load 10 (2 cores): 1.1-1.2
+EDITOR_PROGRESSIVE_ATTR_COST = 1.15
+#: share of the frame interval left to the steps at least, however slow presenting
+#: is (the rest is the measured present + GUI cost and the composition pass)
+EDITOR_PROGRESSIVE_MIN_WORK_SHARE = 0.5
+#: pixels added around the projected boxes of the splats drawn since the last shown
+#: image: the shading pass of :meth:`ProgressiveFrame.show` covers only that rect.  A
+#: splat's quad bounds its ellipse and the low-pass disc (RENDER_LOWPASS_RADIUS_PX =
+#: 0.71 px); point splats are at most a few pixels wide but centred on the splat;
+#: 2 px covers both and the rounding (tests/render/test_progressive.py compares the
+#: composed images with the whole-image CPU composite bit for bit)
+PROGRESSIVE_SHADE_PAD_PX = 2.0

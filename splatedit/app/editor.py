@@ -178,10 +178,6 @@ class Editor(EventRouting, FileActions):
         return self.prompt is not None or self.confirm_quit or self.confirm_open is not None or self.browser.shown
 
     @property
-    def refiner(self):
-        return self.frames.refiner
-
-    @property
     def frame_ms(self) -> float:
         return self.frames.frame_ms
 
@@ -198,8 +194,7 @@ class Editor(EventRouting, FileActions):
         """Nothing left to do until the next input (tests wait for this)."""
         s, fr = self.session, self.frames
         return (s is not None and not self.jobs and s.fit_job is None and self.drag is DragMode.NONE
-                and s.manip is None and not fr.scene_interactive and fr.scene_key == fr.state()
-                and not (fr.refiner is not None and fr.refiner.busy))
+                and s.manip is None and not fr.scene_interactive and fr.scene_key == fr.state())
 
     # -------------------------------------------------------------- actions
     def _action_table(self) -> dict:
@@ -356,6 +351,8 @@ def run_editor(path=None, **options) -> int:
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
+    from splatedit.app.frames import refine_above_ms
+    refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
                              "saves never replace it: choose another path")

@@ -3,14 +3,11 @@ when the full-quality one, presenting it with the overlay, and the
 frame-time bookkeeping that sizes the interactive budget.
 
 Full quality: drawn at once when it is cheap; when it is slow (a large model,
-drawn at a level of detail while moving) it is drawn after motion stops by
-the background refiner (a whole frame on a second device, with the compute
-pre-pass, shown when done) or, with ``SPLATEDIT_REFINE=progressive``, refined
-progressively (:mod:`splatedit.app.progressive_refine`: a chunk of splats per
-idle frame on the same device, composited over the level-of-detail frame,
-dropped on any change: the image sharpens instead of switching, but with a
-submit, a shading pass and a readback per step full quality comes 2-3x later
-at 1M splats; the detail mode always uses the refiner).
+drawn at a level of detail while moving) it is refined progressively after
+motion stops (:mod:`splatedit.app.progressive_refine`: a few chunks of splats
+per presented frame on the editor's one Vulkan device, composed over the
+level-of-detail frame on the device, dropped on any change: the image
+sharpens instead of switching).
 
 Two presentation paths: the GPU path (the editor has a GUI,
 :mod:`splatedit.app.gui_panels`): the scene frame stays on the device and is
@@ -29,13 +26,29 @@ import numpy as np
 
 from splatedit.app import overlay as ov
 from splatedit.app import revision
-from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.tools.base import DragMode
 from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
-from splatedit.errors import SplatEditError
-from splatedit.tolerances import (EDITOR_ASYNC_REFINE_DELAY_S, EDITOR_ASYNC_REFINE_MS,
-                                  EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_REFINE_DELAY_S)
+from splatedit.errors import ParameterError, SplatEditError
+from splatedit.tolerances import (EDITOR_ASYNC_REFINE_MS,
+                                  EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_PROGRESSIVE_STEPS_PER_FRAME,
+                                  EDITOR_REFINE_DELAY_S)
+
+
+def refine_above_ms() -> float:
+    """Full-quality frames predicted slower than this (ms) are refined
+    progressively after motion stops: ``SPLATEDIT_REFINE_ABOVE_MS``, default
+    ``EDITOR_ASYNC_REFINE_MS``.  ParameterError names a bad value."""
+    text = os.environ.get("SPLATEDIT_REFINE_ABOVE_MS", "")
+    if not text:
+        return EDITOR_ASYNC_REFINE_MS
+    try:
+        value = float(text)
+    except ValueError:
+        value = float("nan")
+    if not 0 < value < float("inf"):
+        raise ParameterError("SPLATEDIT_REFINE_ABOVE_MS", f"must be a number of milliseconds > 0, got {text!r}")
+    return value
 
 
 @dataclass(frozen=True)
@@ -57,17 +70,23 @@ class FrameScheduler:
         self.scene = None
         self.scene_key: SceneKey | None = None
         self.scene_interactive = False
-        self.refiner = None
         self.progressive = None          # ProgressiveRefinement of the current view
+        #: (ProgressiveRefinement done, brush pick key): its pick map drawn in chunks while still
+        self.picking = None
+        self._pick_ready = None          # (brush pick key, index map, depth) of the last still view
         #: the last finished ProgressiveRefinement (timings, for benchmarks and tests)
         self.last_progressive = None
+        #: progressive refinements finished (status file, tests)
+        self.refinements = 0
         self._stepped = None             # the refinement stepped in the frame being drawn
-        self._refine_failed_key = None   # view whose background frame failed (not retried)
+        self._refine_failed_key = None   # view whose refinement failed (not retried)
         self.last_motion = 0.0
         self.frame_ms = 0.0
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
         self._rendered_interactive = False
         self.budget_ms = float(budget_ms)
+        #: full-quality frames predicted slower than this (ms) are refined progressively
+        self.refine_above_ms = refine_above_ms()
         self.frame_overhead_ms = 10.0
         self.frames = 0
         self._sel_version_seen = -1
@@ -76,9 +95,26 @@ class FrameScheduler:
         self.scene_key = None
         self.drop_progressive()
 
+    def drop_picking(self) -> None:
+        if self.picking is not None:
+            self.picking[0].close()
+            self.picking = None
+
+    def take_pick(self, key):
+        """(index map, depth) of the view with brush pick key ``key``, drawn in
+        chunks after its refinement (the brush's pick map), or None."""
+        ready = self._pick_ready
+        if ready is not None and ready[0] == key:
+            return ready[1], ready[2]
+        return None
+
     def drop_progressive(self) -> None:
-        if self.progressive is not None:
-            self.progressive.close()
+        self.drop_picking()
+        p = self.progressive
+        if p is not None:
+            if isinstance(self.scene, ResidentFrame) and self.scene.image is p.image:
+                self.scene = self.scene_key = None      # its image goes with it: drawn again
+            p.close()
             self.progressive = None
 
     def motion(self) -> None:
@@ -105,22 +141,22 @@ class FrameScheduler:
                         (vp.distortion_map, vp.grey, vp.splat_scale, vp.background))
 
     def async_refine(self) -> bool:
-        """True when full-quality frames are slow enough to be drawn in the background."""
+        """True when full-quality frames are slow enough to be refined progressively."""
         vp = self.ed.viewport
-        return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > EDITOR_ASYNC_REFINE_MS
+        return vp.ms_per_splat is not None and vp.ms_per_splat * self.ed.session.cloud.n > self.refine_above_ms
 
     def pending(self) -> bool:
         """A frame must be drawn now (the scene is stale or still interactive)."""
         s = self.ed.session
         return (self.scene_key is None or self.ed.drag is not DragMode.NONE or self.progressive is not None
+                or self.picking is not None
                 or (self.scene_interactive and not (s is not None and self.async_refine()))
                 or (s is not None and self.scene_key != self.state()))
 
     def busy(self) -> bool:
-        """Waiting for a background refinement (or its start)."""
+        """A slow view waits for its refinement to start (motion just stopped)."""
         s = self.ed.session
-        refining = self.refiner is not None and self.refiner.busy
-        return refining or (self.scene_interactive and s is not None and self.async_refine())
+        return self.scene_interactive and s is not None and self.async_refine()
 
     # --------------------------------------------------------------- draw
     @property
@@ -148,7 +184,7 @@ class FrameScheduler:
         self.frames += 1
         self.frame_ms = (time.perf_counter() - t0) * 1e3
         if self._stepped is not None:
-            self._stepped.frame_ms.append(self.frame_ms)
+            self._stepped.frame_done(self.frame_ms)
             self._stepped = None
         if self._rendered_interactive:
             self.moving_frame_ms = (self.moving_frame_ms + [self.frame_ms])[-30:]
@@ -161,7 +197,7 @@ class FrameScheduler:
 
     def _draw_gpu(self, w: int, h: int) -> None:
         """One presented frame on the GPU: the scene (a device-resident frame
-        blitted, or pixels from the background refiner uploaded), then the GUI
+        blitted, or pixels uploaded), then the GUI
         pass (panels, help, the tools' overlays) into the swapchain image."""
         ed = self.ed
         src = None
@@ -194,7 +230,7 @@ class FrameScheduler:
         return frame
 
     def _update_scene(self, w: int, h: int) -> None:
-        """Render (or take from the background refiner) the scene when it is stale."""
+        """Render the scene when it is stale, or advance its progressive refinement."""
         ed = self.ed
         sc = self.scene
         if isinstance(sc, ResidentFrame) and getattr(sc.image, "handle", None) is None:
@@ -203,87 +239,107 @@ class FrameScheduler:
         key = self.state()
         now = time.perf_counter()
         moving = now - self.last_motion < EDITOR_REFINE_DELAY_S or ed.drag is not DragMode.NONE
-        stale = self.scene is None or key != self.scene_key
         if self.progressive is not None and (moving or self.progressive.key != key):
             self.drop_progressive()          # any change: camera, selection, pose, display
+        if self.picking is not None:
+            self._pick_step(key, moving)
+        stale = self.scene is None or key != self.scene_key
         if stale or (self.scene_interactive and not moving):
             if not moving and self.async_refine():
-                # a slow full-quality frame: refined progressively, a chunk per frame
+                # a slow full-quality frame: refined progressively, a few chunks per frame
                 if stale:
                     self.render_scene(key, interactive=True)
-                if self.scene_interactive and self._progressive_step(key, w, h):
-                    pass
-                # the detail mode: drawn by the background refiner, once the view
-                # has been still for a while (a started frame cannot be aborted)
-                elif (self.scene_interactive and key != self._refine_failed_key
-                        and time.perf_counter() - self.last_motion >= EDITOR_ASYNC_REFINE_DELAY_S):
-                    self.request_refine(key)
+                if self.scene_interactive and not self._progressive_step(key, w, h):
+                    self.render_scene(key, interactive=False)    # no progressive frame: drawn at once
             else:
                 self.render_scene(key, interactive=moving)
-        if self.refiner is not None and self.refiner.error is not None:
-            # a failed full-quality frame is reported once and not retried for this view
-            failed_key, exc = self.refiner.error
-            ed.say(f"full-quality frame failed: {exc}")
-            self.refiner.error = None
-            self._refine_failed_key = failed_key
-        if self.refiner is not None and self.scene_interactive:
-            img = self.refiner.take(key)
-            if img is not None and img.shape[:2] == (h, w):
-                self.scene, self.scene_interactive = img, False
-                ed.viewport.last_info = FrameInfo(self.refiner.last_ms, ed.session.cloud.n, 1, False, False)
 
     def _progressive_step(self, key, w: int, h: int) -> bool:
-        """One step of the progressive refinement of ``key`` (started here); False
-        where it is not used (the background refiner draws the frame instead):
-        unless ``SPLATEDIT_REFINE=progressive`` (the progressive frame's chunks
-        go through the pre-pass, but per-step submits, shading passes and
-        readbacks make full quality arrive 2-3x later than from the background
-        refiner: 3-5 s against about 2 s at 1M splats, see
-        docs/PERFORMANCE.md), and always in the detail mode (not tested there)."""
-        if os.environ.get("SPLATEDIT_REFINE", "background") != "progressive":
-            return False
+        """Advance the progressive refinement of ``key`` (started here) by one
+        presented frame's worth of chunks; False where there is no progressive
+        frame (a Gaussian document: the caller draws the frame at once)."""
         ed, vp = self.ed, self.ed.viewport
         p = self.progressive
+        if self.gpu:
+            ed.presenter.wait_previous()     # the shown frame may be the image composed now
         if p is None:
             if key == self._refine_failed_key:
                 return True
-            chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK, int(vp.budget_ms / max(vp.ms_per_splat, 1e-9)))
-            if self.gpu:
-                ed.presenter.wait_previous()     # the shown frame may be the full renderer's image
+            chunk = max(EDITOR_PROGRESSIVE_MIN_CHUNK,
+                        int(self.budget_ms / EDITOR_PROGRESSIVE_STEPS_PER_FRAME / max(vp.ms_per_splat, 1e-9)))
             try:
                 frame = vp.progressive(ed.cam, w, h, chunk)
+                if frame is None:
+                    return False
             except SplatEditError as exc:
                 ed.say(f"full-quality frame failed: {exc}")
                 self._refine_failed_key = key
                 return True
-            if frame is None:
-                return False
-            # the level-of-detail frame as pixels, under the chunks
-            under = self.scene if isinstance(self.scene, np.ndarray) else None
-            if under is None or under.shape[:2] != (h, w):
-                under = vp.render(ed.cam, w, h, interactive=True)
-            p = self.progressive = ProgressiveRefinement(frame, key, under, vp.budget_ms)
-            # shown until the first chunk arrives: pixels, not the renderers' images (a
-            # ResidentFrame of the full renderer is destroyed when the steps resize its targets)
-            self.scene = under
+            try:
+                under = self._under(w, h)
+                p = self.progressive = ProgressiveRefinement(frame, key, under, self.budget_ms, self.gpu)
+            except BaseException as exc:
+                frame.close()
+                if not isinstance(exc, SplatEditError):
+                    raise
+                ed.say(f"full-quality frame failed: {exc}")
+                self._refine_failed_key = key
+                return True
         self._stepped = p
         try:
-            img = p.step()
+            img = p.advance()
         except SplatEditError as exc:
             ed.say(f"full-quality frame failed: {exc}")
             self._refine_failed_key = key
             self.drop_progressive()
             return True
-        if img is not None:
-            self.scene = img
+        self.scene = ResidentFrame(img, w, h) if self.gpu else img
         if p.done:
             self.scene_interactive = False
             n = ed.session.cloud.n
             vp.last_info = FrameInfo(p.total_ms, n, 1, False, False)
             vp.ms_per_splat = p.total_ms / max(n, 1)
             self.last_progressive = p
-            self.drop_progressive()
+            self.refinements += 1
+            self.progressive = None
+            pick_key = ed.brush.pick_key()
+            if pick_key is not None and (self._pick_ready is None or self._pick_ready[0] != pick_key):
+                self.picking = (p, pick_key)     # the brush's pick map next, while the view is still
+            else:
+                p.close()
         return True
+
+    def _pick_step(self, key, moving: bool) -> None:
+        """One chunk of the still view's pick map (started when its refinement
+        ended), dropped on any change; kept for the brush when complete."""
+        p, pick_key = self.picking
+        if moving or p.key != key or self.ed.brush.pick_key() != pick_key:
+            self.drop_picking()
+            return
+        f = p.frame
+        try:
+            f.pick_step()
+            if f.pick_done:
+                idx, depth = f.pick_result()
+                self._pick_ready = (pick_key, idx, depth)
+                self.drop_picking()
+        except SplatEditError as exc:
+            self.ed.say(f"pick map failed: {exc}")
+            self.drop_picking()
+
+    def _under(self, w: int, h: int):
+        """The level-of-detail frame shown under the progressive chunks: on the
+        GPU path the LOD renderer's image (not redrawn while the view refines:
+        any change drops the refinement), on the CPU path its pixels.  A frame
+        the full renderer drew at reduced size (no LOD pyramid yet) is drawn
+        again as pixels: the steps re-size that renderer's images."""
+        ed, vp = self.ed, self.ed.viewport
+        sc = self.scene
+        if isinstance(sc, ResidentFrame) and not vp.owns_full_image(sc.image):
+            return sc.image, (sc.width, sc.height)
+        if isinstance(sc, np.ndarray) and sc.shape[:2] == (h, w):
+            return sc
+        return vp.render(ed.cam, w, h, interactive=True)
 
     def render_scene(self, key, interactive: bool) -> None:
         ed = self.ed
@@ -296,25 +352,5 @@ class FrameScheduler:
         info = ed.viewport.last_info
         self.scene_interactive = bool(interactive and info is not None and (info.lod or info.div > 1))
 
-    def request_refine(self, key) -> None:
-        from splatedit.app.viewport import BackgroundRefiner
-        ed = self.ed
-        vp = ed.viewport
-        if self.refiner is None:
-            self.refiner = BackgroundRefiner(ed.wake, vp.budget_ms)
-        s = ed.session
-        w, h = ed.size
-        c = ed.cam
-        cam = OrbitCamera(np.array(c.target, float), c.distance, c.yaw, c.pitch, c.fov_deg,
-                          np.array(c.up_axis, float), c.scene_radius)
-        self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
-                                       handle=s.selection.handle.copy(), sel_version=s.version,
-                                       inactive=s.selection.others(), basis=s.basis, dc=vp.dc, camera=cam,
-                                       w=w, h=h, distortion_map=vp.distortion_map, grey=vp.grey,
-                                       splat_scale=vp.splat_scale, background=vp.background, pick_key=ed.brush.pick_key()))
-
     def close(self) -> None:
         self.drop_progressive()
-        if self.refiner is not None:
-            self.refiner.close()
-            self.refiner = None

@@ -11,6 +11,7 @@ import numpy as np
 
 from splatedit.app.gaussian_doc import gaussians_of
 from splatedit.app.transform_fields import field_target
+from splatedit.render.vk import devices_created
 
 
 def _r(v, nd=1):
@@ -97,11 +98,11 @@ def status_dict(ed) -> dict:
     #: the shown frame is the full-quality one (not a level of detail / reduced size)
     st["full_quality"] = not fr.scene_interactive
     last = fr.last_progressive
-    st["last_refinement"] = None if last is None else {
-        "first_chunk_s": _r(last.first_chunk_s, 3), "done_s": _r(last.done_s, 3), "steps": len(last.step_ms),
-        "step_ms_max": _r(max(last.step_ms)), "shown": len(last.shown_splats),
-        "frame_ms_median": _r(np.median(last.frame_ms)) if last.frame_ms else None,
-        "frame_ms_max": _r(max(last.frame_ms)) if last.frame_ms else None}
+    st["last_refinement"] = None if last is None else last.timings()
+    st["refinements"] = fr.refinements
+    #: the brush's pick map of this view was drawn after its refinement (no pick on first use)
+    st["pick_map_ready"] = fr.take_pick(ed.brush.pick_key()) is not None
+    st["vulkan_devices_created"] = devices_created()
     w, h = ed.size
     gz = ed.gizmo
     if not (w and h):

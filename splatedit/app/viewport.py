@@ -320,15 +320,19 @@ class Viewport:
     def progressive(self, cam: OrbitCamera, w: int, h: int, chunk: int):
         """A :class:`~splatedit.render.progressive.ProgressiveFrame` of the full
         cloud (``chunk`` splats per step) on the full renderer, synced with the
-        document; None where it cannot draw the frame (a Gaussian document, or
-        the detail mode, which has no vertex-path variant)."""
+        document (the detail mode included: its chunks go through its pre-pass);
+        None where it cannot draw the frame (a Gaussian document)."""
         if self.gaussians is not None or self.cloud is None:
             return None
         from splatedit.render.progressive import ProgressiveFrame
         self._sync(self.full)
-        if self.full.r._detail_buf is not None:
-            return None
         return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)
+
+    def owns_full_image(self, image) -> bool:
+        """``image`` is the full renderer's output image (re-created when that
+        renderer draws another size)."""
+        t = self.full.r._targets if self.full is not None else None
+        return t is not None and image is t.out
 
     def pick(self, cam: OrbitCamera, w: int, h: int):
         """(index map (h, w) int64, -1 background; depth (h, w)) of the full cloud."""
@@ -349,113 +353,3 @@ class Viewport:
             self.full.r.close()
             self.full = None
 
-
-class BackgroundRefiner:
-    """Draws full-quality frames in a worker thread with a renderer (and Vulkan
-    device) of its own, so a multi-second frame of a huge model never blocks
-    the window: the editor shows the interactive frame meanwhile and swaps in
-    the refined one when it arrives (if the scene has not changed since).
-
-    ``request(key, state)``: ``state`` holds everything the frame depends on
-    (cloud, masks, selection version, basis, dC, a camera copy, size); a newer
-    request replaces an older one not yet started.  ``take(key)`` returns the
-    image of ``key`` once it is ready.
-    """
-
-    def __init__(self, wake=None, budget_ms: float = 100.0):
-        import threading
-        self._wake = wake
-        self._budget = budget_ms
-        self._cv = threading.Condition()
-        self._req = None
-        self._result = None
-        self._stop = False
-        self.pending_key = None
-        self.last_ms = None
-        self.error = None
-        #: (key, index map, depth) of the last background pick
-        self.pick = None
-        self.thread = threading.Thread(target=self._run, name="splatedit-refine", daemon=True)
-        self.thread.start()
-
-    def request(self, key, state: dict) -> None:
-        with self._cv:
-            if self.pending_key == key:
-                return
-            self._req = (key, state)
-            self.pending_key = key
-            self._cv.notify()
-
-    def take(self, key):
-        with self._cv:
-            if self._result is not None and self._result[0] == key:
-                img = self._result[1]
-                self._result = None
-                return img
-        return None
-
-    def take_pick(self, key):
-        """(index map, depth) picked in the background for ``key``, or None."""
-        with self._cv:
-            if self.pick is not None and self.pick[0] == key:
-                return self.pick[1], self.pick[2]
-        return None
-
-    @property
-    def busy(self) -> bool:
-        return self.pending_key is not None
-
-    def cancel(self) -> None:
-        with self._cv:
-            self._req = None
-            self.pending_key = None
-            self._result = None
-
-    def _run(self) -> None:
-        vp = None
-        try:
-            while True:
-                with self._cv:
-                    while self._req is None and not self._stop:
-                        self._cv.wait()
-                    if self._stop:
-                        break
-                    key, st = self._req
-                    self._req = None
-                try:
-                    if vp is None:
-                        vp = Viewport(budget_ms=self._budget)
-                    vp.set_cloud(st["cloud"])
-                    vp.set_selection(st["support"], st["handle"], st["sel_version"], st.get("inactive"))
-                    vp.set_basis(st["basis"])
-                    vp.set_dc(st["dc"])
-                    vp.distortion_map = bool(st.get("distortion_map", False))
-                    vp.grey = bool(st.get("grey", False))
-                    vp.splat_scale = float(st.get("splat_scale", 1.0))
-                    if st.get("background") is not None:
-                        vp.background = tuple(st["background"])
-                    img = vp.render(st["camera"], st["w"], st["h"])
-                    self.last_ms = vp.last_info.ms
-                    if st.get("pick_key") is not None and st.get("dc") is None:
-                        # the brush's pick map of the same view, while we are at it
-                        idx, depth = vp.pick(st["camera"], st["w"], st["h"])
-                        with self._cv:
-                            self.pick = (st["pick_key"], idx, depth)
-                except Exception as exc:  # noqa: BLE001 - shown by the editor
-                    self.error = (key, exc)   # the view that failed, and why
-                    img = None
-                with self._cv:
-                    if self.pending_key == key:
-                        self._result = (key, img)
-                        self.pending_key = None if self._req is None else self._req[0]
-                if self._wake:
-                    self._wake()
-        finally:
-            if vp is not None:
-                vp.close()
-
-    def close(self) -> None:
-        with self._cv:
-            self._stop = True
-            self._cv.notify()
-        self.thread.join(timeout=30)

@@ -210,11 +210,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         geometry moved outside the model (a handle dragged towards the eye)
         is not clipped."""
         lo, hi = self.bounds
-        if not len(self._basis_rows):
-            return lo, hi
-        move = displacement_bound(self._dC, self._rot)
-        grow = self._basis_reach * move + (self._detail_reach if move > 0 else 0.0)
+        grow = self._displacement_reach()
         return lo - grow, hi + grow
+
+    def _displacement_reach(self) -> float:
+        """A bound (model units) on how far any splat is moved from its uploaded
+        position by the current basis and displacement (0 without a basis)."""
+        if not len(self._basis_rows):
+            return 0.0
+        move = displacement_bound(self._dC, self._rot)
+        return self._basis_reach * move + (self._detail_reach if move > 0 else 0.0)
 
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):

@@ -69,3 +69,10 @@ def test_save_as_the_input_is_refused(model, tmp_path):
     line = one_error(run_edit(model, "--save-as", "bunny.ply", cwd=tmp_path))
     assert "--save-as" in line
     assert model.read_bytes() == before
+
+
+@pytest.mark.parametrize("name, value", [("SPLATEDIT_REFINE_ABOVE_MS", "-5"), ("SPLATEDIT_REFINE_ABOVE_MS", "fast")])
+def test_bad_refinement_settings_are_one_error_line(model, monkeypatch, name, value):
+    monkeypatch.setenv(name, value)
+    line = one_error(run_edit(model))
+    assert name in line and repr(value) in line

@@ -49,6 +49,77 @@ def test_progressive_frame_sharpens_and_ends_equal_to_the_single_frame(vertex_pa
     assert np.array_equal(composite(img, under)[covered[-1]], full[covered[-1]])
 
 
+def test_images_composed_on_the_device_equal_the_cpu_composite(vertex_path):
+    """Chunks drawn without readback and composed on the device (:meth:`show`)
+    over a level-of-detail frame give, at every shown step, exactly the CPU
+    composite of the read-back image so far over that frame (vertex path:
+    deterministic) although each shading pass covers only the projected boxes
+    of its chunks; visibility steps show the frame under unchanged; the last
+    one is the single frame with its background (alpha 255)."""
+    r = vertex_path
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    full = r.render(cam, W, H)
+    under = np.random.default_rng(3).integers(0, 256, (H, W, 4), dtype=np.uint8)
+    under[..., 3] = 255
+    expected = []
+    with ProgressiveFrame(r, cam, W, H, 7000) as pf:
+        while not pf.done:
+            img = pf.step()
+            if img is not None:
+                expected.append(composite(img, under))
+    shown, rects = [], []
+    with ProgressiveFrame(r, cam, W, H, 7000) as pf:
+        pf.set_under(under)
+        while not pf.done:
+            phase = pf.phase
+            pf.step(readback=False)
+            out = pf.show(readback=True)
+            if phase == "depth":
+                assert np.array_equal(out, under)
+            else:
+                shown.append(out)
+                rects.append(pf.shaded_rect)
+        last = pf.show(readback=True)
+    assert len(shown) == len(expected) >= 5
+    for got, want in zip(shown[:-1], expected[:-1]):
+        assert np.array_equal(got[..., :3], want[..., :3])
+    assert np.array_equal(last, full)
+    # each shading pass covered only the rect its chunks can reach (the bunny file is not
+    # spatially sorted: every chunk spans the model, whose box is ~53% of the image)
+    areas = [w * h for _, _, w, h in rects]
+    assert max(areas) < 0.6 * W * H, areas
+
+
+def test_under_a_half_size_device_image_is_pixel_doubled(renderer):
+    """A level-of-detail frame left on the device by another renderer of the
+    same device at half size is blitted (pixel-doubled) under the chunks:
+    uncovered pixels show it as the CPU path's np.repeat would."""
+    from splatedit.render.renderer import Renderer
+    r = renderer
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    with Renderer(device=r.dev) as lod:
+        lod.set_cloud(bunny)
+        lod.background = (0.2, 0.6, 0.3, 1.0)        # told apart from the full frame's background
+        lod.prepass = False                           # deterministic: the two frames below are equal
+        small = lod.render(cam, W // 2, H // 2)
+        image = lod.render_resident(cam, W // 2, H // 2)
+        doubled = np.repeat(np.repeat(small, 2, axis=0), 2, axis=1)
+        with ProgressiveFrame(r, cam, W, H, 20000) as pf:
+            pf.set_under((image, (W // 2, H // 2)))
+            pf.step(readback=False)
+            first = pf.show(readback=True)            # a visibility step: the frame under alone
+            while not (pf.phase == "attr" and pf.next > 0):
+                pf.step(readback=False)
+            out = pf.show(readback=True)
+    assert np.array_equal(first, doubled)
+    changed = (out != doubled).any(axis=2)
+    assert 0.01 < changed.mean() < 0.9, changed.mean()   # the first chunk, drawn over it
+
+
 def test_progressive_frame_starts_over_when_another_frame_is_drawn(vertex_path):
     r = vertex_path
     bunny = read(default_model_path())
@@ -134,3 +205,57 @@ def test_progressive_frame_in_prepass_windows_of_a_deformed_cloud(renderer, monk
         r._free_prep()
     assert starts == [0, 10048, 16384, 26432, 32768, 42816, 49152, 59200]
     _close_to(img, full)
+
+
+def test_progressive_frame_in_the_detail_mode_matches_the_single_frame(renderer):
+    """The detail mode (prepare_detail.comp, pre-pass only) drawn in chunks of
+    1,000 splats: the last image matches its one-submit frame, so the editor
+    refines detail-mode edits progressively too."""
+    from splatedit.deform.detail import DetailBasis
+    from tests.deform.detail_scene import bend, bumpy_plane
+    plane = bumpy_plane(nx=90, ny=30)
+    c = plane.cloud
+    det = DetailBasis.fit(c, plane.support, [plane.handle])
+    dC = det.displacement([bend(plane)])
+    r = renderer
+    r.set_cloud(c)
+    r.set_basis(*det.rows_for_gpu())
+    r.set_detail(det.indices, det.detail_for_gpu())
+    r.set_displacement(dC)
+    cam = Camera.frame(*det.apply(c, dC).bounds(), W / H, direction=(0.3, -1.0, 0.6))
+    full = r.render(cam, W, H)
+    under = np.zeros_like(full)
+    with ProgressiveFrame(r, cam, W, H, 1000) as pf:
+        pf.set_under(under)
+        steps = 0
+        while not pf.done:
+            pf.step(readback=False)
+            steps += 1
+        assert pf.prepared and steps == 2 * -(-c.n // 1024)
+        img = pf.show(readback=True)
+    _close_to(img, full)
+    assert (full[..., :3] < 250).any() and not np.array_equal(full, under)
+
+
+def test_pick_map_in_chunks_equals_the_single_pick(vertex_path):
+    """After the frame, the view's pick map drawn in chunks of 7,000 splats
+    (6 steps) equals :meth:`Renderer.pick` of the same view (vertex path:
+    deterministic), index and depth."""
+    r = vertex_path
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    idx, depth = r.pick(cam, W, H)
+    with ProgressiveFrame(r, cam, W, H, 7000) as pf:
+        while not pf.done:
+            pf.step(readback=False)
+        steps = 0
+        while not pf.pick_done:
+            pf.pick_step()
+            steps += 1
+        got_idx, got_depth = pf.pick_result()
+    assert steps == -(-bunny.n // 7000)
+    assert (idx >= 0).mean() > 0.1
+    assert np.array_equal(got_idx, idx)
+    assert np.array_equal(np.isnan(got_depth), np.isnan(depth))
+    assert np.allclose(got_depth[idx >= 0], depth[idx >= 0], rtol=1e-6)

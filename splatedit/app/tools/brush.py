@@ -112,7 +112,7 @@ class BrushTool(Tool):
         w, h = ed.size
         key = self.pick_key()
         if self.picker is None or self.picker_key != key:
-            ready = ed.refiner.take_pick(key) if ed.refiner is not None else None
+            ready = ed.frames.take_pick(key)     # drawn in chunks after the view's refinement
             idx, front = ready if ready is not None else ed.viewport.pick(ed.cam, w, h)
             self.picker = picker_for_view(idx, front, ed.cam, s.cloud.positions, s.cloud.radii, EDITOR_PICK_TOL_PX)
             self.picker_key = key

@@ -15,10 +15,10 @@ Raw ``vk*`` calls live only in this package.  It provides
   (``graphics``), all cached by their description in a
   :class:`PipelineCache` (``pipelines``, which also builds compute pipelines);
 * :func:`live_handles` - a count of every live Vulkan object by kind, for leak
-  tests.  Everything is destroyed explicitly, in reverse order of creation.
+  tests; :func:`devices_created` - devices created so far in this process.  Everything is destroyed explicitly, in reverse order of creation.
 """
 
-from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError,
+from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError, devices_created,
                                       drain_validation_messages, list_devices, live_handles,
                                       validation_enabled)
 from splatedit.render.vk.resources import Buffer, Image, Sampler, readback_array
@@ -30,7 +30,7 @@ from splatedit.render.vk.graphics import GraphicsDesc, VertexAttribute, VertexBi
 from splatedit.render.vk.pipelines import ComputeDesc, PipelineCache
 
 __all__ = [
-    "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "drain_validation_messages",
+    "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "devices_created", "drain_validation_messages",
     "list_devices", "live_handles", "validation_enabled", "Buffer", "Image", "readback_array",
     "CommandBuffer", "QueryPool", "Attachment", "Binding", "ComputeDesc", "DescriptorSet", "Framebuffer",
     "GraphicsDesc", "LayoutDesc", "PipelineCache", "RenderPassDesc", "Sampler", "VertexAttribute",

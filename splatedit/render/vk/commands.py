@@ -247,6 +247,7 @@ _ACCESS = {
     "indirect_read": vk.VK_ACCESS_INDIRECT_COMMAND_READ_BIT,
     "uniform_read": vk.VK_ACCESS_UNIFORM_READ_BIT,
     "color_write": vk.VK_ACCESS_COLOR_ATTACHMENT_WRITE_BIT,
+    "color_read": vk.VK_ACCESS_COLOR_ATTACHMENT_READ_BIT,
     "depth_write": vk.VK_ACCESS_DEPTH_STENCIL_ATTACHMENT_WRITE_BIT,
     "host_write": vk.VK_ACCESS_HOST_WRITE_BIT,
     "host_read": vk.VK_ACCESS_HOST_READ_BIT,

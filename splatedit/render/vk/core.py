@@ -108,6 +108,14 @@ def flag_bits(table: dict, names, what: str) -> int:
         except KeyError:
             raise ValueError(f"unknown {what} {n!r}; known: {sorted(table)}") from None
     return out
+_CREATED: Counter = Counter()
+
+
+def devices_created() -> int:
+    """Vulkan devices (``vkCreateDevice``) this process has created so far (the
+    editor creates one for rendering, refinement and presentation)."""
+    with _LIVE_LOCK:
+        return _CREATED["device"]
 
 
 def live_handles() -> dict[str, int]:
@@ -286,6 +294,8 @@ class Device:
                                      ppEnabledExtensionNames=extensions or None)
         self.device = call(vk.vkCreateDevice, self.physical, info, None)
         track("device", 1)
+        with _LIVE_LOCK:
+            _CREATED["device"] += 1
         self.queue = vk.vkGetDeviceQueue(self.device, self.queue_family, 0)
         pinfo = vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
