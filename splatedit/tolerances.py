@@ -978,3 +978,18 @@ EDITOR_PROGRESSIVE_MIN_WORK_SHARE = 0.5
 #: 2 px covers both and the rounding (tests/render/test_progressive.py compares the
 #: composed images with the whole-image CPU composite bit for bit)
 PROGRESSIVE_SHADE_PAD_PX = 2.0
+
+
+# --- Orientation: the top of a component votes (a stray above a scan) ------------
+# 100k points on a unit sphere with 1% radial noise plus 50 strays 1.5-4.5 radii
+# above: with the single highest point as the seed, seed 0 of the test cloud came
+# out 0.03% outward (the highest point was a stray); with the vote 100%.
+#: points of the deterministic sample the vote is taken on (every n // this-th point)
+ORIENT_VOTE_SAMPLE = 200_000
+#: a component with fewer sampled points keeps its seed's orientation
+ORIENT_VOTE_MIN_VOTERS = 64
+#: share of a component's sampled points (its highest) that vote
+ORIENT_VOTE_TOP_FRACTION = 0.01
+#: the voters' mean oriented n_z must be below minus this to turn a component
+#: (the tops of the closed test scans give +0.6..+0.9; a vertical wall about 0)
+ORIENT_VOTE_MIN_MEAN_NZ = 0.2

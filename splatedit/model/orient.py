@@ -23,7 +23,11 @@ without ever holding the graph of all n points:
    when that normal is nearly horizontal (``|n_z| < ORIENT_SEED_MIN_NZ``),
    away from the component's centroid;
 4. the flip of a point is the XOR of the edge flips on its tree path to the
-   seed (pointer jumping, O(n log depth)), applied chunk by chunk.
+   seed (pointer jumping, O(n log depth)), applied chunk by chunk;
+5. a single highest point can be a stray above the surface whose normal
+   points anywhere: the highest points of every large component vote with
+   their oriented n_z, and a component whose top on average points down is
+   turned (:func:`_top_vote_flips`).
 
 With one chunk this is the whole-cloud algorithm.  Memory beyond the
 normals: a piece label (int64) and a flip bit per point, one chunk's edges,
@@ -38,7 +42,9 @@ from splatedit.errors import ParameterError
 from splatedit.model.sizing import neighbour_indices
 from splatedit.progress import report
 from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, ORIENT_CHUNK_POINTS, ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS,
-                                  ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_WEIGHT_EPS)
+                                  ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_VOTE_MIN_MEAN_NZ,
+                                  ORIENT_VOTE_MIN_VOTERS, ORIENT_VOTE_SAMPLE, ORIENT_VOTE_TOP_FRACTION,
+                                  ORIENT_WEIGHT_EPS)
 
 
 def _edges(nrm, nb, lo, hi):
@@ -159,8 +165,52 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
         hi = min(lo + chunk, n)
         flip = rel[lo:hi] ^ qflip[lab[lo:hi]]
         nrm[lo:hi][flip] *= -1.0
+    # 5. the top of every large component votes (a stray above the surface
+    #    can be the highest point: alone it would turn the whole surface in)
+    turn = _top_vote_flips(pts, nrm, lab, qlab, ncomp)
+    if turn.any():
+        qturn = turn[qlab]
+        for lo in range(0, n, chunk):
+            hi = min(lo + chunk, n)
+            nrm[lo:hi][qturn[lab[lo:hi]]] *= -1.0
     report(progress, "orienting normals", 1.0)
     return nrm
+
+
+def _top_vote_flips(pts, nrm, lab, qlab, ncomp) -> np.ndarray:
+    """(ncomp,) bool: components whose highest points, voting, say the
+    orientation from the single highest point (the seed) was wrong.
+
+    On a deterministic sample of at most ``ORIENT_VOTE_SAMPLE`` points, every
+    component with at least ``ORIENT_VOTE_MIN_VOTERS`` sampled points lets
+    its highest ``ORIENT_VOTE_TOP_FRACTION`` (at least that many points)
+    vote with their oriented n_z; a mean n_z below ``-ORIENT_VOTE_MIN_MEAN_NZ``
+    turns the component (a stray seed had pointed it inward), a mean near 0
+    (a vertical wall: the seed used the centroid rule) changes nothing.
+    """
+    n = len(pts)
+    turn = np.zeros(ncomp, dtype=bool)
+    step = max(1, n // ORIENT_VOTE_SAMPLE)
+    sample = np.arange(0, n, step)
+    comp = qlab[lab[sample]]
+    count = np.bincount(comp, minlength=ncomp)
+    voting = count >= ORIENT_VOTE_MIN_VOTERS
+    if not voting.any():
+        return turn
+    keep = voting[comp]
+    sample, comp = sample[keep], comp[keep]
+    order = np.lexsort((-pts[sample, 2], comp))           # by component, highest first
+    sample, comp = sample[order], comp[order]
+    start = np.r_[0, np.flatnonzero(np.diff(comp)) + 1]
+    rank = np.arange(len(comp)) - np.repeat(start, np.diff(np.r_[start, len(comp)]))
+    quota = np.maximum(ORIENT_VOTE_MIN_VOTERS,
+                       np.ceil(ORIENT_VOTE_TOP_FRACTION * count)).astype(np.int64)
+    top = rank < quota[comp]
+    votes = np.bincount(comp[top], nrm[sample[top], 2], minlength=ncomp)
+    voters = np.bincount(comp[top], minlength=ncomp)
+    mean_nz = np.divide(votes, voters, out=np.zeros(ncomp), where=voters > 0)
+    turn[:] = voting & (mean_nz < -ORIENT_VOTE_MIN_MEAN_NZ)
+    return turn
 
 
 def _piece_edges(lab, rel, n, i, j, w, neg):
