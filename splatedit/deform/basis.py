@@ -31,13 +31,8 @@ import time
 import numpy as np
 
 from splatedit.deform.apply_plan import apply_hot_path, build_hot_path
-from splatedit.deform.constraints import (
-    Constraints,
-    affine_coordinate_gradients,
-    affine_coordinates,
-    as_mask,
-    build_constraints,
-)
+from splatedit.deform.constraints import Constraints, as_mask, build_constraints
+from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_blocks,

@@ -10,12 +10,8 @@ from hypothesis import strategies as st
 from scipy.spatial import cKDTree
 
 from splatedit.bench.solve import sphere_cloud, wavy_plane_cloud
-from splatedit.deform.constraints import (
-    affine_coordinate_gradients,
-    affine_coordinates,
-    build_constraints,
-    handle_frame,
-)
+from splatedit.deform.constraints import build_constraints
+from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates, handle_frame
 from splatedit.errors import ParameterError, SolverError
 from splatedit.tolerances import BAND_RINGS
 
