@@ -286,31 +286,28 @@ def _deform_gaussians(args) -> int:
 
 
 def _camera_from_args(args, cloud):
-    """The camera of ``splatedit render``: framing the model, then the flags override."""
-    import numpy as np
+    """The camera of ``splatedit render``: the editor's first view (the main
+    body framed from the front about the up axis: :func:`splatedit.render.framing.
+    default_view`), then the flags override; the view's note about far points
+    goes to stderr when it frames the default extent."""
     from splatedit.render.camera import Camera
-    w, h = args.size
-    lo, hi = cloud.bounds()
-    # frames a single point by its splat (the largest semi-axis; einsum: no (n,) norms)
-    rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
-                             np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
-    # all centres in one point: look at the splat face-on (from +z it may be edge-on)
-    direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
-    base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)
+    from splatedit.render.framing import default_view
     if args.fov is not None and not 0.0 < args.fov < 179.0:
         raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
-    fov = base.fov_deg if args.fov is None else args.fov
-    if args.eye is None and args.target is None and args.up is None and args.fov is None:
-        return base
-    if args.eye is None and args.fov is not None and args.target is None and args.up is None:
-        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov, min_radius=rmax, direction=direction)
-    target = base.target if args.target is None else args.target
-    eye = base.eye if args.eye is None else args.eye
-    up = base.up if args.up is None else args.up
     try:
-        return Camera(eye, target, up=up, fov_deg=fov)
+        view = default_view(cloud, args.size, path=args.input, up=args.up, fov_deg=args.fov)
+        if args.eye is None and args.target is None:
+            camera = view.camera
+        else:
+            camera = Camera(view.camera.eye if args.eye is None else args.eye,
+                            view.camera.target if args.target is None else args.target,
+                            up=view.camera.up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
         raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+    if args.target is None and view.extent.note():
+        args.progress.close()
+        print(f"splatedit: note: {view.extent.note()}; the view frames the main body", file=sys.stderr)
+    return camera
 
 
 def cmd_render(args) -> int:
