@@ -24,7 +24,7 @@ from pathlib import Path
 # 10M-splat read.  Set before numpy is imported (the user's setting wins)
 os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
-from splatedit.app.options import parse_size, positive_float
+from splatedit.app.options import join_negative_values, parse_size, positive_float
 from splatedit.bench.runner import BENCHES
 from splatedit.errors import InputWarning, ParameterError, SplatEditError
 
@@ -32,6 +32,8 @@ from splatedit.errors import InputWarning, ParameterError, SplatEditError
 BENCH_NAMES = tuple(BENCHES)
 
 EXIT_BAD_INPUT = 2
+#: options taking x,y,z: a value with a leading minus works (``--eye -0.4,1,2``)
+VECTOR_OPTIONS = ("--eye", "--target", "--up")
 #: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
 EXIT_BROKEN_PIPE = 141
 
@@ -140,7 +142,7 @@ def cmd_info(args) -> int:
     if is_gaussian_file(args.file):
         _print_info(_gaussian_info(args), args.json)
         return 0
-    from splatedit.model.quality import assess, estimate_quality
+    from splatedit.model.quality import assess, estimate_quality, scan_fields_present
     from splatedit.model.spacing import point_spacing
     from splatedit.tolerances import INFO_EXACT_MAX_POINTS
     cloud = read(args.file, progress=args.progress)
@@ -152,13 +154,14 @@ def cmd_info(args) -> int:
         "splats": cloud.n,
         "faces": 0 if cloud.faces is None else int(len(cloud.faces)),
         "colors": cloud.colors is not None,
-        "intensity": cloud.intensity is not None,
-        "classification": cloud.classification is not None,
+        **scan_fields_present(cloud),
         "origin": [_sig(x, 15) for x in cloud.origin],
         "bounds_min": [_sig(x) for x in lo],
         "bounds_max": [_sig(x) for x in hi],
         "diagonal": _sig(np.linalg.norm(hi - lo)),
     }
+    extent, note = _info_extent(cloud)
+    info.update(extent)
     med = np.median(radii)
     if est is None:
         quality = assess(cloud)
@@ -188,8 +191,21 @@ def cmd_info(args) -> int:
                          + ([] if cloud.faces is not None else ["boundary_splats"]),
             "sample_points": est.sample_points,
         })
-    _print_info(info, args.json)
+    _print_info(info | note, args.json)
     return 0
+
+
+def _info_extent(cloud) -> tuple[dict, dict]:
+    """``info``'s scanner dimensions held but all zero and the main body's
+    extent (:func:`splatedit.model.extent.framing_extent`); and a ``note``
+    about the points far outside it, printed last."""
+    from splatedit.model.extent import framing_extent
+    from splatedit.model.quality import scan_fields_all_zero
+    zero = scan_fields_all_zero(cloud)
+    ext = framing_extent(cloud.positions)
+    return (({"all_zero": zero} if zero else {})
+            | {"main_body_diagonal": _sig(2 * ext.radius), "far_from_main_body": ext.n_far},
+            {"note": ext.note()} if ext.note() else {})
 
 
 def cmd_convert(args) -> int:
@@ -362,8 +378,11 @@ def _render_gaussians(args, cloud) -> int:
         if len(load_script(args.edit).edits) != 1:
             raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
                                            "(chained edits need the Gaussian CPU deformation)")
-        _, basis_rows, d_c = _gpu_edit(args, proxy)
-        if not isinstance(d_c, np.ndarray) or len(basis_rows) != 5:
+        def gpu_can_draw(rows, d_c):
+            return isinstance(d_c, np.ndarray) and len(rows) == 5
+
+        _, basis_rows, d_c = _gpu_edit(args, proxy, on_gpu=gpu_can_draw)
+        if not gpu_can_draw(basis_rows, d_c):
             # the Gaussian GPU pass draws a plain dC only: a turning handle (rotation mode) or the
             # detail mode is applied on the CPU as `splatedit deform` does, then drawn undeformed
             from splatedit.gaussian_script import run_script_gaussians
@@ -378,10 +397,12 @@ def _render_gaussians(args, cloud) -> int:
     return 0
 
 
-def _gpu_edit(args, cloud):
+def _gpu_edit(args, cloud, on_gpu=None):
     """Apply an edit script for rendering: every edit but the last is committed
     on the CPU (each edit's result is the next one's base); the last edit goes
     to the GPU as basis rows plus its control-frame displacement dC.
+    ``on_gpu(rows, dC)``: whether the caller's renderer can draw them (else
+    it deforms on the CPU, and the report says so).
 
     Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC).
     """
@@ -398,20 +419,23 @@ def _gpu_edit(args, cloud):
     args.progress.close()
     st = basis.stats
     mode = script.edits[-1].deformation.value
+    detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
+    rows = basis.rows_for_gpu() + ((detail(),) if detail else ())
+    where = ("uploaded to the GPU" if on_gpu is None or on_gpu(rows, d_c)
+             else f"fitted; the {mode} edit is applied on the CPU")
     print(f"edit {len(script.edits) - 1}: {mode} deformation, support {len(basis.indices)} splats, "
           f"{st['method']} with {st['n_centers']} centers (residual {st['residual']:.2e}), "
-          f"{basis.n_columns} basis columns uploaded to the GPU")
+          f"{basis.n_columns} basis columns {where}")
     for c in basis.constraints.conflicts:
         print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
               file=sys.stderr)
     from splatedit.deform.distortion import basis_distortion
-    detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
     dist = basis.distortion(cloud, d_c) if detail else basis_distortion(basis, cloud, d_c)
     print(f"  distortion: {dist.summary()}")
     if dist.exceeds_warn:
         print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
               f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
-    return cloud, basis.rows_for_gpu() + ((detail(),) if detail else ()), d_c
+    return cloud, rows, d_c
 
 
 def cmd_demo(args) -> int:
@@ -515,9 +539,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("input")
     s.add_argument("-o", "--output", required=True, help="output PNG")
     s.add_argument("--size", type=parse_size, default=(1280, 720), help="WxH (default 1280x720)")
-    s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"))
-    s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"))
-    s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"))
+    s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"), metavar="X,Y,Z",
+                   help="camera position (default: the editor's first view, see README)")
+    s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"), metavar="X,Y,Z",
+                   help="look-at point (default: the centre of the model's main body)")
+    s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"), metavar="X,Y,Z",
+                   help="up direction (default: the model's detected up axis, as in the editor)")
     s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
     s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
@@ -560,7 +587,7 @@ def _route_warnings(progress: _Progress) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv), VECTOR_OPTIONS))
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
     restore = _sigterm_as_interrupt()

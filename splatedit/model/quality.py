@@ -112,3 +112,18 @@ def estimate_quality(cloud: SplatCloud, target: int = INFO_SAMPLE_POINTS,
         bnd = boundary_points(pts, nrm, nb)
         boundary = int(round(bnd[exact].sum() * scale))
     return QualityEstimate(spacing, boundary, stat, iso, both, m)
+
+
+def scan_fields_present(cloud: SplatCloud) -> dict[str, bool]:
+    """Which scanner dimensions carry data: ``{"intensity": ..., "classification": ...}``,
+    True only when the cloud has the dimension and it is not all zero (a LAS
+    point record always holds both: a file written from a scan without them
+    has zeros there)."""
+    return {name: arr is not None and bool(arr.any())
+            for name, arr in (("intensity", cloud.intensity), ("classification", cloud.classification))}
+
+
+def scan_fields_all_zero(cloud: SplatCloud) -> list[str]:
+    """The scanner dimensions the cloud holds that are all zero (``info`` lists them)."""
+    return [name for name, arr in (("intensity", cloud.intensity), ("classification", cloud.classification))
+            if arr is not None and not arr.any()]
