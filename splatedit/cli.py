@@ -307,7 +307,7 @@ def _camera_from_args(args, cloud):
     default_view`), then the flags override; the view's note about far points
     goes to stderr when it frames the default extent."""
     from splatedit.render.camera import Camera
-    from splatedit.render.framing import default_view
+    from splatedit.render.framing import default_view, screen_up
     if args.fov is not None and not 0.0 < args.fov < 179.0:
         raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
     try:
@@ -315,9 +315,11 @@ def _camera_from_args(args, cloud):
         if args.eye is None and args.target is None:
             camera = view.camera
         else:
-            camera = Camera(view.camera.eye if args.eye is None else args.eye,
-                            view.camera.target if args.target is None else args.target,
-                            up=view.camera.up, fov_deg=view.camera.fov_deg)
+            eye = view.camera.eye if args.eye is None else args.eye
+            target = view.camera.target if args.target is None else args.target
+            # the model's up, unless --eye looks along it (straight down on a Z-up scan)
+            up = args.up if args.up is not None else screen_up(view.camera.up, eye, target)
+            camera = Camera(eye, target, up=up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
         raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
     if args.target is None and view.extent.note():

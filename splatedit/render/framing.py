@@ -76,3 +76,20 @@ def default_view(cloud, size, *, path=None, up=None, fov_deg: float | None = Non
                           fov_deg=RENDER_FOV_DEG if fov_deg is None else fov_deg,
                           min_radius=_largest_semi_axis(cloud))
     return DefaultView(camera, extent, axis)
+
+
+def screen_up(up, eye, target) -> np.ndarray:
+    """The up hint for a camera at ``eye`` looking at ``target`` (both (3,))
+    about the model's up vector ``up`` (3,): ``up`` itself, unless the view
+    is along it (straight down or up, where it gives no screen direction):
+    then the editor's top / bottom view's screen up, away from / towards the
+    model's front (:func:`~splatedit.model.orientation.front_direction`): a
+    Z-up scan seen from above has +Y (north) up on screen."""
+    u = np.asarray(up, dtype=np.float64)
+    look = np.asarray(target, dtype=np.float64) - np.asarray(eye, dtype=np.float64)
+    if not np.any(u) or not np.any(look):
+        return u                        # Camera names the bad parameter
+    f, un = look / np.linalg.norm(look), u / np.linalg.norm(u)
+    if np.linalg.norm(np.cross(f, un)) > RENDER_CAMERA_MIN_UP_SINE:
+        return u
+    return -front_direction(u) if f @ un < 0 else front_direction(u)
