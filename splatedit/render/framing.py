@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.model.extent import FramingExtent, framing_extent
-from splatedit.model.orientation import UpAxis, detect_up_axis, front_direction
+from splatedit.model.orientation import UpAxis, UpSource, detect_up_axis, front_direction
 from splatedit.render.camera import Camera
 from splatedit.tolerances import RENDER_CAMERA_MIN_UP_SINE, RENDER_FOV_DEG
 
@@ -58,7 +58,12 @@ def default_view(cloud, size, *, path=None, up=None, fov_deg: float | None = Non
     """
     w, h = size
     extent = framing_extent(cloud.positions)
-    axis = detect_up_axis(cloud.normals, cloud.positions, path) if up is None else None
+    axis = None
+    if up is None:
+        # the file's word first (header, format): the normals (an (n, 3) cross product) only without it
+        axis = detect_up_axis(np.zeros((0, 3)), cloud.positions[:0], path)
+        if axis.source is UpSource.DEFAULT:
+            axis = detect_up_axis(cloud.normals, cloud.positions, path)
     up_vec = axis.vector if up is None else np.asarray(up, dtype=np.float64)
     if not np.any(up_vec) or not np.all(np.isfinite(up_vec)):
         direction = np.array([0.0, 0.0, 1.0])       # a bad --up: Camera names it
