@@ -112,7 +112,7 @@ class CameraTool(Tool):
         self.cam.frame(ext.center, ext.radius, w / max(h, 1), area=self.view_area())
         self.ed.motion()
         if say and ext.note():
-            self.ed.say(f"framed the main body: {ext.note()}")
+            self.ed.say(f"left out of the view: {ext.note()}")
 
     def frame_selection(self) -> None:
         """F: the active handle (else the support) fills the free part of the window."""

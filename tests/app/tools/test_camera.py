@@ -98,7 +98,7 @@ def test_home_frames_the_main_body_of_a_cloud_with_far_clumps_and_says_so():
             px, depth = ed.cam.project(plane.positions, w, h)
             boxes.append((px.min(0), px.max(0)))
             if c is cloud:
-                assert ed.messages[-1] == ("framed the main body: 9 points far outside the main body "
+                assert ed.messages[-1] == ("left out of the view: 9 points far outside the main body "
                                            "(outliers?): `splatedit convert --remove-outliers`")
                 strays, d = ed.cam.project(far, w, h)
                 off = (d <= 0) | (strays[:, 0] < 0) | (strays[:, 0] > w) | (strays[:, 1] < 0) | (strays[:, 1] > h)
