@@ -145,6 +145,7 @@ def front_direction(up) -> np.ndarray:
     front view).  The editor's first view (yaw 0, pitch 0) and ``splatedit
     render``'s default camera both look along minus this."""
     u = np.asarray(up, dtype=np.float64)
+    u = u / np.abs(u).max()             # unit-size first: |up| of 1e-300 must not underflow
     u = u / np.linalg.norm(u)
     ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < FRONT_VIEW_Z_UP_COS else np.array([0.0, -1.0, 0.0])
     ref = ref - u * (ref @ u)

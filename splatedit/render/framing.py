@@ -38,6 +38,12 @@ class DefaultView:
     up: UpAxis | None
 
 
+def _unit(v: np.ndarray) -> np.ndarray:
+    """``v`` (3,) scaled to length 1 (unit-size first: no underflow for |v| of 1e-300)."""
+    v = v / np.abs(v).max()
+    return v / np.linalg.norm(v)
+
+
 def _largest_semi_axis(cloud) -> float:
     """The largest splat semi-axis (model units; einsum: no (n,) norms)."""
     return float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
@@ -72,7 +78,7 @@ def default_view(cloud, size, *, path=None, up=None, fov_deg: float | None = Non
     else:
         # all centres in one point: look at the splat face-on (from the front it may be edge-on)
         direction = cloud.normals[0]
-        if np.linalg.norm(np.cross(direction, up_vec / np.linalg.norm(up_vec))) <= RENDER_CAMERA_MIN_UP_SINE:
+        if np.linalg.norm(np.cross(direction, _unit(up_vec))) <= RENDER_CAMERA_MIN_UP_SINE:
             if up is None:
                 up_vec = front_direction(direction)     # any up across the splat's normal
             else:
@@ -94,7 +100,7 @@ def screen_up(up, eye, target) -> np.ndarray:
     look = np.asarray(target, dtype=np.float64) - np.asarray(eye, dtype=np.float64)
     if not np.any(u) or not np.any(look):
         return u                        # Camera names the bad parameter
-    f, un = look / np.linalg.norm(look), u / np.linalg.norm(u)
+    f, un = _unit(look), _unit(u)
     if np.linalg.norm(np.cross(f, un)) > RENDER_CAMERA_MIN_UP_SINE:
         return u
     return -front_direction(u) if f @ un < 0 else front_direction(u)

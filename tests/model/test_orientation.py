@@ -109,3 +109,9 @@ def test_front_direction_is_horizontal_and_faces_the_front_of_y_and_z_up_models(
     for up in np.random.default_rng(4).normal(size=(50, 3)):
         d = front_direction(up)
         assert abs(np.linalg.norm(d) - 1) < 1e-12 and abs(d @ up) < 1e-12 * np.linalg.norm(up)
+
+
+def test_front_direction_of_a_tiny_up_vector_is_a_unit_vector():
+    from splatedit.model.orientation import front_direction
+    assert np.allclose(front_direction([0, 1e-300, 0]), [0, 0, 1])
+    assert np.allclose(front_direction([0, 0, 1e300]), [0, -1, 0])
