@@ -22,7 +22,7 @@ from pathlib import Path
 # 10M-splat read.  Set before numpy is imported (the user's setting wins)
 os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
-from splatedit.app.options import parse_size, positive_float
+from splatedit.app.options import join_negative_values, parse_size, positive_float
 from splatedit.bench.runner import BENCHES
 from splatedit.commands.edits import cmd_convert, cmd_deform
 from splatedit.commands.info import cmd_info
@@ -33,6 +33,8 @@ from splatedit.errors import InputWarning, ParameterError, SplatEditError
 BENCH_NAMES = tuple(BENCHES)
 
 EXIT_BAD_INPUT = 2
+#: options taking x,y,z: a value with a leading minus works (``--eye -0.4,1,2``)
+VECTOR_OPTIONS = ("--eye", "--target", "--up")
 #: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
 EXIT_BROKEN_PIPE = 141
 
@@ -187,9 +189,12 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("input")
     s.add_argument("-o", "--output", required=True, help="output PNG")
     s.add_argument("--size", type=parse_size, default=(1280, 720), help="WxH (default 1280x720)")
-    s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"))
-    s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"))
-    s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"))
+    s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"), metavar="X,Y,Z",
+                   help="camera position (default: the editor's first view, see README)")
+    s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"), metavar="X,Y,Z",
+                   help="look-at point (default: the centre of the model's main body)")
+    s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"), metavar="X,Y,Z",
+                   help="up direction (default: the model's detected up axis, as in the editor)")
     s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
     s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
@@ -233,7 +238,7 @@ def _route_warnings(progress: _Progress) -> None:
 
 def main(argv: list[str] | None = None) -> int:
     parser = build_parser()
-    args = parser.parse_args(argv)
+    args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv), VECTOR_OPTIONS))
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
     restore = _sigterm_as_interrupt()

@@ -74,9 +74,10 @@ def run_demo(output_dir: Path, *, progress=None, log=print, render: bool = True,
         from splatedit.render.headless import render_to_png
         from splatedit.render.vk import VulkanError
         size = (960, 720)
-        lo, hi = cloud.bounds()
-        # the same three-quarter view for both images, framed on the original model
-        camera = Camera.frame(lo, hi, aspect=size[0] / size[1], direction=(-0.45, 0.25, 1.0))
+        from splatedit.model.extent import framing_extent
+        ext = framing_extent(cloud.positions)
+        # the same three-quarter view for both images, framed on the original model's main body
+        camera = Camera.frame(ext.lo, ext.hi, aspect=size[0] / size[1], direction=(-0.45, 0.25, 1.0))
         try:
             for cl, name in ((cloud, "bunny-before.png"), (deformed, "bunny-demo.png")):
                 target = output_dir / name

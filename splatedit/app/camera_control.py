@@ -18,6 +18,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from splatedit.model.orientation import front_direction
 from splatedit.render.camera import perspective
 from splatedit.tolerances import (EDITOR_CLIP_RADII, EDITOR_DOLLY_STEP, EDITOR_FAR_MIN_NEAR,
                                   EDITOR_FRAME_MARGIN, EDITOR_MAX_DIST_REL, EDITOR_MIN_DIST_REL,
@@ -54,9 +55,7 @@ class OrbitCamera:
         """(right, up, back) unit vectors of the camera in world space; the
         camera looks along ``-back``."""
         up = _normalize(np.asarray(self.up_axis, float))
-        # a reference "forward" perpendicular to up for yaw = 0
-        ref = np.array([0.0, 0.0, 1.0]) if abs(up[2]) < 0.9 else np.array([0.0, -1.0, 0.0])
-        ref = _normalize(ref - up * (ref @ up))
+        ref = front_direction(up)        # the view from yaw 0, pitch 0: the model's front
         side = np.cross(up, ref)
         cy, sy = math.cos(self.yaw), math.sin(self.yaw)
         cp, sp = math.cos(self.pitch), math.sin(self.pitch)

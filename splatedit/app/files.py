@@ -243,7 +243,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
     ed.cam.scene_radius = max(r, 1e-9)
     ed.camera.detect_up(cloud, ed.path)
-    ed.camera.frame_all()
+    ed.camera.frame_all(say=False)
     ed.window.set_title(f"splatedit - {ed.cloud_name}")
     if ed.use_lod and scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
@@ -253,8 +253,9 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.brush.tools.prepare(cloud)
     remember(ed, ed.path)
     what = f"{cloud.n:,} splats" if scene is None else describe(scene)
+    note = ed.camera.extent().note()
     ed.say(f"loaded {ed.cloud_name}: {what} (up axis {ed.camera.up.label}, "
-           f"{ed.camera.up.source.value}; U changes it)")
+           f"{ed.camera.up.source.value}; U changes it)" + (f"; {note}" if note else ""))
 
 
 def poll_jobs(ed) -> None:

@@ -188,7 +188,7 @@ KEYMAP: tuple[Binding, ...] = (
             mouse=True, context=C.ANY),
     Binding(S.CAMERA, "Ctrl + middle drag", "dolly", mouse=True, context=C.ANY),
     Binding(S.CAMERA, "Wheel", "zoom to the cursor", mouse=True, context=C.ANY),
-    Binding(S.CAMERA, "Home", "frame the whole model (beside the side panel)", Action.FRAME_ALL, ("home",)),
+    Binding(S.CAMERA, "Home", "frame the model, far outliers left out (beside the side panel)", Action.FRAME_ALL, ("home",)),
     Binding(S.CAMERA, "F  or  numpad .", "frame the selection (handle, else support)", Action.FRAME_SELECTION,
             ("f", "kp_decimal")),
     Binding(S.CAMERA, "Numpad 1 / 3 / 7", "front / right / top view (Ctrl: back / left / bottom), about the up axis",

@@ -7,6 +7,7 @@ Kept apart from :mod:`splatedit.app.editor` so that the command line can offer
 from __future__ import annotations
 
 import argparse
+import re
 
 from splatedit.app.keymap import help_text
 from splatedit.tolerances import IQR_DEFAULT_TOL
@@ -35,6 +36,31 @@ def positive_float(text: str) -> float:
     if not (x > 0 and x != float("inf")):
         raise argparse.ArgumentTypeError(f"must be a finite number > 0, got {text!r}")
     return x
+
+
+#: a comma-separated list of numbers (``-0.4,1,2``, ``-1e3,0,5.``)
+_NUMBERS = re.compile(r"^\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?(\s*,\s*[-+]?(\d+\.?\d*|\.\d+)([eE][-+]?\d+)?)*\s*$")
+
+
+def join_negative_values(argv: list[str], options: tuple[str, ...]) -> list[str]:
+    """``argv`` with ``OPT VALUE`` written ``OPT=VALUE`` where ``OPT`` is one
+    of ``options`` and ``VALUE`` is numbers starting with a minus
+    (``--eye -0.4,1,2``): argparse takes such a value for an option, not
+    for the option's argument."""
+    out: list[str] = []
+    i = 0
+    while i < len(argv):
+        a = argv[i]
+        if a == "--":                   # what follows is positional only
+            out.extend(argv[i:])
+            break
+        if a in options and i + 1 < len(argv) and argv[i + 1].startswith("-") and _NUMBERS.match(argv[i + 1]):
+            out.append(f"{a}={argv[i + 1]}")
+            i += 2
+            continue
+        out.append(a)
+        i += 1
+    return out
 
 
 def add_arguments(p) -> None:

@@ -112,6 +112,8 @@ def cmd_info(args) -> int:
         "bounds_max": [_sig(x) for x in hi],
         "diagonal": _sig(np.linalg.norm(hi - lo)),
     }
+    extent, note = _info_extent(model)
+    info.update(extent)
     if est is None:
         info.update(_exact_figures(model.cloud, med, rmax))
     else:
@@ -129,8 +131,21 @@ def cmd_info(args) -> int:
                          + ([] if model.faces is not None else ["boundary_splats"]),
             "sample_points": est.sample_points,
         })
-    _print_info(info, args.json)
+    _print_info(info | note, args.json)
     return 0
+
+
+def _info_extent(model) -> tuple[dict, dict]:
+    """``info``'s scanner dimensions held but all zero (when the whole cloud
+    was read) and the main body's extent (:func:`splatedit.model.extent.
+    framing_extent`); and a ``note`` about the points far outside it, printed last."""
+    from splatedit.model.extent import framing_extent
+    from splatedit.model.summary import scan_fields_all_zero
+    zero = scan_fields_all_zero(model.cloud) if model.cloud is not None else []
+    ext = framing_extent(model.positions)
+    return (({"all_zero": zero} if zero else {})
+            | {"main_body_diagonal": _sig(2 * ext.radius), "far_from_main_body": ext.n_far},
+            {"note": ext.note()} if ext.note() else {})
 
 
 def _exact_figures(cloud, med: float, rmax: float) -> dict:

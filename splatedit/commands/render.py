@@ -12,31 +12,30 @@ from splatedit.errors import ParameterError
 
 
 def _camera_from_args(args, cloud):
-    """The camera of ``splatedit render``: framing the model, then the flags override."""
-    import numpy as np
+    """The camera of ``splatedit render``: the editor's first view (the main
+    body framed from the front about the up axis: :func:`splatedit.render.framing.
+    default_view`), then the flags override; the view's note about far points
+    goes to stderr when it frames the default extent."""
     from splatedit.render.camera import Camera
-    w, h = args.size
-    lo, hi = cloud.bounds()
-    # frames a single point by its splat (the largest semi-axis; einsum: no (n,) norms)
-    rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
-                             np.einsum("ij,ij->i", cloud.v, cloud.v).max())))
-    # all centres in one point: look at the splat face-on (from +z it may be edge-on)
-    direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
-    base = Camera.frame(lo, hi, aspect=w / h, min_radius=rmax, direction=direction)
+    from splatedit.render.framing import default_view, screen_up
     if args.fov is not None and not 0.0 < args.fov < 179.0:
         raise ParameterError("--fov", f"must be in (0, 179) degrees, got {args.fov:g}")
-    fov = base.fov_deg if args.fov is None else args.fov
-    if args.eye is None and args.target is None and args.up is None and args.fov is None:
-        return base
-    if args.eye is None and args.fov is not None and args.target is None and args.up is None:
-        return Camera.frame(lo, hi, aspect=w / h, fov_deg=fov, min_radius=rmax, direction=direction)
-    target = base.target if args.target is None else args.target
-    eye = base.eye if args.eye is None else args.eye
-    up = base.up if args.up is None else args.up
     try:
-        return Camera(eye, target, up=up, fov_deg=fov)
+        view = default_view(cloud, args.size, path=args.input, up=args.up, fov_deg=args.fov)
+        if args.eye is None and args.target is None:
+            camera = view.camera
+        else:
+            eye = view.camera.eye if args.eye is None else args.eye
+            target = view.camera.target if args.target is None else args.target
+            # the model's up, unless --eye looks along it (straight down on a Z-up scan)
+            up = args.up if args.up is not None else screen_up(view.camera.up, eye, target)
+            camera = Camera(eye, target, up=up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
         raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+    if args.target is None and view.extent.note():
+        args.progress.close()
+        print(f"splatedit: note: {view.extent.note()}; the view frames the main body", file=sys.stderr)
+    return camera
 
 
 def cmd_render(args) -> int:
@@ -91,8 +90,11 @@ def _render_gaussians(args, cloud) -> int:
         if len(load_script(args.edit).edits) != 1:
             raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
                                            "(chained edits need the Gaussian CPU deformation)")
-        _, basis_rows, d_c = _gpu_edit(args, proxy)
-        if not isinstance(d_c, np.ndarray) or len(basis_rows) != 5:
+        def gpu_can_draw(rows, d_c):
+            return isinstance(d_c, np.ndarray) and len(rows) == 5
+
+        _, basis_rows, d_c = _gpu_edit(args, proxy, on_gpu=gpu_can_draw)
+        if not gpu_can_draw(basis_rows, d_c):
             # the Gaussian GPU pass draws a plain dC only: a turning handle (rotation mode) or the
             # detail mode is applied on the CPU as `splatedit deform` does, then drawn undeformed
             from splatedit.gaussian_script import run_script_gaussians
@@ -107,10 +109,12 @@ def _render_gaussians(args, cloud) -> int:
     return 0
 
 
-def _gpu_edit(args, cloud):
+def _gpu_edit(args, cloud, on_gpu=None):
     """Apply an edit script for rendering: every edit but the last is committed
     on the CPU (each edit's result is the next one's base); the last edit goes
     to the GPU as basis rows plus its control-frame displacement dC.
+    ``on_gpu(rows, dC)``: whether the caller's renderer can draw them (else
+    it deforms on the CPU, and the report says so).
 
     Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC).
     """
@@ -127,17 +131,20 @@ def _gpu_edit(args, cloud):
     args.progress.close()
     st = basis.stats
     mode = script.edits[-1].deformation.value
+    detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
+    rows = basis.rows_for_gpu() + ((detail(),) if detail else ())
+    where = ("uploaded to the GPU" if on_gpu is None or on_gpu(rows, d_c)
+             else f"fitted; the {mode} edit is applied on the CPU")
     print(f"edit {len(script.edits) - 1}: {mode} deformation, support {len(basis.indices)} splats, "
           f"{st['method']} with {st['n_centers']} centers (residual {st['residual']:.2e}), "
-          f"{basis.n_columns} basis columns uploaded to the GPU")
+          f"{basis.n_columns} basis columns {where}")
     for c in basis.constraints.conflicts:
         print(f"splatedit: warning: edit {len(script.edits) - 1}: {c.describe(basis.constraints.spacing)}",
               file=sys.stderr)
     from splatedit.deform.distortion import basis_distortion
-    detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
     dist = basis.distortion(cloud, d_c) if detail else basis_distortion(basis, cloud, d_c)
     print(f"  distortion: {dist.summary()}")
     if dist.exceeds_warn:
         print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
               f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
-    return cloud, basis.rows_for_gpu() + ((detail(),) if detail else ()), d_c
+    return cloud, rows, d_c

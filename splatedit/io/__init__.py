@@ -85,6 +85,8 @@ def read(path, *, progress=None) -> SplatCloud:
         InputError: unknown extension, unreadable or malformed file.
     """
     path, scan = split_scan_index(path)
+    if os.path.isdir(path):
+        check_readable_file(path)       # "is a directory", not "unsupported extension '(none)'"
     ext = _ext(path, READ_EXTENSIONS, "reading")
     reader = _READERS[ext]
     check_readable_file(path)

@@ -26,8 +26,8 @@ from pathlib import Path
 
 import numpy as np
 
-from splatedit.tolerances import (UP_AXIS_ALIGNED_COS, UP_AXIS_FLOOR_BAND, UP_AXIS_FLOOR_MIN_IN_BAND,
-                                  UP_AXIS_GROUND_MIN_FRACTION)
+from splatedit.tolerances import (FRONT_VIEW_Z_UP_COS, UP_AXIS_ALIGNED_COS, UP_AXIS_FLOOR_BAND,
+                                  UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION)
 
 #: the formats whose coordinates are Z-up by definition
 Z_UP_SUFFIXES = (".las", ".laz", ".e57")
@@ -135,3 +135,18 @@ def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpA
         if best is not None:
             return UpAxis(best[1], best[2], UpSource.GROUND)
     return UpAxis(1, 1, UpSource.DEFAULT)
+
+
+def front_direction(up) -> np.ndarray:
+    """(3,) float64 unit vector from a model's centre towards the eye of its
+    front view about the up vector ``up`` (3,): horizontal (perpendicular
+    to ``up``), towards +Z for a Y-up model, towards -Y for a Z-up one (the
+    front of a Z-up scan faces -Y: X right, Z up on screen, like Blender's
+    front view).  The editor's first view (yaw 0, pitch 0) and ``splatedit
+    render``'s default camera both look along minus this."""
+    u = np.asarray(up, dtype=np.float64)
+    u = u / np.abs(u).max()             # unit-size first: |up| of 1e-300 must not underflow
+    u = u / np.linalg.norm(u)
+    ref = np.array([0.0, 0.0, 1.0]) if abs(u[2]) < FRONT_VIEW_Z_UP_COS else np.array([0.0, -1.0, 0.0])
+    ref = ref - u * (ref @ u)
+    return ref / np.linalg.norm(ref)

@@ -13,6 +13,21 @@ import numpy as np
 from splatedit.model.cloud import SplatCloud, column_bounds
 
 
+def scan_fields_present(cloud: SplatCloud) -> dict[str, bool]:
+    """Which scanner dimensions carry data: ``{"intensity": ..., "classification": ...}``,
+    True only when the cloud has the dimension and it is not all zero (a LAS
+    point record always holds both: a file written from a scan without them
+    has zeros there)."""
+    return {name: arr is not None and bool(arr.any())
+            for name, arr in (("intensity", cloud.intensity), ("classification", cloud.classification))}
+
+
+def scan_fields_all_zero(cloud: SplatCloud) -> list[str]:
+    """The scanner dimensions the cloud holds that are all zero (``info`` lists them)."""
+    return [name for name, arr in (("intensity", cloud.intensity), ("classification", cloud.classification))
+            if arr is not None and not arr.any()]
+
+
 @dataclass
 class CloudSummary:
     """Centres, splat sizes and attribute presence of a model.
@@ -57,6 +72,6 @@ class CloudSummary:
     @classmethod
     def of_cloud(cls, cloud: SplatCloud) -> "CloudSummary":
         """The summary of a cloud read whole (``cloud`` kept)."""
+        present = scan_fields_present(cloud)       # held and not all zero (LAS always holds both)
         return cls(cloud.positions, cloud.radii, cloud.origin, cloud.faces, cloud.colors is not None,
-                   cloud.intensity is not None, cloud.classification is not None,
-                   cloud.normals_at, cloud)
+                   present["intensity"], present["classification"], cloud.normals_at, cloud)

@@ -52,7 +52,8 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
 
     Args:
         size: (width, height) in pixels.
-        camera: default ``Camera.frame`` of the cloud's bounds.
+        camera: default the editor's first view (:func:`splatedit.render.framing.default_view`:
+            the main body from the front about the detected up axis).
         basis: optional ``(indices, B, Bx, By, Bz)`` deformation basis rows
             (see :meth:`Renderer.set_basis`), plus ``detail`` (N, 4) for the
             detail mode (:meth:`Renderer.set_detail`); applied on the GPU with ``dC``
@@ -77,11 +78,8 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
     for out in outputs:
         _prepare_output(out)
     if camera is None:
-        lo, hi = cloud.bounds()
-        # all centres in one point: look at the splat face-on (from +z it may be edge-on)
-        direction = cloud.normals[0] if not np.any(hi > lo) else (0.0, 0.0, 1.0)
-        camera = Camera.frame(lo, hi, aspect=w / h, min_radius=float(cloud.radii.max()),
-                              direction=direction)
+        from splatedit.render.framing import default_view
+        camera = default_view(cloud, (w, h), path=cloud.source).camera
     with Renderer(device_name=device_name) as r:
         r.set_cloud(cloud)
         if selection is not None:

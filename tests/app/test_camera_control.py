@@ -150,3 +150,13 @@ def test_orbit_views_and_dolly_keep_an_offset_pivot_on_its_pixel():
     d = cam.distance
     cam.dolly(3.0)
     assert cam.distance < d and np.allclose(cam.project(c, w, h)[0][0], p0, atol=1e-6)
+
+
+@pytest.mark.parametrize("up", [(0, 1, 0), (0, 0, 1), (1, 0, 0), (0, -1, 0)])
+def test_the_first_view_looks_at_the_front_render_uses_too(up):
+    """Yaw 0, pitch 0 (the editor's first view) puts the eye along
+    front_direction(up), the direction of ``splatedit render``'s default camera."""
+    from splatedit.model.orientation import front_direction
+    cam = OrbitCamera(up_axis=np.array(up, float))
+    right, cam_up, back = cam.basis()
+    assert np.allclose(back, front_direction(up)) and np.allclose(cam_up, up)

@@ -92,3 +92,33 @@ def test_home_frames_beside_the_panel_and_centres_without_it(xvfb, tmp_path):
         assert ed.status()["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_a_scan_with_far_clumps_opens_framed_on_its_body(xvfb, tmp_path, shared_data):
+    """poste_france.xyz (far clumps make its box 262 units for a 24-unit
+    scan) opens with the scan filling the free part of the window (it was
+    a few specks: tester screenshots 24 / 82), and the load message names
+    the points left out."""
+    ed = EditorProcess(xvfb, tmp_path, str(shared_data / "poste_france.xyz"))
+    w, h = WINDOW
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 120)
+        ed.xdo("mousemove", w + 100, h + 100)                    # no brush circle
+        s = _shown(ed, True)
+        px, py, pw, ph = s["panel_box"]
+        fx0, fy0, fx1, fy1 = (a * b for a, b in zip(s["frame_area"], (w, h, w, h)))
+        ed.xdo("key", "p")                    # hide the panel (the camera stays) to see under it
+        assert _shown(ed, False)["camera"] == s["camera"]
+        x0, y0, x1, y1 = _model_box(ed, fy0)
+        fill = max((x1 - x0) / (fx1 - fx0), (y1 - y0) / (fy1 - fy0))
+        # measured 0.69 of the free part's height (the full box framed: specks, ~0.06)
+        assert MIN_FILL <= fill <= 1.0 / EDITOR_FRAME_MARGIN + 0.02, fill
+        assert x0 >= px + pw                                      # beside the panel, as Home frames
+        ed.xdo("key", "q")
+        assert ed.proc.wait(30) == 0
+        log = ed.stderr_path.read_text()
+        assert "loaded poste_france.xyz" in log
+        assert "points far outside the main body (outliers?): `splatedit convert --remove-outliers`" in log
+        assert ed.status()["validation_messages"] == 0
+    finally:
+        ed.close()

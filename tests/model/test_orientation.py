@@ -95,3 +95,23 @@ def test_a_ply_header_comment_names_the_up_axis(tmp_path):
     write(p, c, True, "made by splatedit; backup copy")   # "backup" is no hint
     assert header_up_hint(p) is None
     assert detect_up_axis(c.normals, c.positions, p).source is UpSource.DEFAULT
+
+
+def test_front_direction_is_horizontal_and_faces_the_front_of_y_and_z_up_models():
+    """The front view (the editor's first view, render's default): a Y-up
+    model is seen from +Z, a Z-up scan from -Y (not from above); for any up
+    the direction is a unit vector perpendicular to it."""
+    from splatedit.model.orientation import front_direction
+    assert np.allclose(front_direction([0, 1, 0]), [0, 0, 1])
+    assert np.allclose(front_direction([0, 0, 1]), [0, -1, 0])
+    assert np.allclose(front_direction([0, 0, -1]), [0, -1, 0])
+    assert np.allclose(front_direction([1, 0, 0]), [0, 0, 1])
+    for up in np.random.default_rng(4).normal(size=(50, 3)):
+        d = front_direction(up)
+        assert abs(np.linalg.norm(d) - 1) < 1e-12 and abs(d @ up) < 1e-12 * np.linalg.norm(up)
+
+
+def test_front_direction_of_a_tiny_up_vector_is_a_unit_vector():
+    from splatedit.model.orientation import front_direction
+    assert np.allclose(front_direction([0, 1e-300, 0]), [0, 0, 1])
+    assert np.allclose(front_direction([0, 0, 1e300]), [0, -1, 0])

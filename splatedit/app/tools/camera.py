@@ -5,11 +5,12 @@ from __future__ import annotations
 
 import math
 
-import numpy as np
 
+from splatedit.app import revision
 from splatedit.app.keymap import Action, Section
 from splatedit.app.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
+from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_up_axis, next_up
 from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
 
@@ -43,6 +44,7 @@ class CameraTool(Tool):
         super().__init__(ed)
         self.zoom_anchor = None          # (x, y, world point) kept while the cursor stays put
         self.up = UpAxis(1, 1)
+        self._extent = None              # (cloud revision, FramingExtent)
 
     @property
     def cam(self):
@@ -88,15 +90,29 @@ class CameraTool(Tool):
         top = ed.gui.menu_height if ed.gui is not None else 0.0
         return free_area(w, h, box, top)
 
-    def frame_all(self) -> None:
-        """Home: the whole model fills the free part of the window."""
+    def extent(self) -> FramingExtent | None:
+        """The open model's :func:`~splatedit.model.extent.framing_extent`
+        (its main body), computed once per cloud revision; None without a model."""
         s = self.session
         if s is None:
+            return None
+        key = revision.of(s.cloud)
+        if self._extent is None or self._extent[0] != key:
+            self._extent = (key, framing_extent(s.cloud.positions))
+        return self._extent[1]
+
+    def frame_all(self, say: bool = True) -> None:
+        """Home: the model's main body (far outlier clumps left out, see
+        :mod:`splatedit.model.extent`) fills the free part of the window;
+        ``say``: tell on the status line when far points are left out."""
+        ext = self.extent()
+        if ext is None:
             return
         w, h = self.ed.size
-        lo, hi = s.cloud.bounds()
-        self.cam.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / max(h, 1), area=self.view_area())
+        self.cam.frame(ext.center, ext.radius, w / max(h, 1), area=self.view_area())
         self.ed.motion()
+        if say and ext.note():
+            self.ed.say(f"left out of the view: {ext.note()}")
 
     def frame_selection(self) -> None:
         """F: the active handle (else the support) fills the free part of the window."""

@@ -65,3 +65,76 @@ def test_home_keeps_the_model_out_of_the_panel_column_and_uses_the_window_withou
         assert abs(ed.cam.project(ed.cam.pivot(), w, h)[0][0, 0] - w / 2) < 1e-6
     finally:
         s.close()
+
+
+def _session_of(cloud):
+    from splatedit.app.session import Session
+    return Session(cloud, fit_sync=True)
+
+
+def test_home_frames_the_main_body_of_a_cloud_with_far_clumps_and_says_so():
+    """Home with 9 stray splats 50 units from a 2-unit plane (1 %): the plane
+    fills the window as it does without them, the strays are off screen, the
+    status line names them; the extent is computed once per cloud revision."""
+    import numpy as np
+
+    from splatedit.model.cloud import SplatCloud
+    from tests.app.sessions import plane_cloud
+    from tests.app.test_editor_routing import StubEditor
+
+    plane = plane_cloud()
+    far = 50.0 * np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0],
+                           [0, 0, -1], [0.6, 0.8, 0], [0, 0.6, 0.8], [0.8, 0, -0.6]])
+    cloud = SplatCloud(np.vstack([plane.positions, far]), np.vstack([plane.u, plane.u[:9]]),
+                       np.vstack([plane.v, plane.v[:9]]), name="plane+strays")
+    boxes = []
+    for c in (plane, cloud):
+        s = _session_of(c)
+        try:
+            ed = StubEditor(s)
+            ed.panel_visible = False
+            w, h = ed.size
+            ed.camera.frame_all()
+            px, depth = ed.cam.project(plane.positions, w, h)
+            boxes.append((px.min(0), px.max(0)))
+            if c is cloud:
+                assert ed.messages[-1] == ("left out of the view: 9 points far outside the main body "
+                                           "(outliers?): `splatedit convert --remove-outliers`")
+                strays, d = ed.cam.project(far, w, h)
+                off = (d <= 0) | (strays[:, 0] < 0) | (strays[:, 0] > w) | (strays[:, 1] < 0) | (strays[:, 1] > h)
+                assert off.all()
+                before = ed.camera.extent()
+                assert ed.camera.extent() is before                     # cached for the revision
+                s.cloud = cloud.replace(positions=cloud.positions * 2)   # an edit: a new cloud
+                after = ed.camera.extent()
+                assert after is not before and np.isclose(after.radius, 2 * before.radius)
+            else:
+                assert ed.messages == []
+        finally:
+            s.close()
+    assert np.allclose(boxes[0][0], boxes[1][0]) and np.allclose(boxes[0][1], boxes[1][1])
+
+
+def test_home_on_the_clean_bunny_frames_its_full_bounding_sphere():
+    """The bundled bunny (no far points): Home frames exactly the box's
+    bounding sphere, as before the main-body extent."""
+    import numpy as np
+
+    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.data import default_model_path
+    from splatedit.io import read
+    from tests.app.test_editor_routing import StubEditor
+
+    cloud = read(default_model_path())
+    s = _session_of(cloud)
+    try:
+        ed = StubEditor(s)
+        w, h = ed.size
+        ed.camera.frame_all()
+        lo, hi = cloud.bounds()
+        ref = OrbitCamera(yaw=ed.cam.yaw, pitch=ed.cam.pitch, up_axis=ed.cam.up_axis)
+        ref.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / h, area=ed.camera.view_area())
+        assert np.allclose(ref.target, ed.cam.target, rtol=0, atol=1e-12) and ref.distance == ed.cam.distance
+        assert ed.messages == []
+    finally:
+        s.close()
