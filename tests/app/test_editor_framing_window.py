@@ -1,6 +1,7 @@
 """Home and F frame into the part of the window the side panel leaves free
 (real window under Xvfb): no model pixel under the panel, the model fills
-the free part; with the panel hidden Home centres it in the whole window."""
+the free part; with the panel hidden Home centres it in the whole window.
+A scan with far outlier clumps opens framed on its main body."""
 
 from __future__ import annotations
 
