@@ -822,6 +822,9 @@ EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
 #: (EDITOR_GUI_PANEL_WIDTH + margin) leaves ~0.75 of the width; at 640 px
 #: ~0.5; a quarter still shows a framed model about 160 px wide at 640 px
 EDITOR_FRAME_MIN_FREE_FRACTION = 0.25
+
+
+# ---------------------------------------------------------------------------
 # Rotation-aware handles about far axes (issue 9 follow-up: rotstretch)
 # ---------------------------------------------------------------------------
 #: the rigid turn (degrees) under which a rotating handle's two arc centres
@@ -887,6 +890,9 @@ ROTSTRETCH_BAR_BASE_MAX_STRETCH = 3.0
 #: against the whole change, measured 0.10 (0.0103 of 0.101 model units)
 #: with ROTATION_PROBE_BLEND, 0.85 with a hard switch (0.092 of 0.108)
 ROTSTRETCH_SLIDE_STEP_SHARE = 0.25
+
+
+# ---------------------------------------------------------------------------
 # Deformation at scan scale: 5M-splat support (issue 11 part 5)
 # ---------------------------------------------------------------------------
 #: most splats per GEMM of the linear CPU apply (splatedit.deform.apply_plan:
@@ -898,6 +904,9 @@ ROTSTRETCH_SLIDE_STEP_SHARE = 0.25
 #: On one thread the size is within the noise; 8,192 keeps three chunks of
 #: (K + 3) float64 rows in L2 like ROTATION_APPLY_CHUNK and DETAIL_APPLY_CHUNK
 LINEAR_APPLY_CHUNK = 8192
+
+
+# ---------------------------------------------------------------------------
 # Stable local origin of georeferenced models, `info` at scan scale (issues 10, 11: iopolish)
 # ---------------------------------------------------------------------------
 #: a model far from 0 (beyond REBASE_MIN_ABS) that carries no origin of its
@@ -914,6 +923,9 @@ REBASE_GRID_MIN = 1.0
 #: twice the grid origin's reach (one float32 bit), and far enough that an
 #: edit moving the model by a fraction of its size keeps the stored origin
 REBASE_STORED_REACH = 2.0
+
+
+# ---------------------------------------------------------------------------
 # Tiled estimation of large raw clouds (issue 11 part 4)
 # ---------------------------------------------------------------------------
 #: points per k-d tree tile of splatedit.model.tiles.tiled_knn (its cells and
@@ -953,6 +965,9 @@ ESTIMATE_PEAK_EXTRA_BYTES_PER_POINT = 300
 #: surface).  One level resolves the points near a cell wall without a tree
 #: over the whole cloud (poste_france.xyz: 105 retried, 39 left)
 TILE_RETRY_LEVELS = 1
+
+
+# ---------------------------------------------------------------------------
 # Progressive refinement by default: chunks composed on the device (issue 10 "one device", issue 11 part 5)
 # ---------------------------------------------------------------------------
 #: chunk steps the work budget of one presented frame is split into (the chunk is
