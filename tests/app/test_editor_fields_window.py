@@ -8,7 +8,7 @@ from __future__ import annotations
 import pytest
 
 from tests.app.test_editor_gui_window import _click
-from tests.app.window_harness import EditorProcess, _foreground_centre
+from tests.app.window_harness import EditorProcess, _foreground_centre, paint_support_stroke
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 pytest.importorskip("imgui_bundle")
@@ -31,10 +31,7 @@ def test_position_field_moves_the_active_curve_point(xvfb, tmp_path):
         assert s["fields"]["kind"] == "none" and "paint a support" in s["fields"]["problem"]
         cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
         # --- support: a bigger brush, a stroke around the model's centre
-        ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
-        ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
-               "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
-               "sleep", "0.1", "mouseup", "1")
+        paint_support_stroke(ed, cx, cy)
         ed.idle(lambda s: s["support"] > 200, "support painted")
         # --- curve tool, three points on the support
         ed.xdo("key", "k")

@@ -17,7 +17,7 @@ import numpy as np
 import pytest
 
 from tests.app.sessions import plane_cloud
-from tests.app.window_harness import WINDOW, EditorProcess, _foreground_centre
+from tests.app.window_harness import EditorProcess, WINDOW, _foreground_centre, paint_support_stroke
 from tests.app.xdnd import drop_files
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
@@ -26,10 +26,7 @@ pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 def _edit_bunny(ed, s):
     """Paint a support and a handle around the model's centre and drag the handle (one edit)."""
     cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
-    ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
-    ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
-           "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
-           "sleep", "0.1", "mouseup", "1")
+    paint_support_stroke(ed, cx, cy)
     ed.idle(lambda s: s["support"] > 200, "support painted")
     ed.xdo("key", "2", "bracketleft", "bracketleft", "bracketleft", "bracketleft", "bracketleft",
            "mousemove", cx, cy, "click", "1")

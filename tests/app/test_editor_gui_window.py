@@ -13,7 +13,7 @@ import numpy as np
 import pytest
 
 from splatedit.app.panel import PANEL_MARGIN
-from tests.app.window_harness import EditorProcess, _foreground_centre
+from tests.app.window_harness import EditorProcess, _foreground_centre, paint_support_stroke
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 pytest.importorskip("imgui_bundle")
@@ -40,10 +40,7 @@ def _click(ed, name: str, dx: int | None = None) -> None:
 
 
 def _paint_support_and_handle(ed, cx: int, cy: int) -> dict:
-    ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
-    ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
-           "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
-           "sleep", "0.1", "mouseup", "1")
+    paint_support_stroke(ed, cx, cy)
     ed.idle(lambda s: s["support"] > 200, "support painted")
     _click(ed, "tool_handle")                           # the palette instead of the 2 key
     ed.idle(lambda s: s["brush"] == "handle", "handle brush from the palette")

@@ -26,7 +26,7 @@ from pathlib import Path
 import numpy as np
 import pytest
 
-from tests.app.window_harness import EditorProcess, _foreground_centre, assert_replay_reproduces
+from tests.app.window_harness import EditorProcess, _foreground_centre, assert_replay_reproduces, paint_support_stroke
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 
@@ -49,10 +49,7 @@ def test_full_edit_session(xvfb, tmp_path):
         n = s["n"]
         cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
         # --- paint the support: a bigger brush, a stroke around the model's centre
-        ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
-        ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
-               "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
-               "sleep", "0.1", "mouseup", "1")
+        paint_support_stroke(ed, cx, cy)
         s = ed.idle(lambda s: s["support"] > 200 and s["history"] == 2, "support painted")
         support = s["support"]
         # --- paint the handle inside it (brush target 2 = handle, smaller brush)

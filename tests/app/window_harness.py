@@ -68,6 +68,15 @@ class EditorProcess:
         self.stderr.close()
 
 
+def paint_support_stroke(ed: "EditorProcess", cx: int, cy: int) -> None:
+    """A user's first support stroke: the brush made bigger (] three times), then
+    one drag around the model's centre (cx, cy) in window pixels."""
+    ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
+    ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
+           "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
+           "sleep", "0.1", "mouseup", "1")
+
+
 def _foreground_centre(img: np.ndarray, panel) -> tuple[int, int]:
     w, h = WINDOW
     a = img[:h, :w].astype(int)
