@@ -65,6 +65,10 @@ from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 PROGRESS_STAGE = "precomputing deformation basis"
 #: progress stage name of the selection closure
 CLOSURE_STAGE = "closing the selection"
+#: progress stages of a commit (:meth:`DeformationBasis.commit`): the support's
+#: chunks deformed, then the deformed cloud checked
+APPLY_STAGE = "applying the edit"
+CHECK_STAGE = "checking the deformed splats"
 #: support splats per chunk when evaluating the RBF for the basis
 _BASIS_CHUNK = 65536
 #: rows per GEMM in the CPU apply: small enough that OpenBLAS runs it on
@@ -149,6 +153,19 @@ def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CH
     order = np.concatenate(order_parts) if order_parts else np.zeros(0, np.intp)
     return order, segments
 
+
+
+def _wrap(cloud, arrays, validate: bool, progress=None):
+    """A copy of ``cloud`` with the deformed ``(positions, u, v)`` arrays
+    (no ``__init__``: skips the O(n) validation on the hot path), checked
+    when ``validate``."""
+    out = copy.copy(cloud)
+    out.positions, out.u, out.v = arrays
+    if validate:
+        report(progress, CHECK_STAGE, 0.0)
+        out.validate()
+        report(progress, CHECK_STAGE, 1.0)
+    return out
 
 class DeformationBasis:
     """Precomputed linear deformation bases of one edit (support + handles
@@ -472,10 +489,12 @@ class DeformationBasis:
         """Drop the hot-path arrays (about 24 (4h + 3) bytes per support splat)."""
         self._cpu = None
 
-    def apply_arrays(self, cloud, dC):
+    def apply_arrays(self, cloud, dC, progress=None):
         """Deformed ``(positions, u, v)`` (n, 3) float64 of ``cloud`` (the
         base cloud the basis was built on).  Splats outside the support are
-        copied bitwise; ``dC == 0`` returns bitwise copies."""
+        copied bitwise; ``dC == 0`` returns bitwise copies.  ``progress``:
+        optional ``progress(APPLY_STAGE, fraction of the support's rows done)``
+        after each chunk of the run plan (a commit in the editor's background)."""
         self._check_cloud(cloud)
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
@@ -491,8 +510,12 @@ class DeformationBasis:
             for dest in c["comp_segments"]:
                 for s, o in zip(srcs, outs):
                     o[dest] = s[dest]
+        report(progress, APPLY_STAGE, 0.0)
+        rows = len(c["arrays"][0])
         if rot is not None:   # rotating handles: extra GEMM columns (splatedit.deform.rotation_apply)
-            apply_segments(c["arrays"], c["segments"], outs, d, rot, handle_blocks(self))
+            apply_segments(c["arrays"], c["segments"], outs, d, rot, handle_blocks(self),
+                           progress=None if progress is None else
+                           (lambda hi: report(progress, APPLY_STAGE, hi / rows)))
         else:
             mx = np.vstack([d, np.eye(3)])
             for lo, hi, dest in c["segments"]:
@@ -501,27 +524,24 @@ class DeformationBasis:
                         np.matmul(a[lo:hi], mx, out=o[dest])
                     else:
                         o[dest] = a[lo:hi] @ mx
+                report(progress, APPLY_STAGE, hi / rows)
         if len(c["filler"]):  # fixed splats computed through: restore them bitwise
             for s, o in zip(srcs, outs):
                 o[c["filler"]] = s[c["filler"]]
         return outs
 
-    def apply(self, cloud, dC, *, validate: bool = False):
+    def apply(self, cloud, dC, *, validate: bool = False, progress=None):
         """The deformed cloud (a new :class:`SplatCloud`; colours, faces and
         name shared with ``cloud``).  ``validate=True`` re-checks the splat
-        invariants (an extreme deformation can flatten splats)."""
-        p, u, v = self.apply_arrays(cloud, dC)
-        out = copy.copy(cloud)  # no __init__: skips the O(n) validation on the hot path
-        out.positions, out.u, out.v = p, u, v
-        if validate:
-            out.validate()
-        return out
+        invariants (an extreme deformation can flatten splats).  ``progress``:
+        see :meth:`apply_arrays` (then ``CHECK_STAGE`` before the check)."""
+        return _wrap(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
 
-    def commit(self, cloud, dC, *, validate: bool = True):
+    def commit(self, cloud, dC, *, validate: bool = True, progress=None):
         """Apply ``dC`` and return the deformed cloud as the new base for the
         next edit (build a new basis on it to chain edits).  Validated by
         default: a committed cloud must satisfy the model invariants."""
-        return self.apply(cloud, dC, validate=validate)
+        return self.apply(cloud, dC, validate=validate, progress=progress)
 
     def __repr__(self) -> str:
         s = self.stats
