@@ -829,15 +829,18 @@ EDITOR_FRAME_MIN_FREE_FRACTION = 0.25
 # ---------------------------------------------------------------------------
 #: a commit whose estimated time (below) is under this runs on the UI thread
 #: (no progress bar flashing for a frame; the window misses at most ~3 frames
-#: at 60 Hz).  The bundled bunny with a third of it as support (12.6k splats)
-#: measured 51 ms; 1M splats with a 333k support 2.4 s; a 100k-Gaussian scene
-#: with a 33k support 0.97 s (2 cores shared by 8 engineers, loaded)
+#: at 60 Hz).  Commits measured with a third of the model as support (2 cores
+#: shared by 8 engineers, load 4.5-7): the bundled bunny (12.6k) 26-51 ms; 1M
+#: splats (333k) 2.0-2.4 s; a 100k-Gaussian scene (33k) 0.87-1.0 s
 EDITOR_COMMIT_SYNC_MS = 50.0
-#: estimated commit cost per support splat (the chunked basis apply, its
-#: first call building the hot-path arrays): 2.0 s cold / 0.92 s warm for a
-#: 333k support of a 1M-splat cloud, 51 ms for the bunny's 12.6k support;
-#: the cold figure, rounded up
-EDITOR_COMMIT_US_PER_SUPPORT_SPLAT = 6.0
+#: estimated commit cost per support splat (the chunked basis apply; each
+#: commit's basis is fresh, so its first call also builds the hot-path
+#: arrays).  Measured (loaded machine): the bundled bunny (mesh order: long
+#: runs of support rows) 12.6k support 26 ms in all, ~2 us per splat; 1M
+#: splats in random order (short runs, gathered) 333k support 2.0 s cold /
+#: 0.92 s warm, 6 / 2.8 us.  3 us: the bunny's edits stay synchronous, a
+#: scattered cloud near the threshold may block ~2x the 50 ms, once
+EDITOR_COMMIT_US_PER_SUPPORT_SPLAT = 3.0
 #: estimated commit cost per splat of the whole cloud (copying the fixed
 #: splats, SplatCloud.validate of the result): validate 0.11-0.18 s and the
 #: copies 0.04 s for 1M splats
