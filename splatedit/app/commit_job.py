@@ -35,18 +35,23 @@ class CommitPlan:
     ``basis``: the fitted DeformationBasis or DetailBasis; ``cloud``: the
     base document (a SplatCloud, maybe with Gaussians attached) it was
     fitted on; ``dc``: (K, 3) float64 or a RotationDisplacement (the whole
-    pose); ``edit``: the :class:`~splatedit.script.Edit` recorded when it
-    lands; ``handles``: the number of handles (the pose is reset to them)."""
+    pose); ``make_edit``: builds the :class:`~splatedit.script.Edit` recorded
+    when it lands (index lists of up to millions of splats: built off the UI
+    thread); ``handles``: the number of handles (the pose is reset to them)."""
     basis: object
     cloud: object
     dc: object
-    edit: object
+    make_edit: object
     handles: int
 
     def work(self, progress=None):
         """The deformed document (``commit_cloud``); ``progress(stage,
         fraction)`` after each chunk.  Raises InputError on a degenerate splat."""
         return commit_cloud(self.basis, self.cloud, self.dc, progress=progress)
+
+    def run(self, progress=None):
+        """``(deformed document, script Edit)``: what a commit job computes."""
+        return self.work(progress), self.make_edit()
 
     def estimate_ms(self) -> float:
         """:func:`estimate_ms` of this plan."""
@@ -93,15 +98,15 @@ class CommitRunner:
     def start(self, plan: CommitPlan) -> None:
         """Run ``plan`` in a daemon thread; :attr:`on_change` is called when it ends."""
         self.plan = plan
-        self.job = Job(COMMIT_JOB, plan.work, self.on_change)
+        self.job = Job(COMMIT_JOB, plan.run, self.on_change)
 
     def progress(self) -> CommitProgress | None:
         j = self.job
         return None if j is None else CommitProgress(j.stage, j.fraction, time.perf_counter() - j.started)
 
     def collect(self):
-        """``(plan, new cloud, error message or None, seconds)`` of a finished
-        job (None while none finished; a cancelled one is dropped)."""
+        """``(plan, (new cloud, edit), error message or None, seconds)`` of a
+        finished job (None while none finished; a cancelled one is dropped)."""
         j = self.job
         if j is None or not j.done:
             return None

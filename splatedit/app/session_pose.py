@@ -180,7 +180,7 @@ class PoseEditing:
             # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
             # length is relative to the *whole* cloud's diagonal, which the edit may change);
             # a Gaussian document: the Gaussians deformed on the CPU (covariances, SH) and re-wrapped
-            new = plan.work()     # raises InputError on a degenerate splat (nothing changed)
+            new = plan.run()     # raises InputError on a degenerate splat (nothing changed)
             self.last_commit_seconds = time.perf_counter() - t0
             self.manip = None
             self.manip_target = None
@@ -207,21 +207,27 @@ class PoseEditing:
             return None
         dc = self.basis.displacement(inputs, mode=self.deformation)
         sel = self.selection
-        idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+        support, handles = sel.support.copy(), [sel.handles[k].copy() for k in hidx]
         curves = ()
         if curve is not None:
             curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.curve_points),
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
-        edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
-                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
-                    fill_holes=False,  # the editor's closed selection, replayed as is
-                    deformation=self.deformation)
-        return CommitPlan(self.basis, self.cloud, dc, edit, len(sel.handles))
+        matrices = tuple(Matrix(_matrix_tuple(m)) for m in mats)
+        mode = self.deformation
 
-    def _land(self, plan, new) -> None:
-        """The deformed cloud ``new`` of ``plan`` becomes the document (one undo step)."""
+        def make_edit():
+            idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+            return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
+                        fill_holes=False,  # the editor's closed selection, replayed as is
+                        deformation=mode)
+        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles))
+
+    def _land(self, plan, result) -> None:
+        """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the
+        document (one undo step)."""
+        new, edit = result
         self.cloud = new
-        self.edits = self.edits + (plan.edit,)
+        self.edits = self.edits + (edit,)
         self.fit.clear()
         self.rig.reset_pose(plan.handles)
         self.rig.clear_curve()
