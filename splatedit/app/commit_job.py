@@ -20,12 +20,27 @@ from dataclasses import dataclass
 
 from splatedit.app.gaussian_doc import commit_cloud, gaussians_of
 from splatedit.app.jobs import Cancelled, Job
+from splatedit.deform.basis import APPLY_STAGE, CHECK_STAGE
+from splatedit.deform.gaussians import GAUSSIAN_STAGE
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_COMMIT_US_PER_SPLAT, EDITOR_COMMIT_US_PER_SUPPORT_GAUSSIAN,
                                   EDITOR_COMMIT_US_PER_SUPPORT_SPLAT)
 
 #: the name of a commit job (its first progress stage)
 COMMIT_JOB = "applying the edit"
+
+
+#: the part of a whole commit each stage covers (measured: the check is
+#: 0.11-0.18 s of 1.2-2.4 s for 1M splats with a 333k support)
+STAGE_SPANS = {CHECK_STAGE: (0.9, 1.0), APPLY_STAGE: (0.0, 0.9), GAUSSIAN_STAGE: (0.0, 1.0)}
+
+
+def _overall(progress):
+    """``progress`` fed the fraction of the whole commit instead of the stage's."""
+    def report(stage: str, fraction: float) -> None:
+        lo, hi = STAGE_SPANS.get(stage, (0.0, 1.0))
+        progress(stage, lo + (hi - lo) * fraction)
+    return report
 
 
 @dataclass(frozen=True)
@@ -50,8 +65,10 @@ class CommitPlan:
         return commit_cloud(self.basis, self.cloud, self.dc, progress=progress)
 
     def run(self, progress=None):
-        """``(deformed document, script Edit)``: what a commit job computes."""
-        return self.work(progress), self.make_edit()
+        """``(deformed document, script Edit)``: what a commit job computes;
+        ``progress(stage, fraction)`` gets the fraction of the whole commit
+        (:data:`STAGE_SPANS`: never decreasing across stages)."""
+        return self.work(None if progress is None else _overall(progress)), self.make_edit()
 
     def estimate_ms(self) -> float:
         """:func:`estimate_ms` of this plan."""

@@ -63,6 +63,10 @@ def test_commit_progress_is_chunked_and_monotone(mode):
         # rotation and detail apply in cache-sized chunks; linear in 65536-row GEMMs (one here)
         steps = 2 if mode is DeformationMode.LINEAR else 4
         assert len(apply) >= steps and apply[-1] == 1.0 and all(np.diff(apply) >= 0), apply
+        # a job sees the fraction of the whole commit: never decreasing across the stages
+        whole = []
+        plan.run(lambda stage, f: whole.append(f))
+        assert all(np.diff(whole) >= 0) and whole[-1] == 1.0 and len(whole) == len(seen), whole
         # the progress callback does not change the result
         ref = s.basis.commit(s.cloud, plan.dc)
         assert np.array_equal(new.positions, ref.positions) and np.array_equal(new.u, ref.u)
