@@ -6,7 +6,9 @@ States::
     FITTING --(done)--> READY (basis available; the handle can be moved)
     READY --G/R/S or drag--> MANIPULATE (matrix changes every mouse move)
     MANIPULATE --Enter / release--> commit: the deformed cloud becomes the
-        new base (the selection is kept, a new fit starts for the next edit)
+        new base (the selection is kept, a new fit starts for the next edit);
+        a long commit goes through COMMITTING (a background job,
+        :mod:`splatedit.app.commit_job`: document changes refused) first
     MANIPULATE --Esc / right click--> cancel (back to READY)
 
 The *rig* of an edit (paper Sect. 3 and 6 end): one support, one or more

@@ -121,7 +121,7 @@ def test_quit_during_a_commit_writes_nothing(xvfb, tmp_path, scene_path):
         ed.xdo("key", "Return")
         ed.wait(lambda s: s["state"] == "committing", "the commit running in the background", 30)
         ed.xdo("key", "q")
-        s = ed.wait(lambda s: s["confirm_quit"], "quit asks first (the running edit is unsaved)", 30)
+        ed.wait(lambda s: s["confirm_quit"], "quit asks first (the running edit is unsaved)", 30)
         t0 = time.time()
         ed.xdo("key", "y")
         assert ed.proc.wait(30) == 0
