@@ -193,7 +193,8 @@ class Editor(EventRouting, FileActions):
     def idle(self) -> bool:
         """Nothing left to do until the next input (tests wait for this)."""
         s, fr = self.session, self.frames
-        return (s is not None and not self.jobs and s.fit_job is None and self.drag is DragMode.NONE
+        return (s is not None and not self.jobs and s.fit_job is None and not s.committing
+                and self.drag is DragMode.NONE
                 and s.manip is None and not fr.scene_interactive and fr.scene_key == fr.state())
 
     # -------------------------------------------------------------- actions
@@ -276,7 +277,8 @@ class Editor(EventRouting, FileActions):
         try:
             while self.running:
                 s = self.session
-                busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None))
+                busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None
+                                                              or s.committing))
                 pending = fr.pending() or (self.gui is not None and self.gui.needs_frames())
                 busy = busy or fr.busy()
                 w, h = self.size
@@ -287,6 +289,7 @@ class Editor(EventRouting, FileActions):
                 self.poll_jobs()
                 if self.session is not None:
                     self.session.poll()
+                    self.gizmo.report_commit()
                 if not self.running:
                     break
                 try:

@@ -36,19 +36,21 @@ def gaussians_of(cloud) -> GaussianCloud | None:
     return getattr(cloud, _ATTR, None) if cloud is not None else None
 
 
-def commit_cloud(basis, cloud, dc):
+def commit_cloud(basis, cloud, dc, progress=None):
     """The editor's commit of one edit: ``basis.commit`` for plain splats; for
     a Gaussian document the Gaussians deformed on the CPU by the basis and
     ``dc`` ((K, 3) or a RotationDisplacement) and re-wrapped as a new document.
+    ``progress``: optional ``progress(stage, fraction)`` after each chunk
+    (raising in it abandons the commit; ``cloud`` is never modified).
 
     Raises:
         InputError: a splat (or Gaussian) degenerates; nothing changes.
     """
     scene = gaussians_of(cloud)
     if scene is None:
-        return basis.commit(cloud, dc)
+        return basis.commit(cloud, dc, progress=progress)
     from splatedit.deform.gaussians import deform_with_evaluator
-    return gaussian_document(deform_with_evaluator(scene, basis, dc))
+    return gaussian_document(deform_with_evaluator(scene, basis, dc, progress=progress))
 
 
 def document_bytes(cloud) -> int:

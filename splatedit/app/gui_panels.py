@@ -330,7 +330,11 @@ class EditorGui:
             imgui.text(f"handles {st.handles}: {sizes}")
             imgui.text(f"curve {st.curve_points} pts   columns {st.columns}/16")
         fit, prog = st.fit, st.progress
-        if prog is not None:
+        if st.commit is not None:             # a commit in the background (issue 10)
+            c = st.commit
+            imgui.progress_bar(c.fraction, imgui.ImVec2(-1, 0), f"{c.stage} {c.fraction * 100:.0f}% "
+                               f"({c.elapsed:.1f} s)")
+        elif prog is not None:
             imgui.progress_bar(prog.fraction, imgui.ImVec2(-1, 0), f"{prog.stage} {prog.fraction * 100:.0f}%")
         elif fit is not None:
             imgui.text(f"{fit.method}: {fit.centers} centers / {fit.constraints} constraints")
@@ -368,7 +372,7 @@ class EditorGui:
                 imgui.end_disabled()
             imgui.same_line()
         imgui.new_line()
-        if s.pose_pending and s.manip is None:
+        if s.pose_pending and s.manip is None and not s.committing:
             imgui.text_colored(YELLOW, "pending moves")
             if imgui.button("Apply (Enter)"):
                 ed.run_action(Action.COMMIT_POSE)
@@ -444,6 +448,9 @@ class EditorGui:
         bars = [(j.stage, j.fraction) for j in ed.jobs.values()]
         if s is not None and s.fit_job is not None and ed.panel_box is None:
             bars.append((s.fit_job.stage, s.fit_job.fraction))
+        c = None if s is None else s.committer.progress()
+        if c is not None:       # a commit: always shown (editing waits for it)
+            bars.append((c.stage, c.fraction))
         if not bars:
             return
         imgui.set_next_window_pos(imgui.ImVec2(w / 2, self.menu_height + PANEL_MARGIN), imgui.Cond_.always,

@@ -82,10 +82,13 @@ def panel_lines(ed) -> list:
         tool = " K:ON" if s.curve_mode else ""
         lines.append((f"handles {len(hs)}: {sizes}   curve {st.curve_points} pts{tool}   "
                       f"columns {st.columns}/16", CURVE_RGB if s.curve_mode else (235, 235, 235)))
-    if s.pose_pending and s.manip is None:
+    if s.pose_pending and s.manip is None and not s.committing:
         lines.append(("pending moves: Enter applies them as one edit, Esc discards", (255, 230, 120)))
     fit, prog = st.fit, st.progress
-    if prog is not None:
+    if st.commit is not None:
+        c = st.commit
+        lines.append((f"edit: {c.stage} {c.fraction * 100:.0f}% ({c.elapsed:.1f} s)", (255, 230, 120)))
+    elif prog is not None:
         lines.append(f"solver: {prog.stage} {prog.fraction * 100:.0f}% ({prog.elapsed:.1f} s)")
     elif fit is not None:
         lines.append(f"solver: {fit.method}, {fit.centers} centers / {fit.constraints} "
@@ -257,6 +260,9 @@ def compose_overlay(ed, w: int, h: int) -> list:
     bars = [(j.stage, j.fraction) for j in ed.jobs.values()]
     if s is not None and s.fit_job is not None:
         bars.append((s.fit_job.stage, s.fit_job.fraction))
+    c = None if s is None else s.committer.progress()
+    if c is not None:
+        bars.append((c.stage, c.fraction))
     for stage, frac in bars:
         bar = ov.progress_bar(360, frac, f"{stage} {frac * 100:3.0f}%")
         patches.append(ov.Patch(x, y, bar))

@@ -23,6 +23,17 @@ from splatedit.errors import SplatEditError
 #: wheel notch -> help lines scrolled
 HELP_WHEEL_LINES = 3
 
+#: what stays available while an edit is applied in the background: the view,
+#: the display, the panel and help, the brush's size and quitting (quitting
+#: asks first: the running edit counts as unsaved).  Every other action
+#: changes the document, the rig or the file and is refused with a message.
+WHILE_COMMITTING = frozenset({
+    Action.FRAME_ALL, Action.FRAME_SELECTION, Action.VIEW_FRONT, Action.VIEW_RIGHT, Action.VIEW_TOP,
+    Action.VIEW_BACK, Action.VIEW_LEFT, Action.VIEW_BOTTOM, Action.CYCLE_UP_AXIS,
+    Action.DISTORTION_MAP, Action.COLOUR_MODE, Action.SPLATS_SMALLER, Action.SPLATS_LARGER,
+    Action.PANEL, Action.HELP, Action.HELP_DOWN, Action.HELP_UP, Action.HELP_CLOSE,
+    Action.BRUSH_SMALLER, Action.BRUSH_LARGER, Action.DISMISS_ERROR, Action.QUIT})
+
 
 class EventRouting:
     """The Editor's ``on_<kind>`` event handlers and action dispatch."""
@@ -50,7 +61,19 @@ class EventRouting:
         self.request_quit()
 
     def on_drop(self, e) -> None:
+        if self.refuse_while_committing():
+            return
         files.on_drop(self, [Path(p) for p in e.paths])
+
+    def refuse_while_committing(self) -> bool:
+        """True (and a message) while an edit is applied in the background."""
+        s = self.session
+        if s is None or not s.committing:
+            return False
+        p = s.committer.progress()
+        pct = f" ({p.fraction * 100:.0f}%)" if p is not None else ""
+        self.say(f"the edit is still being applied{pct}: wait until it lands (the view stays live)")
+        return True
 
     def on_char(self, e) -> None:
         if self.browser.shown and self.prompt is None and self.confirm_open is None:
@@ -110,16 +133,20 @@ class EventRouting:
         if s is None or self.modal():
             return
         self.drag_last = (e.x, e.y)
-        for tool in self.tools:
+        # while an edit is applied in the background only the camera takes presses
+        tools = (self.camera,) if s.committing else self.tools
+        for tool in tools:
             mode = tool.press_modal(e)
             if mode is not None:
                 break
         else:
-            for tool in self.tools:
+            for tool in tools:
                 mode = tool.press(e)
                 if mode is not None:
                     break
             else:
+                if s.committing and e.button == g.MOUSE_BUTTON_LEFT:
+                    self.refuse_while_committing()
                 return
         self.drag = mode
         self.drag_tool = tool if mode is not DragMode.NONE else None
@@ -175,6 +202,9 @@ class EventRouting:
         """Run the handler bound to ``action`` (keys and GUI buttons share it):
         during a G/R/S move its own handler when it has one."""
         s = self.session
+        if s is not None and s.committing and action not in WHILE_COMMITTING:
+            self.refuse_while_committing()
+            return
         manip = s is not None and s.manip is not None
         table = self.manip_actions if manip and action in self.manip_actions else self.actions
         table[action]()

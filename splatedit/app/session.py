@@ -6,7 +6,9 @@ States::
     FITTING --(done)--> READY (basis available; the handle can be moved)
     READY --G/R/S or drag--> MANIPULATE (matrix changes every mouse move)
     MANIPULATE --Enter / release--> commit: the deformed cloud becomes the
-        new base (the selection is kept, a new fit starts for the next edit)
+        new base (the selection is kept, a new fit starts for the next edit);
+        a long commit goes through COMMITTING (a background job,
+        :mod:`splatedit.app.commit_job`: document changes refused) first
     MANIPULATE --Esc / right click--> cancel (back to READY)
 
 The *rig* of an edit (paper Sect. 3 and 6 end): one support, one or more
@@ -57,6 +59,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.app import revision
+from splatedit.app.commit_job import CommitOutcome, CommitProgress, CommitRunner
 from splatedit.app.distortion_feed import DistortionFeed
 from splatedit.app.fitting import FitProgress, FitScheduler, FitStats, fitted_kind
 from splatedit.app.history import History
@@ -67,13 +70,13 @@ from splatedit.app.session_pose import PoseEditing
 from splatedit.app.session_rig import HANDLE_COLUMNS, MAX_CURVE_POINTS, RigEditing, columns_needed  # noqa: F401 (API)
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT, Selection
-from splatedit.tolerances import IQR_DEFAULT_TOL, RENDER_MAX_BASIS_COLUMNS
+from splatedit.tolerances import EDITOR_COMMIT_SYNC_MS, IQR_DEFAULT_TOL, RENDER_MAX_BASIS_COLUMNS
 
 
 @dataclass(frozen=True)
 class SessionStats:
     """What the panel and the status file show of a session."""
-    state: str                  # select / fitting / ready / manipulate / error
+    state: str                  # select / fitting / ready / manipulate / committing / error
     support: int                # splats
     handle: int                 # splats of the active handle
     edits: int
@@ -86,6 +89,7 @@ class SessionStats:
     fit: FitStats | None        # figures of the fitted basis
     progress: FitProgress | None   # the running fit
     error: str | None           # why there is no basis
+    commit: CommitProgress | None = None   # the running background commit
 
 
 class Session(SessionHistory, RigEditing, PoseEditing):
@@ -97,7 +101,13 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     Args:
         cloud: the loaded :class:`SplatCloud`.
         method, tol, max_centers: solver settings (also written to exported scripts).
-        fit_sync: run fits on the calling thread (tests).
+        fit_sync: run fits on the calling thread (tests); commits then never
+            run in the background either.
+
+    Commits (:meth:`commit`) estimated at ``commit_sync_ms`` or more run in
+    the background (:mod:`splatedit.app.commit_job`); meanwhile
+    :attr:`committing` is True and every change of the document is refused
+    (the methods return False) until :meth:`poll` lands it.
     """
 
     def __init__(self, cloud, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
@@ -121,6 +131,12 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.curve_active = 0
         self.version = 0          # bumps whenever cloud or selection changes
         self.last_commit_seconds = 0.0
+        #: commits estimated at this many ms or more run in the background
+        self.commit_sync_ms = float("inf") if fit_sync else EDITOR_COMMIT_SYNC_MS
+        self.committer = CommitRunner(self.on_change)
+        #: how the last background commit ended (the editor shows it and clears it)
+        self.commit_outcome: CommitOutcome | None = None
+        self._rig_before_commit = None
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
 
     # ------------------------------------------- the rig and the fit's state
@@ -144,7 +160,7 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     def paint(self, indices, erase: bool = False) -> bool:
         """Paint the current brush target (no history entry: call
         :meth:`end_stroke` when the stroke ends)."""
-        if self.manip is not None:
+        if self.manip is not None or self.committing:
             return False
         changed = self.selection.paint(indices, self.brush_target, erase)
         if changed:
@@ -156,11 +172,13 @@ class Session(SessionHistory, RigEditing, PoseEditing):
             self.push(f"paint {self.brush_target}")
 
     def clear(self, target: str | None = None) -> None:
-        if self.manip is None and self.selection.clear(target):
+        if self.manip is None and not self.committing and self.selection.clear(target):
             self.pose = [np.eye(4)]
             self.push("clear")
 
     def set_selection(self, support, handle, label: str = "select") -> None:
+        if self.committing:
+            return
         handles = handle if isinstance(handle, (list, tuple)) else [handle]
         self.selection = Selection(self.cloud.n, support, handles=handles)
         self.pose = [np.eye(4)]
@@ -177,7 +195,7 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         """Start (or restart) a background fit of all non-empty handles and
         the curve (when it has at least 2 points)."""
         key = self.selection_key()
-        if self.fit.current(key):
+        if self.fit.current(key) or self.committing:    # a landing commit refits
             return
         self.fit.clear()
         hidx = self.selection.nonempty()
@@ -202,7 +220,10 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.fit.start(key, (tuple(hidx), curve), work)
 
     def poll(self) -> bool:
-        """Collect a finished fit; True when the state changed."""
+        """Land a finished background commit, collect a finished fit; True
+        when the state changed."""
+        if self.poll_commit():
+            return True
         got = self.fit.poll(self.selection_key())
         if got is None:             # fitted for a selection that has changed since
             self.request_fit()
@@ -223,6 +244,8 @@ class Session(SessionHistory, RigEditing, PoseEditing):
 
     @property
     def state(self) -> str:
+        if self.committing:
+            return "committing"
         if self.manip is not None:
             return "manipulate"
         if self.fit_job is not None:
@@ -251,6 +274,8 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     def set_deformation(self, mode) -> DeformationMode:
         """Make ``mode`` (a DeformationMode or its name) the mode of new edits
         (refits when the kind of basis changes, see :meth:`cycle_deformation`)."""
+        if self.committing:
+            return self.deformation
         self.deformation = DeformationMode(mode)
         self.request_fit()          # a no-op unless the basis kind changed
         self.on_change()
@@ -280,7 +305,10 @@ class Session(SessionHistory, RigEditing, PoseEditing):
             handle_sizes=tuple(int(h.sum()) for h in sel.handles), curve_points=len(self.curve_points),
             pose_pending=self.pose_pending,
             columns=fit.columns if fit is not None else columns_needed(len(sel.nonempty()), len(self.curve_points)),
-            fit=fit, progress=self.fit.progress(), error=self.fit_error)
+            fit=fit, progress=self.fit.progress(), error=self.fit_error, commit=self.committer.progress())
 
     def close(self) -> None:
+        """Cancel the running fit and commit (a commit's result is dropped:
+        the document stays as it was)."""
+        self.committer.cancel()
         self.fit.close()

@@ -46,6 +46,8 @@ class SessionHistory:
         self.on_change()
 
     def undo(self) -> bool:
+        if self.committing:
+            return False
         if self.manip is not None:
             self.cancel()
             return True
@@ -56,7 +58,7 @@ class SessionHistory:
         return True
 
     def redo(self) -> bool:
-        if self.manip is not None:
+        if self.manip is not None or self.committing:
             return False
         snap = self.history.redo()
         if snap is None:
@@ -66,4 +68,5 @@ class SessionHistory:
 
     @property
     def dirty(self) -> bool:
-        return self.history.geometry_dirty
+        """Unsaved changes (a commit still running counts: quitting asks first)."""
+        return self.history.geometry_dirty or self.committing

@@ -15,7 +15,6 @@ import time
 
 import numpy as np
 
-from splatedit.app.gaussian_doc import commit_cloud
 from splatedit.app.manipulation import GRAB, Manipulation, ViewInfo
 from splatedit.app.rig import _matrix_tuple
 from splatedit.errors import SplatEditError
@@ -61,6 +60,8 @@ class PoseEditing:
 
     def reset_pose(self) -> bool:
         """Discard the pending transforms and curve moves (an undo step)."""
+        if self.committing:
+            return False
         if self.manip is not None:
             self.cancel()
         if not self.pose_pending:
@@ -83,7 +84,7 @@ class PoseEditing:
 
     def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float]) -> bool:
         """Start G/R/S of the active handle (needs a basis that includes it)."""
-        if self.manip is not None or not self.active_fitted():
+        if self.manip is not None or self.committing or not self.active_fitted():
             return False
         self.manip = Manipulation(mode, self.handle_centroid(), view, mouse)
         self.manip_target = ("handle", self.selection.active)
@@ -91,7 +92,7 @@ class PoseEditing:
 
     def begin_curve_point(self, j: int, view: ViewInfo, mouse: tuple[float, float]) -> bool:
         """Start dragging picked curve point ``j`` (needs a basis with the curve)."""
-        if self.manip is not None or self.basis is None or self.basis_groups[1] is None:
+        if self.manip is not None or self.committing or self.basis is None or self.basis_groups[1] is None:
             return False
         if not 0 <= j < len(self.curve_points):
             return False
@@ -155,45 +156,108 @@ class PoseEditing:
         """Apply the pose (running manipulation included) as one edit: the
         deformed cloud becomes the new base, the edit is recorded, support and
         handles are kept, the curve is consumed.  Raises InputError (state
-        unchanged) when a splat degenerates."""
-        from splatedit.script import Curve, Edit, Matrix
-        from splatedit.select.regions import Indices
-        if self.basis is None:
+        unchanged) when a splat degenerates.
+
+        A commit estimated at ``commit_sync_ms`` or more
+        (:func:`~splatedit.app.commit_job.estimate_ms`) runs in the background
+        (:attr:`committing`; True is returned at once): the running
+        manipulation is stored in the pose, so the viewport keeps drawing the
+        edit; :meth:`poll` lands it (the same single undo step) or, on an
+        error, restores the pose as it was before the manipulation and leaves
+        :attr:`commit_outcome` for the editor to show."""
+        if self.basis is None or self.committing:
             return False
         self._check_manip()
+        plan = self._commit_plan()
+        if plan is None:
+            self.manip = None
+            self.manip_target = None
+            self.on_change()
+            return False
+        if plan.estimate_ms() < self.commit_sync_ms:
+            t0 = time.perf_counter()
+            # the same arrays and the same checks as ``splatedit deform`` and as reading the
+            # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
+            # length is relative to the *whole* cloud's diagonal, which the edit may change);
+            # a Gaussian document: the Gaussians deformed on the CPU (covariances, SH) and re-wrapped
+            new = plan.run()     # raises InputError on a degenerate splat (nothing changed)
+            self.last_commit_seconds = time.perf_counter() - t0
+            self.manip = None
+            self.manip_target = None
+            self._land(plan, new)
+            return True
+        self._rig_before_commit = self.rig.as_tuple()
+        if self.manip is not None:
+            self._bake()            # the pose now draws exactly the frozen edit
+        self.committer.start(plan)
+        self.on_change()
+        return True
+
+    def _commit_plan(self):
+        """The pose frozen as a :class:`~splatedit.app.commit_job.CommitPlan`
+        (None when nothing moves)."""
+        from splatedit.app.commit_job import CommitPlan
+        from splatedit.script import Curve, Edit, Matrix
+        from splatedit.select.regions import Indices
         inputs = self.inputs(live=True)
         moves = self.live_curve_moves(live=True)
         hidx, curve = self.basis_groups
         mats = inputs[:len(hidx)]
         if all(np.array_equal(m, np.eye(4)) for m in mats) and not (curve is not None and moves.any()):
-            self.manip = None
-            self.manip_target = None
-            self.on_change()
-            return False
-        t0 = time.perf_counter()
+            return None
         dc = self.basis.displacement(inputs, mode=self.deformation)
-        # the same arrays and the same checks as ``splatedit deform`` and as reading the
-        # saved file: the whole cloud is validated (SplatCloud.validate: the minimum axis
-        # length is relative to the *whole* cloud's diagonal, which the edit may change)
-        # a Gaussian document: the Gaussians deformed on the CPU (covariances, SH) and re-wrapped
-        new = commit_cloud(self.basis, self.cloud, dc)     # raises InputError on a degenerate splat
-        self.last_commit_seconds = time.perf_counter() - t0
         sel = self.selection
-        idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+        support, handles = sel.support.copy(), [sel.handles[k].copy() for k in hidx]
         curves = ()
         if curve is not None:
             curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.curve_points),
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
-        edit = Edit(idx(sel.support), tuple(idx(sel.handles[k]) for k in hidx),
-                    tuple(Matrix(_matrix_tuple(m)) for m in mats), "$", curves,
-                    fill_holes=False,  # the editor's closed selection, replayed as is
-                    deformation=self.deformation)
-        self.manip = None
-        self.manip_target = None
+        matrices = tuple(Matrix(_matrix_tuple(m)) for m in mats)
+        mode = self.deformation
+
+        def make_edit():
+            idx = lambda m: Indices(tuple(int(i) for i in np.flatnonzero(m)))  # noqa: E731
+            return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
+                        fill_holes=False,  # the editor's closed selection, replayed as is
+                        deformation=mode)
+        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles))
+
+    def _land(self, plan, result) -> None:
+        """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the
+        document (one undo step)."""
+        new, edit = result
         self.cloud = new
         self.edits = self.edits + (edit,)
         self.fit.clear()
-        self.rig.reset_pose(len(sel.handles))
+        self.rig.reset_pose(plan.handles)
         self.rig.clear_curve()
         self.push("edit")
+
+    @property
+    def committing(self) -> bool:
+        """A commit is running in the background (document changes are refused)."""
+        return self.committer.running
+
+    def poll_commit(self) -> bool:
+        """Land a finished background commit (or restore the pose after its
+        error, :attr:`commit_outcome`); True when the state changed."""
+        from splatedit.app.commit_job import CommitOutcome
+        got = self.committer.collect()
+        if got is None:
+            return False
+        plan, new, error, seconds = got
+        if error is None:
+            self.last_commit_seconds = seconds
+            self._land(plan, new)
+        else:
+            self.rig.restore(self._rig_before_commit)
+            self.version += 1
+            self.on_change()
+        self.commit_outcome = CommitOutcome(error, seconds, len(self.edits))
         return True
+
+    def wait_commit(self, timeout: float = 120.0) -> bool:
+        """Block until a background commit lands (tests, scripted use); True when none is left."""
+        self.committer.wait(timeout)
+        self.poll_commit()
+        return not self.committing

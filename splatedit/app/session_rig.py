@@ -45,7 +45,7 @@ class RigEditing:
     def add_handle(self) -> bool:
         """Start a new handle (active; the brush then paints it).  An empty
         active handle is reused.  Raises SplatEditError over 16 columns."""
-        if self.manip is not None:
+        if self.manip is not None or self.committing:
             return False
         self.brush_target = HANDLE
         if not self.selection.handle.any():
@@ -57,7 +57,7 @@ class RigEditing:
 
     def remove_handle(self) -> bool:
         """Remove the active handle (and its pending transform)."""
-        if self.manip is not None:
+        if self.manip is not None or self.committing:
             return False
         i = self.selection.active
         several = len(self.selection.handles) > 1
@@ -72,7 +72,7 @@ class RigEditing:
 
     def select_handle(self, i: int) -> bool:
         """Make handle ``i`` (modulo the count) the active one (not an undo step)."""
-        if self.manip is not None or not self.selection.select_handle(i):
+        if self.manip is not None or self.committing or not self.selection.select_handle(i):
             return False
         self.version += 1
         self.on_change()
@@ -88,7 +88,7 @@ class RigEditing:
 
     def add_curve_point(self, point) -> bool:
         """Append a picked point (2..16 per curve; consecutive ones distinct)."""
-        if self.manip is not None:
+        if self.manip is not None or self.committing:
             return False
         p = np.array(point, dtype=np.float64).reshape(3)
         if len(self.curve_points) >= MAX_CURVE_POINTS:
@@ -107,7 +107,7 @@ class RigEditing:
 
     def remove_curve_point(self) -> bool:
         """Remove the last picked point."""
-        if self.manip is not None or not self.curve_points:
+        if self.manip is not None or self.committing or not self.curve_points:
             return False
         self.curve_points.pop()
         self.curve_moves = self.curve_moves[:-1].copy()
@@ -115,7 +115,7 @@ class RigEditing:
         return True
 
     def clear_curve(self) -> bool:
-        if self.manip is not None or not self.curve_points:
+        if self.manip is not None or self.committing or not self.curve_points:
             return False
         self.rig.clear_curve()
         self.push("clear curve")

@@ -92,6 +92,10 @@ def status_dict(ed) -> dict:
                     "position": None if ft.position is None else [round(float(x), 9) for x in ft.position]}
     st["curve_positions"] = [[round(float(x), 9) for x in q] for q in s.curve_point_positions()]
     st["idle"] = bool(ed.idle())
+    cp = ss.commit
+    #: a commit running in the background: its stage and fraction done
+    st["commit"] = None if cp is None else {"stage": cp.stage, "fraction": round(cp.fraction, 3)}
+    st["last_commit_ms"] = round(s.last_commit_seconds * 1e3, 1)
     fr = ed.frames
     pr = fr.progressive
     st["refining"] = None if pr is None else round(pr.frame.fraction, 3)

@@ -152,6 +152,8 @@ def field_target(s) -> TransformTarget:
 
 
 def _busy(s) -> str | None:
+    if s.committing:
+        return "the last edit is still being applied: wait until it lands"
     if s.manip is not None:
         return "a move is running: finish it (Enter) or cancel it (Esc) first"
     return None

@@ -28,6 +28,11 @@ import numpy as np
 from splatedit.deform.rotation_apply import apply_segments
 from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, LINEAR_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
 
+#: progress stages of a commit (:meth:`DeformationBasis.commit
+#: <splatedit.deform.basis.DeformationBasis.commit>`): the support's chunks
+#: deformed, then the deformed cloud checked
+APPLY_STAGE = "applying the edit"
+CHECK_STAGE = "checking the deformed splats"
 #: most plan rows per run-plan segment (the linear apply works through a
 #: segment in sub-chunks of :func:`apply_chunk_rows`; the detail mode in its own)
 _APPLY_CHUNK = 65536
@@ -172,7 +177,7 @@ def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:
                 segments=segments, comp_segments=comp_segments, filler=filler)
 
 
-def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
+def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None, progress=None):
     """Deformed ``(positions, u, v)`` (n, 3) float64 from the hot path ``c``.
 
     Needs the three outputs and one sub-chunk's products (index-array
@@ -184,6 +189,7 @@ def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
         d: (K, 3) float64 control-point displacements dC.
         rot, blocks: a rotating frame's rotations and handle blocks
             (:mod:`splatedit.deform.rotation_apply`), or None.
+        progress: optional ``progress(rows of the hot path done)`` after each chunk.
     """
     # splats outside the support: bitwise copies (never recomputed)
     if c["comp_segments"] is None:
@@ -194,7 +200,7 @@ def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
             for s, o in zip(srcs, outs):
                 o[dest] = s[dest]
     if rot is not None:   # rotating handles: extra GEMM columns (splatedit.deform.rotation_apply)
-        apply_segments(c["arrays"], c["segments"], outs, d, rot, blocks)
+        apply_segments(c["arrays"], c["segments"], outs, d, rot, blocks, progress=progress)
     else:
         mx = np.vstack([d, np.eye(3)])
         step = apply_chunk_rows(d.shape[0])
@@ -209,6 +215,8 @@ def apply_hot_path(c: dict, srcs, d: np.ndarray, rot=None, blocks=None):
                     rows = dest[cs - lo:ce - lo]
                     for a, o in zip(c["arrays"], outs):
                         o[rows] = a[cs:ce] @ mx
+                if progress is not None:
+                    progress(ce)
     if len(c["filler"]):  # fixed splats computed through: restore them bitwise
         for s, o in zip(srcs, outs):
             o[c["filler"]] = s[c["filler"]]

@@ -30,7 +30,7 @@ import time
 
 import numpy as np
 
-from splatedit.deform.apply_plan import apply_hot_path, build_hot_path
+from splatedit.deform.apply_plan import APPLY_STAGE, CHECK_STAGE, apply_hot_path, build_hot_path
 from splatedit.deform.constraints import Constraints, as_mask, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
@@ -50,6 +50,19 @@ PROGRESS_STAGE = "precomputing deformation basis"
 CLOSURE_STAGE = "closing the selection"
 #: support splats per chunk when evaluating the RBF for the basis and the Jacobians
 _BASIS_CHUNK = 65536
+
+
+def _wrap(cloud, arrays, validate: bool, progress=None):
+    """A copy of ``cloud`` with the deformed ``(positions, u, v)`` arrays
+    (no ``__init__``: skips the O(n) validation on the hot path), checked
+    when ``validate``."""
+    out = copy.copy(cloud)
+    out.positions, out.u, out.v = arrays
+    if validate:
+        report(progress, CHECK_STAGE, 0.0)
+        out.validate()
+        report(progress, CHECK_STAGE, 1.0)
+    return out
 
 
 class DeformationBasis:
@@ -354,10 +367,12 @@ class DeformationBasis:
         """Drop the hot-path arrays (about 24 (4h + 3) bytes per support splat)."""
         self._cpu = None
 
-    def apply_arrays(self, cloud, dC):
+    def apply_arrays(self, cloud, dC, progress=None):
         """Deformed ``(positions, u, v)`` (n, 3) float64 of ``cloud`` (the
         base cloud the basis was built on).  Splats outside the support are
-        copied bitwise; ``dC == 0`` returns bitwise copies."""
+        copied bitwise; ``dC == 0`` returns bitwise copies.  ``progress``:
+        optional ``progress(APPLY_STAGE, fraction of the support's rows done)``
+        after each chunk of the run plan (a commit in the editor's background)."""
         self._check_cloud(cloud)
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
@@ -366,24 +381,23 @@ class DeformationBasis:
             return tuple(s.copy() for s in srcs)
         c = self._cpu_arrays(cloud)
         blocks = None if rot is None else handle_blocks(self)
-        return apply_hot_path(c, srcs, d, rot, blocks)
+        report(progress, APPLY_STAGE, 0.0)
+        rows = max(len(c["arrays"][0]), 1)
+        done = None if progress is None else (lambda hi: report(progress, APPLY_STAGE, hi / rows))
+        return apply_hot_path(c, srcs, d, rot, blocks, progress=done)
 
-    def apply(self, cloud, dC, *, validate: bool = False):
+    def apply(self, cloud, dC, *, validate: bool = False, progress=None):
         """The deformed cloud (a new :class:`SplatCloud`; colours, faces and
         name shared with ``cloud``).  ``validate=True`` re-checks the splat
-        invariants (an extreme deformation can flatten splats)."""
-        p, u, v = self.apply_arrays(cloud, dC)
-        out = copy.copy(cloud)  # no __init__: skips the O(n) validation on the hot path
-        out.positions, out.u, out.v = p, u, v
-        if validate:
-            out.validate()
-        return out
+        invariants (an extreme deformation can flatten splats).  ``progress``:
+        see :meth:`apply_arrays` (then ``CHECK_STAGE`` before the check)."""
+        return _wrap(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
 
-    def commit(self, cloud, dC, *, validate: bool = True):
+    def commit(self, cloud, dC, *, validate: bool = True, progress=None):
         """Apply ``dC`` and return the deformed cloud as the new base for the
         next edit (build a new basis on it to chain edits).  Validated by
         default: a committed cloud must satisfy the model invariants."""
-        return self.apply(cloud, dC, validate=validate)
+        return self.apply(cloud, dC, validate=validate, progress=progress)
 
     def __repr__(self) -> str:
         s = self.stats

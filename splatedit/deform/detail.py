@@ -371,12 +371,13 @@ class DetailBasis:
         """Drop the hot-path arrays (about 24 (K + 3) + 80 bytes per support splat)."""
         self._cpu = None
 
-    def apply_arrays(self, cloud, dC):
+    def apply_arrays(self, cloud, dC, progress=None):
         """Deformed ``(positions, u, v)`` (n, 3) float64 of ``cloud`` (the
         original cloud of :meth:`fit`); splats outside the support are copied
         bitwise, ``dC == 0`` returns bitwise copies.  Three GEMMs per frame in
         the run-plan layout of the linear basis plus element-wise work on
-        cache-sized chunks (:mod:`splatedit.deform.detail_apply`)."""
+        cache-sized chunks (:mod:`splatedit.deform.detail_apply`).  ``progress``:
+        see :meth:`DeformationBasis.apply_arrays`."""
         bb = self.base_basis
         bb._check_cloud(cloud)
         d, rot = split_displacement(dC)
@@ -384,7 +385,8 @@ class DetailBasis:
         srcs = (cloud.positions, cloud.u, cloud.v)
         if not d.any() and rot is None:
             return tuple(x.copy() for x in srcs)
-        return self._hot_path(len(cloud.positions)).apply(srcs, d, rot, self.frames is FrameMode.RIGID)
+        return self._hot_path(len(cloud.positions)).apply(srcs, d, rot, self.frames is FrameMode.RIGID,
+                                                          progress=progress)
 
     def distortion(self, cloud, dC, **kw):
         """:class:`DistortionStats` of the support splats' axes under ``dC``
@@ -393,18 +395,14 @@ class DetailBasis:
         idx = self.indices
         return distortion_from_axes(cloud.u[idx], cloud.v[idx], u[idx], v[idx], **kw)
 
-    def apply(self, cloud, dC, *, validate: bool = False):
+    def apply(self, cloud, dC, *, validate: bool = False, progress=None):
         """The deformed cloud (see :meth:`DeformationBasis.apply`)."""
-        p, u, v = self.apply_arrays(cloud, dC)
-        out = copy.copy(cloud)
-        out.positions, out.u, out.v = p, u, v
-        if validate:
-            out.validate()
-        return out
+        from splatedit.deform.basis import _wrap
+        return _wrap(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
 
-    def commit(self, cloud, dC, *, validate: bool = True):
+    def commit(self, cloud, dC, *, validate: bool = True, progress=None):
         """Apply ``dC`` and return the validated deformed cloud."""
-        return self.apply(cloud, dC, validate=validate)
+        return self.apply(cloud, dC, validate=validate, progress=progress)
 
     def __repr__(self) -> str:
         return (f"DetailBasis({self.base_basis!r}, sigma={self.layer.scale:.3g}, "

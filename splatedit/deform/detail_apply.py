@@ -31,9 +31,10 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.apply_plan import _fill_small_gaps, _run_plan
+from splatedit.deform.apply_plan import APPLY_STAGE, _fill_small_gaps, _run_plan
 from splatedit.deform.rotation import arc_coefficients, handle_blocks
 from splatedit.deform.rotation_apply import _skew
+from splatedit.progress import report
 from splatedit.tolerances import DETAIL_APPLY_CHUNK
 
 
@@ -107,10 +108,12 @@ class DetailHotPath:
             x[cols, 6 + 6 * i:9 + 6 * i] = r.offsets @ (km @ km).T
         return np.ascontiguousarray(x.T), [(h, rot.rotations[h].angle) for h in turning]
 
-    def apply(self, srcs, d: np.ndarray, rot, rigid: bool):
+    def apply(self, srcs, d: np.ndarray, rot, rigid: bool, progress=None):
         """Deformed ``(positions, u, v)`` (n, 3) float64 from the cloud's
         ``srcs`` = (positions, u, v), the residual dC ``d`` (K, 3) and the
-        RotationDisplacement ``rot`` (or None); ``rigid``: FrameMode.RIGID."""
+        RotationDisplacement ``rot`` (or None); ``rigid``: FrameMode.RIGID.
+        ``progress``: optional ``progress(APPLY_STAGE, fraction of rows done)``
+        after each chunk."""
         if self.comp_segments is None:
             outs = tuple(s.copy() for s in srcs)
         else:
@@ -121,6 +124,7 @@ class DetailHotPath:
         xt, turning = self._frame_matrix(d, rot)
         a0, a1, a2 = self.arrays
         step = DETAIL_APPLY_CHUNK
+        total = max(1, a0.shape[1])
         for lo, hi, dest in self.segments:
             for cs in range(lo, hi, step):
                 ce = min(hi, cs + step)
@@ -147,6 +151,7 @@ class DetailHotPath:
                     rows = dest[cs - lo:ce - lo]
                 for o, r in zip(outs, (p, u, v)):
                     o[rows] = r.T
+                report(progress, APPLY_STAGE, ce / total)
         if len(self.filler):            # fixed splats computed through: restore them bitwise
             for s, o in zip(srcs, outs):
                 o[self.filler] = s[self.filler]

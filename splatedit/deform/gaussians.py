@@ -31,6 +31,11 @@ import numpy as np
 from splatedit.errors import InputError
 from splatedit.model.gaussians import GaussianCloud, GaussianKind
 from splatedit.model.spherical_harmonics import rotate_sh
+from splatedit.progress import report
+from splatedit.tolerances import GAUSSIAN_COMMIT_CHUNK
+
+#: progress stage of :func:`deform_gaussians` (an editor commit of a 3DGS document)
+GAUSSIAN_STAGE = "deforming the Gaussians"
 
 _PERMS3 = np.array(list(itertools.permutations(range(3))))
 _PERMS2 = np.array(list(itertools.permutations(range(2))))
@@ -120,7 +125,8 @@ def decompose_factor(m: np.ndarray):
     return scales, rot
 
 
-def deform_gaussians(scene: GaussianCloud, indices, displacements, jacobians) -> GaussianCloud:
+def deform_gaussians(scene: GaussianCloud, indices, displacements, jacobians, *,
+                     progress=None) -> GaussianCloud:
     """Apply a deformation given at some Gaussians.
 
     Args:
@@ -129,6 +135,9 @@ def deform_gaussians(scene: GaussianCloud, indices, displacements, jacobians) ->
             copied bit for bit).
         displacements: (N, 3) float64 centre displacements (model units).
         jacobians: (N, 3, 3) float64 Jacobians of the deformation at the centres.
+        progress: optional ``progress(GAUSSIAN_STAGE, fraction of the N done)``,
+            reported after each chunk of ``GAUSSIAN_COMMIT_CHUNK`` Gaussians
+            (the result does not depend on the chunking).
     Returns:
         a new GaussianCloud: positions float64, log scales, unit quaternions
         (in the hemisphere of the old ones) and SH coefficients float32;
@@ -139,6 +148,25 @@ def deform_gaussians(scene: GaussianCloud, indices, displacements, jacobians) ->
     idx = np.asarray(indices, dtype=np.intp)
     disp = np.asarray(displacements, dtype=np.float64)
     jac = np.asarray(jacobians, dtype=np.float64)
+    positions = scene.positions.copy()
+    positions[idx] = scene.positions[idx] + disp
+    log_scales = scene.log_scales.copy()
+    rotations = scene.rotations.copy()
+    sh = scene.sh
+    if sh.shape[1] > 1 and len(idx):
+        sh = sh.copy()
+    report(progress, GAUSSIAN_STAGE, 0.0)
+    for lo in range(0, len(idx), GAUSSIAN_COMMIT_CHUNK):
+        hi = min(len(idx), lo + GAUSSIAN_COMMIT_CHUNK)
+        _deform_chunk(scene, idx[lo:hi], jac[lo:hi], log_scales, rotations, sh)
+        report(progress, GAUSSIAN_STAGE, hi / len(idx))
+    return scene.replace(positions=positions, log_scales=log_scales, rotations=rotations, sh=sh)
+
+
+def _deform_chunk(scene: GaussianCloud, idx: np.ndarray, jac: np.ndarray, log_scales, rotations, sh) -> None:
+    """Write the new log scales, rotations and (when ``sh`` is not
+    ``scene.sh``) rotated SH coefficients of the Gaussians ``idx`` (with
+    Jacobians ``jac``) into the output arrays."""
     k = 2 if scene.kind == GaussianKind.GS2D else 3
     r_old = scene.rotation_matrices(idx)
     s_old = np.exp(scene.log_scales[idx].astype(np.float64))
@@ -153,26 +181,20 @@ def deform_gaussians(scene: GaussianCloud, indices, displacements, jacobians) ->
     q = quaternions_from_matrices(rot)
     q_old = scene.unit_rotations(idx)
     q *= np.where((q * q_old).sum(axis=1) < 0, -1.0, 1.0)[:, None]
-    positions = scene.positions.copy()
-    positions[idx] = scene.positions[idx] + disp
-    log_scales = scene.log_scales.copy()
     log_scales[idx] = np.log(scales).astype(np.float32)
-    rotations = scene.rotations.copy()
     rotations[idx] = q.astype(np.float32)
-    sh = scene.sh
-    if sh.shape[1] > 1 and len(idx):
-        sh = sh.copy()
+    if sh is not scene.sh:
         sh[idx] = rotate_sh(sh[idx], polar_rotation(jac)).astype(np.float32)
-    return scene.replace(positions=positions, log_scales=log_scales, rotations=rotations, sh=sh)
 
 
-def deform_with_evaluator(scene: GaussianCloud, evaluator, dC) -> GaussianCloud:
+def deform_with_evaluator(scene: GaussianCloud, evaluator, dC, *, progress=None) -> GaussianCloud:
     """:func:`deform_gaussians` with any evaluator that has ``indices`` (N,),
     ``displacements(dC)`` (N, 3) and ``jacobians(dC)`` (N, 3, 3), such as a
     :class:`~splatedit.deform.basis.DeformationBasis` fitted on
-    ``scene.proxy_splats()``."""
+    ``scene.proxy_splats()``.  ``progress``: see :func:`deform_gaussians`."""
+    report(progress, GAUSSIAN_STAGE, 0.0)
     return deform_gaussians(scene, evaluator.indices, evaluator.displacements(dC),
-                            evaluator.jacobians(dC))
+                            evaluator.jacobians(dC), progress=progress)
 
 
 def transform_gaussians(scene: GaussianCloud, matrix) -> GaussianCloud:

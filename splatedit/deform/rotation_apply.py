@@ -168,7 +168,7 @@ def chunk_rows(n_out: int, n_in: int) -> int:
     return int(max(ROTATION_APPLY_MIN_CHUNK, min(ROTATION_APPLY_CHUNK, fit)))
 
 
-def apply_segments(arrays, segments, outs, d: np.ndarray, rot, blocks) -> None:
+def apply_segments(arrays, segments, outs, d: np.ndarray, rot, blocks, progress=None) -> None:
     """Write the deformed support splats of a rotating frame into ``outs``.
 
     Args:
@@ -179,6 +179,7 @@ def apply_segments(arrays, segments, outs, d: np.ndarray, rot, blocks) -> None:
         outs: (positions, u, v) (n, 3) float64 output arrays.
         d: (K, 3) float64 residual dC; rot: the RotationDisplacement;
         blocks: per handle the slice of its 4 columns.
+        progress: optional ``progress(rows done)`` after each chunk.
     """
     xt, angles = frame_matrix(d, rot, blocks)
     step = chunk_rows(*xt.shape)
@@ -196,3 +197,5 @@ def apply_segments(arrays, segments, outs, d: np.ndarray, rot, blocks) -> None:
                 rows = dest[cs - lo:ce - lo]
                 for o, r in zip(outs, (o0, o1, o2)):
                     o[rows] = r[:3].T
+            if progress is not None:
+                progress(ce)

@@ -317,10 +317,28 @@ class GizmoTool(Tool):
             return
         try:
             if action(s):
-                ed.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
+                if s.committing:
+                    ed.say(f"applying edit {len(s.edits) + 1} in the background (the view stays live; "
+                           "editing waits until it lands)")
+                else:
+                    ed.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
         except SplatEditError as exc:
             s.cancel()
             ed.say(f"edit not applied: {exc}")
+        ed.motion()
+
+    def report_commit(self) -> None:
+        """Show how a background commit ended (once): a message, or the
+        error box when a splat degenerated (the document is unchanged)."""
+        s, ed = self.session, self.ed
+        out = s.commit_outcome
+        if out is None:
+            return
+        s.commit_outcome = None
+        if out.error is None:
+            ed.say(f"edit {out.edits} applied in {out.seconds:.1f} s")
+        else:
+            ed.show_error(f"edit not applied: {out.error}")
         ed.motion()
 
     # ------------------------------------------------------------- drawing
