@@ -168,6 +168,15 @@ class FitSolution:
     info: _FitInfo
 
 
+class SingularSystemError(SolverError):
+    """The exact LU system cannot be solved; ``reason`` says how it is singular
+    (``method="auto"`` then falls back to the incremental QR)."""
+
+    def __init__(self, reason: str, advice: str):
+        super().__init__(f"the exact RBF system is {reason}; {advice}")
+        self.reason = reason
+
+
 def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
                       max_centers: Optional[int] = None,
                       progress: Optional[ProgressFn] = None) -> FitSolution:
@@ -240,7 +249,17 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
 
     report(progress, PROGRESS_STAGE, 0.0)
     if used == "lu":
-        w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, use_poly)
+        try:
+            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, use_poly)
+        except SingularSystemError as exc:
+            if method != "auto":
+                raise
+            # dense scans give near-duplicate constraint points (further apart
+            # than the duplicate merge radius, yet nearly equal rows): the
+            # least-squares QR picks well-separated centres and still fits them
+            used = "iqr"
+            head.append(f"auto: incremental QR since the exact system is {exc.reason}")
+    if used == "lu":
         history = None
         head.append(f"lu: exact solve with all {m} constraints as centers, "
                     f"rcond {rcond:.1e}")
@@ -290,14 +309,12 @@ def _fit_lu(pts_n, vals, use_poly):
     anorm = float(np.max(np.sum(np.abs(a), axis=0)))
     lu, piv, info = lapack.dgetrf(a, overwrite_a=0)
     if info > 0:
-        raise SolverError(
-            f"the exact RBF system is singular (zero pivot at {info - 1}); "
-            "use method='iqr' or remove degenerate constraints")
+        raise SingularSystemError(f"singular (zero pivot at {info - 1})",
+                                  "use method='iqr' or remove degenerate constraints")
     rcond, _ = lapack.dgecon(lu, anorm, norm="1")
     if not rcond >= LU_MIN_RCOND:
-        raise SolverError(
-            f"the exact RBF system is numerically singular (rcond {rcond:.1e} < "
-            f"{LU_MIN_RCOND:g}); use method='iqr' or remove near-duplicate constraints")
+        raise SingularSystemError(f"numerically singular (rcond {rcond:.1e} < {LU_MIN_RCOND:g})",
+                                  "use method='iqr' or remove near-duplicate constraints")
     x, info = lapack.dgetrs(lu, piv, rhs)
     res = np.linalg.norm(a @ x - rhs, axis=0)
     residuals = _relative_residuals(res, vals)

@@ -235,6 +235,23 @@ def test_residual_exposes_near_duplicate_points_with_different_values(gap):
         TriharmonicRBF.fit(pts, vals, method="lu")
 
 
+def test_auto_method_falls_back_to_qr_when_the_exact_system_is_singular():
+    """A dense scan's near-duplicate constraint points make the exact system
+    numerically singular (a 1M-splat resampled bunny: rcond 8e-17); "auto"
+    (the editor's and the scripts' default) must still fit, by the QR."""
+    pts = _cloud(300, seed=4)
+    vals = _smooth_values(pts)
+    diag = np.linalg.norm(np.ptp(pts, axis=0))
+    pts = np.vstack([pts, pts[5] + 1e-9 * diag * np.array([0.6, 0.8, 0.0])])
+    vals = np.vstack([vals, vals[5]])
+    with pytest.raises(SolverError, match="numerically singular"):
+        TriharmonicRBF.fit(pts, vals, method="lu")
+    f = TriharmonicRBF.fit(pts, vals, method="auto")
+    assert f.method == "iqr"
+    assert "auto: incremental QR since the exact system is numerically singular" in f.message
+    assert f.residual < 1e-3
+
+
 def test_residual_counts_merged_duplicates_and_every_column():
     pts = _cloud(200, seed=5)
     vals = _smooth_values(pts)
