@@ -10,8 +10,6 @@ import numpy as np
 
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
-# shared with the splat renderer; the packers stay importable from here
-from splatedit.render.gpu_units import pack_basis_rows, pack_deform_block, selection_flags  # noqa: F401
 from splatedit.render.targets import RenderTarget, SizedTargets
 from splatedit.render.uniforms import GS_FRAME_UBO, GS_GEOM, GS_REC
 

@@ -51,7 +51,8 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import _RP_DEPTH, Renderer, _rp_attr
+from splatedit.render.renderer import Renderer
+from splatedit.render.splat_layout import _RP_DEPTH, _rp_attr
 from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP, RP_PICK
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
 

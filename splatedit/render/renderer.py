@@ -33,14 +33,10 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
-from splatedit.render.gpu_units import unit_scale as _unit_scale  # noqa: F401 - importable from here
 from splatedit.render.prepass import PrepassMixin
-# the splat layout, importable from here as before the split (progressive.py, tests)
-from splatedit.render.splat_layout import FLAG_DEFORMED, FLAG_HANDLE, FLAG_INACTIVE, FLAG_SUPPORT  # noqa: F401
 from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
                                            _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
-from splatedit.render.targets import rp_resolve as _rp_resolve  # noqa: F401 - importable from here
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
