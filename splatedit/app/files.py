@@ -242,8 +242,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
         ed.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
     r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
     ed.cam.scene_radius = max(r, 1e-9)
-    ed.camera.detect_up(cloud, ed.path)
-    ed.camera.frame_all()
+    ed.camera.fresh_view(cloud, ed.path)
     ed.window.set_title(f"splatedit - {ed.cloud_name}")
     if ed.use_lod and scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):

@@ -226,3 +226,26 @@ def test_a_typed_path_that_matches_no_entry_is_opened_as_typed(ed, models):
         ed.on_char(types.SimpleNamespace(char=ch))
     key(ed, glfw.KEY_KP_ENTER)
     assert "load" not in ed.jobs and "no such file" in ed.error_box
+
+
+def test_a_newly_opened_model_gets_a_fresh_default_view_for_its_own_up_axis(ed, models):
+    """The old model's orbit angle (yaw 0.6, pitch 0.5 here) is not inherited:
+    a Z-up LAS opens at the first-open view about Z (yaw = pitch = 0), framed."""
+    from splatedit.io import read
+    las = models / "plane.las"
+    cloud = read(str(models / "b_plane.ply"))
+    # the plane is z = const: as a LAS (Z-up by format) it is a ground plane
+    write(str(las), cloud)
+    ed.cam.screen_offset = (0.3, -0.2)
+    ed.open_path(las)
+    ed.settle()
+    assert ed.path == las and ed.camera.up.label.endswith("Z")
+    cam = ed.cam
+    assert cam.yaw == 0.0 and cam.pitch == 0.0
+    assert np.allclose(cam.up_axis, [0, 0, 1])
+    # framed: the model's centre is on screen in the framed area and the camera looks along the ground
+    lo, hi = ed.session.cloud.bounds()
+    _, _, back = cam.basis()
+    assert abs(back @ [0, 0, 1]) < 1e-9
+    px, depth = cam.project((lo + hi) / 2, W, H)
+    assert depth[0] > 0 and 0 < px[0, 0] < W and 0 < px[0, 1] < H
