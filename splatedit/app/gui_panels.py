@@ -86,6 +86,7 @@ class EditorGui:
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
         self._menu_open = False
+        self._close_menus = False          # Esc was pressed with a menu open
         self._press_in_gui = False
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
 
@@ -104,6 +105,13 @@ class EditorGui:
         self.gui.feed(ev)
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
         kind = ev.kind
+        if kind == "key" and self._menu_open and ev.key == self.ed.g.KEY_ESCAPE:
+            # Esc closes an open menu (ImGui does not without keyboard navigation, and
+            # the menu would then swallow the next click: the first stroke did nothing);
+            # the key is the menu's, it cancels nothing else
+            if ev.action == 1:
+                self._close_menus, self._menu_open = True, False
+            return True
         if kind in ("key", "char"):
             return self.wants_keyboard
         if kind == "button":
@@ -143,6 +151,11 @@ class EditorGui:
         return self._press_in_gui or self.owns_point(mx, my)
 
     @property
+    def menu_open(self) -> bool:
+        """A menu of the menu bar was open in the last frame."""
+        return self._menu_open
+
+    @property
     def wants_keyboard(self) -> bool:
         """A text field is being edited (``io.want_text_input``): keys and
         characters are ImGui's.  ImGui's broader ``want_capture_keyboard`` also
@@ -162,6 +175,9 @@ class EditorGui:
         self.rects = {}
         self.windows = []
         self._menu_open = False
+        if self._close_menus:
+            imgui.internal.close_popups_except_modals()
+            self._close_menus = False
         gui_overlay.draw_tools(self.ed, w, h)
         self._menu_bar(w)
         help_full = self.ed.help.shown and self._help_area(w, h)[1]
@@ -213,6 +229,7 @@ class EditorGui:
             if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
                 ed.run_action(Action.REDO)
             imgui.end_menu()
+        self._rect("menu_edit")
         if imgui.begin_menu("View"):
             self._menu_open = True
             if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
