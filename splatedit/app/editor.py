@@ -110,7 +110,7 @@ class Editor(EventRouting, FileActions):
         self.confirm_quit = False
         self.confirm_open: Path | None = None   # open this model without saving?
         self.prompt: str | None = None      # save-as path being typed
-        self.prompt_fresh = False            # the first key replaces the proposed path
+        self.prompt_selected = False         # Ctrl+A selected the whole path (typing replaces it)
         # pointer
         self.drag = DragMode.NONE
         self.drag_tool = None

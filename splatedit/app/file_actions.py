@@ -49,18 +49,33 @@ class FileActions:
         files.poll_jobs(self)
 
     # ------------------------------------------------------- save-as prompt
-    def prompt_key(self, k: int) -> None:
-        """A key while the save-as path is typed: Enter saves, Esc cancels."""
+    def prompt_key(self, k: int, mods: int = 0) -> None:
+        """A key while the save-as path is typed: Enter saves, Esc cancels,
+        Backspace deletes the last character (the whole text once Ctrl+A
+        selected it), Ctrl+A selects all (typing then replaces it),
+        Ctrl+Backspace / Ctrl+U clear the path."""
         g = self.g
+        ctrl = bool(mods & g.MOD_CONTROL)
         if k in (g.KEY_ENTER, g.KEY_KP_ENTER):
             path, self.prompt = self.prompt.strip(), None
             if path:
                 self.save(Path(path).expanduser())
         elif k == g.KEY_ESCAPE:
             self.prompt = None
+        elif ctrl and k == g.KEY_A:
+            self.prompt_selected = bool(self.prompt)
+            return
+        elif (ctrl and k in (g.KEY_BACKSPACE, g.KEY_U)) or (k == g.KEY_BACKSPACE and self.prompt_selected):
+            self.prompt = ""
         elif k == g.KEY_BACKSPACE:
-            self.prompt = "" if self.prompt_fresh else self.prompt[:-1]
-            self.prompt_fresh = False
+            self.prompt = self.prompt[:-1]
+        self.prompt_selected = False
+
+    def prompt_char(self, char: str) -> None:
+        """A typed character: appended to the path (replaces it when selected)."""
+        if char.isprintable():
+            self.prompt = char if self.prompt_selected else self.prompt + char
+            self.prompt_selected = False
 
     # ------------------------------------------------------------- saving
     def save_target(self) -> Path:
@@ -75,7 +90,7 @@ class FileActions:
 
     def ask_save_as(self) -> None:
         self.prompt = str(self.save_target())
-        self.prompt_fresh = True
+        self.prompt_selected = False
 
     def export_script(self) -> None:
         files.export_script(self, self.save_target())

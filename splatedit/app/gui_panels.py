@@ -473,14 +473,13 @@ class EditorGui:
 
     def _question(self, w: int, h: int) -> None:
         ed = self.ed
-        from splatedit.app.panel import open_question
+        from splatedit.app.panel import open_question, save_prompt_lines
         if ed.confirm_open is not None:
             lines = open_question(ed)
         elif ed.confirm_quit:
             lines = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing", "(Ctrl+S saves)")
         elif ed.prompt is not None:
-            lines = ("Save as (type a path; Enter: save, Esc: cancel):",
-                     ed.prompt + ("" if ed.prompt_fresh else "_"))
+            lines = save_prompt_lines(ed)
         else:
             return
         imgui.set_next_window_pos(imgui.ImVec2(w / 2, h / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))

@@ -298,7 +298,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.FILE, "", "", Action.REDO, ("ctrl+shift+z", "ctrl+y")),
     Binding(S.FILE, "Ctrl+S", "save <name>-edited.ply (+ <name>-edited.edits.json edit script)", Action.SAVE,
             ("ctrl+s",)),
-    Binding(S.FILE, "Ctrl+Shift+S", "save as: type a path, Enter", Action.SAVE_AS, ("ctrl+shift+s",)),
+    Binding(S.FILE, "Ctrl+Shift+S", "save as: edit the proposed path (Backspace deletes a character;\n"
+            "Ctrl+A selects all, Ctrl+U or Ctrl+Backspace clears), Enter saves, Esc cancels", Action.SAVE_AS, ("ctrl+shift+s",)),
     Binding(S.FILE, "Ctrl+E", "export only the edit script", Action.EXPORT_SCRIPT, ("ctrl+e",)),
     Binding(S.FILE, "Ctrl+O", "open another model in this window: the file browser (below); asks first when\n"
             "there are unsaved changes (Y opens without saving, N or Esc stays)", Action.OPEN, ("ctrl+o",), C.ANY),

@@ -216,6 +216,14 @@ def open_question(ed) -> tuple | None:
             "(Ctrl+S saves)")
 
 
+def save_prompt_lines(ed) -> tuple:
+    """The save-as prompt's rows: title, the path being typed (a ``_`` cursor
+    at its end; in ``[ ]`` when Ctrl+A selected all of it), the keys' hint."""
+    text = f"[{ed.prompt}]  (selected: typing replaces it)" if ed.prompt_selected else ed.prompt + "_"
+    return ("Save as (edit the path; Enter: save, Esc: cancel):", text,
+            "Backspace deletes a character; Ctrl+A selects all; Ctrl+U or Ctrl+Backspace clears")
+
+
 def error_box(ed, w: int, h: int, y: int) -> list:
     """The error box (a load / save error) at the top centre below ``y``,
     shown until dismissed; records its rectangle in ``ed.error_rect``."""
@@ -272,8 +280,7 @@ def compose_overlay(ed, w: int, h: int) -> list:
         center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
                       "(Ctrl+S saves)")
     elif ed.prompt is not None:
-        center_msg = ("Save as (type a path; Enter: save, Esc: cancel):",
-                      ed.prompt + ("" if ed.prompt_fresh else "_"))
+        center_msg = save_prompt_lines(ed)
     if center_msg:
         img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
         patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))

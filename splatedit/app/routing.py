@@ -56,9 +56,8 @@ class EventRouting:
         if self.browser.shown and self.prompt is None and self.confirm_open is None:
             self.browser.type_char(e.char)
             return
-        if self.prompt is not None and e.char.isprintable():
-            self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
-            self.prompt_fresh = False
+        if self.prompt is not None:
+            self.prompt_char(e.char)
 
     def on_scroll(self, e) -> None:
         if self.browser.shown:
@@ -131,7 +130,7 @@ class EventRouting:
         k = e.key
         ctrl, shift = bool(e.mods & g.MOD_CONTROL), bool(e.mods & g.MOD_SHIFT)
         if self.prompt is not None:
-            self.prompt_key(k)
+            self.prompt_key(k, e.mods)
             return
         if self.confirm_quit:
             if k in (g.KEY_Y, g.KEY_Q):

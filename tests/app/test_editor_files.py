@@ -249,3 +249,42 @@ def test_a_newly_opened_model_gets_a_fresh_default_view_for_its_own_up_axis(ed, 
     assert abs(back @ [0, 0, 1]) < 1e-9
     px, depth = cam.project((lo + hi) / 2, W, H)
     assert depth[0] > 0 and 0 < px[0, 0] < W and 0 < px[0, 1] < H
+
+
+def _chars(ed, text):
+    for ch in text:
+        ed.on_char(types.SimpleNamespace(char=ch))
+
+
+def test_save_as_prompt_backspace_deletes_one_character_and_typing_appends(ed, models, tmp_path):
+    """The proposed path is edited, not replaced: Backspace x3 and "las" turn
+    the suggested .ply into .las; Ctrl+A selects all (typing replaces it,
+    Backspace clears it); Ctrl+U and Ctrl+Backspace clear; Esc cancels."""
+    from splatedit.app.panel import save_prompt_lines
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
+    proposed = ed.prompt
+    assert proposed == str(models / "a_plane-edited.ply")
+    key(ed, glfw.KEY_BACKSPACE)
+    assert ed.prompt == proposed[:-1]
+    key(ed, glfw.KEY_BACKSPACE)
+    key(ed, glfw.KEY_BACKSPACE)
+    _chars(ed, "las")
+    assert ed.prompt == str(models / "a_plane-edited.las")
+    rows = save_prompt_lines(ed)
+    assert rows[1] == ed.prompt + "_" and "Ctrl+A" in rows[2] and "Ctrl+U" in rows[2]
+    key(ed, glfw.KEY_A, glfw.MOD_CONTROL)                   # select all: typing replaces
+    assert ed.prompt_selected and ed.prompt in save_prompt_lines(ed)[1]
+    _chars(ed, "/tmp/x.ply")
+    assert ed.prompt == "/tmp/x.ply" and not ed.prompt_selected
+    key(ed, glfw.KEY_A, glfw.MOD_CONTROL)                   # select all, Backspace clears
+    key(ed, glfw.KEY_BACKSPACE)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_U, glfw.MOD_CONTROL)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_BACKSPACE, glfw.MOD_CONTROL)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_ESCAPE)
+    assert ed.prompt is None and "save" not in ed.jobs
