@@ -14,6 +14,7 @@ from __future__ import annotations
 from pathlib import Path
 
 from splatedit.app import files
+from splatedit.errors import SplatEditError
 
 
 class FileActions:
@@ -41,9 +42,23 @@ class FileActions:
         with unsaved changes unless ``confirmed``); True when loading started."""
         return files.open_path(self, path, confirmed=confirmed)
 
+    def answer_open(self, yes: bool) -> None:
+        """The answer to "open without saving?" (Y / N keys, the question's buttons)."""
+        files.answer_open(self, yes)
+
     def recent_files(self) -> list[Path]:
         """The recent models, most recent first (missing files dropped)."""
         return [] if self.recent is None else self.recent.files()
+
+    def clear_recent(self) -> None:
+        """Forget the recent files (File > Open recent > Clear recent files)."""
+        if self.recent is None:
+            return
+        try:
+            self.recent.clear()
+            self.say("recent files cleared")
+        except SplatEditError as exc:
+            self.say(f"recent files not cleared: {exc}")
 
     def poll_jobs(self) -> None:
         files.poll_jobs(self)
@@ -64,12 +79,14 @@ class FileActions:
             self.prompt = None
         elif ctrl and k == g.KEY_A:
             self.prompt_selected = bool(self.prompt)
-            return
         elif (ctrl and k in (g.KEY_BACKSPACE, g.KEY_U)) or (k == g.KEY_BACKSPACE and self.prompt_selected):
-            self.prompt = ""
+            self.prompt, self.prompt_selected = "", False
         elif k == g.KEY_BACKSPACE:
             self.prompt = self.prompt[:-1]
-        self.prompt_selected = False
+        elif k in (g.KEY_LEFT, g.KEY_RIGHT, g.KEY_HOME, g.KEY_END):
+            self.prompt_selected = False       # no cursor movement: the selection ends
+        # other keys (a character's own key press, modifiers) leave the selection: the
+        # character event that follows replaces the selected path
 
     def prompt_char(self, char: str) -> None:
         """A typed character: appended to the path (replaces it when selected)."""
@@ -94,6 +111,14 @@ class FileActions:
 
     def export_script(self) -> None:
         files.export_script(self, self.save_target())
+
+    def answer_quit(self, yes: bool) -> None:
+        """The answer to "quit without saving?": yes quits, no stays."""
+        if yes:
+            self.running = False
+        else:
+            self.confirm_quit = False
+            self.say("quit cancelled")
 
     def request_quit(self) -> None:
         s = self.session

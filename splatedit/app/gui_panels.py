@@ -34,7 +34,7 @@ from typing import Callable
 
 from imgui_bundle import imgui
 
-from splatedit.app import gui_help, gui_overlay
+from splatedit.app import gui_help, gui_overlay, gui_questions
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
@@ -56,11 +56,16 @@ MESSAGE_SECONDS = 8.0
 @dataclass
 class MenuEntry:
     """One File-menu item: ``label``, the callback, a shortcut text shown at the
-    right, and an optional predicate that enables it (default: always)."""
+    right, and an optional predicate that enables it (default: always).  With
+    ``submenu`` (a function giving its entries when it opens) the item is a
+    submenu and ``action`` is unused; ``name`` records the item's rectangle
+    (``gui_rects`` in the status file)."""
     label: str
-    action: Callable[[], None]
+    action: Callable[[], None] | None
     shortcut: str = ""
     enabled: Callable[[], bool] | None = None
+    submenu: Callable[[], list] | None = None
+    name: str = ""
 
 
 class EditorGui:
@@ -72,6 +77,8 @@ class EditorGui:
         has = lambda: ed.session is not None  # noqa: E731
         #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
         self.file_menu: list[MenuEntry] = [
+            MenuEntry("Open...", lambda: ed.run_action(Action.OPEN), "Ctrl+O", name="menu_open"),
+            MenuEntry("Open recent", None, submenu=self._recent_menu, name="menu_recent"),
             MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
             MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
             MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
@@ -215,10 +222,7 @@ class EditorGui:
         self.windows.append(Box(0, 0, w, int(self.menu_height)))
         if imgui.begin_menu("File"):
             self._menu_open = True
-            for e in self.file_menu:
-                ok = e.enabled() if e.enabled is not None else True
-                if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
-                    e.action()
+            self._menu_entries(self.file_menu)
             imgui.end_menu()
         self._rect("menu_file")
         s = ed.session
@@ -240,6 +244,34 @@ class EditorGui:
                 ed.run_action(Action.FRAME_ALL)
             imgui.end_menu()
         imgui.end_main_menu_bar()
+
+    def _menu_entries(self, entries: list[MenuEntry]) -> None:
+        for e in entries:
+            ok = e.enabled() if e.enabled is not None else True
+            if e.submenu is not None:
+                opened = imgui.begin_menu(e.label, ok)
+                if opened:
+                    self._menu_entries(e.submenu())
+                    imgui.end_menu()
+                if e.name:
+                    self._rect(e.name)
+                continue
+            if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
+                e.action()
+            if e.name:
+                self._rect(e.name)
+
+    def _recent_menu(self) -> list[MenuEntry]:
+        """File > Open recent: the recent models (opened like Ctrl+O's pick, the
+        unsaved-changes question included), then "Clear recent files"."""
+        from splatedit.app.recent import menu_labels
+        ed = self.ed
+        paths = ed.recent_files()
+        if not paths:
+            return [MenuEntry("(no recent files)", lambda: None, enabled=lambda: False, name="recent_none")]
+        rows = [MenuEntry(label, lambda p=p: ed.open_path(p), name=f"recent_{i}")
+                for i, (label, p) in enumerate(zip(menu_labels(paths), paths))]
+        return rows + [MenuEntry("Clear recent files", ed.clear_recent, name="recent_clear")]
 
     # --------------------------------------------------------------- panel
     def _place_panel(self, w: int, h: int) -> tuple[float, float]:
@@ -472,21 +504,4 @@ class EditorGui:
         imgui.end()
 
     def _question(self, w: int, h: int) -> None:
-        ed = self.ed
-        from splatedit.app.panel import open_question, save_prompt_lines
-        if ed.confirm_open is not None:
-            lines = open_question(ed)
-        elif ed.confirm_quit:
-            lines = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing", "(Ctrl+S saves)")
-        elif ed.prompt is not None:
-            lines = save_prompt_lines(ed)
-        else:
-            return
-        imgui.set_next_window_pos(imgui.ImVec2(w / 2, h / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
-        imgui.set_next_window_bg_alpha(0.95)
-        imgui.begin("##question", None, imgui.WindowFlags_.no_decoration.value
-                    | imgui.WindowFlags_.always_auto_resize.value | imgui.WindowFlags_.no_inputs.value)
-        imgui.text_colored(YELLOW, lines[0])
-        for t in lines[1:]:
-            imgui.text(t)
-        imgui.end()
+        gui_questions.draw_question(self, w, h)

@@ -132,15 +132,11 @@ class EventRouting:
         if self.prompt is not None:
             self.prompt_key(k, e.mods)
             return
-        if self.confirm_quit:
-            if k in (g.KEY_Y, g.KEY_Q):
-                self.running = False
-            else:                      # N, Esc or anything else: stay
-                self.confirm_quit = False
-                self.say("quit cancelled")
+        if self.confirm_quit:              # N, Esc or anything else: stay
+            self.answer_quit(k in (g.KEY_Y, g.KEY_Q))
             return
         if self.confirm_open is not None:
-            files.answer_open(self, k == g.KEY_Y)
+            self.answer_open(k == g.KEY_Y)
             return
         if self.browser.shown:
             action = lookup(k, ctrl, shift, [Context.BROWSER])

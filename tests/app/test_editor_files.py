@@ -252,7 +252,10 @@ def test_a_newly_opened_model_gets_a_fresh_default_view_for_its_own_up_axis(ed, 
 
 
 def _chars(ed, text):
+    """Type ``text`` as a window does: each character's key press, then its character event."""
     for ch in text:
+        code = getattr(glfw, f"KEY_{ch.upper()}", glfw.KEY_SLASH if ch == "/" else glfw.KEY_PERIOD)
+        key(ed, code)
         ed.on_char(types.SimpleNamespace(char=ch))
 
 

@@ -1,10 +1,15 @@
-"""The menu bar in the real window (Xvfb + xdotool): a menu closed with Esc
-hands the next stroke to the brush (the first stroke paints)."""
+"""The menu bar and the questions in the real window (Xvfb + xdotool): a
+menu closed with Esc hands the next stroke to the brush (the first stroke
+paints); File > Open recent opens a model through the same path as Ctrl+O
+(the unsaved-changes question first), File > Open... shows the browser, and
+the questions (open without saving, quit) answer to clicks on their buttons."""
 
 from __future__ import annotations
 
 import pytest
 
+from tests.app.sessions import plane_cloud
+from tests.app.test_editor_files_window import _edit_bunny
 from tests.app.window_harness import EditorProcess, _foreground_centre
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
@@ -32,6 +37,63 @@ def test_the_first_stroke_after_a_menu_closed_with_esc_paints(xvfb, tmp_path):
             _stroke(ed, cx, cy)
             s = ed.idle(lambda s: s["support"] > before, "the first stroke paints", 20)
             cy += 25
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
+
+
+def _click_rect(ed, name: str, what: str) -> dict:
+    s = ed.wait(lambda s: name in s.get("gui_rects", {}), what)
+    x, y, w, h = s["gui_rects"][name]
+    ed.xdo("mousemove", x + w // 2, y + h // 2, "sleep", "0.2", "click", "1")
+    return s
+
+
+def _open_recent_0(ed) -> None:
+    _click_rect(ed, "menu_file", "menu bar")
+    _click_rect(ed, "menu_recent", "File menu open")
+    s = _click_rect(ed, "recent_0", "Open recent submenu open")
+    assert "recent_clear" in s["gui_rects"]
+
+
+def test_file_menu_open_recent_asks_first_and_the_questions_have_buttons(xvfb, tmp_path):
+    from splatedit.app.recent import RecentFiles
+    from splatedit.io import write
+    plane = tmp_path / "plane.ply"
+    write(str(plane), plane_cloud(40))
+    RecentFiles().add(plane)                 # the test's private config (XDG_CONFIG_HOME)
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        ed.wait(lambda s: s["loaded"] and s["browser"] is not None, "recent files offered", 90)
+        ed.xdo("key", "Escape")                  # the bunny instead
+        s = ed.idle(lambda s: s["browser"] is None and s["frames_presented"] > 0, "bunny shown")
+        bunny_n = s["n"]
+        s = _edit_bunny(ed, s)
+        # --- File > Open recent > plane.ply: the unsaved-changes question; its "keep editing" button
+        _open_recent_0(ed)
+        s = ed.wait(lambda s: s["confirm_open"] == str(plane), "asks about unsaved changes")
+        _click_rect(ed, "question_no", "question's buttons")
+        s = ed.idle(lambda s: s["confirm_open"] is None, "kept editing")
+        assert s["n"] == bunny_n and s["dirty"] and s["edits"] == 1
+        # --- the quit question's buttons: keep editing
+        ed.xdo("key", "q")
+        ed.wait(lambda s: s["confirm_quit"], "asks before quitting")
+        _click_rect(ed, "question_no", "quit question's buttons")
+        s = ed.idle(lambda s: not s["confirm_quit"], "quit cancelled")
+        assert s["running"] and s["dirty"]
+        # --- again, and "open without saving"
+        _open_recent_0(ed)
+        ed.wait(lambda s: s["confirm_open"] == str(plane), "asks again")
+        _click_rect(ed, "question_yes", "question's buttons")
+        s = ed.idle(lambda s: s["n"] == 1600 and s["path"] == str(plane), "plane opened", 60)
+        assert not s["dirty"] and s["edits"] == 0
+        # --- File > Open...: the browser, in the model's folder
+        _click_rect(ed, "menu_file", "menu bar")
+        _click_rect(ed, "menu_open", "File menu open")
+        s = ed.wait(lambda s: s["browser"] is not None, "browser shown")
+        assert s["browser"]["folder"] == str(tmp_path)
+        ed.xdo("key", "Escape")
+        s = ed.idle(lambda s: s["browser"] is None, "browser closed")
         assert s["validation_messages"] == 0
     finally:
         ed.close()
