@@ -87,16 +87,17 @@ class FrameScheduler:
     # ------------------------------------------------------------ document
     def sync_document(self) -> None:
         s, vp, ed = self.ed.session, self.ed.viewport, self.ed
-        if vp.cloud is not s.cloud:
-            vp.set_cloud(s.cloud)
+        cloud, basis, dc = s.display_state(vp.distortion_map)   # the last edit's, for its heat map
+        if vp.cloud is not cloud:
+            vp.set_cloud(cloud)
             ed.brush.picker = None
         ed.brush.tools.prepare(s.cloud)
         if self._sel_version_seen != s.version:
             vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
             self._sel_version_seen = s.version
-        if vp.basis is not s.basis:
-            vp.set_basis(s.basis)
-        vp.set_dc(s.current_dc() if s.basis is not None else None)
+        if vp.basis is not basis:
+            vp.set_basis(basis)
+        vp.set_dc(dc)
 
     def state(self) -> SceneKey:
         ed, s, vp = self.ed, self.ed.session, self.ed.viewport
@@ -307,9 +308,9 @@ class FrameScheduler:
         c = ed.cam
         cam = OrbitCamera(np.array(c.target, float), c.distance, c.yaw, c.pitch, c.fov_deg,
                           np.array(c.up_axis, float), c.scene_radius)
-        self.refiner.request(key, dict(cloud=s.cloud, support=s.selection.support.copy(),
+        self.refiner.request(key, dict(cloud=vp.cloud, support=s.selection.support.copy(),
                                        handle=s.selection.handle.copy(), sel_version=s.version,
-                                       inactive=s.selection.others(), basis=s.basis, dc=vp.dc, camera=cam,
+                                       inactive=s.selection.others(), basis=vp.basis, dc=vp.dc, camera=cam,
                                        w=w, h=h, distortion_map=vp.distortion_map, grey=vp.grey,
                                        splat_scale=vp.splat_scale, background=vp.background, pick_key=ed.brush.pick_key()))
 

@@ -394,6 +394,10 @@ class EditorGui:
         if d is not None:
             imgui.text_colored(RED if d.exceeds_warn else imgui.ImVec4(0.92, 0.92, 0.92, 1.0),
                                f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
+            source = gui_overlay.ov.distortion_source(s)
+            if source:
+                imgui.text_disabled(source)
+                self._rect("distortion_source")
         info = self.ed.viewport.last_info
         if info is not None and not isinstance(info, dict):
             what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")

@@ -278,7 +278,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.CURVE, "Enter / Esc", "apply the bent curve as an edit (the curve is consumed) / discard moves"),
     # ---- display
     Binding(S.DISPLAY, "D", "distortion heat map on / off: the support coloured by stretch (1x grey .. 3x red)\n"
-            "(the panel shows \"stretch max N.Nx, K > 3x\" while a pose is moved)", Action.DISTORTION_MAP,
+            "(the panel shows \"stretch max N.Nx, K > 3x\" while a pose is moved, then of the last\n"
+            "committed edit until the next change)", Action.DISTORTION_MAP,
             ("d",)),
     Binding(S.DISPLAY, "", "", Action.DISTORTION_MAP, ("d",), C.MANIP),
     Binding(S.DISPLAY, "M", "colours: the file's colours / uniform grey shading (for dark or colourless scans)",

@@ -97,7 +97,7 @@ def panel_lines(ed) -> list:
         lines.append("solver: paint a support (1) then a handle (2)")
     if s.manip is not None:
         lines.append((s.manip.describe(), (255, 230, 120)))
-    lines += ov.distortion_lines(s.distortion(), ed.viewport.distortion_map)
+    lines += ov.distortion_lines(s.distortion(), ed.viewport.distortion_map, ov.distortion_source(s))
     vp = ed.viewport
     up = ed.camera.up
     if up.label != "+Y" or vp.grey or vp.splat_scale != 1.0:     # only when not the defaults

@@ -190,10 +190,12 @@ class PoseEditing:
                     deformation=self.deformation)
         self.manip = None
         self.manip_target = None
+        before, basis = self.cloud, self.basis
         self.cloud = new
         self.edits = self.edits + (edit,)
         self.fit.clear()
         self.rig.reset_pose(len(sel.handles))
         self.rig.clear_curve()
         self.push("edit")
+        self.remember_edit(before, basis, dc)
         return True
