@@ -59,7 +59,7 @@ def status_dict(ed) -> dict:
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
-          "browser": _browser(ed.browser),
+          "browser": _browser(ed.browser), "message": ed.message,
           "script": str(ed.saved_script) if ed.saved_script else None}
     gui = getattr(ed, "gui", None)
     st["gui"] = gui is not None
