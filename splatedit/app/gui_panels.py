@@ -89,6 +89,9 @@ class EditorGui:
         self.help_box: Box | None = None
         self.menu_height = 0.0
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
+        self._sections_h = 400.0           # the panel's scrolling part / footer heights (last frame)
+        self._footer_h = 60.0
+        self.panel_scrolls = False         # the sections are taller than the room: they scroll
         self.help_scroll_set = None
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
@@ -289,6 +292,9 @@ class EditorGui:
         return left.x, left.y
 
     def _panel(self, w: int, h: int) -> None:
+        """The side panel: its sections in a scrolling part sized to what is
+        left of the window, and below it a footer that always shows (the
+        status line, the last frame's time, the keys' hint)."""
         ed = self.ed
         x, y = self._place_panel(w, h)
         imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
@@ -298,20 +304,45 @@ class EditorGui:
         title = f"{ed.cloud_name}###panel"
         expanded, _ = imgui.begin(title, None, flags)
         if expanded:
+            style = imgui.get_style()
+            inner_w = EDITOR_GUI_PANEL_WIDTH - 2 * style.window_padding.x
+            # what the window leaves for the scrolling part: below the title, above the footer
+            room = (h - PANEL_MARGIN - imgui.get_cursor_screen_pos().y - self._footer_h
+                    - style.window_padding.y - style.item_spacing.y)
+            child_h = max(min(self._sections_h, room), 40.0)
+            self.panel_scrolls = self._sections_h > child_h + 0.5
+            imgui.begin_child("##sections", imgui.ImVec2(inner_w, child_h))
             if ed.session is None:
                 imgui.text(f"opening {ed.path}")
             else:
                 self._sections()
-            if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
-                imgui.push_text_wrap_pos(0.0)
-                imgui.text_colored(YELLOW, ed.message)
-                imgui.pop_text_wrap_pos()
-            imgui.text_disabled("F1: help   P: hide panels")
+            sections_h = imgui.get_cursor_pos().y + style.window_padding.y
+            imgui.end_child()
+            top = imgui.get_cursor_screen_pos()
+            self._footer()
+            footer_h = imgui.get_cursor_screen_pos().y - top.y
+            if abs(sections_h - self._sections_h) > 0.5 or abs(footer_h - self._footer_h) > 0.5:
+                self._frames_wanted = max(self._frames_wanted, 1)    # laid out with last frame's sizes
+            self._sections_h, self._footer_h = sections_h, footer_h
+            self.rects["panel_footer"] = Box(int(top.x), int(top.y), int(inner_w), int(self._footer_h))
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self._panel_size = (size.x, size.y)
         self.panel_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
         self.windows.append(self.panel_box)
         imgui.end()
+
+    def _footer(self) -> None:
+        """The panel's pinned lines: the status message, the frame time, the hint."""
+        ed = self.ed
+        imgui.push_text_wrap_pos(0.0)
+        if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
+            imgui.text_colored(YELLOW, ed.message)
+        info = ed.viewport.last_info
+        if ed.session is not None and info is not None and not isinstance(info, dict):
+            what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")
+            imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
+        imgui.text_disabled("F1: help   P: hide panels")
+        imgui.pop_text_wrap_pos()
 
     def _sections(self) -> None:
         s = self.ed.session
@@ -398,10 +429,6 @@ class EditorGui:
             if source:
                 imgui.text_disabled(source)
                 self._rect("distortion_source")
-        info = self.ed.viewport.last_info
-        if info is not None and not isinstance(info, dict):
-            what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")
-            imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {self.ed.frame_ms:.0f} ms")
 
     def _deformation(self) -> None:
         ed, s = self.ed, self.ed.session

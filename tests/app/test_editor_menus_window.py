@@ -97,3 +97,27 @@ def test_file_menu_open_recent_asks_first_and_the_questions_have_buttons(xvfb, t
         assert s["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_the_panel_footer_stays_visible_when_the_panel_is_taller_than_the_window(xvfb, tmp_path):
+    """All sections open with a support and a handle (the panel's full height
+    is more than the 600-pixel window): the panel ends inside the window, its
+    footer (status line, frame time, hint) is at its bottom, fully shown, and
+    the sections above scroll."""
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 90)
+        s = _edit_bunny(ed, s)
+        ed.xdo("key", "ctrl+s")
+        s = ed.idle(lambda s: s["saved"] and "panel_footer" in s["gui_rects"] and s["message"].startswith("saved"),
+                    "saved")
+        w, h = s["window"]
+        px, py, pw, ph = s["panel_box"]
+        fx, fy, fw, fh = s["gui_rects"]["panel_footer"]
+        assert py + ph <= h                                # nothing below the window's edge
+        assert py < fy and fy + fh <= py + ph and fh >= 3 * 12     # message, frame time and hint
+        assert fx >= px and fx + fw <= px + pw
+        assert s["gui_panel_scrolls"]                      # the sections are taller than the room left
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
