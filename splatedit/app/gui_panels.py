@@ -495,7 +495,8 @@ class EditorGui:
             for k, text in enumerate(labels):
                 here = k == hist.position
                 saved = " (saved)" if k == hist.saved_pos else ""
-                if imgui.selectable(f"{k}. {text or 'state'}{saved}##h{k}", here)[0] and not here:
+                name = (text or "state")[:1].upper() + (text or "state")[1:]
+                if imgui.selectable(f"{k}. {name}{saved}##h{k}", here)[0] and not here:
                     self.jump(k)
                 if imgui.is_item_visible():
                     self._rect(f"history_{k}")

@@ -137,6 +137,7 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.last_commit_seconds = 0.0
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
         self.last_edit: LastEdit | None = None
+        self._erasing = False       # the stroke being painted erases (its history name)
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)
@@ -162,13 +163,14 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         if self.manip is not None:
             return False
         changed = self.selection.paint(indices, self.brush_target, erase)
+        self._erasing = erase
         if changed:
             self.version += 1
         return changed
 
     def end_stroke(self, changed: bool) -> None:
         if changed:
-            self.push(f"paint {self.brush_target}")
+            self.push(f"{'Erase' if self._erasing else 'Paint'} {self.brush_target}")
 
     def clear(self, target: str | None = None) -> None:
         if self.manip is None and self.selection.clear(target):
@@ -282,6 +284,20 @@ class Session(SessionHistory, RigEditing, PoseEditing):
             return self._distortion.stats(self.basis, self.cloud, dc)
         last = self.shown_edit()
         return None if last is None else self._distortion.stats(last.basis, last.cloud, last.dc)
+
+    def edit_label(self) -> str:
+        """The history name of the edit a commit now makes: the running
+        move's (``Grab 0.12``, ``Rotate 45 deg about Z``, ``Scale x1.38``,
+        a typed transform), else what the pending pose moves (``Curve``,
+        ``Move 2 handles``, ``Curve + 1 handle``)."""
+        if self.manip is not None and self.single_rig:
+            return self.manip.label()
+        hidx, curve = self.basis_groups
+        moved = sum(1 for k in hidx if not np.array_equal(self.handle_matrix(k), np.eye(4)))
+        parts = (["Curve"] if curve is not None and self.live_curve_moves().any() else [])
+        if moved:
+            parts.append(f"Move {moved} handle" + ("s" if moved > 1 else ""))
+        return " + ".join(parts) or "Edit"
 
     def remember_edit(self, before, basis, dc) -> None:
         """Keep the edit just committed (``before`` deformed by ``dc`` of

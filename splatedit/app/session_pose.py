@@ -143,7 +143,8 @@ class PoseEditing:
         if self.single_rig:
             return "commit" if self.commit() else ""
         moved = not np.array_equal(self.manip.matrix(), np.eye(4))
-        what = "move handle" if self.manip_target[0] == "handle" else "move curve point"
+        t = self.manip_target
+        what = f"{self.manip.label()} ({'handle' if t[0] == 'handle' else 'curve point'} {t[1] + 1}, pending)"
         self._bake()
         if moved:
             self.push(what)
@@ -161,6 +162,7 @@ class PoseEditing:
         if self.basis is None:
             return False
         self._check_manip()
+        label = self.edit_label()
         inputs = self.inputs(live=True)
         moves = self.live_curve_moves(live=True)
         hidx, curve = self.basis_groups
@@ -196,6 +198,6 @@ class PoseEditing:
         self.fit.clear()
         self.rig.reset_pose(len(sel.handles))
         self.rig.clear_curve()
-        self.push("edit")
+        self.push(label)
         self.remember_edit(before, basis, dc)
         return True
