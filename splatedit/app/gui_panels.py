@@ -35,6 +35,7 @@ from typing import Callable
 from imgui_bundle import imgui
 
 from splatedit.app import gui_help, gui_overlay, gui_questions
+from splatedit.app.gaussian_doc import model_summary
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
@@ -339,7 +340,8 @@ class EditorGui:
             imgui.text_colored(YELLOW, ed.message)
         info = ed.viewport.last_info
         if ed.session is not None and info is not None and not isinstance(info, dict):
-            what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")
+            what = (f"{info.splats:,} {'Gaussians' if getattr(info, 'gaussians', False) else 'splats'}"
+                    + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else ""))
             imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
         imgui.text_disabled("F1: help   P: hide panels")
         imgui.pop_text_wrap_pos()
@@ -347,7 +349,10 @@ class EditorGui:
     def _sections(self) -> None:
         s = self.ed.session
         st = s.stats()
-        imgui.text(f"{s.cloud.n:,} splats   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text(f"{model_summary(s.cloud)}   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        imgui.pop_text_wrap_pos()
+        self._rect("panel_summary")
         if s.manip is not None:               # the live readout of a running move
             imgui.text_colored(YELLOW, s.manip.readout())
             imgui.push_text_wrap_pos(0.0)

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from splatedit.app import overlay as ov
 from splatedit.app import selection_tools as seltools
-from splatedit.app.gaussian_doc import describe, gaussians_of
+from splatedit.app.gaussian_doc import model_summary
 from splatedit.select.selection import SUPPORT
 from splatedit.app.keymap import help_lines
 from splatedit.app.tools.curve import CURVE_RGB
@@ -66,8 +66,7 @@ def panel_lines(ed) -> list:
         return [f"splatedit - opening {ed.path}", "F1: help   Ctrl+O: open another model"]
     st = s.stats()
     brush = ed.brush
-    scene = gaussians_of(s.cloud)
-    lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats" if scene is None else f"{ed.cloud_name}   {describe(scene)}"]
+    lines = [f"{ed.cloud_name}   {model_summary(s.cloud)}"]
     tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
     erase = "  ERASE" if brush.erase_toggle else ""
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"
