@@ -219,7 +219,7 @@ class Editor(EventRouting, FileActions):
             Action.HELP_CLOSE: self.help.toggle,
             Action.UNDO: lambda: self.say("undo" if s().undo() else "undo: nothing to do"),
             Action.REDO: lambda: self.say("redo" if s().redo() else "redo: nothing to do"),
-            Action.SAVE: lambda: self.save(self.save_target()), Action.SAVE_AS: self.ask_save_as,
+            Action.SAVE: self.save_edits, Action.SAVE_AS: self.ask_save_as,
             Action.EXPORT_SCRIPT: self.export_script, Action.QUIT: self.request_quit})
         return t
 

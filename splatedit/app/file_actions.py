@@ -105,6 +105,21 @@ class FileActions:
 
     save = files.save
 
+    def save_edits(self) -> None:
+        """Ctrl+S: save to :meth:`save_target`; with no edit (nothing but a
+        selection changed) or nothing new since the last save, say so instead
+        of writing a copy of the model."""
+        s = self.session
+        if s is None:
+            return
+        if not s.edits:
+            self.say("nothing to save (no edits)")
+            return
+        if not s.dirty and self.saved_path is not None:
+            self.say(f"nothing to save (no changes since it was saved to {self.saved_path.name})")
+            return
+        self.save(self.save_target())
+
     def ask_save_as(self) -> None:
         self.prompt = str(self.save_target())
         self.prompt_selected = False

@@ -297,7 +297,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.FILE, "Ctrl+Z / Ctrl+Shift+Z", "undo / redo (edits and selections; Ctrl+Y also redoes)", Action.UNDO,
             ("ctrl+z",)),
     Binding(S.FILE, "", "", Action.REDO, ("ctrl+shift+z", "ctrl+y")),
-    Binding(S.FILE, "Ctrl+S", "save <name>-edited.ply (+ <name>-edited.edits.json edit script)", Action.SAVE,
+    Binding(S.FILE, "Ctrl+S", "save <name>-edited.ply (+ <name>-edited.edits.json edit script); without an edit,\n"
+            "or with nothing new since the last save, it says so and writes nothing", Action.SAVE,
             ("ctrl+s",)),
     Binding(S.FILE, "Ctrl+Shift+S", "save as: edit the proposed path (Backspace deletes a character;\n"
             "Ctrl+A selects all, Ctrl+U or Ctrl+Backspace clears), Enter saves, Esc cancels", Action.SAVE_AS, ("ctrl+shift+s",)),

@@ -291,3 +291,23 @@ def test_save_as_prompt_backspace_deletes_one_character_and_typing_appends(ed, m
     _chars(ed, "abc")
     key(ed, glfw.KEY_ESCAPE)
     assert ed.prompt is None and "save" not in ed.jobs
+
+
+def test_ctrl_s_with_no_edits_says_so_instead_of_writing_a_copy(ed, models):
+    paint_regions(ed.session)                       # a selection only: no edit
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)
+    assert ed.messages[-1] == "nothing to save (no edits)"
+    assert "save" not in ed.jobs and ed.save_as is None
+    assert not (models / "a_plane-edited.ply").exists()
+    s = ed.session
+    assert s.wait_fit() and s.begin(GRAB, view(), (100, 100))
+    s.manip.set_axis(2)
+    for ch in "0.3":
+        s.manip.type_char(ch)
+    assert s.commit()
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)           # an edit: saved
+    ed.settle()
+    assert (models / "a_plane-edited.ply").exists() and not s.dirty
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)           # again, nothing new: not written twice
+    assert ed.messages[-1].startswith("nothing to save (no changes since it was saved to a_plane-edited.ply")
+    assert "save" not in ed.jobs
