@@ -52,6 +52,8 @@ RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
 ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 #: the message line is shown this long (s)
 MESSAGE_SECONDS = 8.0
+#: lines the panel footer keeps for the status line (most messages fit in two at the panel's width)
+FOOTER_MESSAGE_LINES = 2
 
 
 @dataclass
@@ -214,7 +216,14 @@ class EditorGui:
         self.gui.close()
 
     def _rect(self, name: str) -> None:
+        """Record the last widget's rectangle as ``name`` when it is wholly
+        shown (one scrolled out of the panel's sections, or under the footer,
+        is not: it cannot be clicked)."""
         a, b = imgui.get_item_rect_min(), imgui.get_item_rect_max()
+        p, s = imgui.get_window_pos(), imgui.get_window_size()
+        if not imgui.is_item_visible() or a.y < p.y - 0.5 or b.y > p.y + s.y + 0.5:
+            self.rects.pop(name, None)
+            return
         self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
 
     # ------------------------------------------------------------ menu bar
@@ -336,8 +345,15 @@ class EditorGui:
         """The panel's pinned lines: the status message, the frame time, the hint."""
         ed = self.ed
         imgui.push_text_wrap_pos(0.0)
+        # the status line keeps FOOTER_MESSAGE_LINES lines even when shorter or gone, so the
+        # sections above do not jump each time a message comes and goes
+        line = imgui.get_text_line_height_with_spacing()
+        y0 = imgui.get_cursor_pos().y
         if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
             imgui.text_colored(YELLOW, ed.message)
+        used = imgui.get_cursor_pos().y - y0
+        if used < FOOTER_MESSAGE_LINES * line:
+            imgui.dummy(imgui.ImVec2(1.0, FOOTER_MESSAGE_LINES * line - used - imgui.get_style().item_spacing.y))
         info = ed.viewport.last_info
         if ed.session is not None and info is not None and not isinstance(info, dict):
             what = (f"{info.splats:,} {'Gaussians' if getattr(info, 'gaussians', False) else 'splats'}"
@@ -432,7 +448,9 @@ class EditorGui:
                                f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
             source = gui_overlay.ov.distortion_source(s)
             if source:
+                imgui.push_text_wrap_pos(0.0)
                 imgui.text_disabled(source)
+                imgui.pop_text_wrap_pos()
                 self._rect("distortion_source")
 
     def _deformation(self) -> None:
