@@ -111,6 +111,13 @@ def test_the_panel_footer_stays_visible_when_the_panel_is_taller_than_the_window
         ed.xdo("key", "ctrl+s")
         s = ed.idle(lambda s: s["saved"] and "panel_footer" in s["gui_rects"] and s["message"].startswith("saved"),
                     "saved")
+
+        def footer_inside(s):
+            px, py, pw, ph = s["panel_box"]
+            fx, fy, fw, fh = s["gui_rects"]["panel_footer"]
+            return fy + fh <= py + ph
+        # a longer status line (the saved path wraps) grows the footer: the next frame lays it out
+        s = ed.wait(footer_inside, "the footer laid out inside the panel", 10)
         w, h = s["window"]
         px, py, pw, ph = s["panel_box"]
         fx, fy, fw, fh = s["gui_rects"]["panel_footer"]
