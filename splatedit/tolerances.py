@@ -823,3 +823,17 @@ EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH = 2.0
 #: (EDITOR_GUI_PANEL_WIDTH + margin) leaves ~0.75 of the width; at 640 px
 #: ~0.5; a quarter still shows a framed model about 160 px wide at 640 px
 EDITOR_FRAME_MIN_FREE_FRACTION = 0.25
+
+# ---------------------------------------------------------------------------
+# Editor UX fixes (issue 10: the side panel's pinned footer)
+# ---------------------------------------------------------------------------
+#: lines the side panel's footer keeps for the status line even when it is
+#: shorter or gone, so the sections above do not jump as messages come and
+#: go: at EDITOR_GUI_PANEL_WIDTH most messages ("saved bunny-edited.ply and
+#: ...", "distortion heat map on: ...") wrap to 1-2 lines; a long path (4
+#: lines in a pytest tmp folder) grows the footer for that message only
+EDITOR_GUI_FOOTER_MESSAGE_LINES = 2
+#: ImGui lays out in float pixels; two layout heights (or a widget edge and
+#: its window's edge) closer than this are the same (the widget rects in the
+#: status file are whole pixels)
+EDITOR_GUI_LAYOUT_SLACK_PX = 0.5

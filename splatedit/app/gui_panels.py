@@ -4,9 +4,10 @@
 presenter's Vulkan device.  Each presented frame it builds, between
 ``new_frame`` and ``render``:
 
-* the **menu bar**: File (:attr:`EditorGui.file_menu`, a list of
-  :class:`MenuEntry` that other parts of the editor extend, e.g. Open and
-  recent files), Edit (undo / redo), View (panels, help, frame all);
+* the **menu bar** (:mod:`splatedit.app.gui_menus`): File
+  (:attr:`EditorGui.file_menu`, a list of :class:`MenuEntry` that other
+  parts of the editor extend: Open..., Open recent, Save ...), Edit (undo /
+  redo), View (panels, help, frame all);
 * the **side panel** (collapsible sections; P hides it, as before; placed at
   the left below the menu bar, or at the right when the gizmo is on the
   left: it never covers the gizmo): tool palette, selection and solver,
@@ -29,13 +30,12 @@ tests click them).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-from typing import Callable
 
 from imgui_bundle import imgui
 
 from splatedit.app import gui_help, gui_overlay, gui_questions
 from splatedit.app.gaussian_doc import model_summary
+from splatedit.app.gui_menus import MenuBar, MenuEntry  # noqa: F401 (MenuEntry: the File menu's rows)
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
@@ -43,7 +43,8 @@ from splatedit.app.tools.base import DragMode
 from splatedit.app.gui_transform import TransformSection
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
-from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+from splatedit.tolerances import (EDITOR_GUI_FOOTER_MESSAGE_LINES, EDITOR_GUI_LAYOUT_SLACK_PX,
+                                  EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
                                   EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
@@ -52,26 +53,9 @@ RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
 ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 #: the message line is shown this long (s)
 MESSAGE_SECONDS = 8.0
-#: lines the panel footer keeps for the status line (most messages fit in two at the panel's width)
-FOOTER_MESSAGE_LINES = 2
 
 
-@dataclass
-class MenuEntry:
-    """One File-menu item: ``label``, the callback, a shortcut text shown at the
-    right, and an optional predicate that enables it (default: always).  With
-    ``submenu`` (a function giving its entries when it opens) the item is a
-    submenu and ``action`` is unused; ``name`` records the item's rectangle
-    (``gui_rects`` in the status file)."""
-    label: str
-    action: Callable[[], None] | None
-    shortcut: str = ""
-    enabled: Callable[[], bool] | None = None
-    submenu: Callable[[], list] | None = None
-    name: str = ""
-
-
-class EditorGui:
+class EditorGui(MenuBar):
     def __init__(self, ed, device):
         from splatedit.render.gui import Gui
         self.ed = ed
@@ -221,70 +205,11 @@ class EditorGui:
         is not: it cannot be clicked)."""
         a, b = imgui.get_item_rect_min(), imgui.get_item_rect_max()
         p, s = imgui.get_window_pos(), imgui.get_window_size()
-        if not imgui.is_item_visible() or a.y < p.y - 0.5 or b.y > p.y + s.y + 0.5:
+        slack = EDITOR_GUI_LAYOUT_SLACK_PX
+        if not imgui.is_item_visible() or a.y < p.y - slack or b.y > p.y + s.y + slack:
             self.rects.pop(name, None)
             return
         self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
-
-    # ------------------------------------------------------------ menu bar
-    def _menu_bar(self, w: int) -> None:
-        ed = self.ed
-        if not imgui.begin_main_menu_bar():
-            return
-        self.menu_height = imgui.get_window_size().y
-        self.windows.append(Box(0, 0, w, int(self.menu_height)))
-        if imgui.begin_menu("File"):
-            self._menu_open = True
-            self._menu_entries(self.file_menu)
-            imgui.end_menu()
-        self._rect("menu_file")
-        s = ed.session
-        if imgui.begin_menu("Edit", s is not None):
-            self._menu_open = True
-            if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
-                ed.run_action(Action.UNDO)
-            if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
-                ed.run_action(Action.REDO)
-            imgui.end_menu()
-        self._rect("menu_edit")
-        if imgui.begin_menu("View"):
-            self._menu_open = True
-            if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
-                ed.run_action(Action.PANEL)
-            if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
-                ed.run_action(Action.HELP)
-            if imgui.menu_item("Frame all", "Home", False, s is not None)[0]:
-                ed.run_action(Action.FRAME_ALL)
-            imgui.end_menu()
-        imgui.end_main_menu_bar()
-
-    def _menu_entries(self, entries: list[MenuEntry]) -> None:
-        for e in entries:
-            ok = e.enabled() if e.enabled is not None else True
-            if e.submenu is not None:
-                opened = imgui.begin_menu(e.label, ok)
-                if opened:
-                    self._menu_entries(e.submenu())
-                    imgui.end_menu()
-                if e.name:
-                    self._rect(e.name)
-                continue
-            if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
-                e.action()
-            if e.name:
-                self._rect(e.name)
-
-    def _recent_menu(self) -> list[MenuEntry]:
-        """File > Open recent: the recent models (opened like Ctrl+O's pick, the
-        unsaved-changes question included), then "Clear recent files"."""
-        from splatedit.app.recent import menu_labels
-        ed = self.ed
-        paths = ed.recent_files()
-        if not paths:
-            return [MenuEntry("(no recent files)", lambda: None, enabled=lambda: False, name="recent_none")]
-        rows = [MenuEntry(label, lambda p=p: ed.open_path(p), name=f"recent_{i}")
-                for i, (label, p) in enumerate(zip(menu_labels(paths), paths))]
-        return rows + [MenuEntry("Clear recent files", ed.clear_recent, name="recent_clear")]
 
     # --------------------------------------------------------------- panel
     def _place_panel(self, w: int, h: int) -> tuple[float, float]:
@@ -320,7 +245,7 @@ class EditorGui:
             room = (h - PANEL_MARGIN - imgui.get_cursor_screen_pos().y - self._footer_h
                     - style.window_padding.y - style.item_spacing.y)
             child_h = max(min(self._sections_h, room), 40.0)
-            self.panel_scrolls = self._sections_h > child_h + 0.5
+            self.panel_scrolls = self._sections_h > child_h + EDITOR_GUI_LAYOUT_SLACK_PX
             imgui.begin_child("##sections", imgui.ImVec2(inner_w, child_h))
             if ed.session is None:
                 imgui.text(f"opening {ed.path}")
@@ -331,7 +256,7 @@ class EditorGui:
             top = imgui.get_cursor_screen_pos()
             self._footer()
             footer_h = imgui.get_cursor_screen_pos().y - top.y
-            if abs(sections_h - self._sections_h) > 0.5 or abs(footer_h - self._footer_h) > 0.5:
+            if max(abs(sections_h - self._sections_h), abs(footer_h - self._footer_h)) > EDITOR_GUI_LAYOUT_SLACK_PX:
                 self._frames_wanted = max(self._frames_wanted, 1)    # laid out with last frame's sizes
             self._sections_h, self._footer_h = sections_h, footer_h
             self.rects["panel_footer"] = Box(int(top.x), int(top.y), int(inner_w), int(self._footer_h))
@@ -345,15 +270,15 @@ class EditorGui:
         """The panel's pinned lines: the status message, the frame time, the hint."""
         ed = self.ed
         imgui.push_text_wrap_pos(0.0)
-        # the status line keeps FOOTER_MESSAGE_LINES lines even when shorter or gone, so the
+        # the status line keeps EDITOR_GUI_FOOTER_MESSAGE_LINES lines even when shorter or gone, so the
         # sections above do not jump each time a message comes and goes
         line = imgui.get_text_line_height_with_spacing()
         y0 = imgui.get_cursor_pos().y
         if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
             imgui.text_colored(YELLOW, ed.message)
         used = imgui.get_cursor_pos().y - y0
-        if used < FOOTER_MESSAGE_LINES * line:
-            imgui.dummy(imgui.ImVec2(1.0, FOOTER_MESSAGE_LINES * line - used - imgui.get_style().item_spacing.y))
+        if used < EDITOR_GUI_FOOTER_MESSAGE_LINES * line:
+            imgui.dummy(imgui.ImVec2(1.0, EDITOR_GUI_FOOTER_MESSAGE_LINES * line - used - imgui.get_style().item_spacing.y))
         info = ed.viewport.last_info
         if ed.session is not None and info is not None and not isinstance(info, dict):
             what = (f"{info.splats:,} {'Gaussians' if getattr(info, 'gaussians', False) else 'splats'}"
