@@ -1071,3 +1071,16 @@ EDITOR_COMMIT_US_PER_SUPPORT_GAUSSIAN = 25.0
 #: one block 0.39 / 0.34 s, 4096 0.33 / 0.31 s, 8192 0.34 / 0.41 s, 16384
 #: 0.35 / 0.44 s (loaded machine: no cost measurable; 4096 gives ~8 steps)
 GAUSSIAN_COMMIT_CHUNK = 4096
+# ---------------------------------------------------------------------------
+# Editor UX fixes (issue 10: the side panel's pinned footer)
+# ---------------------------------------------------------------------------
+#: lines the side panel's footer keeps for the status line even when it is
+#: shorter or gone, so the sections above do not jump as messages come and
+#: go: at EDITOR_GUI_PANEL_WIDTH most messages ("saved bunny-edited.ply and
+#: ...", "distortion heat map on: ...") wrap to 1-2 lines; a long path (4
+#: lines in a pytest tmp folder) grows the footer for that message only
+EDITOR_GUI_FOOTER_MESSAGE_LINES = 2
+#: ImGui lays out in float pixels; two layout heights (or a widget edge and
+#: its window's edge) closer than this are the same (the widget rects in the
+#: status file are whole pixels)
+EDITOR_GUI_LAYOUT_SLACK_PX = 0.5

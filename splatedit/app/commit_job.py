@@ -57,12 +57,14 @@ class CommitPlan:
     fitted on; ``dc``: (K, 3) float64 or a RotationDisplacement (the whole
     pose); ``make_edit``: builds the :class:`~splatedit.script.Edit` recorded
     when it lands (index lists of up to millions of splats: built off the UI
-    thread); ``handles``: the number of handles (the pose is reset to them)."""
+    thread); ``handles``: the number of handles (the pose is reset to them);
+    ``label``: the edit's name in the history list."""
     basis: object
     cloud: object
     dc: object
     make_edit: object
     handles: int
+    label: str = "Edit"
 
     def work(self, progress=None):
         """The deformed document (``commit_cloud``); ``progress(stage,

@@ -110,7 +110,7 @@ class Editor(EventRouting, FileActions):
         self.confirm_quit = False
         self.confirm_open: Path | None = None   # open this model without saving?
         self.prompt: str | None = None      # save-as path being typed
-        self.prompt_fresh = False            # the first key replaces the proposed path
+        self.prompt_selected = False         # Ctrl+A selected the whole path (typing replaces it)
         # pointer
         self.drag = DragMode.NONE
         self.drag_tool = None
@@ -215,7 +215,7 @@ class Editor(EventRouting, FileActions):
             Action.HELP_CLOSE: self.help.toggle,
             Action.UNDO: lambda: self.say("undo" if s().undo() else "undo: nothing to do"),
             Action.REDO: lambda: self.say("redo" if s().redo() else "redo: nothing to do"),
-            Action.SAVE: lambda: self.save(self.save_target()), Action.SAVE_AS: self.ask_save_as,
+            Action.SAVE: self.save_edits, Action.SAVE_AS: self.ask_save_as,
             Action.EXPORT_SCRIPT: self.export_script, Action.QUIT: self.request_quit})
         return t
 

@@ -12,7 +12,7 @@ from pathlib import Path
 
 import numpy as np
 
-from splatedit.app.gaussian_doc import describe, gaussians_of
+from splatedit.app.gaussian_doc import gaussians_of, model_summary
 from splatedit.app.jobs import Cancelled, Job
 from splatedit.errors import InputError, SplatEditError
 from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
@@ -242,8 +242,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
         ed.viewport.assume_cost(EDITOR_GUESS_MS_PER_SPLAT, max(w * h, 1))
     r = float(np.linalg.norm(cloud.positions.max(0) - cloud.positions.min(0))) / 2
     ed.cam.scene_radius = max(r, 1e-9)
-    ed.camera.detect_up(cloud, ed.path)
-    ed.camera.frame_all(say=False)
+    ed.camera.fresh_view(cloud, ed.path)
     ed.window.set_title(f"splatedit - {ed.cloud_name}")
     if ed.use_lod and scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
@@ -252,7 +251,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
     ed.brush.tools.prepare(cloud)
     remember(ed, ed.path)
-    what = f"{cloud.n:,} splats" if scene is None else describe(scene)
+    what = model_summary(cloud)
     note = ed.camera.extent().note()
     ed.say(f"loaded {ed.cloud_name}: {what} (up axis {ed.camera.up.label}, "
            f"{ed.camera.up.source.value}; U changes it)" + (f"; {note}" if note else ""))

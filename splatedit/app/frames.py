@@ -123,16 +123,17 @@ class FrameScheduler:
     # ------------------------------------------------------------ document
     def sync_document(self) -> None:
         s, vp, ed = self.ed.session, self.ed.viewport, self.ed
-        if vp.cloud is not s.cloud:
-            vp.set_cloud(s.cloud)
+        cloud, basis, dc = s.display_state(vp.distortion_map)   # the last edit's, for its heat map
+        if vp.cloud is not cloud:
+            vp.set_cloud(cloud)
             ed.brush.picker = None
         ed.brush.tools.prepare(s.cloud)
         if self._sel_version_seen != s.version:
             vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
             self._sel_version_seen = s.version
-        if vp.basis is not s.basis:
-            vp.set_basis(s.basis)
-        vp.set_dc(s.current_dc() if s.basis is not None else None)
+        if vp.basis is not basis:
+            vp.set_basis(basis)
+        vp.set_dc(dc)
 
     def state(self) -> SceneKey:
         ed, s, vp = self.ed, self.ed.session, self.ed.viewport

@@ -64,3 +64,10 @@ def document_bytes(cloud) -> int:
 def describe(scene: GaussianCloud) -> str:
     """One line for the status message: count, kind, SH degree."""
     return f"{len(scene):,} Gaussians ({scene.kind.value}, SH degree {scene.sh_degree})"
+
+
+def model_summary(cloud) -> str:
+    """What the document holds, for the panel and the load message:
+    ``37,706 splats`` or ``5,000 Gaussians (3dgs, SH degree 3)``."""
+    scene = gaussians_of(cloud)
+    return f"{cloud.n:,} splats" if scene is None else describe(scene)

@@ -4,9 +4,10 @@
 presenter's Vulkan device.  Each presented frame it builds, between
 ``new_frame`` and ``render``:
 
-* the **menu bar**: File (:attr:`EditorGui.file_menu`, a list of
-  :class:`MenuEntry` that other parts of the editor extend, e.g. Open and
-  recent files), Edit (undo / redo), View (panels, help, frame all);
+* the **menu bar** (:mod:`splatedit.app.gui_menus`): File
+  (:attr:`EditorGui.file_menu`, a list of :class:`MenuEntry` that other
+  parts of the editor extend: Open..., Open recent, Save ...), Edit (undo /
+  redo), View (panels, help, frame all);
 * the **side panel** (collapsible sections; P hides it, as before; placed at
   the left below the menu bar, or at the right when the gizmo is on the
   left: it never covers the gizmo): tool palette, selection and solver,
@@ -29,12 +30,12 @@ tests click them).
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
-from typing import Callable
 
 from imgui_bundle import imgui
 
-from splatedit.app import gui_help, gui_overlay
+from splatedit.app import gui_help, gui_overlay, gui_questions
+from splatedit.app.gaussian_doc import model_summary
+from splatedit.app.gui_menus import MenuBar, MenuEntry  # noqa: F401 (MenuEntry: the File menu's rows)
 from splatedit.app import selection_tools as seltools
 from splatedit.app.keymap import Action
 from splatedit.app.panel import PANEL_MARGIN, Box
@@ -42,7 +43,8 @@ from splatedit.app.tools.base import DragMode
 from splatedit.app.gui_transform import TransformSection
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
-from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+from splatedit.tolerances import (EDITOR_GUI_FOOTER_MESSAGE_LINES, EDITOR_GUI_LAYOUT_SLACK_PX,
+                                  EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
                                   EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
@@ -53,17 +55,7 @@ ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 MESSAGE_SECONDS = 8.0
 
 
-@dataclass
-class MenuEntry:
-    """One File-menu item: ``label``, the callback, a shortcut text shown at the
-    right, and an optional predicate that enables it (default: always)."""
-    label: str
-    action: Callable[[], None]
-    shortcut: str = ""
-    enabled: Callable[[], bool] | None = None
-
-
-class EditorGui:
+class EditorGui(MenuBar):
     def __init__(self, ed, device):
         from splatedit.render.gui import Gui
         self.ed = ed
@@ -72,6 +64,8 @@ class EditorGui:
         has = lambda: ed.session is not None  # noqa: E731
         #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
         self.file_menu: list[MenuEntry] = [
+            MenuEntry("Open...", lambda: ed.run_action(Action.OPEN), "Ctrl+O", name="menu_open"),
+            MenuEntry("Open recent", None, submenu=self._recent_menu, name="menu_recent"),
             MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
             MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
             MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
@@ -82,10 +76,14 @@ class EditorGui:
         self.help_box: Box | None = None
         self.menu_height = 0.0
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
+        self._sections_h = 400.0           # the panel's scrolling part / footer heights (last frame)
+        self._footer_h = 60.0
+        self.panel_scrolls = False         # the sections are taller than the room: they scroll
         self.help_scroll_set = None
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
         self._menu_open = False
+        self._close_menus = False          # Esc was pressed with a menu open
         self._press_in_gui = False
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
 
@@ -104,6 +102,13 @@ class EditorGui:
         self.gui.feed(ev)
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
         kind = ev.kind
+        if kind == "key" and self._menu_open and ev.key == self.ed.g.KEY_ESCAPE:
+            # Esc closes an open menu (ImGui does not without keyboard navigation, and
+            # the menu would then swallow the next click: the first stroke did nothing);
+            # the key is the menu's, it cancels nothing else
+            if ev.action == 1:
+                self._close_menus, self._menu_open = True, False
+            return True
         if kind in ("key", "char"):
             return self.wants_keyboard
         if kind == "button":
@@ -143,6 +148,11 @@ class EditorGui:
         return self._press_in_gui or self.owns_point(mx, my)
 
     @property
+    def menu_open(self) -> bool:
+        """A menu of the menu bar was open in the last frame."""
+        return self._menu_open
+
+    @property
     def wants_keyboard(self) -> bool:
         """A text field is being edited (``io.want_text_input``): keys and
         characters are ImGui's.  ImGui's broader ``want_capture_keyboard`` also
@@ -162,6 +172,9 @@ class EditorGui:
         self.rects = {}
         self.windows = []
         self._menu_open = False
+        if self._close_menus:
+            imgui.internal.close_popups_except_modals()
+            self._close_menus = False
         gui_overlay.draw_tools(self.ed, w, h)
         self._menu_bar(w)
         help_full = self.ed.help.shown and self._help_area(w, h)[1]
@@ -187,42 +200,16 @@ class EditorGui:
         self.gui.close()
 
     def _rect(self, name: str) -> None:
+        """Record the last widget's rectangle as ``name`` when it is wholly
+        shown (one scrolled out of the panel's sections, or under the footer,
+        is not: it cannot be clicked)."""
         a, b = imgui.get_item_rect_min(), imgui.get_item_rect_max()
-        self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
-
-    # ------------------------------------------------------------ menu bar
-    def _menu_bar(self, w: int) -> None:
-        ed = self.ed
-        if not imgui.begin_main_menu_bar():
+        p, s = imgui.get_window_pos(), imgui.get_window_size()
+        slack = EDITOR_GUI_LAYOUT_SLACK_PX
+        if not imgui.is_item_visible() or a.y < p.y - slack or b.y > p.y + s.y + slack:
+            self.rects.pop(name, None)
             return
-        self.menu_height = imgui.get_window_size().y
-        self.windows.append(Box(0, 0, w, int(self.menu_height)))
-        if imgui.begin_menu("File"):
-            self._menu_open = True
-            for e in self.file_menu:
-                ok = e.enabled() if e.enabled is not None else True
-                if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
-                    e.action()
-            imgui.end_menu()
-        self._rect("menu_file")
-        s = ed.session
-        if imgui.begin_menu("Edit", s is not None):
-            self._menu_open = True
-            if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
-                ed.run_action(Action.UNDO)
-            if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
-                ed.run_action(Action.REDO)
-            imgui.end_menu()
-        if imgui.begin_menu("View"):
-            self._menu_open = True
-            if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
-                ed.run_action(Action.PANEL)
-            if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
-                ed.run_action(Action.HELP)
-            if imgui.menu_item("Frame all", "Home", False, s is not None)[0]:
-                ed.run_action(Action.FRAME_ALL)
-            imgui.end_menu()
-        imgui.end_main_menu_bar()
+        self.rects[name] = Box(int(a.x), int(a.y), int(b.x - a.x), int(b.y - a.y))
 
     # --------------------------------------------------------------- panel
     def _place_panel(self, w: int, h: int) -> tuple[float, float]:
@@ -240,6 +227,9 @@ class EditorGui:
         return left.x, left.y
 
     def _panel(self, w: int, h: int) -> None:
+        """The side panel: its sections in a scrolling part sized to what is
+        left of the window, and below it a footer that always shows (the
+        status line, the last frame's time, the keys' hint)."""
         ed = self.ed
         x, y = self._place_panel(w, h)
         imgui.set_next_window_pos(imgui.ImVec2(x, y), imgui.Cond_.always)
@@ -249,25 +239,61 @@ class EditorGui:
         title = f"{ed.cloud_name}###panel"
         expanded, _ = imgui.begin(title, None, flags)
         if expanded:
+            style = imgui.get_style()
+            inner_w = EDITOR_GUI_PANEL_WIDTH - 2 * style.window_padding.x
+            # what the window leaves for the scrolling part: below the title, above the footer
+            room = (h - PANEL_MARGIN - imgui.get_cursor_screen_pos().y - self._footer_h
+                    - style.window_padding.y - style.item_spacing.y)
+            child_h = max(min(self._sections_h, room), 40.0)
+            self.panel_scrolls = self._sections_h > child_h + EDITOR_GUI_LAYOUT_SLACK_PX
+            imgui.begin_child("##sections", imgui.ImVec2(inner_w, child_h))
             if ed.session is None:
                 imgui.text(f"opening {ed.path}")
             else:
                 self._sections()
-            if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
-                imgui.push_text_wrap_pos(0.0)
-                imgui.text_colored(YELLOW, ed.message)
-                imgui.pop_text_wrap_pos()
-            imgui.text_disabled("F1: help   P: hide panels")
+            sections_h = imgui.get_cursor_pos().y + style.window_padding.y
+            imgui.end_child()
+            top = imgui.get_cursor_screen_pos()
+            self._footer()
+            footer_h = imgui.get_cursor_screen_pos().y - top.y
+            if max(abs(sections_h - self._sections_h), abs(footer_h - self._footer_h)) > EDITOR_GUI_LAYOUT_SLACK_PX:
+                self._frames_wanted = max(self._frames_wanted, 1)    # laid out with last frame's sizes
+            self._sections_h, self._footer_h = sections_h, footer_h
+            self.rects["panel_footer"] = Box(int(top.x), int(top.y), int(inner_w), int(self._footer_h))
         pos, size = imgui.get_window_pos(), imgui.get_window_size()
         self._panel_size = (size.x, size.y)
         self.panel_box = Box(int(pos.x), int(pos.y), int(size.x), int(size.y))
         self.windows.append(self.panel_box)
         imgui.end()
 
+    def _footer(self) -> None:
+        """The panel's pinned lines: the status message, the frame time, the hint."""
+        ed = self.ed
+        imgui.push_text_wrap_pos(0.0)
+        # the status line keeps EDITOR_GUI_FOOTER_MESSAGE_LINES lines even when shorter or gone, so the
+        # sections above do not jump each time a message comes and goes
+        line = imgui.get_text_line_height_with_spacing()
+        y0 = imgui.get_cursor_pos().y
+        if ed.message and time.perf_counter() - ed.message_time < MESSAGE_SECONDS:
+            imgui.text_colored(YELLOW, ed.message)
+        used = imgui.get_cursor_pos().y - y0
+        if used < EDITOR_GUI_FOOTER_MESSAGE_LINES * line:
+            imgui.dummy(imgui.ImVec2(1.0, EDITOR_GUI_FOOTER_MESSAGE_LINES * line - used - imgui.get_style().item_spacing.y))
+        info = ed.viewport.last_info
+        if ed.session is not None and info is not None and not isinstance(info, dict):
+            what = (f"{info.splats:,} {'Gaussians' if getattr(info, 'gaussians', False) else 'splats'}"
+                    + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else ""))
+            imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {ed.frame_ms:.0f} ms")
+        imgui.text_disabled("F1: help   P: hide panels")
+        imgui.pop_text_wrap_pos()
+
     def _sections(self) -> None:
         s = self.ed.session
         st = s.stats()
-        imgui.text(f"{s.cloud.n:,} splats   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        imgui.push_text_wrap_pos(0.0)
+        imgui.text(f"{model_summary(s.cloud)}   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        imgui.pop_text_wrap_pos()
+        self._rect("panel_summary")
         if s.manip is not None:               # the live readout of a running move
             imgui.text_colored(YELLOW, s.manip.readout())
             imgui.push_text_wrap_pos(0.0)
@@ -349,10 +375,12 @@ class EditorGui:
         if d is not None:
             imgui.text_colored(RED if d.exceeds_warn else imgui.ImVec4(0.92, 0.92, 0.92, 1.0),
                                f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
-        info = self.ed.viewport.last_info
-        if info is not None and not isinstance(info, dict):
-            what = f"{info.splats:,} splats" + (" LOD" if info.lod else "") + (f" 1/{info.div}" if info.div > 1 else "")
-            imgui.text_disabled(f"frame {info.ms:.0f} ms ({what}), total {self.ed.frame_ms:.0f} ms")
+            source = gui_overlay.ov.distortion_source(s)
+            if source:
+                imgui.push_text_wrap_pos(0.0)
+                imgui.text_disabled(source)
+                imgui.pop_text_wrap_pos()
+                self._rect("distortion_source")
 
     def _deformation(self) -> None:
         ed, s = self.ed, self.ed.session
@@ -419,7 +447,8 @@ class EditorGui:
             for k, text in enumerate(labels):
                 here = k == hist.position
                 saved = " (saved)" if k == hist.saved_pos else ""
-                if imgui.selectable(f"{k}. {text or 'state'}{saved}##h{k}", here)[0] and not here:
+                name = (text or "state")[:1].upper() + (text or "state")[1:]
+                if imgui.selectable(f"{k}. {name}{saved}##h{k}", here)[0] and not here:
                     self.jump(k)
                 if imgui.is_item_visible():
                     self._rect(f"history_{k}")
@@ -462,22 +491,4 @@ class EditorGui:
         imgui.end()
 
     def _question(self, w: int, h: int) -> None:
-        ed = self.ed
-        from splatedit.app.panel import open_question
-        if ed.confirm_open is not None:
-            lines = open_question(ed)
-        elif ed.confirm_quit:
-            lines = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing", "(Ctrl+S saves)")
-        elif ed.prompt is not None:
-            lines = ("Save as (type a path; Enter: save, Esc: cancel):",
-                     ed.prompt + ("" if ed.prompt_fresh else "_"))
-        else:
-            return
-        imgui.set_next_window_pos(imgui.ImVec2(w / 2, h / 2), imgui.Cond_.always, imgui.ImVec2(0.5, 0.5))
-        imgui.set_next_window_bg_alpha(0.95)
-        imgui.begin("##question", None, imgui.WindowFlags_.no_decoration.value
-                    | imgui.WindowFlags_.always_auto_resize.value | imgui.WindowFlags_.no_inputs.value)
-        imgui.text_colored(YELLOW, lines[0])
-        for t in lines[1:]:
-            imgui.text(t)
-        imgui.end()
+        gui_questions.draw_question(self, w, h)

@@ -278,7 +278,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.CURVE, "Enter / Esc", "apply the bent curve as an edit (the curve is consumed) / discard moves"),
     # ---- display
     Binding(S.DISPLAY, "D", "distortion heat map on / off: the support coloured by stretch (1x grey .. 3x red)\n"
-            "(the panel shows \"stretch max N.Nx, K > 3x\" while a pose is moved)", Action.DISTORTION_MAP,
+            "(the panel shows \"stretch max N.Nx, K > 3x\" while a pose is moved, then of the last\n"
+            "committed edit until the next change)", Action.DISTORTION_MAP,
             ("d",)),
     Binding(S.DISPLAY, "", "", Action.DISTORTION_MAP, ("d",), C.MANIP),
     Binding(S.DISPLAY, "M", "colours: the file's colours / uniform grey shading (for dark or colourless scans)",
@@ -296,9 +297,11 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.FILE, "Ctrl+Z / Ctrl+Shift+Z", "undo / redo (edits and selections; Ctrl+Y also redoes)", Action.UNDO,
             ("ctrl+z",)),
     Binding(S.FILE, "", "", Action.REDO, ("ctrl+shift+z", "ctrl+y")),
-    Binding(S.FILE, "Ctrl+S", "save <name>-edited.ply (+ <name>-edited.edits.json edit script)", Action.SAVE,
+    Binding(S.FILE, "Ctrl+S", "save <name>-edited.ply (+ <name>-edited.edits.json edit script); without an edit,\n"
+            "or with nothing new since the last save, it says so and writes nothing", Action.SAVE,
             ("ctrl+s",)),
-    Binding(S.FILE, "Ctrl+Shift+S", "save as: type a path, Enter", Action.SAVE_AS, ("ctrl+shift+s",)),
+    Binding(S.FILE, "Ctrl+Shift+S", "save as: edit the proposed path (Backspace deletes a character;\n"
+            "Ctrl+A selects all, Ctrl+U or Ctrl+Backspace clears), Enter saves, Esc cancels", Action.SAVE_AS, ("ctrl+shift+s",)),
     Binding(S.FILE, "Ctrl+E", "export only the edit script", Action.EXPORT_SCRIPT, ("ctrl+e",)),
     Binding(S.FILE, "Ctrl+O", "open another model in this window: the file browser (below); asks first when\n"
             "there are unsaved changes (Y opens without saving, N or Esc stays)", Action.OPEN, ("ctrl+o",), C.ANY),

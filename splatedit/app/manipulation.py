@@ -174,11 +174,25 @@ class Manipulation:
         ax = f" {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
         if self.mode == GRAB:
             d = self._translation(typed)
-            return (f"distance{ax} {float(np.linalg.norm(d)):.4g}   "
-                    f"({d[0]:+.3g}, {d[1]:+.3g}, {d[2]:+.3g}){src}")
+            return f"distance{ax} {_num(self._distance(d), '.4g')}   ({', '.join(_num(v) for v in d)}){src}"
         if self.mode == ROTATE:
             return f"angle{ax} {self._angle_deg(typed):+.1f} deg{src}"
         return f"factor{ax} {self._factor(typed):.3f}x{src}"
+
+    def _distance(self, d: np.ndarray) -> float:
+        """The grab's main figure: signed along the constraint axis, else the length."""
+        return float(d[self.axis]) if self.axis is not None else float(np.linalg.norm(d))
+
+    def label(self) -> str:
+        """The move's name in the edit history: ``Grab 0.12``, ``Grab -0.05
+        along X``, ``Rotate 45 deg about Z``, ``Scale x1.38``."""
+        typed = self._typed_ok()
+        axis = AXIS_NAMES[self.axis] if self.axis is not None else None
+        if self.mode == GRAB:
+            return f"Grab {_num(self._distance(self._translation(typed)))}" + (f" along {axis}" if axis else "")
+        if self.mode == ROTATE:
+            return f"Rotate {_num(self._angle_deg(typed), '.3g')} deg about {axis or 'the view axis'}"
+        return f"Scale x{_num(self._factor(typed))}" + (f" along {axis}" if axis else "")
 
     def describe(self) -> str:
         name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]
@@ -189,3 +203,9 @@ class Manipulation:
         if bad:
             val += f"  ({bad})"
         return f"{name}{ax}{val}   (Enter/click: apply, Esc/right click: cancel)"
+
+
+def _num(v: float, fmt: str = ".3g") -> str:
+    """``v`` formatted with ``fmt``, never as "-0" (a component rounding to zero reads 0)."""
+    text = format(float(v), fmt)
+    return "0" if float(text) == 0 else text

@@ -197,16 +197,30 @@ DISTORTION_OK_RGB = (235, 235, 235)
 DISTORTION_WARN_RGB = (255, 110, 90)
 
 
-def distortion_lines(stats, heat_map: bool) -> list:
+def distortion_lines(stats, heat_map: bool, source: str = "") -> list:
     """Panel lines of the distortion feedback: ``stretch max N.Nx, K > 3x``
     for the current pose (``stats``: a DistortionStats or None when nothing
-    is moved), red when splats exceed the warn threshold; plus the heat-map
-    legend while it is shown."""
+    is moved), red when splats exceed the warn threshold; ``source`` names
+    the committed edit they belong to when no move is live (see
+    :func:`distortion_source`); plus the heat-map legend while it is shown."""
     out = []
     if stats is not None:
         text = (f"stretch max {stats.max_stretch:.1f}x, {stats.n_above_warn:,} > {stats.warn:g}x"
                 f"   area x{stats.min_area_change:.2f}..{stats.max_area_change:.2f}")
         out.append((text, DISTORTION_WARN_RGB if stats.exceeds_warn else DISTORTION_OK_RGB))
+        if source:
+            out.append((source, DISTORTION_OK_RGB))
     if heat_map:
         out.append(("heat map (D): 1x grey  1.5x yellow  2x orange  3x red  4x+ dark red", (255, 200, 120)))
     return out
+
+
+def distortion_source(session) -> str:
+    """Which edit the distortion figures (and the heat map) show when no
+    move is live: ``of edit 3: Grab 0.12 (until the next change)``; "" for
+    the live pose or when there is none."""
+    last = session.shown_edit()
+    dc = session.current_dc()
+    if last is None or (dc is not None and dc.any()):
+        return ""
+    return f"of edit {last.number}: {last.label} (until the next change)"

@@ -9,7 +9,7 @@ from dataclasses import dataclass
 
 from splatedit.app import overlay as ov
 from splatedit.app import selection_tools as seltools
-from splatedit.app.gaussian_doc import describe, gaussians_of
+from splatedit.app.gaussian_doc import model_summary
 from splatedit.select.selection import SUPPORT
 from splatedit.app.keymap import help_lines
 from splatedit.app.tools.curve import CURVE_RGB
@@ -66,8 +66,7 @@ def panel_lines(ed) -> list:
         return [f"splatedit - opening {ed.path}", "F1: help   Ctrl+O: open another model"]
     st = s.stats()
     brush = ed.brush
-    scene = gaussians_of(s.cloud)
-    lines = [f"{ed.cloud_name}   {s.cloud.n:,} splats" if scene is None else f"{ed.cloud_name}   {describe(scene)}"]
+    lines = [f"{ed.cloud_name}   {model_summary(s.cloud)}"]
     tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
     erase = "  ERASE" if brush.erase_toggle else ""
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"
@@ -100,7 +99,7 @@ def panel_lines(ed) -> list:
         lines.append("solver: paint a support (1) then a handle (2)")
     if s.manip is not None:
         lines.append((s.manip.describe(), (255, 230, 120)))
-    lines += ov.distortion_lines(s.distortion(), ed.viewport.distortion_map)
+    lines += ov.distortion_lines(s.distortion(), ed.viewport.distortion_map, ov.distortion_source(s))
     vp = ed.viewport
     up = ed.camera.up
     if up.label != "+Y" or vp.grey or vp.splat_scale != 1.0:     # only when not the defaults
@@ -219,6 +218,14 @@ def open_question(ed) -> tuple | None:
             "(Ctrl+S saves)")
 
 
+def save_prompt_lines(ed) -> tuple:
+    """The save-as prompt's rows: title, the path being typed (a ``_`` cursor
+    at its end; in ``[ ]`` when Ctrl+A selected all of it), the keys' hint."""
+    text = f"[{ed.prompt}]  (selected: typing replaces it)" if ed.prompt_selected else ed.prompt + "_"
+    return ("Save as (edit the path; Enter: save, Esc: cancel):", text,
+            "Backspace deletes a character; Ctrl+A selects all; Ctrl+U or Ctrl+Backspace clears")
+
+
 def error_box(ed, w: int, h: int, y: int) -> list:
     """The error box (a load / save error) at the top centre below ``y``,
     shown until dismissed; records its rectangle in ``ed.error_rect``."""
@@ -278,8 +285,7 @@ def compose_overlay(ed, w: int, h: int) -> list:
         center_msg = ("Unsaved changes.", "Y / Q / Esc: quit without saving     N: keep editing",
                       "(Ctrl+S saves)")
     elif ed.prompt is not None:
-        center_msg = ("Save as (type a path; Enter: save, Esc: cancel):",
-                      ed.prompt + ("" if ed.prompt_fresh else "_"))
+        center_msg = save_prompt_lines(ed)
     if center_msg:
         img = ov.text_panel(center_msg, size=16, bg=(40, 20, 20, 235), min_width=420)
         patches.append(ov.Patch((w - img.shape[1]) // 2, (h - img.shape[0]) // 2, img))

@@ -62,6 +62,10 @@ class RecentFiles:
                 out.append(p)
         return out[:RECENT_MAX]
 
+    def clear(self) -> None:
+        """Forget every recent file (raises like :meth:`add`)."""
+        self._write([])
+
     def add(self, path) -> None:
         """Put ``path`` first (made absolute) and write the list.
 
@@ -81,3 +85,10 @@ class RecentFiles:
                                  f"{exc.strerror or exc}") from None
         text = json.dumps({"version": RECENT_VERSION, "files": [str(f) for f in files]}, indent=1)
         atomic_write_text(self.path, text + "\n")
+
+
+def menu_labels(files: list[Path]) -> list[str]:
+    """Menu rows for ``files``: the file name, followed by its folder
+    (``scan.ply  (/data/site-a)``) when another entry has the same name."""
+    names = [f.name for f in files]
+    return [f"{f.name}  ({f.parent})" if names.count(f.name) > 1 else f.name for f in files]

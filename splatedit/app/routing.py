@@ -79,9 +79,8 @@ class EventRouting:
         if self.browser.shown and self.prompt is None and self.confirm_open is None:
             self.browser.type_char(e.char)
             return
-        if self.prompt is not None and e.char.isprintable():
-            self.prompt = e.char if self.prompt_fresh else self.prompt + e.char
-            self.prompt_fresh = False
+        if self.prompt is not None:
+            self.prompt_char(e.char)
 
     def on_scroll(self, e) -> None:
         if self.browser.shown:
@@ -158,17 +157,13 @@ class EventRouting:
         k = e.key
         ctrl, shift = bool(e.mods & g.MOD_CONTROL), bool(e.mods & g.MOD_SHIFT)
         if self.prompt is not None:
-            self.prompt_key(k)
+            self.prompt_key(k, e.mods)
             return
-        if self.confirm_quit:
-            if k in (g.KEY_Y, g.KEY_Q):
-                self.running = False
-            else:                      # N, Esc or anything else: stay
-                self.confirm_quit = False
-                self.say("quit cancelled")
+        if self.confirm_quit:              # N, Esc or anything else: stay
+            self.answer_quit(k in (g.KEY_Y, g.KEY_Q))
             return
         if self.confirm_open is not None:
-            files.answer_open(self, k == g.KEY_Y)
+            self.answer_open(k == g.KEY_Y)
             return
         if self.browser.shown:
             action = lookup(k, ctrl, shift, [Context.BROWSER])

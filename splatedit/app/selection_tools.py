@@ -32,7 +32,7 @@ import numpy as np
 
 from splatedit.app import revision
 from splatedit.select.selection import SUPPORT, Selection
-from splatedit.tolerances import EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
+from splatedit.tolerances import CLOSURE_ISLAND_RINGS, EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
 
 #: brush modes: the 3D sphere brush (default) and the visible-only brush
 BRUSH_3D, BRUSH_VISIBLE = "3d", "visible"
@@ -172,18 +172,25 @@ def set_target(sel: Selection, target: str, mask: np.ndarray) -> bool:
     return changed
 
 
-def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = None) -> np.ndarray:
+def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = None,
+                  within: Selection | None = None) -> np.ndarray:
     """Close ``sel`` in place (support and every handle, see
     :func:`~splatedit.select.closure.close_selection`; ``changed``: the splats
     painted or erased since the last closure, so only their neighbourhood is
     worked on); returns the (n,) bool mask of the splats closure added to the
-    support or a handle."""
+    support or a handle.  ``within`` (the selection before an erase stroke):
+    the closed support and handles are cut to it, so erasing never makes a
+    selection grow (closure may only give back what the stroke erased)."""
     from splatedit.select.closure import close_selection
     if not sel.support.any():
         return np.zeros(sel.n, bool)
     res = close_selection(cloud, sel.support, list(sel.handles), graph=graph, changed=changed)
     support = np.asarray(res.support, bool)
     handles = [np.asarray(h, bool) for h in res.handles]
+    if within is not None:
+        support = support & within.support
+        handles = [h & within.handles[i] if i < len(within.handles) else h & within.support
+                   for i, h in enumerate(handles)]
     before = [sel.support] + list(sel.handles)
     added = np.zeros(sel.n, bool)
     for b, a in zip(before, [support] + handles):
@@ -199,6 +206,21 @@ def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = Non
         sel.handles.append(np.zeros(sel.n, bool))
     sel.active = min(sel.active, len(sel.handles) - 1)
     return added
+
+
+def erase_refill_message(before: np.ndarray, stroked: np.ndarray, after: np.ndarray, what: str) -> str:
+    """The status line after an erase stroke of the ``what`` mask (support /
+    handle): ``before`` the stroke, ``stroked`` as the brush left it,
+    ``after`` closure ((n,) bool each).  Says when closure filled (part of)
+    the erased hole again; "" when it kept everything the stroke erased."""
+    erased = before & ~stroked
+    refilled = int((erased & after).sum())
+    if not refilled:
+        return f"erased {int((before & ~after).sum()):,} splats from the {what}" if erased.any() else ""
+    kept = int((before & ~after).sum())
+    return (f"closure refilled {refilled:,} of the {int(erased.sum()):,} splats erased from the {what} "
+            f"({kept:,} stay erased): closure fills holes up to about {2 * CLOSURE_ISLAND_RINGS} point "
+            f"spacings across; erase a larger patch, or from the {what}'s edge")
 
 
 # ------------------------------------------------------------------ overlay
@@ -316,10 +338,11 @@ class SelectionTools:
         return None
 
     # -------------------------------------------------------- closure
-    def close(self, session) -> int | None:
+    def close(self, session, within: Selection | None = None) -> int | None:
         """Close the session's selection in place (no history entry); returns
         the number of splats closure added, or None when the graph is not
-        ready yet (``closure_pending`` is then set)."""
+        ready yet (``closure_pending`` is then set).  ``within``: see
+        :func:`apply_closure` (an erase stroke's selection before it)."""
         g = self.graph(session.cloud)
         if g is None:
             self.closure_pending = True
@@ -331,7 +354,7 @@ class SelectionTools:
             changed = last[1] ^ sel.support
             for before, now in zip(last[2], sel.handles):
                 changed |= before ^ now
-        added = apply_closure(sel, session.cloud, g, changed)
+        added = apply_closure(sel, session.cloud, g, changed, within)
         self._last_closed = (session.cloud, sel.support.copy(), [h.copy() for h in sel.handles])
         self.closure_pending = False
         self.last_added = int(added.sum())

@@ -74,6 +74,20 @@ from splatedit.tolerances import EDITOR_COMMIT_SYNC_MS, IQR_DEFAULT_TOL, RENDER_
 
 
 @dataclass(frozen=True)
+class LastEdit:
+    """The last committed edit, kept to show its distortion after the commit:
+    the cloud it deformed, its basis and dC (deforming ``cloud`` by ``dc``
+    gives the committed cloud), its history label and number (1-based), and
+    the history state it produced (it is shown while that state is current)."""
+    cloud: object
+    basis: object
+    dc: object
+    label: str
+    number: int
+    state: object
+
+
+@dataclass(frozen=True)
 class SessionStats:
     """What the panel and the status file show of a session."""
     state: str                  # select / fitting / ready / manipulate / committing / error
@@ -138,6 +152,8 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.commit_outcome: CommitOutcome | None = None
         self._rig_before_commit = None
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
+        self.last_edit: LastEdit | None = None
+        self._erasing = False       # the stroke being painted erases (its history name)
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)
@@ -163,13 +179,14 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         if self.manip is not None or self.committing:
             return False
         changed = self.selection.paint(indices, self.brush_target, erase)
+        self._erasing = erase
         if changed:
             self.version += 1
         return changed
 
     def end_stroke(self, changed: bool) -> None:
         if changed:
-            self.push(f"paint {self.brush_target}")
+            self.push(f"{'Erase' if self._erasing else 'Paint'} {self.brush_target}")
 
     def clear(self, target: str | None = None) -> None:
         if self.manip is None and not self.committing and self.selection.clear(target):
@@ -283,13 +300,54 @@ class Session(SessionHistory, RigEditing, PoseEditing):
 
     def distortion(self):
         """:class:`~splatedit.deform.distortion.DistortionStats` of the support
-        for the current pose (live manipulation included), or None without a
-        basis, when nothing is moved, or before the first figures are ready
-        (computed off the UI thread: :class:`~splatedit.app.distortion_feed.DistortionFeed`)."""
+        for the current pose (live manipulation included), else of the last
+        committed edit while it is :meth:`shown_edit`; None without either, or
+        before the first figures are ready (computed off the UI thread:
+        :class:`~splatedit.app.distortion_feed.DistortionFeed`)."""
         dc = self.current_dc()
-        if dc is None or not dc.any():
+        if dc is not None and dc.any():
+            return self._distortion.stats(self.basis, self.cloud, dc)
+        last = self.shown_edit()
+        return None if last is None else self._distortion.stats(last.basis, last.cloud, last.dc)
+
+    def edit_label(self) -> str:
+        """The history name of the edit a commit now makes: the running
+        move's (``Grab 0.12``, ``Rotate 45 deg about Z``, ``Scale x1.38``,
+        a typed transform), else what the pending pose moves (``Curve``,
+        ``Move 2 handles``, ``Curve + 1 handle``)."""
+        if self.manip is not None and self.single_rig:
+            return self.manip.label()
+        hidx, curve = self.basis_groups
+        moved = sum(1 for k in hidx if not np.array_equal(self.handle_matrix(k), np.eye(4)))
+        parts = (["Curve"] if curve is not None and self.live_curve_moves().any() else [])
+        if moved:
+            parts.append(f"Move {moved} handle" + ("s" if moved > 1 else ""))
+        return " + ".join(parts) or "Edit"
+
+    def remember_edit(self, before, basis, dc) -> None:
+        """Keep the edit just committed (``before`` deformed by ``dc`` of
+        ``basis``) for :meth:`shown_edit`."""
+        cur = self.history.current
+        self.last_edit = LastEdit(before, basis, dc, cur.label, len(self.edits), cur)
+
+    def shown_edit(self) -> LastEdit | None:
+        """The last committed edit while the document is still what it made
+        (no change since: a stroke, an undo, another edit ... ends it) and no
+        move is live or pending; else None."""
+        last = self.last_edit
+        if last is None or self.history.current is not last.state or self.manip is not None or self.pose_pending:
             return None
-        return self._distortion.stats(self.basis, self.cloud, dc)
+        return last
+
+    def display_state(self, heat_map: bool) -> tuple:
+        """(cloud, basis, dC) the viewport draws: the document with the live
+        pose, or with the heat map on and nothing moving, the last committed
+        edit's cloud, basis and dC (:meth:`shown_edit`: the same deformed
+        surface, its stretch coloured)."""
+        last = self.shown_edit() if heat_map else None
+        if last is not None:
+            return last.cloud, last.basis, last.dc
+        return self.cloud, self.basis, self.current_dc() if self.basis is not None else None
 
     # ---------------------------------------------------------------- export
     def edit_script(self):

@@ -144,7 +144,8 @@ class PoseEditing:
         if self.single_rig:
             return "commit" if self.commit() else ""
         moved = not np.array_equal(self.manip.matrix(), np.eye(4))
-        what = "move handle" if self.manip_target[0] == "handle" else "move curve point"
+        t = self.manip_target
+        what = f"{self.manip.label()} ({'handle' if t[0] == 'handle' else 'curve point'} {t[1] + 1}, pending)"
         self._bake()
         if moved:
             self.push(what)
@@ -199,6 +200,7 @@ class PoseEditing:
         from splatedit.app.commit_job import CommitPlan
         from splatedit.script import Curve, Edit, Matrix
         from splatedit.select.regions import Indices
+        label = self.edit_label()                     # before the running move is baked
         inputs = self.inputs(live=True)
         moves = self.live_curve_moves(live=True)
         hidx, curve = self.basis_groups
@@ -220,7 +222,7 @@ class PoseEditing:
             return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
                         fill_holes=False,  # the editor's closed selection, replayed as is
                         deformation=mode)
-        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles))
+        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles), label)
 
     def _land(self, plan, result) -> None:
         """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the
@@ -231,7 +233,8 @@ class PoseEditing:
         self.fit.clear()
         self.rig.reset_pose(plan.handles)
         self.rig.clear_curve()
-        self.push("edit")
+        self.push(plan.label)
+        self.remember_edit(plan.cloud, plan.basis, plan.dc)
 
     @property
     def committing(self) -> bool:

@@ -60,7 +60,7 @@ def status_dict(ed) -> dict:
           "saved": str(ed.saved_path) if ed.saved_path else None,
           "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
-          "browser": _browser(ed.browser),
+          "browser": _browser(ed.browser), "message": ed.message,
           "script": str(ed.saved_script) if ed.saved_script else None}
     gui = getattr(ed, "gui", None)
     st["gui"] = gui is not None
@@ -68,6 +68,8 @@ def status_dict(ed) -> dict:
         st["gui_rects"] = {k: [b.x, b.y, b.w, b.h] for k, b in sorted(gui.rects.items())}
         st["gui_wants_mouse"] = bool(gui.wants_mouse)
         st["gui_wants_keyboard"] = bool(gui.wants_keyboard)
+        st["gui_menu_open"] = bool(gui.menu_open)
+        st["gui_panel_scrolls"] = bool(gui.panel_scrolls)
         st["background"] = [round(float(x), 4) for x in vp.background[:3]]
         st["distortion_map"] = bool(vp.distortion_map)
     if s is None:

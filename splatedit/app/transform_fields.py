@@ -71,6 +71,18 @@ class TransformInput:
         self.degrees = 0.0
         self.factor = 1.0
 
+    def label(self) -> str:
+        """The edit's name in the history: ``Move (0.05, 0, 0), Rotate 30 deg, Scale x1.2``."""
+        from splatedit.app.manipulation import _num
+        parts = []
+        if any(self.translate):
+            parts.append(f"Move ({', '.join(_num(v) for v in self.translate)})")
+        if self.degrees != 0:
+            parts.append(f"Rotate {_num(self.degrees)} deg")
+        if self.factor != 1.0:
+            parts.append(f"Scale x{_num(self.factor)}")
+        return ", ".join(parts) or "Transform"
+
     def describe(self) -> str:
         t = self.translate
         return (f"move ({t[0]:+.4g}, {t[1]:+.4g}, {t[2]:+.4g})  rotate {self.degrees:+.4g} deg about "
@@ -80,11 +92,15 @@ class TransformInput:
 class FixedManipulation(Manipulation):
     """A manipulation whose matrix was typed into the fields (not the mouse's)."""
 
-    def __init__(self, fixed: np.ndarray, pivot, text: str):
+    def __init__(self, fixed: np.ndarray, pivot, text: str, label: str = "Transform"):
         view = ViewInfo(np.eye(3)[0], np.eye(3)[1], np.eye(3)[2], (0.0, 0.0), 1.0)
         super().__init__(GRAB, np.asarray(pivot, float), view, (0.0, 0.0))
         self._fixed = np.array(fixed, float)
         self._text = text
+        self._label = label
+
+    def label(self) -> str:
+        return self._label
 
     def matrix(self) -> np.ndarray:
         return self._fixed.copy()
@@ -175,7 +191,7 @@ def apply_transform(ed, fields: TransformInput) -> bool:
     if bad is not None:
         ed.say(f"transform: {bad}")
         return False
-    s.manip = FixedManipulation(fields.matrix(t.position), t.position, fields.describe())
+    s.manip = FixedManipulation(fields.matrix(t.position), t.position, fields.describe(), fields.label())
     s.manip_target = (t.kind.value, t.index)
     ed.gizmo.finish_manip()
     return True

@@ -163,3 +163,30 @@ def test_3d_brush_paints_the_ear_through_and_the_grab_does_not_tear(xvfb, tmp_pa
     assert len(frag_out) == len(frag_in) and frag_out[-1] >= frag_in[-1], report
     # --- `splatedit deform` with the exported script replays the saved file exactly
     assert_replay_reproduces(script_path, out, tmp_path)
+
+
+def test_an_erase_stroke_in_a_support_never_grows_it_and_says_when_closure_refills(xvfb, tmp_path):
+    """Ctrl+drag across the middle of a painted support: the support ends up
+    no bigger than before the stroke (the tester saw 9158 -> 9209), and the
+    status line says whether closure refilled the erased splats."""
+    from tests.app.window_harness import _foreground_centre
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 90)
+        cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
+        ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright", "bracketright")
+        ed.xdo("mousemove", cx - 60, cy - 30, "mousedown", "1", "mousemove", cx + 60, cy - 30,
+               "mousemove", cx + 60, cy, "mousemove", cx - 60, cy, "mousemove", cx - 60, cy + 30,
+               "mousemove", cx + 60, cy + 30, "sleep", "0.1", "mouseup", "1")
+        s = ed.idle(lambda s: s["support"] > 1000 and s["history"] == 2, "support painted")
+        before = s["support"]
+        ed.xdo("key", "bracketleft", "bracketleft", "bracketleft", "bracketleft", "bracketleft", "bracketleft")
+        ed.xdo("mousemove", cx - 15, cy, "keydown", "ctrl", "mousedown", "1", "mousemove", cx, cy,
+               "mousemove", cx + 15, cy, "sleep", "0.1", "mouseup", "1", "keyup", "ctrl")
+        s = ed.idle(lambda s: s["history"] == 3, "erase stroke")
+        assert s["support"] <= before
+        msg = s["message"]
+        assert msg.startswith("closure refilled") or msg.startswith("erased "), msg
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()

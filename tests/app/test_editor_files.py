@@ -226,3 +226,88 @@ def test_a_typed_path_that_matches_no_entry_is_opened_as_typed(ed, models):
         ed.on_char(types.SimpleNamespace(char=ch))
     key(ed, glfw.KEY_KP_ENTER)
     assert "load" not in ed.jobs and "no such file" in ed.error_box
+
+
+def test_a_newly_opened_model_gets_a_fresh_default_view_for_its_own_up_axis(ed, models):
+    """The old model's orbit angle (yaw 0.6, pitch 0.5 here) is not inherited:
+    a Z-up LAS opens at the first-open view about Z (yaw = pitch = 0), framed."""
+    from splatedit.io import read
+    las = models / "plane.las"
+    cloud = read(str(models / "b_plane.ply"))
+    # the plane is z = const: as a LAS (Z-up by format) it is a ground plane
+    write(str(las), cloud)
+    ed.cam.screen_offset = (0.3, -0.2)
+    ed.open_path(las)
+    ed.settle()
+    assert ed.path == las and ed.camera.up.label.endswith("Z")
+    cam = ed.cam
+    assert cam.yaw == 0.0 and cam.pitch == 0.0
+    assert np.allclose(cam.up_axis, [0, 0, 1])
+    # framed: the model's centre is on screen in the framed area and the camera looks along the ground
+    lo, hi = ed.session.cloud.bounds()
+    _, _, back = cam.basis()
+    assert abs(back @ [0, 0, 1]) < 1e-9
+    px, depth = cam.project((lo + hi) / 2, W, H)
+    assert depth[0] > 0 and 0 < px[0, 0] < W and 0 < px[0, 1] < H
+
+
+def _chars(ed, text):
+    """Type ``text`` as a window does: each character's key press, then its character event."""
+    for ch in text:
+        code = getattr(glfw, f"KEY_{ch.upper()}", glfw.KEY_SLASH if ch == "/" else glfw.KEY_PERIOD)
+        key(ed, code)
+        ed.on_char(types.SimpleNamespace(char=ch))
+
+
+def test_save_as_prompt_backspace_deletes_one_character_and_typing_appends(ed, models, tmp_path):
+    """The proposed path is edited, not replaced: Backspace x3 and "las" turn
+    the suggested .ply into .las; Ctrl+A selects all (typing replaces it,
+    Backspace clears it); Ctrl+U and Ctrl+Backspace clear; Esc cancels."""
+    from splatedit.app.panel import save_prompt_lines
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
+    proposed = ed.prompt
+    assert proposed == str(models / "a_plane-edited.ply")
+    key(ed, glfw.KEY_BACKSPACE)
+    assert ed.prompt == proposed[:-1]
+    key(ed, glfw.KEY_BACKSPACE)
+    key(ed, glfw.KEY_BACKSPACE)
+    _chars(ed, "las")
+    assert ed.prompt == str(models / "a_plane-edited.las")
+    rows = save_prompt_lines(ed)
+    assert rows[1] == ed.prompt + "_" and "Ctrl+A" in rows[2] and "Ctrl+U" in rows[2]
+    key(ed, glfw.KEY_A, glfw.MOD_CONTROL)                   # select all: typing replaces
+    assert ed.prompt_selected and ed.prompt in save_prompt_lines(ed)[1]
+    _chars(ed, "/tmp/x.ply")
+    assert ed.prompt == "/tmp/x.ply" and not ed.prompt_selected
+    key(ed, glfw.KEY_A, glfw.MOD_CONTROL)                   # select all, Backspace clears
+    key(ed, glfw.KEY_BACKSPACE)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_U, glfw.MOD_CONTROL)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_BACKSPACE, glfw.MOD_CONTROL)
+    assert ed.prompt == ""
+    _chars(ed, "abc")
+    key(ed, glfw.KEY_ESCAPE)
+    assert ed.prompt is None and "save" not in ed.jobs
+
+
+def test_ctrl_s_with_no_edits_says_so_instead_of_writing_a_copy(ed, models):
+    paint_regions(ed.session)                       # a selection only: no edit
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)
+    assert ed.messages[-1] == "nothing to save (no edits)"
+    assert "save" not in ed.jobs and ed.save_as is None
+    assert not (models / "a_plane-edited.ply").exists()
+    s = ed.session
+    assert s.wait_fit() and s.begin(GRAB, view(), (100, 100))
+    s.manip.set_axis(2)
+    for ch in "0.3":
+        s.manip.type_char(ch)
+    assert s.commit()
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)           # an edit: saved
+    ed.settle()
+    assert (models / "a_plane-edited.ply").exists() and not s.dirty
+    key(ed, glfw.KEY_S, glfw.MOD_CONTROL)           # again, nothing new: not written twice
+    assert ed.messages[-1].startswith("nothing to save (no changes since it was saved to a_plane-edited.ply")
+    assert "save" not in ed.jobs

@@ -124,7 +124,7 @@ def test_full_edit_session(xvfb, tmp_path):
         near = lambda a, b, tol: float(np.linalg.norm(np.subtract(a, b))) < tol  # noqa: E731
         s = ed.idle(lambda s: near(s["camera"]["pivot"], cam0["pivot"], 0.03 * cam0["distance"])
                     and not near(s["camera"]["pivot"], panned, 0.06 * cam0["distance"]), "frame all")
-        # --- help overlay, save as (a typed path replaces the proposed one)
+        # --- help overlay, save as (Ctrl+A, then a typed path replaces the proposed one)
         ed.xdo("key", "F1")
         ed.wait(lambda s: s["help"], "help shown")
         ed.xdo("key", "F1")
@@ -132,7 +132,7 @@ def test_full_edit_session(xvfb, tmp_path):
         other = tmp_path / "typed.ply"
         ed.xdo("key", "ctrl+shift+s")
         ed.wait(lambda s: s["prompt"] == str(out), "save-as prompt")
-        ed.xdo("type", "--delay", "5", str(other))
+        ed.xdo("key", "ctrl+a", "type", "--delay", "5", str(other))    # select all, type a new path
         ed.wait(lambda s: s["prompt"] == str(other), "path typed")
         ed.xdo("key", "Return")
         ed.idle(lambda s: s["saved"] == str(other), "saved as")
@@ -165,7 +165,7 @@ def test_full_edit_session(xvfb, tmp_path):
         ring_out = tmp_path / "ring.ply"
         ed.xdo("key", "ctrl+shift+s")
         ed.wait(lambda s: s["prompt"] is not None, "save-as prompt for the ring edit")
-        ed.xdo("type", "--delay", "5", str(ring_out))
+        ed.xdo("key", "ctrl+u", "type", "--delay", "5", str(ring_out))   # clear, type a new path
         ed.wait(lambda s: s["prompt"] == str(ring_out), "ring path typed")
         ed.xdo("key", "Return")
         s = ed.idle(lambda s: s["saved"] == str(ring_out) and not s["dirty"], "ring edit saved")

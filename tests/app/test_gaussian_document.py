@@ -215,3 +215,14 @@ def test_two_handles_and_a_curve_draw_live_and_commit_as_one_edit(scene):
     assert (np.abs(live.astype(int) - before)[..., :3].max(axis=2) > 16).mean() > 0.01
     assert np.abs(live.astype(int) - committed)[..., :3].mean() < GS_REF_MEAN_TOL
     assert not np.array_equal(a, np.eye(4))
+
+
+def test_the_panel_names_gaussians_as_gaussians(scene):
+    """The panel's first line says "5,000 Gaussians (3dgs, SH degree 3)" as
+    the load message and README do, a plain cloud "N splats"."""
+    from splatedit.app.gaussian_doc import model_summary
+    doc = gaussian_document(scene)
+    assert model_summary(doc) == f"{len(scene):,} Gaussians ({scene.kind.value}, SH degree {scene.sh_degree})"
+    assert "splats" not in model_summary(doc)
+    plain = scene.proxy_splats()
+    assert model_summary(plain) == f"{plain.n:,} splats"

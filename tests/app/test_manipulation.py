@@ -28,7 +28,7 @@ def test_grab_readout_is_the_matrix_translation():
     assert m.readout().startswith("distance X 0.3")
     for ch in "-2":
         m.type_char(ch)
-    assert "(typed)" in m.readout() and _number(m.readout(), "distance X") == 2.0
+    assert "(typed)" in m.readout() and _number(m.readout(), "distance X") == -2.0   # signed along the axis
     assert np.allclose(m.matrix()[:3, 3], [-2.0, 0, 0])
 
 
@@ -48,3 +48,29 @@ def test_scale_readout_is_the_factor():
     m.mouse = (140.0, 100.0)                      # twice as far from the pivot's pixel
     assert math.isclose(_number(m.readout(), "factor"), 2.0)
     assert np.allclose(np.diag(m.matrix())[:3], 2.0)
+
+
+def test_grab_readout_is_signed_along_the_axis_and_never_shows_minus_zero():
+    """The tester's `distance X 0.1861 (-0.186, -0, -0)`: the main figure along
+    an axis keeps the move's sign and a zero component reads 0."""
+    m = Manipulation(GRAB, np.zeros(3), _view(), (100.0, 100.0))
+    m.set_axis(0)
+    m.mouse = (81.39, 100.0)                      # 18.61 px left: -0.1861 along X
+    text = m.readout()
+    assert text.startswith("distance X -0.1861 ") and "(-0.186, 0, 0)" in text and "-0," not in text
+    assert m.label() == "Grab -0.186 along X"
+
+
+def test_moves_name_their_history_entries():
+    m = Manipulation(ROTATE, np.zeros(3), _view(), (120.0, 100.0))
+    m.set_axis(2)
+    for ch in "45":
+        m.type_char(ch)
+    assert m.label() == "Rotate 45 deg about Z"
+    s = Manipulation(SCALE, np.zeros(3), _view(), (120.0, 100.0))
+    for ch in "1.38":
+        s.type_char(ch)
+    assert s.label() == "Scale x1.38"
+    g = Manipulation(GRAB, np.zeros(3), _view(), (100.0, 100.0))
+    g.mouse = (112.0, 100.0)
+    assert g.label() == "Grab 0.12"

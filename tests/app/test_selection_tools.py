@@ -180,3 +180,76 @@ def test_tool_with_closure_is_one_undo_step(bunny):
     assert t.highlighted(cloud) is None or t.highlighted(cloud).sum() == t.last_added
     assert s.undo() and np.array_equal(s.selection.support, before)
     s.close()
+
+
+def _erase_stroke(s, t, centre, radius, within):
+    """An erase stroke of the support (a ball of ``radius`` about ``centre``),
+    then the stroke's closure (cut to the selection before it when ``within``)."""
+    p = s.cloud.positions
+    before = s.selection.copy()
+    s.paint(np.flatnonzero(np.linalg.norm(p - centre, axis=1) < radius), erase=True)
+    stroked = s.selection.support.copy()
+    t.close(s, within=before if within else None)
+    return before.support, stroked, s.selection.support.copy()
+
+
+@pytest.mark.parametrize("within", [False, True])
+def test_an_erase_stroke_never_grows_the_support_and_says_when_closure_refills(bunny, within):
+    """A painted support with unclosed gaps at its rim (a notch); an erase
+    stroke in its middle: closure alone refills the hole *and* fills the rim
+    notch (the support grows: the tester's 9158 -> 9209); cut to the support
+    before the stroke, it only gives back erased splats, and the message says
+    the hole was refilled."""
+    from splatedit.app.session import Session
+    cloud, graph = bunny
+    p = cloud.positions
+    s = Session(cloud, fit_sync=True)
+    t = tools.SelectionTools()
+    t._store(cloud, graph)
+    c = p[np.argmax(p[:, 0])]
+    d = np.linalg.norm(p - c, axis=1)
+    rim = p[np.flatnonzero((d > 0.105) & (d < 0.12))[0]]
+    notch = np.linalg.norm(p - rim, axis=1) < 0.012           # a gap at the rim, never closed
+    s.paint(np.flatnonzero((d < 0.12) & ~notch))
+    s.end_stroke(True)
+    inside = np.flatnonzero(s.selection.support & (d < 0.04))[0]
+    before, stroked, after = _erase_stroke(s, t, p[inside], 0.02, within)
+    erased = before & ~stroked
+    assert erased.sum() > 10
+    grown = int((after & ~before).sum())
+    if not within:
+        assert grown > 0                     # the bug: closure refilled the notch too
+    else:
+        assert grown == 0 and after.sum() <= before.sum()
+        assert after[erased].all()           # the small hole is filled again ...
+        msg = tools.erase_refill_message(before, stroked, after, "support")
+        assert msg.startswith(f"closure refilled {int(erased.sum()):,} of the {int(erased.sum()):,} splats")
+        assert "point spacings across" in msg
+    s.close()
+
+
+def test_an_erase_stroke_at_the_edge_mostly_stays_erased_and_the_message_counts_it(bunny):
+    from splatedit.app.session import Session
+    cloud, graph = bunny
+    p = cloud.positions
+    s = Session(cloud, fit_sync=True)
+    t = tools.SelectionTools()
+    t._store(cloud, graph)
+    c = p[np.argmax(p[:, 0])]
+    d = np.linalg.norm(p - c, axis=1)
+    s.paint(np.flatnonzero(d < 0.12))
+    s.end_stroke(True)
+    t.close(s)
+    edge = p[np.flatnonzero(s.selection.support & (d > 0.11))[0]]
+    before, stroked, after = _erase_stroke(s, t, edge, 0.03, True)
+    erased = before & ~stroked
+    kept = int((before & ~after).sum())
+    assert erased.sum() > 10 and not (after & ~before).any() and kept > 0.5 * erased.sum()
+    msg = tools.erase_refill_message(before, stroked, after, "support")
+    refilled = int(after[erased].sum())           # closing the rim's gaps may give a few back
+    if refilled:
+        assert msg.startswith(f"closure refilled {refilled:,} of the {int(erased.sum()):,} splats erased "
+                              f"from the support ({kept:,} stay erased)")
+    else:
+        assert msg == f"erased {kept:,} splats from the support"
+    s.close()

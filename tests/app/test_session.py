@@ -176,3 +176,22 @@ def test_rotation_mode_is_the_default_cycles_and_is_exported(tmp_path, session):
     assert np.array_equal(out.positions, s.cloud.positions)
     lin = b.apply(base, b.displacement(mats))
     assert ring_r(s.cloud) > ring_r(lin)
+
+
+def test_history_entries_are_named_after_what_they_did(session):
+    """Paint / Erase strokes and committed moves get their own names (not "edit")."""
+    s = session
+    paint_regions(s)
+    assert s.wait_fit()
+    p = s.cloud.positions
+    s.brush_target = SUPPORT
+    edge = np.flatnonzero(s.selection.support)[0]
+    assert s.paint(np.flatnonzero(np.linalg.norm(p - p[edge], axis=1) < 0.05), erase=True)  # the rim
+    s.end_stroke(True)
+    assert s.wait_fit() and s.begin(GRAB, view(), (100, 100))
+    s.manip.set_axis(2)
+    for ch in "0.12":
+        s.manip.type_char(ch)
+    assert s.finish() == "commit"
+    assert s.history.labels == ["open", "Paint support", "Paint handle", "Erase support", "Grab 0.12 along Z"]
+    assert s.last_edit.label == "Grab 0.12 along Z"

@@ -27,6 +27,7 @@ class BrushTool(Tool):
         self.radius = 24.0               # pixels
         self.erase_toggle = False
         self.stroke_changed = False
+        self.stroke_before = None      # the selection before an erase stroke (Selection)
         self.picker: BrushPicker | None = None
         self.picker_key = None
         self.tools = seltools.SelectionTools(ed.start_graph_job)
@@ -155,6 +156,8 @@ class BrushTool(Tool):
         if e.button != self.ed.g.MOUSE_BUTTON_LEFT:
             return None
         self.stroke_changed = False
+        # an erase stroke: the selection before it bounds what closure may give back
+        self.stroke_before = self.session.selection.copy() if self.erasing() else None
         self.paint_at([(e.x, e.y)])
         return DragMode.PAINT
 
@@ -166,7 +169,16 @@ class BrushTool(Tool):
         if mode is not DragMode.PAINT:
             return
         s = self.session
-        if self.stroke_changed:
+        before, self.stroke_before = self.stroke_before, None
+        if self.stroke_changed and before is not None:
+            target = lambda sel: sel.support if s.brush_target == SUPPORT else sel.handle  # noqa: E731
+            stroked = target(s.selection).copy()
+            self.tools.close(s, within=before)
+            msg = seltools.erase_refill_message(target(before), stroked, target(s.selection),
+                                                "support" if s.brush_target == SUPPORT else "handle")
+            if msg:
+                self.ed.say(msg)
+        elif self.stroke_changed:
             added = self.tools.close(s)
             if added:
                 self.ed.say(f"closure added {added:,} splats")

@@ -66,6 +66,16 @@ class CameraTool(Tool):
         """Set the up axis from the model (and the file's format)."""
         self.set_up(detect_up_axis(cloud.normals, cloud.positions, path))
 
+    def fresh_view(self, cloud, path) -> None:
+        """The view a newly opened model gets (as on the first open): its own
+        up axis, the default front angle about it (yaw = pitch = 0), framed
+        whole -- nothing of the previous model's view is kept."""
+        self.zoom_anchor = None
+        self.cam.yaw = self.cam.pitch = 0.0
+        self.cam.screen_offset = (0.0, 0.0)
+        self.detect_up(cloud, path)
+        self.frame_all(say=False)             # the load message names far points
+
     def set_up(self, up: UpAxis) -> None:
         self.up = up
         self.cam.up_axis = up.vector

@@ -1,0 +1,96 @@
+"""The editor's menu bar (Dear ImGui): File (:attr:`EditorGui.file_menu`,
+rows of :class:`MenuEntry`, with Open... and the Open recent submenu), Edit
+(undo / redo) and View (panels, help, frame all).
+
+A part of :class:`~splatedit.app.gui_panels.EditorGui` (mixed into it: it
+uses its ``ed``, ``windows``, ``rects`` and ``_rect``).  Esc closes an open
+menu (:meth:`~splatedit.app.gui_panels.EditorGui.feed`)."""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+from typing import Callable
+
+from imgui_bundle import imgui
+
+from splatedit.app.keymap import Action
+from splatedit.app.panel import Box
+
+
+@dataclass
+class MenuEntry:
+    """One File-menu item: ``label``, the callback, a shortcut text shown at the
+    right, and an optional predicate that enables it (default: always).  With
+    ``submenu`` (a function giving its entries when it opens) the item is a
+    submenu and ``action`` is unused; ``name`` records the item's rectangle
+    (``gui_rects`` in the status file)."""
+    label: str
+    action: Callable[[], None] | None
+    shortcut: str = ""
+    enabled: Callable[[], bool] | None = None
+    submenu: Callable[[], list] | None = None
+    name: str = ""
+
+
+class MenuBar:
+    """The menu bar of the EditorGui."""
+
+    # ------------------------------------------------------------ menu bar
+    def _menu_bar(self, w: int) -> None:
+        ed = self.ed
+        if not imgui.begin_main_menu_bar():
+            return
+        self.menu_height = imgui.get_window_size().y
+        self.windows.append(Box(0, 0, w, int(self.menu_height)))
+        if imgui.begin_menu("File"):
+            self._menu_open = True
+            self._menu_entries(self.file_menu)
+            imgui.end_menu()
+        self._rect("menu_file")
+        s = ed.session
+        if imgui.begin_menu("Edit", s is not None):
+            self._menu_open = True
+            if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
+                ed.run_action(Action.UNDO)
+            if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
+                ed.run_action(Action.REDO)
+            imgui.end_menu()
+        self._rect("menu_edit")
+        if imgui.begin_menu("View"):
+            self._menu_open = True
+            if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
+                ed.run_action(Action.PANEL)
+            if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
+                ed.run_action(Action.HELP)
+            if imgui.menu_item("Frame all", "Home", False, s is not None)[0]:
+                ed.run_action(Action.FRAME_ALL)
+            imgui.end_menu()
+        imgui.end_main_menu_bar()
+
+    def _menu_entries(self, entries: list[MenuEntry]) -> None:
+        for e in entries:
+            ok = e.enabled() if e.enabled is not None else True
+            if e.submenu is not None:
+                opened = imgui.begin_menu(e.label, ok)
+                if opened:
+                    self._menu_entries(e.submenu())
+                    imgui.end_menu()
+                if e.name:
+                    self._rect(e.name)
+                continue
+            if imgui.menu_item(e.label, e.shortcut, False, ok)[0]:
+                e.action()
+            if e.name:
+                self._rect(e.name)
+
+    def _recent_menu(self) -> list[MenuEntry]:
+        """File > Open recent: the recent models (opened like Ctrl+O's pick, the
+        unsaved-changes question included), then "Clear recent files"."""
+        from splatedit.app.recent import menu_labels
+        ed = self.ed
+        paths = ed.recent_files()
+        if not paths:
+            return [MenuEntry("(no recent files)", lambda: None, enabled=lambda: False, name="recent_none")]
+        rows = [MenuEntry(label, lambda p=p: ed.open_path(p), name=f"recent_{i}")
+                for i, (label, p) in enumerate(zip(menu_labels(paths), paths))]
+        return rows + [MenuEntry("Clear recent files", ed.clear_recent, name="recent_clear")]
