@@ -8,6 +8,7 @@ from __future__ import annotations
 import time
 
 import numpy as np
+from scipy import ndimage
 import pytest
 
 from splatedit.tolerances import EDITOR_FRAME_MARGIN
@@ -24,6 +25,9 @@ FOREGROUND_MAX = 230
 #: part's binding side (its height: measured 0.55 at 960x600, beside the panel
 #: and in the whole window alike)
 MIN_FILL = 0.45
+#: a lingering brush ring (a 2 px arc) or its mode label (~20 x 15 px) stays below this;
+#: the smallest part of a model counted here, poste_france's far clump, has ~2,800
+MODEL_BLOB_MIN_PX = 1000
 #: the model's box centre from the free part's centre, as a fraction of the
 #: part's side (the bunny is not symmetric in its bounding sphere: measured
 #: -11 / +12 px beside the panel, -4 / +12 px in the whole window, <= 0.025)
@@ -38,6 +42,11 @@ def _model_box(ed, top: float) -> tuple[int, int, int, int]:
     np.save(ed.status_path.parent / "shot.npy", shot)
     fg = shot.astype(int).min(axis=2) < FOREGROUND_MAX
     fg[: int(np.ceil(top))] = False
+    # the brush ring and its mode label can linger at the last cursor place
+    # (thin or small): only blobs of at least MODEL_BLOB_MIN_PX pixels count
+    labels, count = ndimage.label(fg)
+    sizes = np.bincount(labels.ravel(), minlength=count + 1)
+    fg = (sizes >= MODEL_BLOB_MIN_PX)[labels] & fg
     ys, xs = np.nonzero(fg)
     assert len(xs) > 2000, "the model is not visible"
     return int(xs.min()), int(ys.min()), int(xs.max()) + 1, int(ys.max()) + 1
