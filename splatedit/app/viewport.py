@@ -109,7 +109,7 @@ class Viewport:
         self.gs_lod = None
         self.gs_lod_slot: _Slot | None = None
         self._gs_full = None         # (ms, pixels, n) of the last full Gaussian frame
-        self._gs_ms_per: dict = {}   # divisor -> ms per Gaussian of recent LOD frames (ms, pixels)
+        self._gs_ms_per: dict = {}   # "last": (ms per Gaussian, pixels, divisor) of the last LOD frame
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -358,8 +358,8 @@ class Viewport:
         resolution (no ranking yet, or the full frame fits the budget).
 
         The count is the budget over the measured milliseconds per drawn
-        Gaussian (the last LOD frames at that divisor; before them the full
-        frame's, or GS_LOD_GUESS_MS_PER_GAUSSIAN), clamped to
+        Gaussian (the last LOD frame's, scaled to the divisor by DIV_EXP;
+        before one the full frame's, or GS_LOD_GUESS_MS_PER_GAUSSIAN), clamped to
         GS_LOD_MIN_COUNT..the largest level; half resolution when full
         resolution fits fewer than GS_LOD_PREFER_COUNT of them."""
         lod, scene = self.gs_lod, self.gaussians
@@ -376,9 +376,12 @@ class Viewport:
             return None
         lo = min(GS_LOD_MIN_COUNT, lod.m)
         count = lo
+        last = self._gs_ms_per.get("last")        # (ms per Gaussian, pixels, divisor) of the last LOD frame
         for div in (1, 2):
-            m = self._gs_ms_per.get(div)
-            per = m[0] * px / max(m[1], 1) if m is not None else per_full / div ** self.DIV_EXP
+            if last is not None:
+                per = last[0] * px / max(last[1], 1) * (last[2] / div) ** self.DIV_EXP
+            else:
+                per = per_full / div ** self.DIV_EXP
             fits = self.budget_ms / max(per, 1e-12)
             count = int(min(max(fits, lo), lod.m))
             if fits >= min(GS_LOD_PREFER_COUNT, lod.m):
@@ -396,6 +399,7 @@ class Viewport:
         set) with their coverage compensation, at 1/``div`` resolution."""
         lod = self.gs_lod
         slot = self._gs_lod_slot()
+        warm = slot.cloud is self.gaussians and slot.level is lod
         self._sync(slot, lod)
         slot.r.set_draw_count(count)
         slot.r.splat_scale = self.splat_scale * lod.compensation(count)
@@ -407,11 +411,12 @@ class Viewport:
             if img.shape[0] < h or img.shape[1] < w:
                 img = np.pad(img, ((0, h - img.shape[0]), (0, w - img.shape[1]), (0, 0)), mode="edge")
         ms = (time.perf_counter() - t0) * 1e3
-        per = ms / count
-        old = self._gs_ms_per.get(div)
-        if old is not None and old[1] == w * h:
-            per = 0.5 * (old[0] + per)
-        self._gs_ms_per[div] = (per, w * h)
+        if warm:          # not the first frame after an upload (pipelines, first-touch of the buffers)
+            per = ms / count
+            old = self._gs_ms_per.get("last")
+            if old is not None and old[1] == w * h and old[2] == div:
+                per = 0.5 * (old[0] + per)
+            self._gs_ms_per["last"] = (per, w * h, div)
         self.interactive_frames_ms.append(ms)
         self.last_info = FrameInfo(ms, count, div, True, True, gaussians=True)
         return np.ascontiguousarray(img)
