@@ -1053,5 +1053,7 @@ GS_LOD_PREFER_COUNT = 40_000
 GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
 #: the LOD's image against the full frame in tests: mean per-pixel
 #: max-channel difference (1/255) at most this, with the level's Gaussians a
-#: quarter (bunny at 25%: 2.2) or a tenth (200k sphere at 10%: 4.9) of the scene
-GS_LOD_TEST_MEAN_DIFF = 6.0
+#: quarter or a tenth of the scene, compensated.  Measured at 240x180: bunny
+#: 25% 3.43 (4.76 uncompensated), 100k sphere 10% 5.20 (7.57); the editor
+#: bench at 1280x720 (16k of 1M at half resolution): 4.92
+GS_LOD_TEST_MEAN_DIFF = 6.5
