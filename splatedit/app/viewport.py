@@ -315,6 +315,8 @@ class Viewport:
             ms = (time.perf_counter() - t0) * 1e3
             n = len(self.gaussians)
             self._gs_full = (ms, w * h, n)
+            self._ref_pixels = w * h          # the scheduler's measure: slow full frames are refined in chunks
+            self.ms_per_splat = ms / n if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + ms / n)
             (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
             self.last_info = FrameInfo(ms, n, 1, False, interactive, gaussians=True)
             return img
@@ -425,9 +427,16 @@ class Viewport:
         """A :class:`~splatedit.render.progressive.ProgressiveFrame` of the full
         cloud (``chunk`` splats per step) on the full renderer, synced with the
         document (the detail mode included: its chunks go through its pre-pass);
-        None where it cannot draw the frame (a Gaussian document)."""
-        if self.gaussians is not None or self.cloud is None:
+        for a Gaussian document a
+        :class:`~splatedit.render.gs_progressive.GaussianProgressiveFrame` of
+        all its Gaussians (``chunk`` per step, after one sorting step); None
+        without a document."""
+        if self.cloud is None:
             return None
+        if self.gaussians is not None:
+            from splatedit.render.gs_progressive import GaussianProgressiveFrame
+            self._sync(self.gs_slot)
+            return GaussianProgressiveFrame(self.gs_slot.r, render_camera(cam), w, h, chunk)
         from splatedit.render.progressive import ProgressiveFrame
         self._sync(self.full)
         return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)

@@ -96,6 +96,8 @@ class GaussianRenderer:
         self.n = 0
         #: Gaussians drawn: the first ``count`` of the scene (:meth:`set_draw_count`)
         self.count = 0
+        #: counts the pre-passes (frames and picks): chunked frames check their records are current
+        self.epoch = 0
         self._dC = np.zeros((4, 3))
         self._rot = None            # RotationDisplacement of the frame, or None
         self._cols = 4
@@ -384,6 +386,7 @@ class GaussianRenderer:
         self._check()
         self._targets_for(width, height)
         self._write_ubo(camera, width, height, srgb_target)
+        self.epoch += 1
         dv = self._draws.view(np.uint32)
         dv[:] = (4, 0, 0, 0)
         t0 = time.perf_counter()
@@ -439,6 +442,28 @@ class GaussianRenderer:
         t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
         cb.timestamp(self._query, 4)
 
+    def record_chunk(self, first: int, count: int, clear: bool) -> None:
+        """Draw Gaussians ``first`` .. ``first + count`` of the sorted order of
+        the last :meth:`prepare_frame` into the accumulation target (cleared
+        first with ``clear``, else blended over what it holds); submits and
+        waits.  Consecutive chunks from 0 give :meth:`record_draw`'s sums
+        (front-to-back blending in the same order)."""
+        t = self._targets
+        fmt = self.accum_format
+        rp = _rp_accum(fmt) if clear else V.RenderPassDesc(
+            colors=(V.Attachment(fmt, "load", initial="shader_read", final="shader_read"),))
+        pipe = self._draw_pipeline()
+
+        def rec(cb):
+            cb.memory_barrier("host", "host_write", "vertex", "shader_read")
+            cb.begin_render_pass(self.cache.render_pass(rp), t.fb_accum, [(0.0, 0.0, 0.0, 0.0) if clear else None])
+            if count > 0:
+                cb.bind_pipeline(pipe)
+                cb.bind_descriptor_set(pipe, self._dset)
+                cb.draw(4, int(count), 0, int(first))
+            cb.end_render_pass()
+        self.dev.submit(rec)
+
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
         self.prepare_frame(camera, width, height)
@@ -465,6 +490,8 @@ class GaussianRenderer:
         layout = V.LayoutDesc(sets=(_GS_SET,))
         pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
                                                   depth_write=True, depth_compare="less", spec=((0, 1),)))
+
+        self.epoch += 1
 
         def rec(cb):
             self._write_ubo(camera, width, height)
