@@ -442,28 +442,6 @@ class GaussianRenderer:
         t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
         cb.timestamp(self._query, 4)
 
-    def record_chunk(self, first: int, count: int, clear: bool) -> None:
-        """Draw Gaussians ``first`` .. ``first + count`` of the sorted order of
-        the last :meth:`prepare_frame` into the accumulation target (cleared
-        first with ``clear``, else blended over what it holds); submits and
-        waits.  Consecutive chunks from 0 give :meth:`record_draw`'s sums
-        (front-to-back blending in the same order)."""
-        t = self._targets
-        fmt = self.accum_format
-        rp = _rp_accum(fmt) if clear else V.RenderPassDesc(
-            colors=(V.Attachment(fmt, "load", initial="shader_read", final="shader_read"),))
-        pipe = self._draw_pipeline()
-
-        def rec(cb):
-            cb.memory_barrier("host", "host_write", "vertex", "shader_read")
-            cb.begin_render_pass(self.cache.render_pass(rp), t.fb_accum, [(0.0, 0.0, 0.0, 0.0) if clear else None])
-            if count > 0:
-                cb.bind_pipeline(pipe)
-                cb.bind_descriptor_set(pipe, self._dset)
-                cb.draw(4, int(count), 0, int(first))
-            cb.end_render_pass()
-        self.dev.submit(rec)
-
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
         self.prepare_frame(camera, width, height)

@@ -25,7 +25,31 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.gs_resources import _RESOLVE_SET
+from splatedit.render.gs_resources import _RESOLVE_SET, _rp_accum
+
+
+def draw_chunk(r, first: int, count: int, clear: bool) -> None:
+    """Draw Gaussians ``first`` .. ``first + count`` of the sorted order of
+    the last :meth:`GaussianRenderer.prepare_frame` of ``r`` into its
+    accumulation target (cleared first with ``clear``, else blended over what
+    it holds); submits and waits.  Consecutive chunks from 0 give
+    :meth:`GaussianRenderer.record_draw`'s sums (front-to-back blending in the
+    same order)."""
+    t = r._targets
+    fmt = r.accum_format
+    rp = _rp_accum(fmt) if clear else V.RenderPassDesc(
+        colors=(V.Attachment(fmt, "load", initial="shader_read", final="shader_read"),))
+    pipe = r._draw_pipeline()
+
+    def rec(cb):
+        cb.memory_barrier("host", "host_write", "vertex", "shader_read")
+        cb.begin_render_pass(r.cache.render_pass(rp), t.fb_accum, [(0.0, 0.0, 0.0, 0.0) if clear else None])
+        if count > 0:
+            cb.bind_pipeline(pipe)
+            cb.bind_descriptor_set(pipe, r._dset)
+            cb.draw(4, int(count), 0, int(first))
+        cb.end_render_pass()
+    r.dev.submit(rec)
 
 
 class GaussianProgressiveFrame:
@@ -88,7 +112,7 @@ class GaussianProgressiveFrame:
                 self._finish()
             return
         first, count = self.next, min(self.chunk, self._visible - self.next)
-        r.record_chunk(first, count, clear=first == 0)
+        draw_chunk(r, first, count, clear=first == 0)
         self.next += count
         if self.next >= self._visible:
             self._finish()
@@ -97,7 +121,7 @@ class GaussianProgressiveFrame:
         r = self.r
         t = r._targets_for(self.width, self.height)
         if self._visible == 0:
-            r.record_chunk(0, 0, clear=True)
+            draw_chunk(r, 0, 0, clear=True)
         self._image = t.read_output(lambda cb: t.record_resolve(cb, t.offscreen, "gs_resolve.frag", _RESOLVE_SET))
         self.next = self.n
         self.phase = "done"
