@@ -304,7 +304,8 @@ class FrameScheduler:
             self.refinements += 1
             self.progressive = None
             pick_key = ed.brush.pick_key()
-            if pick_key is not None and (self._pick_ready is None or self._pick_ready[0] != pick_key):
+            if (pick_key is not None and getattr(p.frame, "chunked_pick", True)
+                    and (self._pick_ready is None or self._pick_ready[0] != pick_key)):
                 self.picking = (p, pick_key)     # the brush's pick map next, while the view is still
             else:
                 p.close()

@@ -59,7 +59,11 @@ class GaussianProgressiveFrame:
     :class:`~splatedit.render.progressive.ProgressiveFrame` that the
     refinement uses: ``phase`` ("sort", "attr", "done"), ``next``, ``n``,
     ``chunk``, ``done``, ``fraction``, :meth:`set_under`, :meth:`step`,
-    :meth:`show`, the pick map (:meth:`pick_step`, drawn whole), :meth:`close`."""
+    :meth:`show`, :meth:`close`.  No pick map in chunks (``chunked_pick``
+    False): the brush picks the view when it needs it
+    (:meth:`GaussianRenderer.pick`, one pass)."""
+
+    chunked_pick = False
 
     def __init__(self, renderer, camera: Camera, width: int, height: int, chunk: int):
         if chunk < 1:
@@ -76,7 +80,6 @@ class GaussianProgressiveFrame:
         self._epoch = None
         self._under = None
         self._image = None
-        self._pick = None
 
     @property
     def done(self) -> bool:
@@ -135,22 +138,6 @@ class GaussianProgressiveFrame:
             return self._under
         return np.full((self.height, self.width, 4), 255, np.uint8)
 
-    # -------------------------------------------------------------- picking
-    @property
-    def pick_done(self) -> bool:
-        return self._pick is not None
-
-    def pick_step(self) -> None:
-        """The view's pick map, whole (:meth:`GaussianRenderer.pick`)."""
-        if not self.done or self.pick_done:
-            raise ParameterError("pick", "the frame is not done, or its pick map is")
-        self._pick = self.r.pick(self.camera, self.width, self.height)
-
-    def pick_result(self):
-        if self._pick is None:
-            raise ParameterError("pick", "the pick map is not complete")
-        return self._pick
-
     def close(self) -> None:
         """Nothing of its own to free (the renderer's targets are reused)."""
-        self._under = self._image = self._pick = None
+        self._under = self._image = None
