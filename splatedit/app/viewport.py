@@ -110,6 +110,7 @@ class Viewport:
         self.gs_lod_slot: _Slot | None = None
         self._gs_full = None         # (ms, pixels, n) of the last full Gaussian frame
         self._gs_ms_per: dict = {}   # "last": (ms per Gaussian, pixels, divisor) of the last LOD frame
+        self._gs_lod_warm = False    # the LOD renderer drew since its last upload (its frames are measured)
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -156,6 +157,9 @@ class Viewport:
         self._gs_ms_per = {}
         if self.gs_lod_slot is not None:
             self.gs_lod_slot.cloud = self.gs_lod_slot.level = None
+        if lod is not None and self.full is not None and lod.fits(self.gaussians):
+            # upload the level now (1M Gaussians: 0.4 s), not in the first moving frame
+            self._sync(self._gs_lod_slot(), lod)
 
     def set_pyramid(self, pyramid) -> None:
         self.pyramid = pyramid
@@ -187,6 +191,7 @@ class Viewport:
             if slot.cloud is not self.gaussians or slot.level is not level:
                 slot.r.set_cloud(level.cloud(self.gaussians))   # the ranked Gaussians, most important first
                 slot.cloud, slot.level = self.gaussians, level
+                self._gs_lod_warm = False
                 slot.sel = slot.basis = slot.dc = None
         elif level is not None:
             src = self.pyramid.source
@@ -401,8 +406,8 @@ class Viewport:
         set) with their coverage compensation, at 1/``div`` resolution."""
         lod = self.gs_lod
         slot = self._gs_lod_slot()
-        warm = slot.cloud is self.gaussians and slot.level is lod
         self._sync(slot, lod)
+        warm = self._gs_lod_warm
         slot.r.set_draw_count(count)
         slot.r.splat_scale = self.splat_scale * lod.compensation(count)
         rw, rh = max(1, w // div), max(1, h // div)
@@ -413,12 +418,13 @@ class Viewport:
             if img.shape[0] < h or img.shape[1] < w:
                 img = np.pad(img, ((0, h - img.shape[0]), (0, w - img.shape[1]), (0, 0)), mode="edge")
         ms = (time.perf_counter() - t0) * 1e3
-        if warm:          # not the first frame after an upload (pipelines, first-touch of the buffers)
+        if warm:          # not the first frame after an upload (pipeline compiles, first touch of the buffers)
             per = ms / count
             old = self._gs_ms_per.get("last")
             if old is not None and old[1] == w * h and old[2] == div:
                 per = 0.5 * (old[0] + per)
             self._gs_ms_per["last"] = (per, w * h, div)
+        self._gs_lod_warm = True
         self.interactive_frames_ms.append(ms)
         self.last_info = FrameInfo(ms, count, div, True, True, gaussians=True)
         return np.ascontiguousarray(img)
