@@ -136,7 +136,7 @@ class Viewport:
         """The seam for Gaussian Splatting documents (issue 13).  With a
         GaussianCloud set, frames and picks come from a
         :class:`~splatedit.render.gaussians.GaussianRenderer` on the same
-        Vulkan device (full quality, no LOD), while the document cloud of
+        Vulkan device (still frames: every Gaussian), while the document cloud of
         :meth:`set_cloud` stays the Gaussians' splat proxy
         (:func:`splatedit.render.gs_headless.splat_proxy`, same indices) for
         the tools: selection tints, basis rows and dC apply row for row.
