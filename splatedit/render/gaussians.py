@@ -336,7 +336,8 @@ class GaussianRenderer:
                        GS_ALPHA_MIN)
         u["params"] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
         u["background"] = (*self.background, 1.0)
-        u["counts"] = (self.count, self._rest_uints, self._n2 if self.sort == "gpu" else self.count, 1 if srgb_target else 0)
+        u["counts"] = (self.count, self._rest_uints, self._n2 if self.sort == "gpu" else self.count,
+                       1 if srgb_target else 0)
         u["tint_support"] = RENDER_TINT_SUPPORT
         u["tint_handle"] = RENDER_TINT_HANDLE
         u["display"] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0,
