@@ -1084,3 +1084,35 @@ EDITOR_GUI_FOOTER_MESSAGE_LINES = 2
 #: its window's edge) closer than this are the same (the widget rects in the
 #: status file are whole pixels)
 EDITOR_GUI_LAYOUT_SLACK_PX = 0.5
+
+# ---------------------------------------------------------------------------
+# Gaussian level of detail while moving (splatedit.model.gaussian_lod, the
+# editor's Viewport).  Sweeps recorded in docs/PERFORMANCE.md "Gaussian level
+# of detail while moving": 960x600, importance subsets of the bundled bunny
+# (5,000) and of unit-sphere scenes (200k, 1M; splatedit.bench.gs_scenes).
+# ---------------------------------------------------------------------------
+#: the largest level holds this share of the scene (ranked by importance):
+#: 1M Gaussians on lavapipe draw 250k in ~1 s, far over any interactive
+#: budget, so larger levels are never chosen there
+GS_LOD_MAX_FRACTION = 0.25
+#: ... but at least this many Gaussians (the whole scene when smaller), and no
+#: level is drawn with fewer (a 5,000-Gaussian bunny at 200: mean difference 5.2/255)
+GS_LOD_MIN_COUNT = 2_000
+#: the kept Gaussians' standard deviations are drawn (total importance / kept
+#: importance) ** this times larger.  Mean per-pixel max-channel difference to
+#: the full frame (1/255), 4% kept: bunny 5.2 / 5.9 / 6.7 with 0.5 / 0.35 /
+#: 0.25, 200k sphere 5.8 / 7.5 / 9.0; no compensation at 1M, 4%: 9.1, with 0.5: 4.0
+GS_LOD_COVER_EXP = 0.5
+#: a level is drawn at full resolution only when the budget fits at least this
+#: many Gaussians (else at half resolution, as point models' coarsest level):
+#: at 1M, 4% (40k) kept gives a mean difference of 4.0/255, 10% 3.5, 25% 2.5
+GS_LOD_PREFER_COUNT = 40_000
+#: cost guess per Gaussian (ms) before the first full frame is measured
+#: (docs/PERFORMANCE.md: 1M Gaussians ~4 s a frame on lavapipe, 100k ~0.5 s)
+GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
+#: the LOD's image against the full frame in tests: mean per-pixel
+#: max-channel difference (1/255) at most this, with the level's Gaussians a
+#: quarter or a tenth of the scene, compensated.  Measured at 240x180: bunny
+#: 25% 3.43 (4.76 uncompensated), 100k sphere 10% 5.20 (7.57); the editor
+#: bench at 1280x720 (16k of 1M at half resolution): 4.92
+GS_LOD_TEST_MEAN_DIFF = 6.5

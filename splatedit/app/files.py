@@ -234,7 +234,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
                            on_change=ed.wake)
     ed.viewport.set_cloud(cloud)
-    scene = gaussians_of(cloud)      # a Gaussian scene: drawn by the Gaussian renderer, no levels of detail
+    scene = gaussians_of(cloud)      # a Gaussian scene: drawn by the Gaussian renderer, its own LOD
     if scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
         # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so
         # that a huge model's first full-quality frame is already drawn in the background
@@ -249,6 +249,12 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
             from splatedit.model.lod import LodPyramid
             return LodPyramid(cloud, progress=progress, background=True)   # preview first
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
+    ed.viewport.set_gaussian_lod(None)
+    if ed.use_lod and scene is not None:
+        def rank(progress):       # the Gaussians' ranking for moving frames (the model module's)
+            from splatedit.model.gaussian_lod import build_gaussian_lod
+            return build_gaussian_lod(scene, progress=progress)
+        ed.jobs["lod"] = Job("Gaussian level of detail", rank, ed.wake)
     ed.brush.tools.prepare(cloud)
     remember(ed, ed.path)
     what = model_summary(cloud)
@@ -288,6 +294,9 @@ def poll_jobs(ed) -> None:
             continue
         if name == "load":
             ed.on_loaded(job.result, job.key)
+        elif name == "lod" and hasattr(job.result, "rank"):      # a GaussianLod
+            ed.viewport.set_gaussian_lod(job.result)
+            ed.say(f"level of detail ready (moving: up to {job.result.m:,} of {job.result.n:,} Gaussians)")
         elif name == "lod":
             ed.viewport.set_pyramid(job.result)
             counts = ", ".join(f"{lvl.n:,}" for lvl in job.result.levels)

@@ -258,7 +258,7 @@ class FrameScheduler:
     def _progressive_step(self, key, w: int, h: int) -> bool:
         """Advance the progressive refinement of ``key`` (started here) by one
         presented frame's worth of chunks; False where there is no progressive
-        frame (a Gaussian document: the caller draws the frame at once)."""
+        frame (the caller draws the frame at once)."""
         ed, vp = self.ed, self.ed.viewport
         p = self.progressive
         if self.gpu:
@@ -294,17 +294,19 @@ class FrameScheduler:
             self._refine_failed_key = key
             self.drop_progressive()
             return True
-        self.scene = ResidentFrame(img, w, h) if self.gpu else img
+        # a Gaussian frame's images are pixels on both paths (uploaded on the GPU path)
+        self.scene = ResidentFrame(img, w, h) if self.gpu and not isinstance(img, np.ndarray) else img
         if p.done:
             self.scene_interactive = False
             n = ed.session.cloud.n
-            vp.last_info = FrameInfo(p.total_ms, n, 1, False, False)
+            vp.last_info = FrameInfo(p.total_ms, n, 1, False, False, gaussians=vp.gaussians is not None)
             vp.ms_per_splat = p.total_ms / max(n, 1)
             self.last_progressive = p
             self.refinements += 1
             self.progressive = None
             pick_key = ed.brush.pick_key()
-            if pick_key is not None and (self._pick_ready is None or self._pick_ready[0] != pick_key):
+            if (pick_key is not None and getattr(p.frame, "chunked_pick", True)
+                    and (self._pick_ready is None or self._pick_ready[0] != pick_key)):
                 self.picking = (p, pick_key)     # the brush's pick map next, while the view is still
             else:
                 p.close()

@@ -10,6 +10,10 @@ renderer is only updated when it draws) and chooses what to draw:
   fit.  The prediction uses measured frame times (ms per splat, updated
   after every frame).
 
+A Gaussian Splatting scene moves as its most important Gaussians (a
+budgeted prefix of :class:`~splatedit.model.gaussian_lod.GaussianLod`'s
+ranking, :meth:`Viewport.gaussian_plan`), all of them when still.
+
 The LOD level is drawn by a second :class:`~splatedit.render.renderer.Renderer`
 sharing the first one's Vulkan device; its deformation-basis rows are the
 representatives' rows (:meth:`LodLevel.rows`), so the handles move at LOD too.
@@ -33,6 +37,7 @@ from splatedit.app import revision
 from splatedit.app.gaussian_doc import gaussians_of
 from splatedit.app.camera_control import OrbitCamera
 from splatedit.render.camera import Camera
+from splatedit.tolerances import GS_LOD_GUESS_MS_PER_GAUSSIAN, GS_LOD_MIN_COUNT, GS_LOD_PREFER_COUNT
 
 
 def render_camera(cam: OrbitCamera) -> Camera:
@@ -98,6 +103,14 @@ class Viewport:
         #: a GaussianCloud drawn and picked instead of the splats (set_gaussians)
         self.gaussians = None
         self.gs_slot: _Slot | None = None
+        #: ranking of the Gaussians for the level of detail while moving (built in
+        #: the background on open, set_gaussian_lod), its renderer, and the cost
+        #: measured per drawn Gaussian: full frames, LOD frames per resolution divisor
+        self.gs_lod = None
+        self.gs_lod_slot: _Slot | None = None
+        self._gs_full = None         # (ms, pixels, n) of the last full Gaussian frame
+        self._gs_ms_per: dict = {}   # "last": (ms per Gaussian, pixels, divisor) of the last LOD frame
+        self._gs_lod_warm = False    # the LOD renderer drew since its last upload (its frames are measured)
         self.ms_per_splat = None     # measured on full-quality frames
         self._ref_pixels = 1
         self._measured: dict = {}    # (level id, divisor) -> (ms, pixels, splats) of recent frames
@@ -123,15 +136,30 @@ class Viewport:
         """The seam for Gaussian Splatting documents (issue 13).  With a
         GaussianCloud set, frames and picks come from a
         :class:`~splatedit.render.gaussians.GaussianRenderer` on the same
-        Vulkan device (full quality, no LOD), while the document cloud of
+        Vulkan device (still frames: every Gaussian), while the document cloud of
         :meth:`set_cloud` stays the Gaussians' splat proxy
         (:func:`splatedit.render.gs_headless.splat_proxy`, same indices) for
         the tools: selection tints, basis rows and dC apply row for row.
+        Moving frames draw a level of detail once its ranking is set
+        (:meth:`set_gaussian_lod`, :meth:`gaussian_plan`): a second
+        GaussianRenderer holding the ranked Gaussians, the rows and tints
+        mapped by :class:`~splatedit.model.gaussian_lod.GaussianLod`.
         None returns to the splat renderer."""
         self.gaussians = gaussians
         if gaussians is not None and self.gs_slot is None:
             from splatedit.render.gaussians import GaussianRenderer
             self.gs_slot = _Slot(GaussianRenderer(device=self.full.r.dev))
+
+    def set_gaussian_lod(self, lod) -> None:
+        """The :class:`~splatedit.model.gaussian_lod.GaussianLod` of the open
+        Gaussian scene (None: every frame draws all Gaussians)."""
+        self.gs_lod = lod
+        self._gs_ms_per = {}
+        if self.gs_lod_slot is not None:
+            self.gs_lod_slot.cloud = self.gs_lod_slot.level = None
+        if lod is not None and self.full is not None and lod.fits(self.gaussians):
+            # upload the level now (1M Gaussians: 0.4 s), not in the first moving frame
+            self._sync(self._gs_lod_slot(), lod)
 
     def set_pyramid(self, pyramid) -> None:
         self.pyramid = pyramid
@@ -159,7 +187,13 @@ class Viewport:
         bg = tuple(float(x) for x in self.background[:3])
         if tuple(slot.r.background[:3]) != bg:       # only a change (GUI colour picker)
             slot.r.background = (*bg, *tuple(slot.r.background)[3:])
-        if level is not None:
+        if level is not None and slot is self.gs_lod_slot:
+            if slot.cloud is not self.gaussians or slot.level is not level:
+                slot.r.set_cloud(level.cloud(self.gaussians))   # the ranked Gaussians, most important first
+                slot.cloud, slot.level = self.gaussians, level
+                self._gs_lod_warm = False
+                slot.sel = slot.basis = slot.dc = None
+        elif level is not None:
             src = self.pyramid.source
             if slot.cloud is not cloud or slot.level is not level:
                 lc = level.cloud if cloud is src else level.deformed(cloud.positions, cloud.u, cloud.v)
@@ -197,7 +231,7 @@ class Viewport:
                 # are drawn together and switching the active handle costs nothing
                 rows = basis.rows_for_gpu()
                 detail = getattr(basis, "detail_for_gpu", None)   # a DetailBasis (the detail mode)
-                if detail is not None and slot is not self.gs_slot:
+                if detail is not None and slot is not self.gs_slot and slot is not self.gs_lod_slot:
                     rows = rows + (detail(),)   # (n_b, lambda) rows: a level's splat keeps its
                 if level is not None:           # representative's position, so b = p - lambda n_b holds
                     rows = level.rows(*rows)
@@ -277,12 +311,19 @@ class Viewport:
         path) a :class:`ResidentFrame` instead when the splat renderer drew it
         (no readback; the Gaussian renderer still returns pixels)."""
         if self.gaussians is not None:
+            plan = self.gaussian_plan(w, h) if interactive else None
+            if plan is not None:
+                return self._render_gaussian_lod(cam, w, h, *plan)
             self._sync(self.gs_slot)
             t0 = time.perf_counter()
             img = self.gs_slot.r.render(render_camera(cam), w, h)
             ms = (time.perf_counter() - t0) * 1e3
+            n = len(self.gaussians)
+            self._gs_full = (ms, w * h, n)
+            self._ref_pixels = w * h          # the scheduler's measure: slow full frames are refined in chunks
+            self.ms_per_splat = ms / n if self.ms_per_splat is None else 0.5 * (self.ms_per_splat + ms / n)
             (self.interactive_frames_ms if interactive else self.full_frames_ms).append(ms)
-            self.last_info = FrameInfo(ms, len(self.gaussians), 1, False, interactive, gaussians=True)
+            self.last_info = FrameInfo(ms, n, 1, False, interactive, gaussians=True)
             return img
         level, div = self.choose(interactive, w, h)
         slot = self.full if level is None else self._lod_slot()
@@ -317,13 +358,91 @@ class Viewport:
         self.last_info = FrameInfo(ms, count, div, level is not None, interactive)
         return img if resident else np.ascontiguousarray(img)
 
+    # ------------------------------------------------ Gaussian level of detail
+    def gaussian_plan(self, w: int, h: int):
+        """(Gaussians drawn, resolution divisor) of the level of detail for a
+        moving frame of w x h pixels, or None for all of them at full
+        resolution (no ranking yet, or the full frame fits the budget).
+
+        The count is the budget over the measured milliseconds per drawn
+        Gaussian (the last LOD frame's, scaled to the divisor by DIV_EXP;
+        before one the full frame's, or GS_LOD_GUESS_MS_PER_GAUSSIAN), clamped to
+        GS_LOD_MIN_COUNT..the largest level; half resolution when full
+        resolution fits fewer than GS_LOD_PREFER_COUNT of them."""
+        lod, scene = self.gs_lod, self.gaussians
+        if lod is None or not lod.fits(scene) or lod.n <= GS_LOD_MIN_COUNT:
+            return None
+        px = max(w * h, 1)
+        n = len(scene)
+        if self._gs_full is not None:
+            ms, fpx, fn = self._gs_full
+            per_full = ms * px / max(fpx, 1) / max(fn, 1)
+        else:
+            per_full = GS_LOD_GUESS_MS_PER_GAUSSIAN
+        if per_full * n <= self.budget_ms:
+            return None
+        lo = min(GS_LOD_MIN_COUNT, lod.m)
+        count = lo
+        last = self._gs_ms_per.get("last")        # (ms per Gaussian, pixels, divisor) of the last LOD frame
+        for div in (1, 2):
+            if last is not None:
+                per = last[0] * px / max(last[1], 1) * (last[2] / div) ** self.DIV_EXP
+            else:
+                per = per_full / div ** self.DIV_EXP
+            fits = self.budget_ms / max(per, 1e-12)
+            count = int(min(max(fits, lo), lod.m))
+            if fits >= min(GS_LOD_PREFER_COUNT, lod.m):
+                return count, div
+        return count, 2
+
+    def _gs_lod_slot(self) -> _Slot:
+        if self.gs_lod_slot is None:
+            from splatedit.render.gaussians import GaussianRenderer
+            self.gs_lod_slot = _Slot(GaussianRenderer(device=self.full.r.dev))
+        return self.gs_lod_slot
+
+    def _render_gaussian_lod(self, cam: OrbitCamera, w: int, h: int, count: int, div: int) -> np.ndarray:
+        """The first ``count`` ranked Gaussians (deformed, tinted as the full
+        set) with their coverage compensation, at 1/``div`` resolution."""
+        lod = self.gs_lod
+        slot = self._gs_lod_slot()
+        self._sync(slot, lod)
+        warm = self._gs_lod_warm
+        slot.r.set_draw_count(count)
+        slot.r.splat_scale = self.splat_scale * lod.compensation(count)
+        rw, rh = max(1, w // div), max(1, h // div)
+        t0 = time.perf_counter()
+        img = slot.r.render(render_camera(cam), rw, rh)
+        if div > 1:
+            img = np.repeat(np.repeat(img, div, axis=0), div, axis=1)[:h, :w]
+            if img.shape[0] < h or img.shape[1] < w:
+                img = np.pad(img, ((0, h - img.shape[0]), (0, w - img.shape[1]), (0, 0)), mode="edge")
+        ms = (time.perf_counter() - t0) * 1e3
+        if warm:          # not the first frame after an upload (pipeline compiles, first touch of the buffers)
+            per = ms / count
+            old = self._gs_ms_per.get("last")
+            if old is not None and old[1] == w * h and old[2] == div:
+                per = 0.5 * (old[0] + per)
+            self._gs_ms_per["last"] = (per, w * h, div)
+        self._gs_lod_warm = True
+        self.interactive_frames_ms.append(ms)
+        self.last_info = FrameInfo(ms, count, div, True, True, gaussians=True)
+        return np.ascontiguousarray(img)
+
     def progressive(self, cam: OrbitCamera, w: int, h: int, chunk: int):
         """A :class:`~splatedit.render.progressive.ProgressiveFrame` of the full
         cloud (``chunk`` splats per step) on the full renderer, synced with the
         document (the detail mode included: its chunks go through its pre-pass);
-        None where it cannot draw the frame (a Gaussian document)."""
-        if self.gaussians is not None or self.cloud is None:
+        for a Gaussian document a
+        :class:`~splatedit.render.gs_progressive.GaussianProgressiveFrame` of
+        all its Gaussians (``chunk`` per step, after one sorting step); None
+        without a document."""
+        if self.cloud is None:
             return None
+        if self.gaussians is not None:
+            from splatedit.render.gs_progressive import GaussianProgressiveFrame
+            self._sync(self.gs_slot)
+            return GaussianProgressiveFrame(self.gs_slot.r, render_camera(cam), w, h, chunk)
         from splatedit.render.progressive import ProgressiveFrame
         self._sync(self.full)
         return ProgressiveFrame(self.full.r, render_camera(cam), w, h, chunk)
@@ -343,6 +462,9 @@ class Viewport:
         return self.full.r.pick(render_camera(cam), w, h)
 
     def close(self) -> None:
+        if self.gs_lod_slot is not None:
+            self.gs_lod_slot.r.close()
+            self.gs_lod_slot = None
         if self.gs_slot is not None:
             self.gs_slot.r.close()
             self.gs_slot = None

@@ -53,6 +53,15 @@ def _gaussian_render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
                                size=(640, 360) if quick else (1280, 720))
 
 
+def _gaussian_editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    try:
+        from splatedit.app.bench_gaussians import bench_gaussian_editor_frames
+    except ImportError:
+        return
+    yield from bench_gaussian_editor_frames(counts=counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)),
+                                            size=(640, 360) if quick else (1280, 720))
+
+
 def _editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
         from splatedit.app.bench import bench_editor_frames
@@ -130,6 +139,7 @@ BENCHES = {
     "gui": _gui,
     "gaussians": _gaussians,
     "gaussian-render": _gaussian_render,
+    "gaussian-editor": _gaussian_editor,
 }
 
 

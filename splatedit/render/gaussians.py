@@ -94,6 +94,10 @@ class GaussianRenderer:
         self._dset = None
         self.cloud = None
         self.n = 0
+        #: Gaussians drawn: the first ``count`` of the scene (:meth:`set_draw_count`)
+        self.count = 0
+        #: counts the pre-passes (frames and picks): chunked frames check their records are current
+        self.epoch = 0
         self._dC = np.zeros((4, 3))
         self._rot = None            # RotationDisplacement of the frame, or None
         self._cols = 4
@@ -158,7 +162,7 @@ class GaussianRenderer:
             self._basis_buf = None
         self._dset = None
         self.cloud = None
-        self.n = 0
+        self.n = self.count = 0
 
     def _buf(self, size, usage=("storage",), host_visible=False):
         b = V.Buffer(self.dev, max(int(size), 16), usage, host_visible=host_visible)
@@ -210,7 +214,7 @@ class GaussianRenderer:
         self._dummy_basis = self._buf(64, host_visible=True)
         self._dummy_basis.view(np.float32)[:] = 0.0
         self.cloud = cloud
-        self.n = n
+        self.n = self.count = n
         self._cols, self._dC, self._basis_idx, self._reach = 4, np.zeros((4, 3)), np.zeros(0, np.int64), 0.0
         self._rot = None
         self._write_dset()
@@ -226,6 +230,16 @@ class GaussianRenderer:
     def set_cloud(self, cloud: GaussianCloud) -> None:
         """:meth:`set_gaussians` under the splat renderer's name (the editor's viewport calls it)."""
         self.set_gaussians(cloud)
+
+    def set_draw_count(self, count: int | None) -> None:
+        """Draw (and pick) only the first ``count`` Gaussians of the scene (a
+        budgeted level of detail uploaded in importance order,
+        :mod:`splatedit.model.gaussian_lod`); None or >= n: all of them."""
+        self._check()
+        c = self.n if count is None else int(count)
+        if c < 1:
+            raise ParameterError("count", f"must be >= 1, got {count!r}")
+        self.count = min(c, self.n)
 
     def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
         """Tint the support (blue) and handle (green) Gaussians as the splat
@@ -322,7 +336,8 @@ class GaussianRenderer:
                        GS_ALPHA_MIN)
         u["params"] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
         u["background"] = (*self.background, 1.0)
-        u["counts"] = (self.n, self._rest_uints, self._n2 if self.sort == "gpu" else self.n, 1 if srgb_target else 0)
+        u["counts"] = (self.count, self._rest_uints, self._n2 if self.sort == "gpu" else self.count,
+                       1 if srgb_target else 0)
         u["tint_support"] = RENDER_TINT_SUPPORT
         u["tint_handle"] = RENDER_TINT_HANDLE
         u["display"] = (float(self.splat_scale), 1.0 if self.grey_shading else 0.0,
@@ -344,7 +359,7 @@ class GaussianRenderer:
         pipe = self._bind_compute(cb, "gs_prepare.comp", GS_PREP_PUSH)
         groups = self._groups if len(self._basis_idx) else 1
         cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS), GS_PREP_PUSH))
-        count = self._n2 if self.sort == "gpu" else self.n
+        count = self._n2 if self.sort == "gpu" else self.count
         cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
 
     def _record_gpu_sort(self, cb):
@@ -372,6 +387,7 @@ class GaussianRenderer:
         self._check()
         self._targets_for(width, height)
         self._write_ubo(camera, width, height, srgb_target)
+        self.epoch += 1
         dv = self._draws.view(np.uint32)
         dv[:] = (4, 0, 0, 0)
         t0 = time.perf_counter()
@@ -400,7 +416,7 @@ class GaussianRenderer:
             timings["prepass"] = max((time.perf_counter() - t0) * 1e3 - timings["sort"], 0.0)
         else:
             t1 = time.perf_counter()
-            keys = self._keys.view(np.uint32)[:self.n]
+            keys = self._keys.view(np.uint32)[:self.count]
             # positive float32 depths sort as their bit patterns; culled keys are 0xFFFFFFFF (last)
             # (numpy's default introsort: SIMD-vectorised, 6-10x faster than kind="stable"
             # on 1M random uint32 keys, 23 vs 136-230 ms; equal depths are left in any order)
@@ -454,6 +470,8 @@ class GaussianRenderer:
         pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
                                                   depth_write=True, depth_compare="less", spec=((0, 1),)))
 
+        self.epoch += 1
+
         def rec(cb):
             self._write_ubo(camera, width, height)
             self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
@@ -465,6 +483,6 @@ class GaussianRenderer:
             cb.begin_render_pass(self.cache.render_pass(RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
             cb.bind_pipeline(pipe)
             cb.bind_descriptor_set(pipe, self._dset)
-            cb.draw(4, self.n)
+            cb.draw(4, self.count)
             cb.end_render_pass()
         return t.read_pick(rect, rec)

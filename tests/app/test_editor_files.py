@@ -30,6 +30,9 @@ class _Viewport(types.SimpleNamespace):
     def set_pyramid(self, p):
         self.pyramid = p
 
+    def set_gaussian_lod(self, lod):
+        self.gs_lod = lod
+
 
 class StubEditor(Editor):
     size = (W, H)
