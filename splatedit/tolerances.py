@@ -1025,3 +1025,10 @@ FRAMING_SAMPLE_POINTS = 20_000
 #: +-Z (|up_z| >= this), then -Y: the editor's turntable used it first; any
 #: value well away from 0 and 1 keeps the reference far from parallel to up
 FRONT_VIEW_Z_UP_COS = 0.9
+
+# --- selection graph at scan scale (splatedit.select.graph, issue 11 part 5) ---
+#: rows per chunk when NeighbourGraph.build recomputes its edge lengths in
+#: float64 (two passes: local scales, then edges): a chunk's gathers are
+#: about 100 bytes per row and neighbour (13 MB per 2^17 rows at k = 10), so
+#: the build's working memory next to its (n, k + 1) int32 table stays small
+GRAPH_BUILD_CHUNK = 1 << 17

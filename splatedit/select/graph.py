@@ -24,7 +24,10 @@ import numpy as np
 from scipy import sparse
 from scipy.spatial import cKDTree
 
-from splatedit.tolerances import GRAPH_COARSE_STRIDE, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
+from splatedit.model.pca import morton_codes
+from splatedit.model.tiles import tiled_knn
+from splatedit.progress import report
+from splatedit.tolerances import GRAPH_BUILD_CHUNK, GRAPH_COARSE_STRIDE, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
 
 
 def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
@@ -36,6 +39,51 @@ def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     return values[scratch[values] == order]
 
 
+def _knn_table(pts: np.ndarray, k: int, progress=None) -> np.ndarray:
+    """(n, k) int32 (int64 from 2^31 splats) indices of the k nearest splats
+    of every splat of ``pts`` (n, 3) float64, nearest first (itself
+    included), in the input's order: :func:`tiled_knn` over the Morton-sorted
+    points, renumbered back."""
+    n = len(pts)
+    codes, lo, scale = morton_codes(pts)
+    order = np.argsort(codes, kind="stable")
+    codes = codes[order]
+    itype = np.int32 if n < 2 ** 31 else np.int64
+    _, nb = tiled_knn(pts[order], codes, lo, scale, k, dist_columns=1, progress=progress)
+    del codes
+    order = order.astype(itype)
+    out = np.empty_like(nb)
+    for lo_i in range(0, n, GRAPH_BUILD_CHUNK):          # out[order] = order[nb], in chunks
+        out[order[lo_i:lo_i + GRAPH_BUILD_CHUNK]] = order[nb[lo_i:lo_i + GRAPH_BUILD_CHUNK]]
+    return out
+
+
+def _lengths(pts: np.ndarray, start: int, nb: np.ndarray) -> np.ndarray:
+    """(m, k) float64 distances from splats ``start .. start + m - 1`` to their
+    neighbours ``nb`` (m, k), summed x, y, z in that order as cKDTree does (the
+    same float64 values as its query)."""
+    p = pts[start:start + len(nb), None, :]
+    q = pts[nb]
+    dx, dy, dz = q[..., 0] - p[..., 0], q[..., 1] - p[..., 1], q[..., 2] - p[..., 2]
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+def _symmetric(counts: np.ndarray, indices: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
+    """(indptr (n + 1,) int64, indices int32) of the union of a directed graph
+    (row ``i`` holds ``counts[i]`` targets, ``indices`` concatenated) and its
+    transpose, rows sorted: scipy's CSR transpose and sum, on int32 indices
+    while the edge count allows."""
+    itype = np.int32 if len(indices) < 2 ** 30 and n < 2 ** 31 else np.int64
+    indptr = np.zeros(n + 1, itype)
+    np.cumsum(counts, out=indptr[1:])
+    a = sparse.csr_matrix((np.ones(len(indices), np.int8), indices.astype(itype, copy=False), indptr),
+                          shape=(n, n))
+    del indices, indptr
+    a = (a + a.T.tocsr()).tocsr()
+    a.sort_indices()
+    return a.indptr.astype(np.int64), a.indices.astype(np.int32, copy=False)
+
+
 @dataclass(frozen=True)
 class NeighbourGraph:
     """Symmetric neighbour graph of ``n`` splats (CSR, read-only arrays).
@@ -44,50 +92,86 @@ class NeighbourGraph:
         indptr: (n + 1,) int64 CSR row pointers.
         indices: (E,) int32 neighbour indices (each undirected edge twice).
         spacing: median nearest-neighbour distance of distinct splats (model units).
-        tree: cKDTree of the positions (reused by the brush), or None for a
-            :meth:`subgraph`.
+        positions: (n, 3) float64 splat centres (model units; the array the
+            graph was built from, not a copy), or None for a :meth:`subgraph`.
         diagonal: bounding-box diagonal of the positions (model units).
+
+    :attr:`tree` (a cKDTree of the positions) is built on first use.
     """
 
     indptr: np.ndarray
     indices: np.ndarray
     spacing: float
-    tree: cKDTree | None = None
+    positions: np.ndarray | None = None
     diagonal: float = 0.0
 
     @classmethod
-    def build(cls, positions: np.ndarray, k: int = GRAPH_NEIGHBOURS,
-              tree: cKDTree | None = None) -> "NeighbourGraph":
-        """Graph of ``positions`` (n, 3) float64 (model units)."""
-        pts = np.asarray(positions, dtype=np.float64)
+    def build(cls, positions: np.ndarray, k: int = GRAPH_NEIGHBOURS, tree: cKDTree | None = None,
+              progress=None) -> "NeighbourGraph":
+        """Graph of ``positions`` (n, 3) float64 (model units).
+
+        The k nearest neighbours come from :func:`splatedit.model.tiles.tiled_knn`
+        (Morton tiles, no k-d tree over all points, exact); edge lengths are
+        recomputed in float64 in row chunks, so the edges are those of one
+        global ``cKDTree`` query (ties between equal distances aside).  Memory
+        is the (n, k + 1) int32 neighbour table plus the CSR arrays.
+        ``tree``: an existing cKDTree of ``positions`` to reuse for
+        :attr:`tree` (built lazily otherwise).  ``progress(stage, fraction)``
+        is called per tile and per chunk; an exception it raises (a cancelled
+        editor job) abandons the build there.
+        """
+        pts = np.ascontiguousarray(positions, dtype=np.float64)
         n = len(pts)
-        tree = cKDTree(pts) if tree is None else tree
         diagonal = float(np.linalg.norm(pts.max(axis=0) - pts.min(axis=0))) if n else 0.0
         if n < 2:
             ptr = np.zeros(n + 1, np.int64)
-            return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, tree, diagonal)
+            return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, pts, diagonal, tree)
         kk = min(k, n - 1)
-        d, j = tree.query(pts, k=kk + 1, workers=-1)
-        d, j = d[:, 1:], j[:, 1:].astype(np.int32)
-        # the nearest neighbour at a different position (duplicates looked through)
-        first = np.where(d > 0, d, np.inf).min(axis=1)
+        nb = _knn_table(pts, kk + 1, progress)[:, 1:]      # column 0: the splat itself
+        chunks = range(0, n, GRAPH_BUILD_CHUNK)
+        # pass 1: local scales (median distance to the k neighbours) and the spacing
+        scale = np.empty(n)
+        first = np.empty(n)
+        for c, lo in enumerate(chunks):
+            d = _lengths(pts, lo, nb[lo:lo + GRAPH_BUILD_CHUNK])
+            first[lo:lo + len(d)] = np.where(d > 0, d, np.inf).min(axis=1)   # duplicates looked through
+            scale[lo:lo + len(d)] = np.median(d, axis=1)
+            report(progress, "neighbour graph: local scales", (c + 1) / len(chunks))
         positive = first[np.isfinite(first)]
         spacing = float(np.median(positive)) if len(positive) else 0.0
-        scale = np.median(d, axis=1)
-        i = np.repeat(np.arange(n, dtype=np.int32), kk)
-        j = j.ravel()
-        keep = d.ravel() <= GRAPH_EDGE_MAX_REL * np.minimum(scale[i], scale[j])
-        i, j = i[keep], j[keep]
-        a = sparse.coo_matrix((np.ones(len(i), np.int8), (i, j)), shape=(n, n)).tocsr()
-        a = (a + a.T).tocsr()
-        a.sort_indices()
-        return cls._frozen(a.indptr.astype(np.int64), a.indices.astype(np.int32), spacing, tree, diagonal)
+        del first, positive
+        # pass 2: the edges short enough for both ends, as a directed CSR
+        counts = np.zeros(n, np.int64)
+        kept = []
+        for c, lo in enumerate(chunks):
+            j = nb[lo:lo + GRAPH_BUILD_CHUNK]
+            d = _lengths(pts, lo, j)
+            keep = d <= GRAPH_EDGE_MAX_REL * np.minimum(scale[lo:lo + len(d), None], scale[j])
+            counts[lo:lo + len(d)] = keep.sum(axis=1)
+            kept.append(j[keep])
+            report(progress, "neighbour graph: edges", (c + 1) / len(chunks))
+        del nb, scale
+        indices = np.concatenate(kept)
+        del kept
+        indptr, indices = _symmetric(counts, indices, n)
+        report(progress, "neighbour graph: edges", 1.0)
+        return cls._frozen(indptr, indices, spacing, pts, diagonal, tree)
 
     @classmethod
-    def _frozen(cls, indptr, indices, spacing, tree, diagonal) -> "NeighbourGraph":
+    def _frozen(cls, indptr, indices, spacing, positions, diagonal, tree=None) -> "NeighbourGraph":
         indptr.setflags(write=False)
         indices.setflags(write=False)
-        return cls(indptr, indices, float(spacing), tree, float(diagonal))
+        graph = cls(indptr, indices, float(spacing), positions, float(diagonal))
+        if tree is not None:
+            object.__setattr__(graph, "tree", tree)      # the cached_property's slot
+        return graph
+
+    @cached_property
+    def tree(self) -> cKDTree | None:
+        """cKDTree of the positions (built on first use, e.g. by :meth:`warm`:
+        closure's ray queries and the brush's ball queries), or None for a
+        :meth:`subgraph`."""
+        return None if self.positions is None else cKDTree(self.positions)
 
     def subgraph(self, index: np.ndarray) -> "NeighbourGraph":
         """The graph induced by the splats ``index`` (sorted unique int array),
@@ -109,16 +193,17 @@ class NeighbourGraph:
         """(indices, k-d tree, spacing) of an even subsample of every
         ``GRAPH_COARSE_STRIDE``-th splat (built on first use): for queries
         far from the surface, which the full tree answers slowly."""
-        if self.tree is None:
+        if self.positions is None:
             raise ValueError("a subgraph has no positions for a coarse tree")
-        pts = self.tree.data
+        pts = self.positions
         index = np.arange(0, len(pts), GRAPH_COARSE_STRIDE)
         return index, cKDTree(pts[index]), self.spacing * GRAPH_COARSE_STRIDE ** 0.5
 
     def warm(self) -> "NeighbourGraph":
-        """Build the lazily built search structures now (``coarse``,
-        ``axis_orders``: 0.5 s at 1M splats), e.g. in a background job, so
-        the first closure after it does not pay for them; returns self."""
+        """Build the lazily built search structures now (``tree``, ``coarse``,
+        ``axis_orders``), e.g. in a background job, so the first closure or
+        brush stroke after it does not pay for them; returns self."""
+        self.tree
         self.coarse
         self.axis_orders
         return self
@@ -128,9 +213,9 @@ class NeighbourGraph:
         """(orders (3, n), sorted coordinates (3, n)): the splats sorted along
         x, y and z (built on first use), for box queries whose cost follows
         the box, not the cloud."""
-        if self.tree is None:
+        if self.positions is None:
             raise ValueError("a subgraph has no positions to sort")
-        pts = self.tree.data
+        pts = self.positions
         orders = np.stack([np.argsort(pts[:, a], kind="stable") for a in range(3)])
         return orders, np.stack([pts[orders[a], a] for a in range(3)])
 
@@ -144,7 +229,7 @@ class NeighbourGraph:
             np.searchsorted(coords[2], hi[2], "right")
         axis = int(np.argmin([b[k] - a[k] for k in range(3)]))
         cand = orders[axis, a[axis]:b[axis]]
-        p = self.tree.data[cand]
+        p = self.positions[cand]
         inside = np.all((p >= lo) & (p <= hi), axis=1)
         return np.sort(cand[inside])
 
