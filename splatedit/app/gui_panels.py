@@ -320,6 +320,9 @@ class EditorGui:
                                         imgui.SliderFlags_.logarithmic.value)
         if changed:
             b.set_radius(r)
+        note = b.mode_note()
+        if note:
+            imgui.text_colored(YELLOW, note)
 
     def _stats(self, st) -> None:
         s = self.ed.session

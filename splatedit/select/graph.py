@@ -240,7 +240,9 @@ class NeighbourGraph:
     def matrix(self) -> sparse.csr_matrix:
         """The adjacency as a scipy CSR matrix (n, n), unit weights."""
         data = np.ones(len(self.indices), np.int8)
-        return sparse.csr_matrix((data, self.indices, self.indptr), shape=(self.n, self.n))
+        # int32 row pointers while they fit: scipy would copy the indices to int64 otherwise
+        indptr = self.indptr.astype(np.int32) if len(self.indices) < 2 ** 31 else self.indptr
+        return sparse.csr_matrix((data, self.indices, indptr), shape=(self.n, self.n))
 
     def neighbours_of(self, index: np.ndarray) -> np.ndarray:
         """Concatenated neighbour lists of the splats ``index`` (E',) int32 (with repeats)."""
@@ -321,7 +323,7 @@ class NeighbourGraph:
         index = np.asarray(index, np.int64)
         if len(index) == 0:
             return 0, np.zeros(0, np.int64)
-        sub = self.matrix()[index][:, index]
+        sub = self.subgraph(index).matrix()      # the whole graph's matrix would be 5 bytes an edge end
         from scipy.sparse.csgraph import connected_components
         count, labels = connected_components(sub, directed=False)
         return int(count), labels
