@@ -1032,3 +1032,9 @@ FRONT_VIEW_Z_UP_COS = 0.9
 #: about 100 bytes per row and neighbour (13 MB per 2^17 rows at k = 10), so
 #: the build's working memory next to its (n, k + 1) int32 table stays small
 GRAPH_BUILD_CHUNK = 1 << 17
+#: NeighbourGraph.build decides "edge length <= GRAPH_EDGE_MAX_REL x the
+#: smaller local scale" on tiled_knn's float32 distances (each within 2^-24
+#: = 6e-8 relative of the float64 one, the median scales likewise); a
+#: comparison closer than this (relative) is redone in float64, so the edges
+#: are exactly those of the float64 rule (16x the worst float32 error)
+GRAPH_EXACT_MARGIN_REL = 1e-6

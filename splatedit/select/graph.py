@@ -27,7 +27,7 @@ from scipy.spatial import cKDTree
 from splatedit.model.pca import morton_codes
 from splatedit.model.tiles import tiled_knn
 from splatedit.progress import report
-from splatedit.tolerances import GRAPH_BUILD_CHUNK, GRAPH_COARSE_STRIDE, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
+from splatedit.tolerances import GRAPH_BUILD_CHUNK, GRAPH_COARSE_STRIDE, GRAPH_EXACT_MARGIN_REL, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
 
 
 def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
@@ -39,30 +39,51 @@ def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     return values[scratch[values] == order]
 
 
-def _knn_table(pts: np.ndarray, k: int, progress=None) -> np.ndarray:
-    """(n, k) int32 (int64 from 2^31 splats) indices of the k nearest splats
-    of every splat of ``pts`` (n, 3) float64, nearest first (itself
-    included), in the input's order: :func:`tiled_knn` over the Morton-sorted
-    points, renumbered back."""
+def _knn_table(pts: np.ndarray, k: int, progress=None) -> tuple[np.ndarray, np.ndarray]:
+    """(dist (n, k) float32 model units, idx (n, k) int32 (int64 from 2^31
+    splats)): the k nearest splats of every splat of ``pts`` (n, 3) float64,
+    nearest first (itself included), in the input's order: :func:`tiled_knn`
+    over the Morton-sorted points, renumbered back."""
     n = len(pts)
     codes, lo, scale = morton_codes(pts)
     order = np.argsort(codes, kind="stable")
     codes = codes[order]
     itype = np.int32 if n < 2 ** 31 else np.int64
-    _, nb = tiled_knn(pts[order], codes, lo, scale, k, dist_columns=1, progress=progress)
+    dist, nb = tiled_knn(pts[order], codes, lo, scale, k, progress=progress)
     del codes
     order = order.astype(itype)
     out = np.empty_like(nb)
     for lo_i in range(0, n, GRAPH_BUILD_CHUNK):          # out[order] = order[nb], in chunks
         out[order[lo_i:lo_i + GRAPH_BUILD_CHUNK]] = order[nb[lo_i:lo_i + GRAPH_BUILD_CHUNK]]
-    return out
+    del nb
+    back = np.empty_like(dist)
+    back[order] = dist
+    return back, out
 
 
-def _lengths(pts: np.ndarray, start: int, nb: np.ndarray) -> np.ndarray:
-    """(m, k) float64 distances from splats ``start .. start + m - 1`` to their
-    neighbours ``nb`` (m, k), summed x, y, z in that order as cKDTree does (the
-    same float64 values as its query)."""
-    p = pts[start:start + len(nb), None, :]
+def _exact_keep(pts: np.ndarray, nb: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """Whether the edges (i, j) ((m,) int arrays, j among i's neighbours
+    ``nb`` (n, k)) are at most GRAPH_EDGE_MAX_REL times the smaller local
+    scale of their ends, all in float64 (the few comparisons float32 leaves
+    open)."""
+    rows, inv = np.unique(np.concatenate([i, j]), return_inverse=True)
+    s = np.median(_lengths(pts, rows, nb[rows]), axis=1)
+    d = _pair_lengths(pts, i, j)
+    return d <= GRAPH_EDGE_MAX_REL * np.minimum(s[inv[:len(i)]], s[inv[len(i):]])
+
+
+def _pair_lengths(pts: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
+    """(m,) float64 distances between splats i and j, summed as cKDTree does."""
+    dx, dy, dz = (pts[j, a] - pts[i, a] for a in range(3))
+    return np.sqrt(dx * dx + dy * dy + dz * dz)
+
+
+def _lengths(pts: np.ndarray, rows, nb: np.ndarray) -> np.ndarray:
+    """(m, k) float64 distances from splats ``rows`` (an int start of m
+    consecutive splats, or (m,) indices) to their neighbours ``nb`` (m, k),
+    summed x, y, z in that order as cKDTree does (the same float64 values as
+    its query)."""
+    p = pts[rows:rows + len(nb), None, :] if np.isscalar(rows) else pts[rows][:, None, :]
     q = pts[nb]
     dx, dy, dz = q[..., 0] - p[..., 0], q[..., 1] - p[..., 1], q[..., 2] - p[..., 2]
     return np.sqrt(dx * dx + dy * dy + dz * dz)
@@ -127,29 +148,42 @@ class NeighbourGraph:
             ptr = np.zeros(n + 1, np.int64)
             return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, pts, diagonal, tree)
         kk = min(k, n - 1)
-        nb = _knn_table(pts, kk + 1, progress)[:, 1:]      # column 0: the splat itself
+        dist, nb = _knn_table(pts, kk + 1, progress)
+        dist, nb = dist[:, 1:], nb[:, 1:]                  # column 0: the splat itself
         chunks = range(0, n, GRAPH_BUILD_CHUNK)
-        # pass 1: local scales (median distance to the k neighbours) and the spacing
+        # pass 1: local scales (median distance to the k neighbours, from the
+        # float32 distances: within 2^-24 of the float64 ones) and the spacing
+        # (the nearest neighbour at a different position, duplicates looked
+        # through: its float64 length, one gather per splat)
         scale = np.empty(n)
         first = np.empty(n)
         for c, lo in enumerate(chunks):
-            d = _lengths(pts, lo, nb[lo:lo + GRAPH_BUILD_CHUNK])
-            first[lo:lo + len(d)] = np.where(d > 0, d, np.inf).min(axis=1)   # duplicates looked through
+            d = dist[lo:lo + GRAPH_BUILD_CHUNK].astype(np.float64)
             scale[lo:lo + len(d)] = np.median(d, axis=1)
+            col = np.minimum(np.argmax(d > 0, axis=1), kk - 1)
+            exact = _lengths(pts, lo, nb[lo:lo + len(d)][np.arange(len(d)), col][:, None])[:, 0]
+            first[lo:lo + len(d)] = np.where(exact > 0, exact, np.inf)
             report(progress, "neighbour graph: local scales", (c + 1) / len(chunks))
         positive = first[np.isfinite(first)]
         spacing = float(np.median(positive)) if len(positive) else 0.0
         del first, positive
-        # pass 2: the edges short enough for both ends, as a directed CSR
+        # pass 2: the edges short enough for both ends, as a directed CSR; a
+        # comparison closer than GRAPH_EXACT_MARGIN_REL is redone in float64
         counts = np.zeros(n, np.int64)
         kept = []
         for c, lo in enumerate(chunks):
             j = nb[lo:lo + GRAPH_BUILD_CHUNK]
-            d = _lengths(pts, lo, j)
-            keep = d <= GRAPH_EDGE_MAX_REL * np.minimum(scale[lo:lo + len(d), None], scale[j])
-            counts[lo:lo + len(d)] = keep.sum(axis=1)
+            d = dist[lo:lo + len(j)].astype(np.float64)
+            limit = GRAPH_EDGE_MAX_REL * np.minimum(scale[lo:lo + len(j), None], scale[j])
+            keep = d <= limit
+            near = np.abs(d - limit) <= GRAPH_EXACT_MARGIN_REL * limit
+            if near.any():
+                r, q = np.nonzero(near)
+                keep[r, q] = _exact_keep(pts, nb, lo + r, j[r, q])
+            counts[lo:lo + len(j)] = keep.sum(axis=1)
             kept.append(j[keep])
             report(progress, "neighbour graph: edges", (c + 1) / len(chunks))
+        del dist
         del nb, scale
         indices = np.concatenate(kept)
         del kept

@@ -86,3 +86,10 @@ def test_the_global_tree_is_built_on_first_use_and_reused():
     assert g.warm().tree is g.tree and g.tree.n == len(pts)
     given = cKDTree(pts)
     assert NeighbourGraph.build(pts, tree=given).tree is given
+
+
+def test_the_float64_fallback_alone_gives_the_same_edges(small_tiles, monkeypatch):
+    """Every comparison sent to the float64 path (a margin of 10x): the edges
+    do not depend on which comparisons float32 settles."""
+    monkeypatch.setattr(graph_mod, "GRAPH_EXACT_MARGIN_REL", 10.0)
+    _same_graph(read(default_model_path()).positions)
