@@ -305,11 +305,7 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
     open_[labels[np.isin(shell, last)]] = True
     # a component with a neighbour outside the reach (not allowed, or beyond)
     # that is not selected is not enclosed either
-    nb_counts = graph.indptr[shell + 1] - graph.indptr[shell]
-    nb = graph.neighbours_of(shell)
-    leaks = ~reach[nb]
-    row = np.repeat(np.arange(len(shell)), nb_counts)
-    open_[labels[row[leaks]]] = True
+    open_[labels[graph.any_neighbour(shell, ~reach)]] = True
     if edge is not None:
         open_[labels[edge[shell]]] = True
     return shell[~open_[labels]]

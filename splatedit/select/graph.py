@@ -27,7 +27,14 @@ from scipy.spatial import cKDTree
 from splatedit.model.pca import morton_codes
 from splatedit.model.tiles import tiled_knn
 from splatedit.progress import report
-from splatedit.tolerances import GRAPH_BUILD_CHUNK, GRAPH_COARSE_STRIDE, GRAPH_EXACT_MARGIN_REL, GRAPH_EDGE_MAX_REL, GRAPH_NEIGHBOURS
+from splatedit.tolerances import (
+    GRAPH_BUILD_CHUNK,
+    GRAPH_COARSE_STRIDE,
+    GRAPH_EDGE_MAX_REL,
+    GRAPH_EXACT_MARGIN_REL,
+    GRAPH_NEIGHBOURS,
+    GRAPH_ROWS_CHUNK,
+)
 
 
 def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
@@ -103,6 +110,14 @@ def _symmetric(counts: np.ndarray, indices: np.ndarray, n: int) -> tuple[np.ndar
     a = (a + a.T.tocsr()).tocsr()
     a.sort_indices()
     return a.indptr.astype(np.int64), a.indices.astype(np.int32, copy=False)
+
+
+def _row_sums(flags: np.ndarray, counts: np.ndarray) -> np.ndarray:
+    """(m,) int64 number of True ``flags`` in each of m consecutive runs of
+    ``counts`` (m,) entries (empty runs included)."""
+    cs = np.concatenate([[0], np.cumsum(flags, dtype=np.int64)])
+    ends = np.cumsum(counts)
+    return cs[ends] - cs[ends - counts]
 
 
 @dataclass(frozen=True)
@@ -214,13 +229,18 @@ class NeighbourGraph:
         index = np.asarray(index, np.int64)
         lookup = np.full(self.n, -1, np.int32)
         lookup[index] = np.arange(len(index), dtype=np.int32)
-        counts = self.indptr[index + 1] - self.indptr[index]
-        nb = lookup[self.neighbours_of(index)]
-        keep = nb >= 0
-        row = np.repeat(np.arange(len(index)), counts)[keep]
+        counts = np.zeros(len(index), np.int64)
+        parts = []
+        for lo in range(0, len(index), GRAPH_ROWS_CHUNK):     # bounded temporaries
+            rows = index[lo:lo + GRAPH_ROWS_CHUNK]
+            nb = lookup[self.neighbours_of(rows)]
+            keep = nb >= 0
+            counts[lo:lo + len(rows)] = _row_sums(keep, self.indptr[rows + 1] - self.indptr[rows])
+            parts.append(nb[keep])
         indptr = np.zeros(len(index) + 1, np.int64)
-        np.cumsum(np.bincount(row, minlength=len(index)), out=indptr[1:])
-        return self._frozen(indptr, nb[keep].astype(np.int32), self.spacing, None, self.diagonal)
+        np.cumsum(counts, out=indptr[1:])
+        indices = np.concatenate(parts) if parts else np.zeros(0, np.int32)
+        return self._frozen(indptr, indices.astype(np.int32, copy=False), self.spacing, None, self.diagonal)
 
     @cached_property
     def coarse(self) -> tuple[np.ndarray, cKDTree, float]:
@@ -279,7 +299,8 @@ class NeighbourGraph:
         return sparse.csr_matrix((data, self.indices, indptr), shape=(self.n, self.n))
 
     def neighbours_of(self, index: np.ndarray) -> np.ndarray:
-        """Concatenated neighbour lists of the splats ``index`` (E',) int32 (with repeats)."""
+        """Concatenated neighbour lists of the splats ``index`` (E',) int32
+        (with repeats); its temporaries are bounded by GRAPH_ROWS_CHUNK rows."""
         index = np.asarray(index, np.int64)
         if len(index) == 0:
             return np.zeros(0, np.int32)
@@ -288,9 +309,28 @@ class NeighbourGraph:
         total = int(counts.sum())
         if total == 0:
             return np.zeros(0, np.int32)
-        # positions start[r] .. stop[r] - 1 for every row r, vectorised
-        offsets = np.repeat(start - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
-        return self.indices[np.arange(total) + offsets]
+        if len(index) <= GRAPH_ROWS_CHUNK:
+            # positions start[r] .. stop[r] - 1 for every row r, vectorised
+            offsets = np.repeat(start - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+            return self.indices[np.arange(total) + offsets]
+        out = np.empty(total, np.int32)
+        at = 0
+        for lo in range(0, len(index), GRAPH_ROWS_CHUNK):
+            part = self.neighbours_of(index[lo:lo + GRAPH_ROWS_CHUNK])
+            out[at:at + len(part)] = part
+            at += len(part)
+        return out
+
+    def any_neighbour(self, index: np.ndarray, where: np.ndarray) -> np.ndarray:
+        """(len(index),) bool: which splats ``index`` have a neighbour in
+        ``where`` (n,) bool (temporaries bounded by GRAPH_ROWS_CHUNK rows)."""
+        index = np.asarray(index, np.int64)
+        out = np.zeros(len(index), bool)
+        for lo in range(0, len(index), GRAPH_ROWS_CHUNK):
+            rows = index[lo:lo + GRAPH_ROWS_CHUNK]
+            hit = where[self.neighbours_of(rows)]
+            out[lo:lo + len(rows)] = _row_sums(hit, self.indptr[rows + 1] - self.indptr[rows]) > 0
+        return out
 
     def ring(self, mask: np.ndarray) -> np.ndarray:
         """Sorted indices of the splats not in ``mask`` with a neighbour in it (the one-ring)."""
@@ -303,14 +343,7 @@ class NeighbourGraph:
         idx = np.flatnonzero(mask)
         if len(idx) == 0:
             return idx
-        start, stop = self.indptr[idx], self.indptr[idx + 1]
-        counts = stop - start
-        nb = self.neighbours_of(idx)
-        outside = ~mask[nb]
-        row = np.repeat(np.arange(len(idx)), counts)
-        has = np.zeros(len(idx), bool)
-        has[row[outside]] = True
-        return idx[has]
+        return idx[self.any_neighbour(idx, ~mask)]
 
     def grow(self, mask: np.ndarray, rings: int = 1, within: np.ndarray | None = None) -> np.ndarray:
         """``mask`` (n,) bool plus every splat at most ``rings`` edges from it
