@@ -244,17 +244,12 @@ def _level_pass(pts, lo, scale, grid: CellGrid, k, kd, todo, tile_points, dist, 
     threads = min(max(int(threads), 1), ntiles)
     inner = 1 if threads > 1 else -1             # threads over tiles, or over one tile's queries
     failed = []
-    pool = ThreadPoolExecutor(threads)
-    try:
+    with ThreadPoolExecutor(threads) as pool:
         for ncand, end, bad in pool.map(tile, range(ntiles)):
             stats.tiles += 1
             stats.tree_points += ncand
             if bad is not None and len(bad):
                 failed.append(bad)
             report(progress, "finding neighbours", end / n if todo is None else 1.0)
-    finally:
-        # a progress callback that raises (a cancelled job) stops here: the
-        # queued tiles are dropped, only the running ones are waited for
-        pool.shutdown(wait=True, cancel_futures=True)
     return np.concatenate(failed) if failed else np.zeros(0, np.int64)
 
