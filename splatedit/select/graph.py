@@ -46,26 +46,45 @@ def unique_indices(values: np.ndarray, scratch: np.ndarray) -> np.ndarray:
     return values[scratch[values] == order]
 
 
-def _knn_table(pts: np.ndarray, k: int, progress=None) -> tuple[np.ndarray, np.ndarray]:
-    """(dist (n, k) float32 model units, idx (n, k) int32 (int64 from 2^31
-    splats)): the k nearest splats of every splat of ``pts`` (n, 3) float64,
-    nearest first (itself included), in the input's order: :func:`tiled_knn`
-    over the Morton-sorted points, renumbered back."""
-    n = len(pts)
+def _sorted_knn(pts: np.ndarray, k: int, progress=None):
+    """The splats ``pts`` (n, 3) float64 along a Z-order curve and their k
+    nearest neighbours there: (sorted positions (n, 3), order (n,) int64 with
+    ``sorted = pts[order]``, dist (n, k) float32 model units, idx (n, k) int32
+    (int64 from 2^31 splats) in the sorted numbering, nearest first, itself
+    included) from :func:`tiled_knn`.  The build stays in the sorted
+    numbering (its gathers are local) until :func:`_renumbered`."""
     codes, lo, scale = morton_codes(pts)
     order = np.argsort(codes, kind="stable")
     codes = codes[order]
-    itype = np.int32 if n < 2 ** 31 else np.int64
-    dist, nb = tiled_knn(pts[order], codes, lo, scale, k, progress=progress)
-    del codes
-    order = order.astype(itype)
-    out = np.empty_like(nb)
-    for lo_i in range(0, n, GRAPH_BUILD_CHUNK):          # out[order] = order[nb], in chunks
-        out[order[lo_i:lo_i + GRAPH_BUILD_CHUNK]] = order[nb[lo_i:lo_i + GRAPH_BUILD_CHUNK]]
-    del nb
-    back = np.empty_like(dist)
-    back[order] = dist
-    return back, out
+    sp = pts[order]
+    dist, nb = tiled_knn(sp, codes, lo, scale, k, progress=progress)
+    return sp, order, dist, nb
+
+
+def _renumbered(indptr_s: np.ndarray, indices_s: np.ndarray, order: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The CSR graph (``indptr_s`` (n + 1,), ``indices_s``) of the Z-order
+    sorted splats in the input's numbering (sorted splat s is splat
+    ``order[s]``): rows moved, indices mapped, each row sorted.  Returns
+    (indptr (n + 1,) int64, indices int32)."""
+    n = len(order)
+    counts_s = np.diff(indptr_s)
+    counts = np.empty(n, np.int64)
+    counts[order] = counts_s
+    indptr = np.zeros(n + 1, np.int64)
+    np.cumsum(counts, out=indptr[1:])
+    order_i = order.astype(indices_s.dtype)
+    indices = np.empty(len(indices_s), indices_s.dtype)
+    for lo in range(0, n, GRAPH_BUILD_CHUNK):
+        hi = min(lo + GRAPH_BUILD_CHUNK, n)
+        a, b = int(indptr_s[lo]), int(indptr_s[hi])
+        shift = np.repeat(indptr[order[lo:hi]] - indptr_s[lo:hi], counts_s[lo:hi])
+        indices[np.arange(a, b) + shift] = order_i[indices_s[a:b]]
+    del indices_s, order_i
+    small = len(indices) < 2 ** 31
+    m = sparse.csr_matrix((np.ones(len(indices), np.int8), indices, indptr.astype(np.int32) if small else indptr),
+                          shape=(n, n))
+    m.sort_indices()
+    return indptr, m.indices.astype(np.int32, copy=False)
 
 
 def _exact_keep(pts: np.ndarray, nb: np.ndarray, i: np.ndarray, j: np.ndarray) -> np.ndarray:
@@ -99,7 +118,7 @@ def _lengths(pts: np.ndarray, rows, nb: np.ndarray) -> np.ndarray:
 def _symmetric(counts: np.ndarray, indices: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """(indptr (n + 1,) int64, indices int32) of the union of a directed graph
     (row ``i`` holds ``counts[i]`` targets, ``indices`` concatenated) and its
-    transpose, rows sorted: scipy's CSR transpose and sum, on int32 indices
+    transpose, rows in no particular order: scipy's CSR transpose and sum, on int32 indices
     while the edge count allows."""
     itype = np.int32 if len(indices) < 2 ** 30 and n < 2 ** 31 else np.int64
     indptr = np.zeros(n + 1, itype)
@@ -107,8 +126,7 @@ def _symmetric(counts: np.ndarray, indices: np.ndarray, n: int) -> tuple[np.ndar
     a = sparse.csr_matrix((np.ones(len(indices), np.int8), indices.astype(itype, copy=False), indptr),
                           shape=(n, n))
     del indices, indptr
-    a = (a + a.T.tocsr()).tocsr()
-    a.sort_indices()
+    a = a + a.T.tocsr()                      # rows unsorted: _renumbered sorts them
     return a.indptr.astype(np.int64), a.indices.astype(np.int32, copy=False)
 
 
@@ -147,10 +165,13 @@ class NeighbourGraph:
         """Graph of ``positions`` (n, 3) float64 (model units).
 
         The k nearest neighbours come from :func:`splatedit.model.tiles.tiled_knn`
-        (Morton tiles, no k-d tree over all points, exact); edge lengths are
-        recomputed in float64 in row chunks, so the edges are those of one
-        global ``cKDTree`` query (ties between equal distances aside).  Memory
-        is the (n, k + 1) int32 neighbour table plus the CSR arrays.
+        (Morton tiles, no k-d tree over all points, exact) on the splats sorted
+        along a Z-order curve; the edge rule runs on its float32 distances
+        with the comparisons float32 cannot settle redone in float64, so the
+        edges are those of one global ``cKDTree`` query (ties between equal
+        distances aside).  The graph is built in the sorted numbering and
+        renumbered at the end.  Memory: the (n, k + 1) float32 and int32
+        neighbour tables, then about three copies of the CSR indices.
         ``tree``: an existing cKDTree of ``positions`` to reuse for
         :attr:`tree` (built lazily otherwise).  ``progress(stage, fraction)``
         is called per tile and per chunk; an exception it raises (a cancelled
@@ -163,7 +184,7 @@ class NeighbourGraph:
             ptr = np.zeros(n + 1, np.int64)
             return cls._frozen(ptr, np.zeros(0, np.int32), 0.0, pts, diagonal, tree)
         kk = min(k, n - 1)
-        dist, nb = _knn_table(pts, kk + 1, progress)
+        sp, order, dist, nb = _sorted_knn(pts, kk + 1, progress)
         dist, nb = dist[:, 1:], nb[:, 1:]                  # column 0: the splat itself
         chunks = range(0, n, GRAPH_BUILD_CHUNK)
         # pass 1: local scales (median distance to the k neighbours, from the
@@ -176,7 +197,7 @@ class NeighbourGraph:
             d = dist[lo:lo + GRAPH_BUILD_CHUNK].astype(np.float64)
             scale[lo:lo + len(d)] = np.median(d, axis=1)
             col = np.minimum(np.argmax(d > 0, axis=1), kk - 1)
-            exact = _lengths(pts, lo, nb[lo:lo + len(d)][np.arange(len(d)), col][:, None])[:, 0]
+            exact = _lengths(sp, lo, nb[lo:lo + len(d)][np.arange(len(d)), col][:, None])[:, 0]
             first[lo:lo + len(d)] = np.where(exact > 0, exact, np.inf)
             report(progress, "neighbour graph: local scales", (c + 1) / len(chunks))
         positive = first[np.isfinite(first)]
@@ -194,15 +215,16 @@ class NeighbourGraph:
             near = np.abs(d - limit) <= GRAPH_EXACT_MARGIN_REL * limit
             if near.any():
                 r, q = np.nonzero(near)
-                keep[r, q] = _exact_keep(pts, nb, lo + r, j[r, q])
+                keep[r, q] = _exact_keep(sp, nb, lo + r, j[r, q])
             counts[lo:lo + len(j)] = keep.sum(axis=1)
             kept.append(j[keep])
             report(progress, "neighbour graph: edges", (c + 1) / len(chunks))
-        del dist
-        del nb, scale
+        del dist, nb, scale, sp
         indices = np.concatenate(kept)
         del kept
         indptr, indices = _symmetric(counts, indices, n)
+        del counts
+        indptr, indices = _renumbered(indptr, indices, order)
         report(progress, "neighbour graph: edges", 1.0)
         return cls._frozen(indptr, indices, spacing, pts, diagonal, tree)
 
