@@ -118,8 +118,8 @@ def _lengths(pts: np.ndarray, rows, nb: np.ndarray) -> np.ndarray:
 def _symmetric(counts: np.ndarray, indices: np.ndarray, n: int) -> tuple[np.ndarray, np.ndarray]:
     """(indptr (n + 1,) int64, indices int32) of the union of a directed graph
     (row ``i`` holds ``counts[i]`` targets, ``indices`` concatenated) and its
-    transpose, rows in no particular order: scipy's CSR transpose and sum, on int32 indices
-    while the edge count allows."""
+    transpose, each row's entries in no particular order: scipy's CSR
+    transpose and sum, on int32 indices while the edge count allows."""
     itype = np.int32 if len(indices) < 2 ** 30 and n < 2 ** 31 else np.int64
     indptr = np.zeros(n + 1, itype)
     np.cumsum(counts, out=indptr[1:])
