@@ -1027,10 +1027,10 @@ FRAMING_SAMPLE_POINTS = 20_000
 FRONT_VIEW_Z_UP_COS = 0.9
 
 # --- selection graph at scan scale (splatedit.select.graph, issue 11 part 5) ---
-#: rows per chunk when NeighbourGraph.build recomputes its edge lengths in
-#: float64 (two passes: local scales, then edges): a chunk's gathers are
-#: about 100 bytes per row and neighbour (13 MB per 2^17 rows at k = 10), so
-#: the build's working memory next to its (n, k + 1) int32 table stays small
+#: rows per chunk of NeighbourGraph.build's passes over its k-NN table
+#: (local scales, edge rule, renumbering): a chunk's float64 temporaries are
+#: about 50 bytes per row and neighbour (~65 MB per 2^17 rows at k = 10),
+#: small next to the (n, k + 1) float32 + int32 tables (1M splats: 88 MB)
 GRAPH_BUILD_CHUNK = 1 << 17
 #: NeighbourGraph.build decides "edge length <= GRAPH_EDGE_MAX_REL x the
 #: smaller local scale" on tiled_knn's float32 distances (each within 2^-24
