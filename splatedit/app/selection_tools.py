@@ -39,10 +39,10 @@ BRUSH_3D, BRUSH_VISIBLE = "3d", "visible"
 #: the graph job's progress bar label, and the bar's span for each stage of
 #: NeighbourGraph.build and the search trees after it (fractions of the job,
 #: from a 1M-splat build: k-NN over the tiles 2.1 s, local scales 0.3 s,
-#: edges with CSR 0.8 s, global k-d tree 0.9 s, coarse tree + axis orders 0.5 s)
+#: edges with CSR 0.8 s, global k-d tree 0.9 s, coarse tree + axis orders 0.2 s)
 GRAPH_JOB_STAGE = "neighbour graph (3D brush)"
-GRAPH_PROGRESS_SPAN = {"finding neighbours": (0.0, 0.46), "neighbour graph: local scales": (0.46, 0.53),
-                       "neighbour graph: edges": (0.53, 0.7), "search trees": (0.7, 1.0)}
+GRAPH_PROGRESS_SPAN = {"finding neighbours": (0.0, 0.49), "neighbour graph: local scales": (0.49, 0.56),
+                       "neighbour graph: edges": (0.56, 0.75), "search trees": (0.75, 1.0)}
 #: colour of the splats closure added (a brief highlight)
 CLOSURE_RGB = (255, 200, 0)
 
@@ -284,7 +284,7 @@ class SelectionTools:
             graph = NeighbourGraph.build(positions, progress=overall)
             overall("search trees", 0.0)
             graph.tree
-            overall("search trees", 0.65)
+            overall("search trees", 0.8)
             return graph.warm()   # its first closure pays nothing more
 
         if self._start_job is None:
