@@ -213,7 +213,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--gaussians", action="store_true",
                    help="with 'render': the Gaussian splatting renderer (100k and 1M Gaussians, both sorts)")
     s.add_argument("--splats", type=_positive_count, nargs="+", metavar="N",
-                   help="point/splat counts of estimate, render, editor and the Gaussian benches, "
+                   help="point/splat counts of estimate, render, editor, closure and the Gaussian benches, "
                         "support splats of basis "
                         "(e.g. --splats 1000000 10000000)")
     s.add_argument("--large", action="store_true",

@@ -1116,3 +1116,22 @@ GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
 #: 25% 3.43 (4.76 uncompensated), 100k sphere 10% 5.20 (7.57); the editor
 #: bench at 1280x720 (16k of 1M at half resolution): 4.92
 GS_LOD_TEST_MEAN_DIFF = 6.5
+
+# --- selection graph at scan scale (splatedit.select.graph, issue 11 part 5) ---
+#: rows per chunk of NeighbourGraph.build's passes over its k-NN table
+#: (local scales, edge rule, renumbering): a chunk's float64 temporaries are
+#: about 50 bytes per row and neighbour (~65 MB per 2^17 rows at k = 10),
+#: small next to the (n, k + 1) float32 + int32 tables (1M splats: 88 MB)
+GRAPH_BUILD_CHUNK = 1 << 17
+#: NeighbourGraph.build decides "edge length <= GRAPH_EDGE_MAX_REL x the
+#: smaller local scale" on tiled_knn's float32 distances (each within 2^-24
+#: = 6e-8 relative of the float64 one, the median scales likewise); a
+#: comparison closer than this (relative) is redone in float64, so the edges
+#: are exactly those of the float64 rule (16x the worst float32 error)
+GRAPH_EXACT_MARGIN_REL = 1e-6
+#: rows per block when the graph gathers neighbour lists of many splats
+#: (subgraph, boundary, closure's islands): the int64 position temporaries
+#: are 16 bytes per edge end of the block, so a block of 2^16 rows (~11 ends
+#: each) costs ~12 MB instead of 16 bytes per end of the whole request
+#: (1.4M-splat shell at 5M: ~250 MB)
+GRAPH_ROWS_CHUNK = 1 << 16

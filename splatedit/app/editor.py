@@ -316,6 +316,7 @@ class Editor(EventRouting, FileActions):
         for j in list(self.jobs.values()):
             if j.name == "saving":
                 j.wait()     # never leave a half-written file behind
+        self.brush.tools.cancel()   # a graph build stops at its next tile (its pool would hold up the exit)
         self.frames.close()
         if self.gui is not None:
             if self.presenter is not None:

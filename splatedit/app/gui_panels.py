@@ -346,6 +346,9 @@ class EditorGui(MenuBar):
                                         imgui.SliderFlags_.logarithmic.value)
         if changed:
             b.set_radius(r)
+        note = b.mode_note()
+        if note:
+            imgui.text_colored(YELLOW, note)
 
     def _stats(self, st) -> None:
         s = self.ed.session

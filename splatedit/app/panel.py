@@ -72,6 +72,9 @@ def panel_lines(ed) -> list:
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"
     lines.append((f"brush: {tgt} {mode}{erase}  radius {brush.radius:.0f} px   (Tab, V, E, [ ])",
                   ov.SUPPORT_RGB if s.brush_target == SUPPORT else ov.HANDLE_RGB))
+    note = brush.mode_note()
+    if note:
+        lines.append((note, (255, 230, 120)))
     lines.append(f"support {st.support:,}   handle {st.handle:,}   "
                  f"deformation {s.deformation.value.upper()} (B)")
     hs = s.selection.handles

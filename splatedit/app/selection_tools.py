@@ -36,6 +36,13 @@ from splatedit.tolerances import CLOSURE_ISLAND_RINGS, EDITOR_CLOSURE_HIGHLIGHT_
 
 #: brush modes: the 3D sphere brush (default) and the visible-only brush
 BRUSH_3D, BRUSH_VISIBLE = "3d", "visible"
+#: the graph job's progress bar label, and the bar's span for each stage of
+#: NeighbourGraph.build and the search trees after it (fractions of the job,
+#: from a 1M-splat build: k-NN over the tiles 2.1 s, local scales 0.3 s,
+#: edges with CSR 0.8 s, global k-d tree 0.9 s, coarse tree + axis orders 0.2 s)
+GRAPH_JOB_STAGE = "neighbour graph (3D brush)"
+GRAPH_PROGRESS_SPAN = {"finding neighbours": (0.0, 0.49), "neighbour graph: local scales": (0.49, 0.56),
+                       "neighbour graph: edges": (0.56, 0.75), "search trees": (0.75, 1.0)}
 #: colour of the splats closure added (a brief highlight)
 CLOSURE_RGB = (255, 200, 0)
 
@@ -290,14 +297,37 @@ class SelectionTools:
 
         def work(progress):
             from splatedit.select.graph import NeighbourGraph
-            progress("neighbour graph", 0.0)
-            return NeighbourGraph.build(positions).warm()   # its first closure pays nothing more
+
+            def overall(stage, fraction):        # one bar: the tiles' k-NN, then edges, then the trees
+                at = GRAPH_PROGRESS_SPAN.get(stage, (0.0, 1.0))
+                progress(GRAPH_JOB_STAGE, at[0] + (at[1] - at[0]) * fraction)
+
+            overall("", 0.0)
+            graph = NeighbourGraph.build(positions, progress=overall)
+            overall("search trees", 0.0)
+            graph.tree
+            overall("search trees", 0.8)
+            return graph.warm()   # its first closure pays nothing more
 
         if self._start_job is None:
             self._store(cloud, work(lambda *a: None))
             return
         self._job = self._start_job("neighbour graph", work)
         self._job_cloud = cloud
+
+    def building(self, cloud) -> float | None:
+        """The fraction done (0..1) of the background job building ``cloud``'s
+        graph, or None when no build for it is running (ready, or not asked)."""
+        job = self._job
+        if job is None or self._job_cloud is not cloud or job.done:
+            return None
+        return float(job.fraction)
+
+    def cancel(self) -> None:
+        """Abandon a running graph build (quitting): the job stops at its next
+        tile or chunk."""
+        if self._job is not None:
+            self._job.cancel.set()
 
     def _store(self, cloud, graph) -> None:
         # keep the graphs of the last few base clouds (undo / redo switch between them)

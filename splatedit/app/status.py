@@ -87,7 +87,7 @@ def status_dict(ed) -> dict:
               basis_columns=None if s.basis is None else s.basis.n_columns,
               deformation=s.deformation.value,
               basis_kind=None if s.basis is None else type(s.basis).__name__,
-              brush_mode=tools.mode, closure_added=tools.last_added,
+              brush_mode=tools.mode, brush_note=ed.brush.mode_note(), closure_added=tools.last_added,
               closure_highlight=tools.highlighted(s.cloud) is not None)
     ft = field_target(s)
     st["fields"] = {"kind": ft.kind.value, "index": ft.index, "problem": ft.problem,

@@ -77,7 +77,7 @@ def _editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
 
 def _closure(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     from splatedit.bench.closure import bench_closure
-    yield from bench_closure(counts=(20_000, 100_000) if quick else (100_000, 1_000_000),
+    yield from bench_closure(counts=counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)),
                              repeats=2 if quick else 3)
 
 
@@ -146,7 +146,7 @@ BENCHES = {
 def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
               large: bool = False) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
-    ``counts``: splat/point counts for ``estimate``, ``render``, ``editor`` and
+    ``counts``: splat/point counts for ``estimate``, ``render``, ``editor``, ``closure`` and
     support splats for ``basis``
     (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``."""
     names = list(BENCHES) if what == "all" else [what]

@@ -305,11 +305,7 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
     open_[labels[np.isin(shell, last)]] = True
     # a component with a neighbour outside the reach (not allowed, or beyond)
     # that is not selected is not enclosed either
-    nb_counts = graph.indptr[shell + 1] - graph.indptr[shell]
-    nb = graph.neighbours_of(shell)
-    leaks = ~reach[nb]
-    row = np.repeat(np.arange(len(shell)), nb_counts)
-    open_[labels[row[leaks]]] = True
+    open_[labels[graph.any_neighbour(shell, ~reach)]] = True
     if edge is not None:
         open_[labels[edge[shell]]] = True
     return shell[~open_[labels]]
@@ -412,7 +408,11 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         width = max(BAND_RINGS * graph.spacing,
                     min(CLOSURE_HANDLE_MARGIN_REL * _rms_radius(hp), CLOSURE_HANDLE_MARGIN_MAX_REL * diag))
         lo, hi = hp.min(axis=0) - width, hp.max(axis=0) + width
-        cand = np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1) & ~sup)
+        if graph.positions is pos:      # the graph's sorted axes: the cost follows the box
+            cand = graph.in_box(lo, hi)
+            cand = cand[~sup[cand]]
+        else:
+            cand = np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1) & ~sup)
         if len(cand) == 0:
             continue
         d, _ = cKDTree(hp).query(pos[cand], k=1, distance_upper_bound=width, workers=_workers(len(cand)))

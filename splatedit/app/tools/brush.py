@@ -54,6 +54,16 @@ class BrushTool(Tool):
     def mode(self) -> str:
         return self.tools.mode
 
+    def mode_note(self) -> str | None:
+        """While the 3D brush waits for the neighbour graph: what it does
+        meanwhile and how far the graph is (shown in the panel), else None."""
+        if self.tools.mode != seltools.BRUSH_3D or self.ed.session is None:
+            return None
+        done = self.tools.building(self.session.cloud)
+        if done is None:
+            return None
+        return f"3D brush: visible-only until the neighbour graph is ready ({done * 100:.0f}%)"
+
     def toggle_mode(self) -> None:
         mode = self.tools.toggle_mode()
         self.ed.say("brush: 3D (everything inside the sphere, front and back)" if mode == seltools.BRUSH_3D
