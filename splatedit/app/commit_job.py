@@ -91,7 +91,7 @@ class CommitPlan:
 
 def estimate_ms(cloud, support: int) -> float:
     """Estimated milliseconds of a commit of ``support`` splats (Gaussians)
-    of ``cloud`` on this kind of machine (the figures in tolerances.py)."""
+    of ``cloud`` on this kind of machine (the figures in splatedit/tolerances/app.py)."""
     per = (EDITOR_COMMIT_US_PER_SUPPORT_GAUSSIAN if gaussians_of(cloud) is not None
            else EDITOR_COMMIT_US_PER_SUPPORT_SPLAT)
     return 1e-3 * (per * support + EDITOR_COMMIT_US_PER_SPLAT * cloud.n)
