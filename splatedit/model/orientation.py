@@ -27,7 +27,7 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.tolerances import (FRONT_VIEW_Z_UP_COS, UP_AXIS_ALIGNED_COS, UP_AXIS_FLOOR_BAND,
-                                  UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION)
+                                  UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION, UP_AXIS_SAMPLE)
 
 #: the formats whose coordinates are Z-up by definition
 Z_UP_SUFFIXES = (".las", ".laz", ".e57")
@@ -135,6 +135,20 @@ def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpA
         if best is not None:
             return UpAxis(best[1], best[2], UpSource.GROUND)
     return UpAxis(1, 1, UpSource.DEFAULT)
+
+
+def detect_cloud_up_axis(cloud, path=None) -> UpAxis:
+    """:func:`detect_up_axis` of a :class:`~splatedit.model.cloud.SplatCloud`:
+    the file's word first (no normals needed), else the floor rule on every
+    ``n // UP_AXIS_SAMPLE``-th splat (its tests are shares of points, which a
+    sample of that size gives to well under a percent; the normals of all
+    10M splats alone cost 2.8 s)."""
+    hint = detect_up_axis(np.zeros((0, 3)), np.zeros((0, 3)), path)
+    if hint.source is not UpSource.DEFAULT:
+        return hint
+    step = max(1, -(-cloud.n // UP_AXIS_SAMPLE))
+    rows = slice(0, cloud.n, step)
+    return detect_up_axis(cloud.normals_at(rows), cloud.positions[rows], path)
 
 
 def front_direction(up) -> np.ndarray:

@@ -4,7 +4,7 @@ camera): the editor's first view.
 
 It frames the model's main body (:func:`splatedit.model.extent.framing_extent`:
 far outlier clumps are left out) from the front about the model's up axis
-(:func:`splatedit.model.orientation.detect_up_axis`, as the editor detects
+(:func:`splatedit.model.orientation.detect_cloud_up_axis`, as the editor detects
 it; :func:`~splatedit.model.orientation.front_direction`): a Y-up model is
 seen from +Z, a Z-up scan (LAS/LAZ/E57, a floor) from -Y with Z up on
 screen, not from above.
@@ -17,7 +17,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.model.extent import FramingExtent, framing_extent
-from splatedit.model.orientation import UpAxis, UpSource, detect_up_axis, front_direction
+from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, front_direction
 from splatedit.render.camera import Camera
 from splatedit.tolerances import RENDER_CAMERA_MIN_UP_SINE, RENDER_FOV_DEG
 
@@ -66,10 +66,7 @@ def default_view(cloud, size, *, path=None, up=None, fov_deg: float | None = Non
     extent = framing_extent(cloud.positions)
     axis = None
     if up is None:
-        # the file's word first (header, format): the normals (an (n, 3) cross product) only without it
-        axis = detect_up_axis(np.zeros((0, 3)), cloud.positions[:0], path)
-        if axis.source is UpSource.DEFAULT:
-            axis = detect_up_axis(cloud.normals, cloud.positions, path)
+        axis = detect_cloud_up_axis(cloud, path)
     up_vec = axis.vector if up is None else np.asarray(up, dtype=np.float64)
     if not np.any(up_vec) or not np.all(np.isfinite(up_vec)):
         direction = np.array([0.0, 0.0, 1.0])       # a bad --up: Camera names it

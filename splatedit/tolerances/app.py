@@ -105,6 +105,10 @@ UP_AXIS_GROUND_MIN_FRACTION = 0.25
 #: z (they cover its whole depth); a floor: all of them
 UP_AXIS_FLOOR_BAND = 0.1
 UP_AXIS_FLOOR_MIN_IN_BAND = 0.5
+#: the floor rule runs on every n // this-th splat of a large model: its two tests
+#: are shares of points (binomial error of a share near the 0.25 / 0.5 limits with
+#: 200k samples: 0.1%); 10M splats: 0.07 s instead of 3.5 s (normals 2.8 s + rule 0.7 s)
+UP_AXIS_SAMPLE = 200_000
 #: splat size scale steps (Shift+[ / Shift+]) and its range: 0.25x makes a
 #: dense scan's splats visibly separate points, 4x closes the holes of a
 #: sparse one (poste_france at 1x shows gaps of ~2 splat radii)

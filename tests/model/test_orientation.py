@@ -115,3 +115,27 @@ def test_front_direction_of_a_tiny_up_vector_is_a_unit_vector():
     from splatedit.model.orientation import front_direction
     assert np.allclose(front_direction([0, 1e-300, 0]), [0, 0, 1])
     assert np.allclose(front_direction([0, 0, 1e300]), [0, -1, 0])
+
+
+def test_cloud_up_axis_on_a_sample_agrees_with_all_splats(monkeypatch):
+    """A Z-up floor scan above UP_AXIS_SAMPLE splats: the floor rule on the
+    stride sample gives the same axis as on every splat."""
+    from splatedit.model.cloud import SplatCloud
+    from splatedit.model import orientation
+    rng = np.random.default_rng(7)
+    n = 60_000
+    floor = np.column_stack([rng.uniform(-5, 5, n), rng.uniform(-5, 5, n), np.zeros(n)])
+    m = 20_000
+    d = rng.normal(size=(m, 3))
+    d /= np.linalg.norm(d, axis=1)[:, None]
+    ball = d + [0.0, 0.0, 2.0]
+    pos = np.vstack([floor, ball])
+    nrm = np.vstack([np.tile([0.0, 0.0, 1.0], (n, 1)), d])
+    t = np.cross(nrm, [0.3, 0.5, 0.8])
+    t /= np.linalg.norm(t, axis=1)[:, None]
+    cloud = SplatCloud(pos, 0.05 * t, 0.05 * np.cross(nrm, t))
+    whole = orientation.detect_up_axis(cloud.normals, cloud.positions)
+    monkeypatch.setattr(orientation, "UP_AXIS_SAMPLE", 5_000)
+    sampled = orientation.detect_cloud_up_axis(cloud)
+    assert (sampled.axis, sampled.sign, sampled.source) == (whole.axis, whole.sign, whole.source)
+    assert (whole.axis, whole.sign) == (2, 1)
