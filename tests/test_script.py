@@ -378,3 +378,16 @@ def test_script_modes_differ_only_in_rotation_and_report_the_mode():
             np.linalg.norm(cloud.positions[mid] - cloud.positions[mid].mean(0), axis=1).mean()
     print(spread)
     assert spread["rotation"] > spread["linear"]
+
+
+def test_a_misspelt_required_key_is_named_with_the_missing_one():
+    """A user wrote "degress": the error names the missing 'degrees' and the
+    misspelling (it used to name only the missing key)."""
+    script = {"version": 1, "edits": [{
+        "support": {"sphere": {"center": [0, 0, 0], "radius": 1}},
+        "handle": {"sphere": {"center": [0, 0, 0], "radius": 0.2}},
+        "transform": {"rotate": {"axis": [0, 0, 1], "degress": 30}}}]}
+    with pytest.raises(EditScriptError) as err:
+        parse_script(script)
+    assert err.value.json_path == "$.edits[0].transform.rotate"
+    assert "missing key 'degrees' (is 'degress' a misspelling of it?)" in str(err.value)

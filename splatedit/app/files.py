@@ -18,17 +18,26 @@ from splatedit.errors import InputError, SplatEditError
 from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
 
 
+#: inputs saved in their own format (their scanner dimensions: intensity,
+#: classification, the LAS scale/offset or E57 pose, survive); everything else
+#: is saved as splatedit's lossless splat PLY
+KEEP_FORMAT_SUFFIXES = (".las", ".laz", ".e57")
+
+
 def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
-    """``<stem>-edited.ply`` next to the input (the current directory for the
-    bundled model or an unwritable folder), never an existing file."""
+    """``<stem>-edited.ply`` (``.las`` / ``.laz`` / ``.e57`` for such inputs)
+    next to the input (the current directory for the bundled model or an
+    unwritable folder), never an existing file."""
     stem = Path(name).stem if name else (src.stem if src else "model")
+    suffix = Path(name).suffix.lower() if name else (src.suffix.lower() if src else "")
+    ext = suffix if suffix in KEEP_FORMAT_SUFFIXES else ".ply"
     folder = Path.cwd()
     if src is not None and not bundled and os.access(src.parent, os.W_OK):
         folder = src.parent
-    p = folder / f"{stem}-edited.ply"
+    p = folder / f"{stem}-edited{ext}"
     k = 2
     while p.exists():
-        p = folder / f"{stem}-edited-{k}.ply"
+        p = folder / f"{stem}-edited-{k}{ext}"
         k += 1
     return p
 
@@ -234,6 +243,9 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
                            on_change=ed.wake)
     ed.viewport.set_cloud(cloud)
+    # the heat map shows an edit's stretch: a freshly opened model has none (it
+    # would draw as a flat grey silhouette), so it opens shaded
+    ed.viewport.distortion_map = False
     scene = gaussians_of(cloud)      # a Gaussian scene: drawn by the Gaussian renderer, its own LOD
     if scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS and ed.viewport.ms_per_splat is None:
         # a first guess of the device's cost (lavapipe: ~0.5-1 us per splat at 720p) so

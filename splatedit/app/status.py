@@ -147,7 +147,10 @@ class StatusWriter:
             return
         text = json.dumps(status_dict(ed), sort_keys=True)
         if text != self._last:
-            tmp = self.path.with_suffix(".tmp")
+            # a temporary name of this process's own: two editors given the same
+            # status file (a test restarting one while the other quits) must not
+            # rename each other's temporary away
+            tmp = self.path.with_name(f"{self.path.name}.{os.getpid()}.tmp")
             tmp.write_text(text)
             os.replace(tmp, self.path)
             self._last = text

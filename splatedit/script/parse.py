@@ -3,6 +3,8 @@ value checked with errors naming the JSON path of the bad value."""
 
 from __future__ import annotations
 
+import difflib
+
 import json
 import math
 from pathlib import Path
@@ -30,7 +32,10 @@ class _Ctx:
             raise self.fail(jp, f"must be an object, got {_kind(value)}")
         for key in required:
             if key not in value:
-                raise self.fail(jp, f"missing key {key!r}")
+                known = set(allowed if allowed is not None else required)
+                typo = difflib.get_close_matches(key, [k for k in value if k not in known], n=1)
+                hint = f" (is {typo[0]!r} a misspelling of it?)" if typo else ""
+                raise self.fail(jp, f"missing key {key!r}{hint}")
         if allowed is not None:
             extra = sorted(set(value) - set(allowed))
             if extra:

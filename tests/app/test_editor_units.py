@@ -34,3 +34,15 @@ def test_controls_document_every_required_binding():
                    "G / R / S", "X / Y / Z", "Ctrl+Z", "Ctrl+Shift+Z", "Ctrl+S", "Ctrl+Shift+S",
                    "F1", "[ / ]", "Esc"):
         assert needle in CONTROLS, needle
+
+
+def test_default_save_path_keeps_scanner_formats(tmp_path):
+    """A LAS / LAZ / E57 scan is saved in its own format (its intensity,
+    classification and georeference survive, as CloudCompare users expect);
+    text formats go to the lossless splat PLY."""
+    for name, expected in (("scan.las", "scan-edited.las"), ("scan.LAZ", "scan-edited.laz"),
+                           ("site.e57", "site-edited.e57"), ("pts.xyz", "pts-edited.ply"),
+                           ("scan.pcd", "scan-edited.ply")):
+        src = tmp_path / name
+        src.write_bytes(b"")
+        assert _default_save_path(src, name, bundled=False) == tmp_path / expected
