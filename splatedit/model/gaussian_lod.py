@@ -32,7 +32,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.model.gaussians import GaussianCloud
-from splatedit.tolerances import GS_LOD_COVER_EXP, GS_LOD_MAX_FRACTION, GS_LOD_MIN_COUNT
+from splatedit.tolerances import GS_LOD_COVER_EXP, GS_LOD_MAX_COMPENSATION, GS_LOD_MAX_FRACTION, GS_LOD_MIN_COUNT
 
 
 def importance(scene: GaussianCloud) -> np.ndarray:
@@ -102,12 +102,12 @@ class GaussianLod:
     def compensation(self, count: int) -> float:
         """Factor >= 1 on the standard deviations of the first ``count``
         Gaussians drawn instead of all n: (total importance / the first
-        ``count``'s) ** GS_LOD_COVER_EXP."""
+        ``count``'s) ** GS_LOD_COVER_EXP, at most GS_LOD_MAX_COMPENSATION."""
         c = min(max(int(count), 1), self.m)
         kept = float(self.cumulative[c - 1])
         if c >= self.n or not kept > 0:
             return 1.0
-        return float(max(self.total / kept, 1.0) ** GS_LOD_COVER_EXP)
+        return float(min(max(self.total / kept, 1.0) ** GS_LOD_COVER_EXP, GS_LOD_MAX_COMPENSATION))
 
 
 def build_gaussian_lod(scene: GaussianCloud, progress=None) -> GaussianLod:

@@ -266,6 +266,12 @@ GS_LOD_MIN_COUNT = 2_000
 #: the full frame (1/255), 4% kept: bunny 5.2 / 5.9 / 6.7 with 0.5 / 0.35 /
 #: 0.25, 200k sphere 5.8 / 7.5 / 9.0; no compensation at 1M, 4%: 9.1, with 0.5: 4.0
 GS_LOD_COVER_EXP = 0.5
+#: ... but at most this factor: the cost of a Gaussian grows with its screen
+#: area (factor squared), so an uncapped factor makes fewer Gaussians no
+#: cheaper (a tester's 1M tiled-bunny scene in the window: 2,000 Gaussians
+#: at sigma x22 took 240 ms at half resolution, the budget kept shrinking
+#: the count to the minimum and the image became a few giant blobs)
+GS_LOD_MAX_COMPENSATION = 3.0
 #: a level is drawn at full resolution only when the budget fits at least this
 #: many Gaussians (else at half resolution, as point models' coarsest level):
 #: at 1M, 4% (40k) kept gives a mean difference of 4.0/255, 10% 3.5, 25% 2.5

@@ -63,3 +63,18 @@ def test_compensation_keeps_opacity_weighted_area(scene):
     assert imp[lod.order[:c]].sum() * lod.compensation(c) ** 2 == pytest.approx(imp.sum(), rel=1e-9)
     whole = build_gaussian_lod(subset(scene, np.arange(GS_LOD_MIN_COUNT)))
     assert whole.m == whole.n and whole.compensation(whole.n) == 1.0
+
+
+def test_compensation_is_capped_so_fewer_gaussians_stay_cheaper():
+    """A Gaussian's cost grows with its screen area (factor squared): the
+    compensation stops at GS_LOD_MAX_COMPENSATION (uncapped, 2,000 of a 1M
+    tiled-bunny scene were drawn at sigma x22: 240 ms a frame at half
+    resolution; capped at 3: 75 ms)."""
+    from splatedit.bench.gaussians import bench_scene
+    from splatedit.tolerances import GS_LOD_MAX_COMPENSATION
+    scene = bench_scene(40_000)
+    lod = build_gaussian_lod(scene)
+    factors = [lod.compensation(c) for c in (lod.m, 2_000, 200, 1)]
+    assert all(1.0 <= f <= GS_LOD_MAX_COMPENSATION for f in factors)
+    assert factors == sorted(factors)
+    assert factors[-1] == GS_LOD_MAX_COMPENSATION
