@@ -1,6 +1,6 @@
 """The editor's menu bar (Dear ImGui): File (:attr:`EditorGui.file_menu`,
 rows of :class:`MenuEntry`, with Open... and the Open recent submenu), Edit
-(undo / redo) and View (panels, help, frame all).
+(undo / redo) and View (panels, help, frame all, the six views about the up axis).
 
 A part of :class:`~splatedit.app.gui_panels.EditorGui` (mixed into it: it
 uses its ``ed``, ``windows``, ``rects`` and ``_rect``).  Esc closes an open
@@ -15,6 +15,17 @@ from imgui_bundle import imgui
 
 from splatedit.app.keymap import Action
 from splatedit.app.panel import Box
+
+#: View menu: the six views about the up axis (label, shortcut shown, action);
+#: the shortcuts without a numpad are the keymap's Shift + 1 / 3 / 7 rows
+_VIEW_ENTRIES = (
+    ("Front", "Numpad 1 / Shift+1", Action.VIEW_FRONT),
+    ("Right", "Numpad 3 / Shift+3", Action.VIEW_RIGHT),
+    ("Top", "Numpad 7 / Shift+7", Action.VIEW_TOP),
+    ("Back", "Ctrl+Numpad 1", Action.VIEW_BACK),
+    ("Left", "Ctrl+Numpad 3", Action.VIEW_LEFT),
+    ("Bottom", "Ctrl+Numpad 7", Action.VIEW_BOTTOM),
+)
 
 
 @dataclass
@@ -64,6 +75,10 @@ class MenuBar:
                 ed.run_action(Action.HELP)
             if imgui.menu_item("Frame all", "Home", False, s is not None)[0]:
                 ed.run_action(Action.FRAME_ALL)
+            imgui.separator()
+            for label, shortcut, action in _VIEW_ENTRIES:
+                if imgui.menu_item(label, shortcut, False, s is not None)[0]:
+                    ed.run_action(action)
             imgui.end_menu()
         imgui.end_main_menu_bar()
 

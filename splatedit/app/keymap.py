@@ -198,6 +198,13 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.CAMERA, "", "", Action.VIEW_BACK, ("ctrl+kp_1",)),
     Binding(S.CAMERA, "", "", Action.VIEW_LEFT, ("ctrl+kp_3",)),
     Binding(S.CAMERA, "", "", Action.VIEW_BOTTOM, ("ctrl+kp_7",)),
+    Binding(S.CAMERA, "Shift + 1 / 3 / 7", "the same views without a numpad (Ctrl+Shift: back / left / bottom;\n"
+            "also in the View menu)", Action.VIEW_FRONT, ("shift+1",)),
+    Binding(S.CAMERA, "", "", Action.VIEW_RIGHT, ("shift+3",)),
+    Binding(S.CAMERA, "", "", Action.VIEW_TOP, ("shift+7",)),
+    Binding(S.CAMERA, "", "", Action.VIEW_BACK, ("ctrl+shift+1",)),
+    Binding(S.CAMERA, "", "", Action.VIEW_LEFT, ("ctrl+shift+3",)),
+    Binding(S.CAMERA, "", "", Action.VIEW_BOTTOM, ("ctrl+shift+7",)),
     Binding(S.CAMERA, "U", "up axis: detected from the model; U cycles +Y, +Z, +X, -Y, -Z, -X (panel shows it)",
             Action.CYCLE_UP_AXIS, ("u",)),
     # ---- selection

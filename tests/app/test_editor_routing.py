@@ -91,6 +91,12 @@ def test_keys_reach_the_tools_through_the_keymap(ed):
     assert s.manip is None and "support" in ed.messages[-1]
     key(ed, glfw.KEY_KP_1, glfw.MOD_CONTROL)
     assert math.isclose(ed.cam.yaw, math.pi) and ed.cam.pitch == 0.0
+    key(ed, glfw.KEY_7, glfw.MOD_SHIFT)                       # without a numpad: Shift + top-row digit
+    assert ed.cam.pitch > 1.5
+    key(ed, glfw.KEY_3, glfw.MOD_SHIFT | glfw.MOD_CONTROL)    # Ctrl+Shift+3: left
+    assert math.isclose(abs(ed.cam.yaw), math.pi / 2) and ed.cam.pitch == 0.0
+    key(ed, glfw.KEY_1)                                       # the plain digit is still the support brush
+    assert ed.session.brush_target == SUPPORT
     key(ed, glfw.KEY_U)
     assert ed.camera.up.label == "+Z" and np.allclose(ed.cam.up_axis, [0, 0, 1])
 

@@ -198,6 +198,12 @@ def test_full_edit_session(xvfb, tmp_path):
         ed.idle(lambda s: abs(abs(s["camera"]["yaw"]) - math.pi) < 1e-5, "back view")   # status rounds to 6 digits
         ed.xdo("key", "ctrl+KP_7")
         ed.idle(lambda s: s["camera"]["pitch"] < -1.5, "bottom view")
+        # --- the same views without a numpad: Shift + top-row digits
+        ed.xdo("key", "shift+7")
+        ed.idle(lambda s: s["camera"]["pitch"] > 1.5, "top view from Shift+7")
+        ed.xdo("key", "shift+1")
+        ed.idle(lambda s: abs(s["camera"]["yaw"]) < 1e-5 and abs(s["camera"]["pitch"]) < 1e-5,
+                "front view from Shift+1")
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation again")
         ed.xdo("key", "y")
