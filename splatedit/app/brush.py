@@ -82,6 +82,7 @@ class BrushPicker:
     def __post_init__(self):
         self.pick = np.asarray(self.pick)
         self._order = None
+        self._all = None          # (indices, rows) of every projected centre, by row (see covered)
         if self.centers_px is not None:
             h, w = self.pick.shape
             px = self.centers_px
@@ -127,6 +128,34 @@ class BrushPicker:
             near = (p[:, 0] - cx) ** 2 + (p[:, 1] - cy) ** 2 <= r * r
             if near.any():
                 out = np.union1d(out, cand[near])
+        return out
+
+
+    def covered(self, cx: float, cy: float, radius: float) -> np.ndarray:
+        """Sorted unique indices of every splat in front of the camera whose
+        centre projects into the brush circle, hidden or not (the dab's 3D
+        reach: its circle extruded along the view through the model), plus
+        :meth:`query`'s.  Without projected centres: :meth:`query`'s."""
+        out = self.query(cx, cy, radius)
+        if self.centers_px is None or self.depths is None:
+            return out
+        if self._all is None:     # bucket every projected centre by row, once per view
+            px = self.centers_px
+            with np.errstate(invalid="ignore"):
+                ok = np.isfinite(px).all(1) & (self.depths > 0)
+            idx = np.flatnonzero(ok)
+            rows = np.floor(px[idx, 1]).astype(np.int64)
+            order = np.argsort(rows, kind="stable")
+            self._all = (idx[order], rows[order])
+        idx, rows = self._all
+        r = max(float(radius), 0.5)
+        lo = np.searchsorted(rows, int(math.floor(cy - r)), "left")
+        hi = np.searchsorted(rows, int(math.floor(cy + r)), "right")
+        cand = idx[lo:hi]
+        if len(cand):
+            p = self.centers_px[cand]
+            near = (p[:, 0] - cx) ** 2 + (p[:, 1] - cy) ** 2 <= r * r
+            out = np.union1d(out, cand[near])
         return out
 
 

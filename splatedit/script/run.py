@@ -151,6 +151,32 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
     return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes, edit.deformation)
 
 
+#: progress stage name of the selection closure
+CLOSURE_STAGE = "closing the selection"
+
+
+def close_edit(cloud, r: ResolvedEdit, progress=None):
+    """Close an edit's selection inside its regions (unless ``fill_holes`` is
+    off): back sides, gaps and the handle margin stay inside the support's
+    region and each handle's inside its own region, so no splat outside a
+    region the script gave moves; holes enclosed by the selection are filled
+    (see :mod:`splatedit.select.closure`).
+
+    Returns:
+        (support (n,) bool, handles list of (n,) bool, ClosureResult or None, seconds)
+    """
+    from splatedit.select.closure import close_selection
+    if not r.fill_holes:
+        return r.support, list(r.handles), None, 0.0
+    t0 = time.perf_counter()
+    if progress is not None:
+        progress(CLOSURE_STAGE, 0.0)
+    res = close_selection(cloud, r.support, r.handles, reach=r.support, handle_reach=list(r.handles))
+    if progress is not None:
+        progress(CLOSURE_STAGE, 1.0)
+    return res.support, list(res.handles), res, time.perf_counter() - t0
+
+
 def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
              tol: float | None = None, source: str | None = None, progress=None):
     """Resolve one edit on ``cloud`` and fit its deformation basis.
@@ -171,12 +197,13 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
     if r.deformation is DeformationMode.DETAIL:
         from splatedit.deform.detail import DetailBasis
         fit = DetailBasis.fit
+    support, handles, closure, t_closure = close_edit(cloud, r, progress)
     try:
-        basis = fit(cloud, r.support, r.handles, curves=r.curves,
-                                     method=method or solver.method,
-                                     tol=solver.tol if tol is None else tol,
-                                     max_centers=solver.max_centers, fill_holes=r.fill_holes,
-                                     progress=progress)
+        basis = fit(cloud, support, handles, curves=r.curves,
+                    method=method or solver.method, tol=solver.tol if tol is None else tol,
+                    max_centers=solver.max_centers, progress=progress)
+        basis.stats["closure_seconds"] = t_closure
+        basis.stats["closure_added"] = 0 if closure is None else closure.n_added
         d_c = basis.displacement(r.inputs, mode=edit.deformation)
     except CurveSamplesError as exc:
         jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")
