@@ -39,7 +39,10 @@ back of the tip (the user grabbed the tip).  A handle's thickness bound is
 ``CLOSURE_HANDLE_THIN_MAX_REL`` times its RMS radius (larger than the
 support's: the support bounds it, and a handle painted over the face of a
 head from one view, RMS radius about 0.87 of the head's, must reach the
-back of the head two radii behind).  Closure only adds splats.
+back of the head two radii behind).  Closure only adds splats.  It
+is not idempotent in general (T and the handle margin grow with the
+selection), so the editor closes after each stroke and fits the closed
+selection as it is, and exported scripts say ``"fill_holes": false``.
 
 **What the user gave is kept.**  Closure adds only what the selection
 encloses or hides, never beyond what the user marked:
@@ -47,19 +50,18 @@ encloses or hides, never beyond what the user marked:
 * ``reach`` (support) and ``handle_reach`` (per handle): the region the user
   gave (a script's sphere, box or index list; in the editor, every splat
   whose centre projects into a brush dab's circle, at any depth: what the
-  strokes covered on screen, the far side of the part included).  Rules 1,
-  2 and 4 add only splats inside it, so the rim of a region never moves and
-  the handle margin never reaches outside the user's support.  Rule 3's
-  enclosed islands may lie anywhere: they are surrounded by the selection.
+  strokes covered on screen, the far side of the part included).  All four
+  rules add only splats inside it, so the rim of a region never moves and
+  the handle margin never reaches outside the user's support (rule 3 too:
+  a sphere cut across a sparse scan leaves specks just outside it that its
+  rim encloses).  The region of an index list is the list and
+  the holes it encloses (:func:`enclosed_holes`).
 * ``erased`` (support) and ``handle_erased`` (per handle): splats the user
   erased (the editor remembers every erase stroke in the
   :class:`~splatedit.select.selection.Selection`).  No rule adds them; they
   count as outside, so an island next to them is not enclosed.
 
-None (the default) puts no limit: a Python caller closing a bare mask.  It
-is not idempotent in general (T and the handle margin grow with the
-selection), so the editor closes after each stroke and fits the closed
-selection as it is, and exported scripts say ``"fill_holes": false``.
+None (the default) puts no limit: a Python caller closing a bare mask.
 """
 
 from __future__ import annotations
@@ -334,16 +336,14 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
 
 
 def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
-                 edge: np.ndarray | None = None, reach: np.ndarray | None = None) -> tuple[np.ndarray, int, int]:
-    """Rules 2 and 3 for one mask: (closed mask, gaps, islands).  ``allowed``:
-    splats either rule may add (not erased; for a handle, inside the support
-    and outside the other handles); ``reach``: the gaps (rule 2) stay inside
-    it as well (None: no limit), the enclosed islands (rule 3) need not.
-    ``edge``: splats of a region's graph with neighbours outside it; what
-    lies beyond is unknown, so nothing is added near them."""
+                 edge: np.ndarray | None = None) -> tuple[np.ndarray, int, int]:
+    """Rules 2 and 3 for one mask inside ``allowed`` (the splats closure may
+    add: inside the reach, not erased; for a handle also inside the support
+    and outside the other handles): (closed mask, gaps, islands).  ``edge``:
+    splats of a region's graph with neighbours outside it; what lies beyond
+    is unknown, so nothing is added near them."""
     out = sel.copy()
-    gap_allowed = allowed if reach is None else allowed & reach
-    closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=gap_allowed | out), CLOSURE_GAP_RINGS)
+    closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=allowed | out), CLOSURE_GAP_RINGS)
     if edge is not None and edge.any():
         closed &= ~graph.grow(edge, 2 * CLOSURE_GAP_RINGS)
     gaps = int((closed & ~out).sum())
@@ -422,8 +422,9 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
 
     # rule 1 for the support, then rules 2-3 on the graph around the change
     sup = sup_in.copy()
-    free = ~sup if erased is None else ~sup & ~erased          # what closure may add at all
-    inside = free if reach is None else free & reach           # ... and inside the user's region
+    inside = ~sup if erased is None else ~sup & ~erased        # what closure may add at all ...
+    if reach is not None:
+        inside &= reach                                        # ... inside the user's region
     back = _back_sides(cloud, graph, tree, fronts(sup), inside, thickness[0])
     sup[back] = True
     n_back = len(back)
@@ -435,9 +436,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         region = _box_region(graph, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
         sub = graph.subgraph(region)
         edge = (graph.indptr[region + 1] - graph.indptr[region]) != np.diff(sub.indptr)
-    allowed_sup = np.ones(n, bool) if erased is None else ~erased
-    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], allowed_sup[region], edge,
-                                            None if reach is None else reach[region])
+    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], inside[region] | sup[region], edge)
     sup[region] = sup_r
 
     # the handles: rules 1-3 inside the closed support, outside the other handles
@@ -456,8 +455,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         back = _back_sides(cloud, graph, tree, fronts(h), inside_h & ~h, thickness[1 + i])
         h[back] = True
         n_back += len(back)
-        h_r, g, isl = _close_graph(sub, h[region], allowed[region], edge,
-                                   None if h_reach[i] is None else h_reach[i][region])
+        h_r, g, isl = _close_graph(sub, h[region], (inside_h | h)[region], edge)
         h[region] = h_r
         n_gaps, n_islands = n_gaps + g, n_islands + isl
 
@@ -495,6 +493,18 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         added_h &= ~h
     counts = ClosureCounts(n_back, n_gaps, n_islands, n_margin)
     return ClosureResult(sup, hs, sup & ~sup_in, added_h, counts)
+
+
+def enclosed_holes(graph: NeighbourGraph, mask: np.ndarray) -> np.ndarray:
+    """(n,) bool: the splats outside ``mask`` (n,) bool in pieces it encloses
+    (rule 3's islands: within ``CLOSURE_ISLAND_RINGS`` rings of it and
+    reaching no farther).  ``mask | enclosed_holes(graph, mask)`` is the
+    region an explicit list of splats covers (a script's ``indices``)."""
+    mask = np.asarray(mask, bool)
+    out = np.zeros(graph.n, bool)
+    if mask.any():
+        out[_enclosed(graph, mask, ~mask)] = True
+    return out
 
 
 def closed_masks(cloud, support: np.ndarray, handles=(), **kw) -> tuple[np.ndarray, list, ClosureResult]:

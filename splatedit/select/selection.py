@@ -11,7 +11,8 @@ and each handle):
 
 * *reach*: the splats the strokes covered (the painted ones, plus what the
   brush passed over on screen at any depth, see :meth:`Selection.paint`'s
-  ``reach``): closure adds back sides, gaps and the handle margin only there;
+  ``reach``): closure adds splats only there.  A selection made from masks
+  (not painted) has no reach (None): closure is not limited;
 * *erased*: the splats erase strokes (or tools that removed splats) took
   out: closure never adds them again; painting a splat clears its mark.
 """
@@ -51,11 +52,12 @@ class Selection:
         if not self.handles:
             self.handles.append(np.zeros(self.n, bool))
         self.active = int(min(max(active, 0), len(self.handles) - 1))
-        #: (n,) bool: the support's reach and erased splats (see the module docstring)
-        self.reach = self.support.copy()
+        #: (n,) bool: the support's reach (None: not painted, no limit) and
+        #: erased splats (see the module docstring)
+        self.reach = None if support is not None else np.zeros(self.n, bool)
         self.erased = np.zeros(self.n, bool)
         #: per handle, the same (lists aligned with ``handles``)
-        self.handle_reach = [h.copy() for h in self.handles]
+        self.handle_reach = [None if support is not None else np.zeros(self.n, bool) for _ in self.handles]
         self.handle_erased = [np.zeros(self.n, bool) for _ in self.handles]
 
     def copy(self) -> "Selection":
@@ -66,22 +68,22 @@ class Selection:
     # ---------------------------------------------------------------- memory
     def memory(self) -> tuple:
         """The stroke memory as bit-packed bytes (reach, erased, then per
-        handle reach and erased), for undo snapshots."""
+        handle reach and erased; b"" for a reach of None), for undo snapshots."""
         masks = [self.reach, self.erased]
         for r, e in zip(self.handle_reach, self.handle_erased):
             masks += [r, e]
-        return tuple(np.packbits(m).tobytes() for m in masks)
+        return tuple(b"" if m is None else np.packbits(m).tobytes() for m in masks)
 
     def set_memory(self, packed: tuple) -> None:
-        """Restore :meth:`memory`'s bytes (an empty tuple keeps the defaults:
-        each mask is its own reach, nothing erased)."""
+        """Restore :meth:`memory`'s bytes (an empty tuple keeps the defaults)."""
         if not packed:
             return
-        m = [np.unpackbits(np.frombuffer(b, np.uint8), count=self.n).astype(bool) for b in packed]
+        m = [None if not b else np.unpackbits(np.frombuffer(b, np.uint8), count=self.n).astype(bool)
+             for b in packed]
         self.reach, self.erased = m[0], m[1]
-        self.handle_reach = [m[2 + 2 * k] if 3 + 2 * k < len(m) else h.copy() for k, h in enumerate(self.handles)]
-        self.handle_erased = [m[3 + 2 * k] if 3 + 2 * k < len(m) else np.zeros(self.n, bool)
-                              for k in range(len(self.handles))]
+        k = len(self.handles)
+        self.handle_reach = [m[2 + 2 * i] if 3 + 2 * i < len(m) else None for i in range(k)]
+        self.handle_erased = [m[3 + 2 * i] if 3 + 2 * i < len(m) else np.zeros(self.n, bool) for i in range(k)]
 
     def closure_limits(self) -> dict:
         """Keyword arguments of :func:`~splatedit.select.closure.close_selection`
@@ -102,7 +104,7 @@ class Selection:
         marked erased."""
         r, e = self._memory_of(target)
         for idx in (painted, reach):
-            if idx is not None:
+            if idx is not None and r is not None:      # None: no limit to widen
                 r[np.asarray(idx, np.int64)] = True
         if painted is not None:
             e[np.asarray(painted, np.int64)] = False
@@ -160,7 +162,7 @@ class Selection:
         if len(self.handles) == 1:
             changed = bool(self.handles[0].any())
             self.handles[0][:] = False
-            self.handle_reach[0][:] = False
+            self.handle_reach[0] = np.zeros(self.n, bool)
             self.handle_erased[0][:] = False
             return changed
         del self.handles[i]
