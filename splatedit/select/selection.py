@@ -69,6 +69,7 @@ class Selection:
     def memory(self) -> tuple:
         """The stroke memory as bit-packed bytes (reach, erased, then per
         handle reach and erased; b"" for a reach of None), for undo snapshots."""
+        self._aligned()
         masks = [self.reach, self.erased]
         for r, e in zip(self.handle_reach, self.handle_erased):
             masks += [r, e]
@@ -85,14 +86,24 @@ class Selection:
         self.handle_reach = [m[2 + 2 * i] if 3 + 2 * i < len(m) else None for i in range(k)]
         self.handle_erased = [m[3 + 2 * i] if 3 + 2 * i < len(m) else np.zeros(self.n, bool) for i in range(k)]
 
+    def _aligned(self) -> None:
+        """Keep the per-handle memory lists as long as ``handles`` (code that
+        replaces ``handles`` wholesale keeps the count; this guards the rest:
+        a new handle has no reach limit yet, nothing erased)."""
+        k = len(self.handles)
+        self.handle_reach = (self.handle_reach + [None] * k)[:k]
+        self.handle_erased = (self.handle_erased + [np.zeros(self.n, bool) for _ in range(k)])[:k]
+
     def closure_limits(self) -> dict:
         """Keyword arguments of :func:`~splatedit.select.closure.close_selection`
         that keep the user's strokes: reach and erased marks of the support and
         of every handle."""
+        self._aligned()
         return dict(reach=self.reach, erased=self.erased, handle_reach=list(self.handle_reach),
                     handle_erased=list(self.handle_erased))
 
-    def _memory_of(self, target: str) -> tuple[np.ndarray, np.ndarray]:
+    def _memory_of(self, target: str) -> tuple[np.ndarray | None, np.ndarray]:
+        self._aligned()
         if target == SUPPORT:
             return self.reach, self.erased
         return self.handle_reach[self.active], self.handle_erased[self.active]
