@@ -31,7 +31,7 @@ import time
 import numpy as np
 
 from splatedit.deform.apply_plan import APPLY_STAGE, CHECK_STAGE, apply_hot_path, build_hot_path
-from splatedit.deform.constraints import Constraints, as_mask, build_constraints
+from splatedit.deform.constraints import Constraints, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
