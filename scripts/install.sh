@@ -4,7 +4,8 @@
 #   glslang (shader compiler, for the SPIR-V staleness test), the Khronos
 #   validation layer (the test suite runs with it on), Xvfb + xdotool (window
 #   tests) and the DejaVu fonts (editor overlay).
-#   Python: this package and its test extras from PyPI.
+#   Python: this package and its test extras from PyPI, at the exact versions
+#   of constraints.txt.
 #   Node.js (Debian's nodejs + npm when no node is on PATH) and PlayCanvas's
 #   splat-transform into ./.node: the independent reader of our Gaussian PLYs
 #   in tests/io/test_splat_transform.py (2.7.1 is the newest release that runs
@@ -32,8 +33,13 @@ fi
 if [ ! -x .venv/bin/python ]; then
     python3 -m venv .venv
 fi
+# Exact versions from constraints.txt (PIP_CONSTRAINT also pins the build
+# backend in pip's isolated build environment); see constraints.txt for how to
+# update them on purpose.
+export PIP_CONSTRAINT="$PWD/constraints.txt"
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q -e '.[test]'
+unset PIP_CONSTRAINT
 
 splat_transform_version=2.7.1
 if ! command -v node >/dev/null 2>&1 || ! command -v npm >/dev/null 2>&1; then

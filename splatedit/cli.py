@@ -190,7 +190,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-o", "--output", required=True, help="output PNG")
     s.add_argument("--size", type=parse_size, default=(1280, 720), help="WxH (default 1280x720)")
     s.add_argument("--eye", type=lambda t: _parse_vec3(t, "--eye"), metavar="X,Y,Z",
-                   help="camera position (default: the editor's first view, see README)")
+                   help="camera position (default: the editor's first view, see docs/commands.md)")
     s.add_argument("--target", type=lambda t: _parse_vec3(t, "--target"), metavar="X,Y,Z",
                    help="look-at point (default: the centre of the model's main body)")
     s.add_argument("--up", type=lambda t: _parse_vec3(t, "--up"), metavar="X,Y,Z",

@@ -9,7 +9,7 @@ Modules (the pure ones are unit-tested without a window or GPU):
   actions, its overlay and its help entries: camera, brush (selection tools),
   gizmo (G/R/S, live readout), curve.
 * :mod:`~splatedit.app.keymap` - the one declarative table of key and mouse
-  bindings; generates the F1 help, ``splatedit edit --help`` and README's
+  bindings; generates the F1 help, ``splatedit edit --help`` and the manual's
   controls list (pure).
 * :mod:`~splatedit.app.frames` - frame scheduling: interactive / full
   quality / background refinement, overlay compositing, present.

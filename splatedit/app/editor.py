@@ -14,7 +14,7 @@ The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve) through the event
 routing (:mod:`splatedit.app.routing`), keys are looked
 up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
-help and README's controls list) and run the bound action; each tool draws
+help and the manual's controls list) and run the bound action; each tool draws
 its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
 dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,

@@ -7,9 +7,9 @@ text.  From this one table come
 
 * the key dispatch (:func:`lookup`: glfw key + modifiers + context -> action),
 * the F1 help window and ``splatedit edit --help`` (:func:`help_lines`),
-* the README's controls list (:func:`readme_block`; ``python -m
+* the editor manual's controls list (docs/editor.md) (:func:`readme_block`; ``python -m
   splatedit.app.keymap --write-readme`` rewrites it, and a test fails when
-  README is out of sync with the table).
+  the manual is out of sync with the table).
 
 Mouse gestures are rows with ``mouse=True``: the tools handle them (they
 depend on what is under the cursor), the table documents them.  This module
@@ -442,9 +442,9 @@ def write_readme(path: Path) -> bool:
 def main(argv=None) -> int:
     import argparse
     p = argparse.ArgumentParser(prog="python -m splatedit.app.keymap",
-                                description="print the editor's controls, or rewrite README's list")
-    p.add_argument("--write-readme", nargs="?", const="README.md", metavar="README",
-                   help="rewrite the controls block of README (default ./README.md)")
+                                description="print the editor's controls, or rewrite the manual's list")
+    p.add_argument("--write-readme", nargs="?", const="docs/editor.md", metavar="MANUAL",
+                   help="rewrite the controls block of the editor manual (default ./docs/editor.md)")
     a = p.parse_args(argv)
     if a.write_readme:
         changed = write_readme(Path(a.write_readme))

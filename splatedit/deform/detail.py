@@ -54,7 +54,8 @@ from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
-from splatedit.model.estimate import estimate_normals, tangent_frame
+from splatedit.model.estimate import estimate_normals
+from splatedit.model.tangents import tangent_frame
 from splatedit.progress import report
 from splatedit.select.graph import NeighbourGraph
 from splatedit.tolerances import (BAND_RINGS, DETAIL_MAX_ITERATIONS,

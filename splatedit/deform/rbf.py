@@ -253,7 +253,7 @@ class TriharmonicRBF:
         workers = min(EVAL_THREADS, len(starts))
         if workers > 1:
             # those threads already fill the cores: OpenBLAS's own threads on top
-            # of them oversubscribe (4.5-9x slower at a 1M support, see README)
+            # of them oversubscribe (4.5-9x slower at a 1M support, see docs/PERFORMANCE.md)
             with single_blas_thread(), ThreadPoolExecutor(max_workers=workers) as pool:
                 list(pool.map(one_chunk, starts))
         else:

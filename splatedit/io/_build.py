@@ -10,6 +10,7 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud, column_bounds
+from splatedit.model.tangents import splats_from_normals, usable_normals
 from splatedit.tolerances import (MAX_COORDINATE_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
                                   REBASE_STORED_REACH)
 
@@ -232,6 +233,12 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
             row = int(np.flatnonzero(bad)[0])
             raise InputError(f"radius must be > 0, got {radius[row]}", path=source,
                              element="vertex", row=row, prop="radius")
+    if normals is not None and radius is not None and usable_normals(normals):
+        # the file says where the surface faces and how large each splat is:
+        # discs straight from that, no neighbour search (no scipy import)
+        cloud = splats_from_normals(positions, normals, radius, colors, faces, name=name, source=source,
+                                    progress=progress)
+        return _with_scan_fields(cloud, scan, origin)
     # estimation needs scipy (0.5-1 s to import): readers of files that carry
     # their splats, and `info`'s lean path, never load it
     from splatedit.model.estimate import estimate_splats
@@ -242,8 +249,13 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     else:
         cloud = estimate_splats(positions, normals, colors, progress, radius=radius, faces=faces,
                                 name=name, source=source)
-    if origin.any() or any(v is not None for v in (intensity, classification, quantization,
-                                                   point_fields)):
+    return _with_scan_fields(cloud, scan, origin)
+
+
+def _with_scan_fields(cloud: SplatCloud, scan: dict, origin) -> SplatCloud:
+    """``cloud`` with the reader's origin and scan attributes set (validated)."""
+    if origin.any() or any(scan[k] is not None for k in ("intensity", "classification", "quantization",
+                                                         "point_fields")):
         for k, val in scan.items():
             setattr(cloud, k, val)
         cloud.validate()

@@ -39,7 +39,11 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
     src = str(path)
     spec = vertex_columns(layout, src)
     body, n, dtype = layout
-    if not spec.axes or (spec.colors and not spec.int_colors):
+    if spec.colors and not spec.int_colors:
+        return None
+    if not spec.axes:
+        if spec.normals and "radius" in spec.names:
+            return _normals_radius_summary(path, layout, spec, progress, stored_origin)
         return None
     # x y z, the axes and the normals are checked through their bounds and
     # squared lengths (a NaN or a value beyond MAX_COORDINATE_ABS makes a
@@ -109,6 +113,63 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
 
     names = spec.names
     # rounding is monotonic: the rebased extremes are the extremes rebased
+    bounds = (lo_b - origin, hi_b - origin) if origin.any() else (lo_b, hi_b)
+    return CloudSummary(positions, radii, origin, None, bool(spec.colors), "intensity" in names,
+                        "classification" in names, normals_of, known_bounds=bounds)
+
+
+def _normals_radius_summary(path, layout, spec, progress, stored_origin) -> CloudSummary | None:
+    """:func:`read_ply_summary` of a binary PLY holding normals and a radius
+    per point (as scanner pipelines and Open3D write them): the radii are the
+    file's, nothing is estimated; None when a value fails a check (a zero or
+    non-finite normal, a radius not > 0) so that the full reader names the row
+    or fills the normal."""
+    src = str(path)
+    body, n, dtype = layout
+    vectors = ("x", "y", "z") + spec.normals + ("radius",)
+    others = [p for p in spec.checked if p not in vectors]
+    others += [p for p in ("intensity", "classification") if p in spec.names and dtype[p].kind == "f"]
+    limit2 = MAX_COORDINATE_ABS ** 2
+    positions = np.empty((n, 3))
+    radii = np.empty(n)
+    lo_b, hi_b = np.full(3, np.inf), np.full(3, -np.inf)
+    smallest = np.inf
+    for lo, hi, buf in body_chunks(path, layout):
+        m = hi - lo
+        rec = np.frombuffer(buf, dtype=dtype, count=m)
+        blk = positions[lo:hi]
+        blk[...] = _triple(buf, rec, dtype, ("x", "y", "z"), m)
+        r = radii[lo:hi]
+        r[...] = rec["radius"]
+        nrm = _triple(buf, rec, dtype, spec.normals, m)
+        nn = np.einsum("ij,ij->i", nrm, nrm)
+        # NaN fails every comparison below, so a NaN anywhere returns None
+        ok = (_grow_bounds(blk, lo_b, hi_b) and (nn > 0).all() and (nn <= limit2).all()
+              and (r > 0).all() and (r <= MAX_COORDINATE_ABS).all())
+        if not (ok and all(in_range(rec[p]) for p in others)):
+            return None
+        smallest = min(smallest, float(r.min()))
+        if spec.colors:
+            try:
+                colors_from_columns([rec[p] for p in spec.colors], spec.colors, src)
+            except InputError:
+                return None
+        del rec
+        report(progress, "reading", hi / n)
+    diag = float(np.linalg.norm(hi_b - lo_b))
+    if not smallest > MIN_AXIS_LENGTH_REL * max(diag, 1e-300):
+        return None
+    origin = local_origin(positions, bounds=(lo_b, hi_b), stored=stored_origin)
+    positions = rebase(positions, origin)
+
+    def normals_of(rows: np.ndarray) -> np.ndarray:
+        mm = np.memmap(path, dtype=dtype, mode="r", offset=body, shape=(n,))
+        rec = mm[rows]
+        nrm = np.column_stack([rec[p] for p in spec.normals]).astype(np.float64)
+        del mm
+        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+    names = spec.names
     bounds = (lo_b - origin, hi_b - origin) if origin.any() else (lo_b, hi_b)
     return CloudSummary(positions, radii, origin, None, bool(spec.colors), "intensity" in names,
                         "classification" in names, normals_of, known_bounds=bounds)

@@ -4,7 +4,7 @@ A splat i is the ellipse ``{p_i + s u_i + t v_i : s^2 + t^2 <= 1}``: the
 tangent axes ``u``, ``v`` carry the ellipse's semi-axes as their lengths and
 the normal is ``normalize(u x v)``.
 
-Precision (a deliberate choice, see README "Precision"): positions and axes
+Precision (a deliberate choice, see docs/files.md "Precision"): positions and axes
 are float64 on the CPU.  The fitting (RBF solves, Jacobians applied to the
 axes) needs float64, and our PLY stores both bit-exactly; float32 axes would
 save 240 MB per 10M splats but break that round trip and make every

@@ -32,6 +32,7 @@ from splatedit.model.pca import morton_codes, neighbourhood_covariances, smalles
 from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
                                     neighbour_indices, neighbour_median)
 from splatedit.model.spacing import nearest_neighbour_distances
+from splatedit.model.tangents import tangent_frame
 from splatedit.model.tiles import tiled_knn
 from splatedit.progress import report
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, ESTIMATE_CHUNK_POINTS,
@@ -122,28 +123,6 @@ def estimate_normals(points, k: int = NORMAL_NEIGHBOURS, *, tree: cKDTree | None
         for end in pool.map(chunk, starts):
             report(progress, "estimating normals", end / len(idx_q))
     return out
-
-
-def tangent_frame(normals) -> tuple[np.ndarray, np.ndarray]:
-    """Orthonormal tangent vectors ``(t1, t2)`` with ``t1 x t2 = n``.
-
-    Uses the branch-free construction of Duff et al., "Building an
-    Orthonormal Basis, Revisited" (JCGT 2017), which is continuous except
-    across the equator sign switch of n_z.
-
-    Args:
-        normals: (n, 3) float64 unit normals.
-    Returns:
-        two (n, 3) float64 arrays of unit vectors.
-    """
-    nrm = np.asarray(normals, dtype=np.float64)
-    x, y, z = nrm[:, 0], nrm[:, 1], nrm[:, 2]
-    s = np.where(z >= 0.0, 1.0, -1.0)
-    a = -1.0 / (s + z)
-    b = x * y * a
-    t1 = np.stack([1.0 + s * x * x * a, s * b, -s * x], axis=1)
-    t2 = np.stack([b, s + y * y * a, -y], axis=1)
-    return t1, t2
 
 
 def splat_radii(points, k: int = SPACING_NEIGHBOUR, factor: float = SPLAT_RADIUS_FACTOR, *,

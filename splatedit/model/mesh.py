@@ -42,7 +42,8 @@ from scipy.spatial import cKDTree
 
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud
-from splatedit.model.estimate import fill_missing_normals, knn, splat_radii, tangent_frame
+from splatedit.model.estimate import fill_missing_normals, knn, splat_radii
+from splatedit.model.tangents import tangent_frame
 from splatedit.model.outliers import detect_outliers
 from splatedit.model.sizing import (limit_outlier_radii, limit_radii, mesh_border_ring,
                                     neighbour_indices)

@@ -1,4 +1,4 @@
-"""The one keymap: README's controls list is generated from it, every bound
+"""The one keymap: the manual's controls list (docs/editor.md) is generated from it, every bound
 action has a handler in the editor, no chord is bound twice, and the help
 the window shows comes from the same table."""
 
@@ -12,14 +12,14 @@ import pytest
 from splatedit.app import keymap
 from splatedit.app.keymap import KEYMAP, Action, Chord, Context, Section
 
-README = Path(__file__).resolve().parents[2] / "README.md"
+README = Path(__file__).resolve().parents[2] / "docs" / "editor.md"
 
 
 def test_readme_controls_are_the_generated_block():
     block = keymap.readme_controls(README.read_text())
     assert block is not None, "README lacks the controls markers"
     assert block == keymap.readme_block(), \
-        "README's controls list is out of date: run `python -m splatedit.app.keymap --write-readme`"
+        "docs/editor.md's controls list is out of date: run `python -m splatedit.app.keymap --write-readme`"
 
 
 def test_write_readme_fixes_a_stale_list(tmp_path):

@@ -163,6 +163,12 @@ def test_iqr_all_centers_equals_exact():
         assert sorted(f.center_indices.tolist()) == list(range(300))
 
 
+#: relative residuals (||r|| / ||b||) below this are round-off:
+#: the third column (0.01 z^2, a polynomial term) ends at 1.5e-16 incremental
+#: against 1.0e-15 recomputed (numpy 2.4.6, OpenBLAS); 1e-12 is 1e-7 of the tol
+IQR_HISTORY_ROUNDOFF = 1e-12
+
+
 def test_iqr_history_monotone_and_stops_at_first_prefix_below_tol():
     pts = _cloud(400, seed=11)
     vals = np.c_[np.sin(0.3 * pts[:, 0]), np.cos(0.2 * pts[:, 1]), 0.01 * pts[:, 2] ** 2]
@@ -170,7 +176,9 @@ def test_iqr_history_monotone_and_stops_at_first_prefix_below_tol():
     f = TriharmonicRBF.fit(pts, vals, method="iqr", tol=tol)
     hist = f.residual_history
     assert hist.shape == (f.n_centers + 1, 3)
-    assert np.all(np.diff(hist, axis=0) <= 0)
+    # non-increasing up to round-off: a column already fitted to ~1e-16
+    # relative may wiggle by a few eps from one Givens update to the next
+    assert np.all(np.diff(hist, axis=0) <= IQR_HISTORY_ROUNDOFF)
     assert 0 < f.n_centers < 400
     assert np.all(hist[-1] < tol)
     assert np.any(hist[-2] >= tol)
@@ -182,7 +190,10 @@ def test_iqr_history_monotone_and_stops_at_first_prefix_below_tol():
     x = np.vstack([f.poly_coeffs, f.weights])
     b = np.vstack([vals, np.zeros((10, 3))])
     direct = np.linalg.norm(a @ x - b, axis=0) / np.linalg.norm(vals, axis=0)
-    np.testing.assert_allclose(direct, hist[-1], rtol=1e-4, atol=1e-15)
+    # the incremental (Givens-updated) and the recomputed residual agree to
+    # 1e-4 relative; where a column's residual is at round-off level both are
+    # noise of size ~cond * eps, hence the absolute floor (1e-7 of tol)
+    np.testing.assert_allclose(direct, hist[-1], rtol=1e-4, atol=IQR_HISTORY_ROUNDOFF)
     assert f.solver_residual == hist[-1].max()
     # the reported residual: what the weights achieve at the constraints
     achieved = np.linalg.norm(f(pts) - vals, axis=0) / np.linalg.norm(vals, axis=0)

@@ -177,9 +177,32 @@ def test_write_refuses_non_finite_deformed_values(tmp_path):
     assert not (tmp_path / "x.ply").exists()
 
 
+# The script's float64 maths (SH projection by least squares, rotation to
+# quaternion, exp/log) goes through numpy/scipy/BLAS kernels whose last bits
+# differ between releases and CPUs (numpy 2.4.6 + scipy 1.17.1 changed a few
+# float32-stored values by one ulp); the scene is the script's up to that
+# round-off: every stored float32 within 4 ulp-sized steps of its magnitude
+# (relative 5e-7) or 1e-6 absolute, quaternions compared up to sign.
+SCENE_REPRODUCTION_RTOL = 5e-7
+SCENE_REPRODUCTION_ATOL = 1e-6
+
+
+def _assert_scene_reproduced(made, shipped):
+    assert len(made) == len(shipped) and made.kind == shipped.kind and made.sh_degree == shipped.sh_degree
+    for nm in ("positions", "log_scales", "opacity_logits", "sh", "normals"):
+        x, y = getattr(made, nm), getattr(shipped, nm)
+        assert x.dtype == y.dtype and x.shape == y.shape, nm
+        np.testing.assert_allclose(x, y, rtol=SCENE_REPRODUCTION_RTOL, atol=SCENE_REPRODUCTION_ATOL, err_msg=nm)
+    qa, qb = made.rotations.astype(np.float64), shipped.rotations.astype(np.float64)
+    sign = np.where(np.sum(qa * qb, axis=1) < 0, -1.0, 1.0)[:, None]
+    np.testing.assert_allclose(qa * sign, qb, rtol=SCENE_REPRODUCTION_RTOL, atol=SCENE_REPRODUCTION_ATOL,
+                               err_msg="rotations")
+
+
 def test_shipped_scene_is_what_its_script_makes(tmp_path):
-    """data_tools/make_gaussian_scene.py reproduces bunny_gaussians.ply byte for byte,
-    and the scene has the spread the provenance promises."""
+    """data_tools/make_gaussian_scene.py reproduces bunny_gaussians.ply up to the
+    float round-off of the installed numpy/scipy (byte for byte on the versions
+    of constraints.txt), and the scene has the spread the provenance promises."""
     import importlib.util
 
     from tests.conftest import REPO_ROOT
@@ -188,8 +211,8 @@ def test_shipped_scene_is_what_its_script_makes(tmp_path):
     mod = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(mod)
     out = write_gaussians(tmp_path / "made.ply", mod.make_scene())
-    assert out.read_bytes() == gaussian_scene_path().read_bytes()
     g = read_gaussians(out)
+    _assert_scene_reproduced(g, read_gaussians(gaussian_scene_path()))
     op = g.opacities()
     assert op.min() >= 0.05 - 1e-6 and op.max() <= 0.995 + 1e-6 and 0.2 < (op < 0.8).mean() < 0.4
     assert np.abs(g.sh[:, 1:]).max() > 0.05         # view-dependent colour in bands 1-3

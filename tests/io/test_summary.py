@@ -83,3 +83,39 @@ def test_info_prints_the_same_through_the_lean_and_the_full_read(tmp_path, monke
         outs.append(json.loads(capsys.readouterr().out))
     assert outs[0] == outs[1]
     assert "spacing" in outs[0]["estimated"] and outs[0]["colors"] and outs[0]["intensity"]
+
+
+def _normals_radius_file(tmp_path, name="nr.ply", n=20_000, fdtype="f4", zero_normal_row=None,
+                         bad_radius_row=None):
+    c = _scan(n)
+    nrm = np.cross(c.u, c.v)
+    radius = np.linalg.norm(c.u, axis=1)
+    if zero_normal_row is not None:
+        nrm[zero_normal_row] = 0.0
+    if bad_radius_row is not None:
+        radius[bad_radius_row] = -1.0
+    return make_ply(tmp_path / name, c.world_positions(), fdtype=fdtype, normals=nrm, radius=radius,
+                    colors=c.colors)
+
+
+@pytest.mark.parametrize("fdtype", ["f4", "f8"])
+def test_lean_summary_of_a_normals_and_radius_file_equals_the_full_read(tmp_path, fdtype):
+    """Files with normals and a radius per point (scanner pipelines, Open3D)
+    take the lean path too: the file's radii, no estimation."""
+    path = _normals_radius_file(tmp_path, fdtype=fdtype)
+    lean = read_summary(path, lean_above=0)
+    full = read(path)
+    assert lean.cloud is None and lean.n == full.n
+    assert np.array_equal(lean.origin, full.origin)
+    assert np.array_equal(lean.positions, full.positions)
+    np.testing.assert_allclose(lean.radii, full.radii, rtol=1e-12)
+    rows = np.arange(0, full.n, 97)
+    assert np.allclose(lean.normals_at(rows), full.normals_at(rows), rtol=0, atol=1e-6)
+
+
+def test_a_normals_and_radius_file_with_a_zero_normal_or_bad_radius_takes_the_full_read(tmp_path):
+    path = _normals_radius_file(tmp_path, "zero.ply", n=3000, zero_normal_row=17)
+    assert read_summary(path, lean_above=0).cloud is not None        # the full reader fills the normal
+    path = _normals_radius_file(tmp_path, "neg.ply", n=3000, bad_radius_row=1234)
+    with pytest.raises(InputError, match="row 1234"):
+        read_summary(path, lean_above=0)

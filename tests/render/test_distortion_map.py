@@ -26,12 +26,20 @@ def heat(renderer, request):
     renderer.prepass, renderer.distortion_map = saved
 
 
-def _quadratic_stretch(cloud, a=1.5):
-    """Splats with x > 0 move by a x^2 along x: J = I + 2 a x e_x e_x^T, so
-    a splat's stretch is 1 + 2 a x (1x at x = 0 up to 4x at x = 1)."""
+#: the support (x > 0) stays rigid up to x = CALM_BAND: a band of 1x stretch as
+#: wide as 30% of the plane, whatever pixels a driver's blending gives the
+#: support's border (an H200 left 5 and 49 calm pixels of a 1x band only a
+#: few splats wide)
+CALM_BAND = 0.3
+
+
+def _quadratic_stretch(cloud, a=3.0 / (2.0 * (1.0 - CALM_BAND))):
+    """Splats with x > 0 move by a max(x - CALM_BAND, 0)^2 along x:
+    J = I + 2 a max(x - CALM_BAND, 0) e_x e_x^T, so a splat's stretch is 1x up
+    to x = CALM_BAND, then 1 + 2 a (x - CALM_BAND), up to 4x at x = 1."""
     idx = np.flatnonzero(cloud.positions[:, 0] > 0.0)
-    x = cloud.positions[idx, :1]
-    B, Bx, zero = x * x, 2.0 * x, np.zeros_like(x)
+    d = np.maximum(cloud.positions[idx, :1] - CALM_BAND, 0.0)
+    B, Bx, zero = d * d, 2.0 * d, np.zeros_like(d)
     return idx, (B, Bx, zero, zero), np.array([[a, 0.0, 0.0]])
 
 
@@ -111,7 +119,8 @@ def test_stretch_matches_the_cpu_definition_and_turns_red_beyond_3x(heat):
     assert (r[red] > 90).all() and (r[red] > 3 * g[red]).all() and (r[red] > 2 * b[red]).all()
     calm = s < 1.1
     mid = (s > 1.8) & (s < 2.2)                                      # orange: red > green > blue
-    assert calm.sum() > 50 and mid.sum() > 200
+    # lavapipe: 922 calm, 438 mid, 2026 red pixels; the calm band is ~20 splats wide
+    assert calm.sum() > 500 and mid.sum() > 200, (calm.sum(), mid.sum(), red.sum())
     assert ((r[mid] > g[mid]) & (g[mid] > b[mid])).mean() > 0.95
     assert np.mean(r[calm] - b[calm]) < 0.5 * np.mean(r[mid] - b[mid])   # ~1x: near neutral
     # the ramp darkens monotonically: luminance falls with the stretch

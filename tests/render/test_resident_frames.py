@@ -1,7 +1,15 @@
 """Device-resident frames (the editor's GPU presentation path): a frame left
 on the device by ``Renderer.render_resident`` and blitted into a bgra8 image
-(as into a swapchain image) holds the very pixels ``render`` reads back, and
-a half-resolution frame blitted to full size is pixel-doubled."""
+(as into a swapchain image) holds exactly the frame's pixels (no channel swap,
+sRGB conversion or filtering), a half-resolution frame blitted to full size is
+pixel-doubled, and a resident frame is the frame ``render`` reads back, up to
+the rounding of its additive float16 accumulation.
+
+Two frames of one scene are not bit-identical on every device: the pre-pass
+appends splat records through atomic counters, so a GPU that runs workgroups
+in another order draws the splats in another order and the additive
+accumulation rounds differently (seen on an NVIDIA H200; lavapipe happens to
+be deterministic).  ``REPLAY_LEVELS`` and ``REPLAY_PIXEL_SHARE`` bound that."""
 
 from __future__ import annotations
 
@@ -10,6 +18,34 @@ import numpy as np
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from tests.render.scenes import sphere
+
+#: two renders of one frame differ by at most this many 8-bit sRGB levels per
+#: channel (float16 sums of ~2-3 overlapping splats in another order; a
+#: shuffled draw order on lavapipe: at most 1 level, on 1.9% of the pixels)
+REPLAY_LEVELS = 2
+#: ... on at most this share of the pixels
+REPLAY_PIXEL_SHARE = 0.05
+
+
+def _read_image(renderer, image, w, h):
+    """The rgba8 pixels of a TRANSFER_SRC image, copied without conversion."""
+    buf = V.Buffer(renderer.dev, w * h * 4, ("transfer_dst",), host_visible=True)
+    try:
+        def rec(cb):
+            cb.copy_image_to_buffer(image, buf)
+            cb.host_read_barrier()
+        renderer.dev.submit(rec)
+        return buf.read().reshape(h, w, 4).copy()
+    finally:
+        buf.destroy()
+
+
+def _assert_same_frame_up_to_rounding(got, ref):
+    diff = np.abs(got[..., :3].astype(int) - ref[..., :3].astype(int))
+    assert diff.max() <= REPLAY_LEVELS, diff.max()
+    assert (diff.max(axis=2) > 0).mean() <= REPLAY_PIXEL_SHARE, (diff.max(axis=2) > 0).mean()
+    # rounding has no sign: a channel swap or an sRGB/linear mix-up would
+    assert abs(float((got[..., :3].astype(int) - ref[..., :3].astype(int)).mean())) < 0.05
 
 
 def _blit_read(renderer, frame, w, h, src_size):
@@ -31,23 +67,43 @@ def _blit_read(renderer, frame, w, h, src_size):
         dst.destroy()
 
 
-def test_resident_frame_blitted_equals_the_read_back_frame(renderer):
-    cloud = sphere(3000, overlap=1.0)
-    renderer.set_cloud(cloud)
+def test_resident_frame_blitted_holds_exactly_its_pixels(renderer):
+    renderer.set_cloud(sphere(3000, overlap=1.0))
+    cam = Camera(eye=(0, 0, 4.0), target=(0, 0, 0), fov_deg=35)
+    img = renderer.render_resident(cam, 96, 64)
+    own = _read_image(renderer, img, 96, 64)
+    assert (own[..., :3].min(axis=2) < 200).sum() > 1000        # the sphere is in the frame
+    got = _blit_read(renderer, img, 96, 64, (96, 64))
+    assert np.array_equal(got[..., :3], own[..., :3])
+    assert renderer.last_timings_ms["total"] > 0
+
+
+def test_resident_frame_is_the_read_back_frame_up_to_rounding(renderer):
+    renderer.set_cloud(sphere(3000, overlap=1.0))
     cam = Camera(eye=(0, 0, 4.0), target=(0, 0, 0), fov_deg=35)
     ref = renderer.render(cam, 96, 64)
-    assert (ref[..., :3].min(axis=2) < 200).sum() > 1000        # the sphere is in the frame
-    img = renderer.render_resident(cam, 96, 64)
-    got = _blit_read(renderer, img, 96, 64, (96, 64))
-    assert np.array_equal(got[..., :3], ref[..., :3])
-    assert renderer.last_timings_ms["total"] > 0
+    got = _read_image(renderer, renderer.render_resident(cam, 96, 64), 96, 64)
+    _assert_same_frame_up_to_rounding(got, ref)
+
+
+def test_another_splat_order_changes_the_frame_only_by_rounding(renderer):
+    """What another GPU's workgroup order does to the pre-pass's records,
+    done here by drawing the same splats in a shuffled order: the frame
+    changes within REPLAY_LEVELS / REPLAY_PIXEL_SHARE, the tolerance of the
+    test above."""
+    cloud = sphere(3000, overlap=1.0, colors=True)
+    cam = Camera(eye=(0, 0, 4.0), target=(0, 0, 0), fov_deg=35)
+    renderer.set_cloud(cloud)
+    ref = renderer.render(cam, 96, 64)
+    renderer.set_cloud(cloud.subset(np.random.default_rng(7).permutation(cloud.n)))
+    _assert_same_frame_up_to_rounding(renderer.render(cam, 96, 64), ref)
 
 
 def test_half_resolution_frame_is_pixel_doubled(renderer):
     renderer.set_cloud(sphere(3000, overlap=1.0))
     cam = Camera(eye=(0, 0, 4.0), target=(0, 0, 0), fov_deg=35)
-    half = renderer.render(cam, 48, 32)
     img = renderer.render_resident(cam, 48, 32)
+    half = _read_image(renderer, img, 48, 32)
     got = _blit_read(renderer, img, 96, 64, (48, 32))
     assert np.array_equal(got[..., :3], np.repeat(np.repeat(half, 2, axis=0), 2, axis=1)[..., :3])
 
