@@ -82,7 +82,7 @@ class BrushPicker:
     def __post_init__(self):
         self.pick = np.asarray(self.pick)
         self._order = None
-        self._all = None          # (indices, rows) of every projected centre, by row (see covered)
+        self._all = None          # every projected centre by pixel: (indices, keys, row stride), see covered
         if self.centers_px is not None:
             h, w = self.pick.shape
             px = self.centers_px
