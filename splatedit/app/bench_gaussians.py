@@ -64,7 +64,9 @@ def bench_gaussian_editor_frames(counts=(100_000, 1_000_000), size=(1280, 720), 
             vp.set_cloud(doc)
             sup, hnd = _support_and_handle(doc)
             vp.set_selection(sup, hnd, 1)
-            basis = DeformationBasis.fit(doc, sup, [hnd])
+            from splatedit.select.closure import closed_masks
+            sup, hs, _ = closed_masks(doc, sup, [hnd])
+            basis = DeformationBasis.fit(doc, sup, hs)
             vp.set_basis(basis)
             vp.set_dc(None)
             cam = OrbitCamera(scene_radius=doc.diagonal / 2, yaw=0.3, pitch=0.2)

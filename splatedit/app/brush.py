@@ -82,6 +82,7 @@ class BrushPicker:
     def __post_init__(self):
         self.pick = np.asarray(self.pick)
         self._order = None
+        self._all = None          # every projected centre by pixel: (indices, keys, row stride), see covered
         if self.centers_px is not None:
             h, w = self.pick.shape
             px = self.centers_px
@@ -128,6 +129,43 @@ class BrushPicker:
             if near.any():
                 out = np.union1d(out, cand[near])
         return out
+
+
+    def covered(self, cx: float, cy: float, radius: float) -> np.ndarray:
+        """Sorted unique indices of every splat in front of the camera whose
+        centre projects into the brush circle, hidden or not (the dab's 3D
+        reach: its circle extruded along the view through the model), plus
+        :meth:`query`'s.  Without projected centres: :meth:`query`'s."""
+        out = self.query(cx, cy, radius)
+        if self.centers_px is None or self.depths is None:
+            return out
+        if self._all is None:     # every projected centre sorted by pixel (row, column), once per view
+            h, w = self.pick.shape
+            px = self.centers_px
+            with np.errstate(invalid="ignore"):
+                ok = np.isfinite(px).all(1) & (self.depths > 0) & (px[:, 0] > -1) & (px[:, 0] < w + 1) \
+                    & (px[:, 1] > -1) & (px[:, 1] < h + 1)
+            idx = np.flatnonzero(ok)
+            key = (np.floor(px[idx, 1]).astype(np.int64) + 1) * (w + 3) + np.floor(px[idx, 0]).astype(np.int64) + 1
+            order = np.argsort(key, kind="stable")
+            self._all = (idx[order], key[order], w + 3)
+        idx, key, stride = self._all
+        r = max(float(radius), 0.5)
+        rows = np.arange(int(math.floor(cy - r)), int(math.floor(cy + r)) + 1) + 1
+        x0, x1 = int(math.floor(cx - r)) + 1, int(math.floor(cx + r)) + 1
+        x0, x1 = max(x0, 0), min(x1, stride - 1)
+        if x0 > x1 or not len(rows):
+            return out
+        lo = np.searchsorted(key, rows * stride + x0, "left")
+        hi = np.searchsorted(key, rows * stride + x1, "right")
+        counts = hi - lo
+        if counts.sum() == 0:
+            return out
+        starts = np.repeat(lo - np.concatenate([[0], np.cumsum(counts)[:-1]]), counts)
+        cand = idx[starts + np.arange(counts.sum())]
+        p = self.centers_px[cand]
+        near = (p[:, 0] - cx) ** 2 + (p[:, 1] - cy) ** 2 <= r * r
+        return np.union1d(out, cand[near])
 
 
 def picker_for_view(pick: np.ndarray, front_depth: np.ndarray | None, camera, positions: np.ndarray,

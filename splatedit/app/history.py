@@ -32,15 +32,16 @@ class Snapshot:
     handles: tuple = ()           # every handle (packbits), in order
     active: int = 0               # index of the active handle
     rig: tuple = ()               # session state beyond the masks (curve, pending pose)
+    memory: tuple = ()            # the selection's stroke memory (Selection.memory: packbits)
 
     @staticmethod
     def make(cloud, support: np.ndarray, handle, edits=(), label: str = "", *, active: int = 0,
-             rig: tuple = ()) -> "Snapshot":
+             rig: tuple = (), memory: tuple = ()) -> "Snapshot":
         """``handle``: one mask or a list of masks (``active`` picks the active one)."""
         hs = [handle] if isinstance(handle, np.ndarray) else list(handle)
         packed = tuple(np.packbits(h).tobytes() for h in hs)
         return Snapshot(cloud, np.packbits(support).tobytes(), packed[active], tuple(edits), label,
-                        len(support), packed, active, tuple(rig))
+                        len(support), packed, active, tuple(rig), tuple(memory))
 
     def _unpack(self, b: bytes) -> np.ndarray:
         return np.unpackbits(np.frombuffer(b, np.uint8), count=self.n).astype(bool)
@@ -95,7 +96,7 @@ class History:
             if revision.of(s.cloud) not in seen:
                 seen.add(revision.of(s.cloud))
                 total += _cloud_bytes(s.cloud)
-            total += len(s.support) + sum(len(b) for b in s.handles)
+            total += len(s.support) + sum(len(b) for b in s.handles) + sum(len(b) for b in s.memory)
         return total
 
     @property

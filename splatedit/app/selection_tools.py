@@ -16,7 +16,9 @@ job for big clouds.  After every stroke and tool the selection is *closed*
 (:func:`~splatedit.select.closure.close_selection`: holes of the support
 filled, splats enclosed by a handle added to it) so that no unselected splat
 stays fixed inside or next to the moving region; what closure added is
-highlighted for a moment.
+highlighted for a moment.  Closure keeps to what the strokes covered and
+never gives back an erased splat: the selection remembers both per stroke
+(:class:`~splatedit.select.selection.Selection`'s reach and erased marks).
 
 Pure functions here take masks and return masks; :class:`SelectionTools`
 holds the editor-side state (brush mode, graph cache, highlight).
@@ -32,7 +34,7 @@ import numpy as np
 
 from splatedit.app import revision
 from splatedit.select.selection import SUPPORT, Selection
-from splatedit.tolerances import CLOSURE_ISLAND_RINGS, EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
+from splatedit.tolerances import EDITOR_CLOSURE_HIGHLIGHT_S, EDITOR_GRAPH_SYNC_MAX_SPLATS
 
 #: brush modes: the 3D sphere brush (default) and the visible-only brush
 BRUSH_3D, BRUSH_VISIBLE = "3d", "visible"
@@ -169,7 +171,9 @@ def inverted(sel: Selection, target: str) -> np.ndarray:
 def set_target(sel: Selection, target: str, mask: np.ndarray) -> bool:
     """Make the target's mask ``mask`` with the brush rules (a handle stays
     inside the support and disjoint from the others; removing support splats
-    removes them from every handle).  Returns True when something changed."""
+    removes them from every handle).  The tool's result is remembered like a
+    stroke's: splats it removed count as erased, those it added as painted.
+    Returns True when something changed."""
     old = target_mask(sel, target)
     mask = np.asarray(mask, bool)
     add = np.flatnonzero(mask & ~old)
@@ -187,11 +191,13 @@ def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = Non
     worked on); returns the (n,) bool mask of the splats closure added to the
     support or a handle.  ``within`` (the selection before an erase stroke):
     the closed support and handles are cut to it, so erasing never makes a
-    selection grow (closure may only give back what the stroke erased)."""
+    selection grow.  Closure keeps to the selection's memory (its reach, and
+    no erased splat comes back: :meth:`Selection.closure_limits`)."""
     from splatedit.select.closure import close_selection
     if not sel.support.any():
         return np.zeros(sel.n, bool)
-    res = close_selection(cloud, sel.support, list(sel.handles), graph=graph, changed=changed)
+    res = close_selection(cloud, sel.support, list(sel.handles), graph=graph, changed=changed,
+                          **sel.closure_limits())
     support = np.asarray(res.support, bool)
     handles = [np.asarray(h, bool) for h in res.handles]
     if within is not None:
@@ -215,19 +221,13 @@ def apply_closure(sel: Selection, cloud, graph, changed: np.ndarray | None = Non
     return added
 
 
-def erase_refill_message(before: np.ndarray, stroked: np.ndarray, after: np.ndarray, what: str) -> str:
+def erase_message(before: np.ndarray, after: np.ndarray, what: str) -> str:
     """The status line after an erase stroke of the ``what`` mask (support /
-    handle): ``before`` the stroke, ``stroked`` as the brush left it,
-    ``after`` closure ((n,) bool each).  Says when closure filled (part of)
-    the erased hole again; "" when it kept everything the stroke erased."""
-    erased = before & ~stroked
-    refilled = int((erased & after).sum())
-    if not refilled:
-        return f"erased {int((before & ~after).sum()):,} splats from the {what}" if erased.any() else ""
-    kept = int((before & ~after).sum())
-    return (f"closure refilled {refilled:,} of the {int(erased.sum()):,} splats erased from the {what} "
-            f"({kept:,} stay erased): closure fills holes up to about {2 * CLOSURE_ISLAND_RINGS} point "
-            f"spacings across; erase a larger patch, or from the {what}'s edge")
+    handle): ``before`` the stroke, ``after`` it and its closure ((n,) bool
+    each); "" when the stroke erased nothing.  (Closure never gives erased
+    splats back: the selection remembers them.)"""
+    gone = int((before & ~after).sum())
+    return f"erased {gone:,} splats from the {what}" if gone else ""
 
 
 # ------------------------------------------------------------------ overlay

@@ -173,12 +173,13 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     del _delegate
 
     # ------------------------------------------------------------ selection
-    def paint(self, indices, erase: bool = False) -> bool:
+    def paint(self, indices, erase: bool = False, reach=None) -> bool:
         """Paint the current brush target (no history entry: call
-        :meth:`end_stroke` when the stroke ends)."""
+        :meth:`end_stroke` when the stroke ends); ``reach``: the splats the
+        dab covered at any depth (see :meth:`Selection.paint`)."""
         if self.manip is not None or self.committing:
             return False
-        changed = self.selection.paint(indices, self.brush_target, erase)
+        changed = self.selection.paint(indices, self.brush_target, erase, reach=reach)
         self._erasing = erase
         if changed:
             self.version += 1

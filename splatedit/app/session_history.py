@@ -19,12 +19,14 @@ class SessionHistory:
     # ---------------------------------------------------------- snapshots
     def _snapshot(self, label: str) -> Snapshot:
         return Snapshot.make(self.cloud, self.selection.support, self.selection.handles, self.edits,
-                             label, active=self.selection.active, rig=self.rig.as_tuple())
+                             label, active=self.selection.active, rig=self.rig.as_tuple(),
+                             memory=self.selection.memory())
 
     def _restore(self, snap: Snapshot) -> None:
         self.cloud = snap.cloud
         s, _ = snap.masks()
         self.selection = Selection(len(s), s, handles=snap.handle_masks(), active=snap.active)
+        self.selection.set_memory(snap.memory)
         self.rig.restore(snap.rig)
         self._sync_pose()
         self.edits = snap.edits

@@ -53,8 +53,10 @@ def bench_gaussian_deform(n: int, repeat: int = 3) -> dict:
     proxy = g.proxy_splats()
     y = proxy.positions[:, 1]
     support, handle = y > 0.0, y > np.percentile(y, 80)
+    from splatedit.select.closure import closed_masks
     t0 = time.perf_counter()
-    basis = DeformationBasis.fit(proxy, support, [handle])
+    support, hs, _ = closed_masks(proxy, support, [handle])
+    basis = DeformationBasis.fit(proxy, support, hs)
     fit = time.perf_counter() - t0
     m = TRS(rotate_axis=(1.0, 0.0, 0.0), rotate_degrees=30.0).matrix(proxy.positions[handle].mean(0))
     d_c = basis.displacement([m])

@@ -172,7 +172,9 @@ def sweep(cloud, basis: DeformationBasis, edit: OneViewEdit, angles=ANGLES, dist
 def fit_one_view(cloud, view=(1.0, 0.0, 0.0)) -> tuple[OneViewEdit, DeformationBasis]:
     """The one-view edit of ``cloud`` and its fitted basis."""
     edit = one_view_edit(cloud, view)
-    return edit, DeformationBasis.fit(cloud, edit.support, [edit.handle])
+    from splatedit.select.closure import closed_masks
+    sup, hs, _ = closed_masks(cloud, edit.support, [edit.handle])
+    return edit, DeformationBasis.fit(cloud, sup, hs)
 
 
 def table(results: list[StretchResult], model: str) -> list[str]:

@@ -31,7 +31,7 @@ import time
 import numpy as np
 
 from splatedit.deform.apply_plan import APPLY_STAGE, CHECK_STAGE, apply_hot_path, build_hot_path
-from splatedit.deform.constraints import Constraints, as_mask, build_constraints
+from splatedit.deform.constraints import Constraints, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
@@ -41,13 +41,10 @@ from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
-from splatedit.select.closure import close_selection
 from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
-#: progress stage name of the selection closure
-CLOSURE_STAGE = "closing the selection"
 #: support splats per chunk when evaluating the RBF for the basis and the Jacobians
 _BASIS_CHUNK = 65536
 
@@ -79,7 +76,8 @@ class DeformationBasis:
         control_frames: (h, 4, 3) control frames C of the handles.
         stats: dict of fit statistics: ``n_constraints`` (m), ``n_centers``,
             ``residual``, ``method``, ``polynomial``, ``closure_seconds``,
-            ``closure_added`` (splats the closure added), ``n_conflicts``
+            ``closure_added`` (0 here; a caller that closed the selection
+            first fills both in), ``n_conflicts``
             (fixed splats dropped next to handle bands), ``constraints_seconds``
             (bands and control frames), ``fit_seconds`` (the RBF solve),
             ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
@@ -94,7 +92,6 @@ class DeformationBasis:
         self._pack = pack  # (N, 4, K): B, Bx, By, Bz
         self.stats = stats
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
-        self.closure = None  # the ClosureResult when fit() closed the selection
         self.stretch_probe = None  # free splats where rotation centres are compared (fit() sets it)
 
     # ------------------------------------------------------------ building
@@ -102,7 +99,7 @@ class DeformationBasis:
     def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
             tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
             rings: float = BAND_RINGS, spacing: float | None = None,
-            fill_holes: bool = True, graph=None, progress=None) -> "DeformationBasis":
+            fill_holes: bool = False, graph=None, progress=None) -> "DeformationBasis":
         """Build constraints, fit one RBF to all group columns, evaluate bases.
 
         Args:
@@ -113,30 +110,19 @@ class DeformationBasis:
             method, tol, max_centers: passed to :meth:`TriharmonicRBF.fit`
                 ("auto" = exact LU up to AUTO_EXACT_MAX_CONSTRAINTS, else IQR).
             rings, spacing: band thickness (see :func:`build_constraints`).
-            fill_holes: close the selection first (default; see
-                :mod:`splatedit.select.closure`: back sides of thin parts,
-                gaps, enclosed islands, a margin around handles); the closed
-                masks are ``closure.support`` / ``closure.handles``.
-            graph: the cloud's :class:`~splatedit.select.graph.NeighbourGraph`
-                for the closure (built when None).
+            fill_holes: must be False (kept so that old calls saying so
+                still run).  The fit uses the masks as given: selection policy
+                (closing a painted selection, :mod:`splatedit.select.closure`)
+                is the caller's, e.g. ``closed_masks(cloud, support, handles)``.
+            graph: unused (the closure's graph belonged here before).
             progress: optional ``progress(stage, fraction)``.
         Raises:
             ParameterError / SolverError from the constraints and the fit.
         """
         t0 = time.perf_counter()
-        closure = None
         if fill_holes:
-            n = len(cloud.positions)
-            if isinstance(handles, np.ndarray) and handles.ndim == 1:
-                handles = [handles]
-            sup_mask = as_mask("support", support, n)
-            h_masks = [as_mask(f"handles[{i}]", h, n) for i, h in enumerate(handles)]
-            report(progress, CLOSURE_STAGE, 0.0)
-            closure = close_selection(cloud, sup_mask, [h & sup_mask for h in h_masks], graph=graph)
-            # handle splats outside the painted support stay an error of build_constraints
-            support = closure.support
-            handles = [c | (h & ~sup_mask) for c, h in zip(closure.handles, h_masks)]
-            report(progress, CLOSURE_STAGE, 1.0)
+            raise ParameterError("fill_holes", "the fit takes the selection as given: close it first with "
+                                 "splatedit.select.closure.closed_masks (edit scripts and the editor do)")
         t_closure = time.perf_counter()
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
@@ -173,8 +159,7 @@ class DeformationBasis:
         stats = dict(
             n_constraints=con.n_constraints, n_centers=int(rbf.n_centers),
             residual=float(rbf.residual), method=rbf.method, polynomial=bool(rbf.polynomial),
-            closure_seconds=t_closure - t0,
-            closure_added=0 if closure is None else closure.n_added,
+            closure_seconds=0.0, closure_added=0,
             n_conflicts=sum(c.count for c in con.conflicts),
             constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
             n_fixed_band=int(len(con.fixed_index)),
@@ -184,7 +169,6 @@ class DeformationBasis:
             spacing=float(con.spacing), message=getattr(rbf, "message", ""),
         )
         out = cls(con, rbf, pack, stats)
-        out.closure = closure
         if len(free_rows):
             out.stretch_probe = StretchProbe.sample(pack, free_rows, cloud.u[idx[free_rows]],
                                                     cloud.v[idx[free_rows]])

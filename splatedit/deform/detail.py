@@ -57,7 +57,6 @@ from splatedit.errors import ParameterError
 from splatedit.model.estimate import estimate_normals
 from splatedit.model.tangents import tangent_frame
 from splatedit.progress import report
-from splatedit.select.closure import close_selection
 from splatedit.select.graph import NeighbourGraph
 from splatedit.tolerances import (BAND_RINGS, DETAIL_MAX_ITERATIONS,
                                   DETAIL_NORMAL_NEIGHBOURS, DETAIL_SCALE_SPACINGS, DETAIL_STEP,
@@ -245,7 +244,6 @@ class DetailBasis:
         base_basis: the :class:`DeformationBasis` of the base cloud (rows at b).
         layer: the :class:`DetailLayer` of the support.
         frames: the :class:`FrameMode` of the splat axes.
-        closure: the ClosureResult of the selection closure (or None).
     """
 
     mode = "detail"
@@ -255,7 +253,6 @@ class DetailBasis:
         self.base_basis = base_basis
         self.layer = layer
         self.frames = FrameMode(frames)
-        self.closure = None
         t1, t2 = tangent_frame(layer.normals)
         self._t = (t1, t2)
         idx = layer.index
@@ -266,25 +263,24 @@ class DetailBasis:
     @classmethod
     def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
             tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
-            rings: float = BAND_RINGS, spacing: float | None = None, fill_holes: bool = True,
+            rings: float = BAND_RINGS, spacing: float | None = None, fill_holes: bool = False,
             graph=None, progress=None, scale_spacings: float = DETAIL_SCALE_SPACINGS,
             frames: FrameMode = FrameMode.STRETCH) -> "DetailBasis":
-        """Close the selection (on ``cloud``), decompose the support, fit the
-        linear basis on the base cloud (support splats at b), keep the layer.
-        Arguments as :meth:`DeformationBasis.fit`, plus ``scale_spacings`` (see
+        """Decompose the support (as given: close a painted selection first,
+        :func:`splatedit.select.closure.closed_masks`), fit the linear basis
+        on the base cloud (support splats at b), keep the layer.  Arguments
+        as :meth:`DeformationBasis.fit` (``graph``: the neighbour graph of the
+        decomposition, built when None), plus ``scale_spacings`` (see
         :func:`decompose`) and ``frames``."""
-        t0 = time.perf_counter()
         n = len(cloud.positions)
         graph = NeighbourGraph.build(cloud.positions) if graph is None else graph
         if isinstance(handles, np.ndarray) and handles.ndim == 1:
             handles = [handles]
         sup_mask = as_mask("support", support, n)
         h_masks = [as_mask(f"handles[{i}]", h, n) for i, h in enumerate(handles)]
-        closure = None
         if fill_holes:
-            closure = close_selection(cloud, sup_mask, [h & sup_mask for h in h_masks], graph=graph)
-            h_masks = [c | (h & ~sup_mask) for c, h in zip(closure.handles, h_masks)]
-            sup_mask = closure.support
+            raise ParameterError("fill_holes", "the fit takes the selection as given: close it first with "
+                                 "splatedit.select.closure.closed_masks (edit scripts and the editor do)")
         t1 = time.perf_counter()
         layer = decompose(cloud, sup_mask, graph=graph, scale_spacings=scale_spacings,
                           progress=progress)
@@ -298,9 +294,6 @@ class DetailBasis:
                                   tol=tol, max_centers=max_centers, rings=rings, spacing=spacing,
                                   fill_holes=False, progress=progress)
         out = cls(bb, layer, cloud.u, cloud.v, frames)
-        out.closure = closure
-        bb.stats["closure_seconds"] = t1 - t0
-        bb.stats["closure_added"] = 0 if closure is None else closure.n_added
         bb.stats["decompose_seconds"] = t2 - t1
         bb.stats["detail_iterations"] = layer.iterations
         bb.stats["detail_scale"] = layer.scale

@@ -15,7 +15,7 @@ from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.script.model import Edit, EditScript, SolverSettings
 from splatedit.script.parse import _Ctx
-from splatedit.select.regions import Indices, Region
+from splatedit.select.regions import Box, Indices, Region, Sphere
 
 
 @dataclass
@@ -151,6 +151,45 @@ def resolve_edit_inputs(cloud, edit: Edit, source: str | None = None) -> Resolve
     return ResolvedEdit(support, handles, matrices, curves, moves, edit.fill_holes, edit.deformation)
 
 
+#: progress stage name of the selection closure
+CLOSURE_STAGE = "closing the selection"
+
+
+def close_edit(cloud, r: ResolvedEdit, progress=None, regions: tuple | None = None):
+    """Close an edit's selection inside its regions (unless ``fill_holes`` is
+    off, see :mod:`splatedit.select.closure`): whatever closure adds to the
+    support lies inside the support's region, and to a handle inside that
+    handle's, so no splat outside a region the script gave moves.  A sphere
+    or a box selects all it covers, so closure only fills what an index list
+    encloses (its holes, :func:`~splatedit.select.closure.enclosed_holes`)
+    and closes handle index lists inside theirs.
+
+    Args:
+        regions: (support Region, handle Regions) of ``r``; None counts
+            every region as an index list.
+    Returns:
+        (support (n,) bool, handles list of (n,) bool, ClosureResult or None, seconds)
+    """
+    from splatedit.select.closure import close_selection, enclosed_holes
+    from splatedit.select.graph import NeighbourGraph
+    if not r.fill_holes:
+        return r.support, list(r.handles), None, 0.0
+    t0 = time.perf_counter()
+    if progress is not None:
+        progress(CLOSURE_STAGE, 0.0)
+    graph = NeighbourGraph.build(cloud.positions)
+    sup_region, h_regions = regions if regions is not None else (None, [None] * len(r.handles))
+
+    def reach_of(region, mask):     # the region the user gave, as a mask
+        return mask if isinstance(region, (Sphere, Box)) else mask | enclosed_holes(graph, mask)
+
+    res = close_selection(cloud, r.support, r.handles, graph=graph, reach=reach_of(sup_region, r.support),
+                          handle_reach=[reach_of(g, h) for g, h in zip(h_regions, r.handles)])
+    if progress is not None:
+        progress(CLOSURE_STAGE, 1.0)
+    return res.support, list(res.handles), res, time.perf_counter() - t0
+
+
 def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = None,
              tol: float | None = None, source: str | None = None, progress=None):
     """Resolve one edit on ``cloud`` and fit its deformation basis.
@@ -171,12 +210,13 @@ def fit_edit(cloud, edit: Edit, solver: SolverSettings, *, method: str | None = 
     if r.deformation is DeformationMode.DETAIL:
         from splatedit.deform.detail import DetailBasis
         fit = DetailBasis.fit
+    support, handles, closure, t_closure = close_edit(cloud, r, progress, (edit.support, edit.handles))
     try:
-        basis = fit(cloud, r.support, r.handles, curves=r.curves,
-                                     method=method or solver.method,
-                                     tol=solver.tol if tol is None else tol,
-                                     max_centers=solver.max_centers, fill_holes=r.fill_holes,
-                                     progress=progress)
+        basis = fit(cloud, support, handles, curves=r.curves,
+                    method=method or solver.method, tol=solver.tol if tol is None else tol,
+                    max_centers=solver.max_centers, progress=progress)
+        basis.stats["closure_seconds"] = t_closure
+        basis.stats["closure_added"] = 0 if closure is None else closure.n_added
         d_c = basis.displacement(r.inputs, mode=edit.deformation)
     except CurveSamplesError as exc:
         jp = f"{edit.json_path}.curves[{exc.curve}]" + (".samples" if exc.given else ".points")

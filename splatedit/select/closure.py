@@ -35,10 +35,33 @@ Python API alike), by four rules, each on the neighbour graph of
 
 Handles are closed by rules 1-3 too, inside the closed support and outside
 the other handles: a handle painted on the front of an ear's tip takes the
-back of the tip (the user grabbed the tip).  Closure only adds splats.  It
+back of the tip (the user grabbed the tip).  A handle's thickness bound is
+``CLOSURE_HANDLE_THIN_MAX_REL`` times its RMS radius (larger than the
+support's: the support bounds it, and a handle painted over the face of a
+head from one view, RMS radius about 0.87 of the head's, must reach the
+back of the head two radii behind).  Closure only adds splats.  It
 is not idempotent in general (T and the handle margin grow with the
 selection), so the editor closes after each stroke and fits the closed
 selection as it is, and exported scripts say ``"fill_holes": false``.
+
+**What the user gave is kept.**  Closure adds only what the selection
+encloses or hides, never beyond what the user marked:
+
+* ``reach`` (support) and ``handle_reach`` (per handle): the region the user
+  gave (a script's sphere, box or index list; in the editor, every splat
+  whose centre projects into a brush dab's circle, at any depth: what the
+  strokes covered on screen, the far side of the part included).  All four
+  rules add only splats inside it, so the rim of a region never moves and
+  the handle margin never reaches outside the user's support (rule 3 too:
+  a sphere cut across a sparse scan leaves specks just outside it that its
+  rim encloses).  The region of an index list is the list and
+  the holes it encloses (:func:`enclosed_holes`).
+* ``erased`` (support) and ``handle_erased`` (per handle): splats the user
+  erased (the editor remembers every erase stroke in the
+  :class:`~splatedit.select.selection.Selection`).  No rule adds them; they
+  count as outside, so an island next to them is not enclosed.
+
+None (the default) puts no limit: a Python caller closing a bare mask.
 """
 
 from __future__ import annotations
@@ -55,6 +78,7 @@ from splatedit.tolerances import (
     CLOSURE_FRONT_RINGS,
     CLOSURE_GAP_RINGS,
     CLOSURE_HANDLE_MARGIN_MAX_REL,
+    CLOSURE_HANDLE_THIN_MAX_REL,
     CLOSURE_HANDLE_MARGIN_REL,
     CLOSURE_ISLAND_RINGS,
     CLOSURE_REGION_RINGS,
@@ -313,9 +337,11 @@ def _enclosed(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
 
 def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
                  edge: np.ndarray | None = None) -> tuple[np.ndarray, int, int]:
-    """Rules 2 and 3 for one mask inside ``allowed``: (closed mask, gaps,
-    islands).  ``edge``: splats of a region's graph with neighbours outside
-    it; what lies beyond is unknown, so nothing is added near them."""
+    """Rules 2 and 3 for one mask inside ``allowed`` (the splats closure may
+    add: inside the reach, not erased; for a handle also inside the support
+    and outside the other handles): (closed mask, gaps, islands).  ``edge``:
+    splats of a region's graph with neighbours outside it; what lies beyond
+    is unknown, so nothing is added near them."""
     out = sel.copy()
     closed = graph.shrink(graph.grow(out, CLOSURE_GAP_RINGS, within=allowed | out), CLOSURE_GAP_RINGS)
     if edge is not None and edge.any():
@@ -327,8 +353,20 @@ def _close_graph(graph: NeighbourGraph, sel: np.ndarray, allowed: np.ndarray,
     return out, gaps, len(islands)
 
 
+def _limit(mask: np.ndarray | None, n: int, name: str) -> np.ndarray | None:
+    """A caller's (n,) bool limit mask, or None."""
+    if mask is None:
+        return None
+    m = np.asarray(mask, bool)
+    if m.shape != (n,):
+        raise ValueError(f"{name} must be an ({n},) bool mask, got shape {m.shape}")
+    return m
+
+
 def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourGraph | None = None,
-                    changed: np.ndarray | None = None) -> ClosureResult:
+                    changed: np.ndarray | None = None, reach: np.ndarray | None = None,
+                    erased: np.ndarray | None = None, handle_reach=None,
+                    handle_erased=None) -> ClosureResult:
     """Close a painted selection (see the module docstring).
 
     Args:
@@ -343,8 +381,17 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
             the change is closed (the thickness bound T and the handle margin
             still come from the whole selection): the cost follows the
             stroke, not the model (see ``splatedit bench closure``).
+        reach: (n,) bool, the region the user gave the support (a script's
+            region, the editor's stroke reach), or None: back sides, gaps and
+            the handle margin join the support only inside it.
+        erased: (n,) bool, splats the user erased from the support, or None:
+            closure never adds them (to the support nor to a handle).
+        handle_reach, handle_erased: the same per handle (a list as long as
+            ``handles``, entries None), or None.
     Returns:
         A :class:`ClosureResult`; the input masks are not modified.
+    Raises:
+        ValueError: a limit mask of the wrong shape, a graph of another cloud.
     """
     pos = cloud.positions
     n = len(pos)
@@ -353,6 +400,12 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
     nothing = np.zeros(n, bool)
     if not sup_in.any():
         return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], nothing, nothing.copy())
+    reach = _limit(reach, n, "reach")
+    erased = _limit(erased, n, "erased")
+    h_reach = [_limit(m, n, f"handle_reach[{i}]") for i, m in enumerate(handle_reach or [None] * len(hs_in))]
+    h_erased = [_limit(m, n, f"handle_erased[{i}]") for i, m in enumerate(handle_erased or [None] * len(hs_in))]
+    if len(h_reach) != len(hs_in) or len(h_erased) != len(hs_in):
+        raise ValueError(f"handle_reach and handle_erased need one entry per handle ({len(hs_in)})")
     graph = NeighbourGraph.build(pos) if graph is None else graph
     if graph.n != n:
         raise ValueError(f"the neighbour graph has {graph.n} splats, the cloud {n}")
@@ -361,14 +414,18 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         return ClosureResult(sup_in.copy(), [h.copy() for h in hs_in], nothing, nothing.copy())
     tree = graph.tree if graph.tree is not None else cKDTree(pos)
     diag = graph.diagonal
-    thickness = [CLOSURE_THIN_MAX_REL * _mask_rms_radius(pos, m) for m in [sup_in] + hs_in]
+    thickness = [CLOSURE_THIN_MAX_REL * _mask_rms_radius(pos, sup_in)] + \
+        [CLOSURE_HANDLE_THIN_MAX_REL * _mask_rms_radius(pos, m) for m in hs_in]
 
     def fronts(mask):
         return np.flatnonzero(mask if changed is None else mask & changed)
 
     # rule 1 for the support, then rules 2-3 on the graph around the change
     sup = sup_in.copy()
-    back = _back_sides(cloud, graph, tree, fronts(sup), ~sup, thickness[0])
+    inside = ~sup if erased is None else ~sup & ~erased        # what closure may add at all ...
+    if reach is not None:
+        inside &= reach                                        # ... inside the user's region
+    back = _back_sides(cloud, graph, tree, fronts(sup), inside, thickness[0])
     sup[back] = True
     n_back = len(back)
     if changed is None:
@@ -379,7 +436,7 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         region = _box_region(graph, pos, touched, CLOSURE_REGION_RINGS * graph.spacing)
         sub = graph.subgraph(region)
         edge = (graph.indptr[region + 1] - graph.indptr[region]) != np.diff(sub.indptr)
-    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], np.ones(len(region), bool), edge)
+    sup_r, n_gaps, n_islands = _close_graph(sub, sup[region], inside[region] | sup[region], edge)
     sup[region] = sup_r
 
     # the handles: rules 1-3 inside the closed support, outside the other handles
@@ -392,14 +449,18 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
             if k != i:
                 others |= o
         allowed = sup & ~others
-        back = _back_sides(cloud, graph, tree, fronts(h), allowed & ~h, thickness[1 + i])
+        if h_erased[i] is not None:
+            allowed &= ~h_erased[i]
+        inside_h = allowed if h_reach[i] is None else allowed & h_reach[i]
+        back = _back_sides(cloud, graph, tree, fronts(h), inside_h & ~h, thickness[1 + i])
         h[back] = True
         n_back += len(back)
-        h_r, g, isl = _close_graph(sub, h[region], allowed[region], edge)
+        h_r, g, isl = _close_graph(sub, h[region], (inside_h | h)[region], edge)
         h[region] = h_r
         n_gaps, n_islands = n_gaps + g, n_islands + isl
 
-    # rule 4: a margin of support around every handle (where a handle changed)
+    # rule 4: a margin of support around every handle (where a handle changed),
+    # inside the user's support region, never onto erased splats
     n_margin = 0
     for i, h in enumerate(hs):
         if not h.any() or (changed is not None and not (hs_in[i] & changed).any()):
@@ -410,9 +471,13 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         lo, hi = hp.min(axis=0) - width, hp.max(axis=0) + width
         if graph.positions is pos:      # the graph's sorted axes: the cost follows the box
             cand = graph.in_box(lo, hi)
-            cand = cand[~sup[cand]]
         else:
-            cand = np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1) & ~sup)
+            cand = np.flatnonzero(np.all((pos >= lo) & (pos <= hi), axis=1))
+        cand = cand[~sup[cand]]
+        if reach is not None:
+            cand = cand[reach[cand]]
+        if erased is not None:
+            cand = cand[~erased[cand]]
         if len(cand) == 0:
             continue
         d, _ = cKDTree(hp).query(pos[cand], k=1, distance_upper_bound=width, workers=_workers(len(cand)))
@@ -428,6 +493,44 @@ def close_selection(cloud, support: np.ndarray, handles=(), *, graph: NeighbourG
         added_h &= ~h
     counts = ClosureCounts(n_back, n_gaps, n_islands, n_margin)
     return ClosureResult(sup, hs, sup & ~sup_in, added_h, counts)
+
+
+def enclosed_holes(graph: NeighbourGraph, mask: np.ndarray) -> np.ndarray:
+    """(n,) bool: the splats outside ``mask`` (n,) bool in pieces it encloses
+    (rule 3's islands: within ``CLOSURE_ISLAND_RINGS`` rings of it and
+    reaching no farther).  ``mask | enclosed_holes(graph, mask)`` is the
+    region an explicit list of splats covers (a script's ``indices``)."""
+    mask = np.asarray(mask, bool)
+    out = np.zeros(graph.n, bool)
+    if mask.any():
+        out[_enclosed(graph, mask, ~mask)] = True
+    return out
+
+
+def closed_masks(cloud, support: np.ndarray, handles=(), **kw) -> tuple[np.ndarray, list, ClosureResult]:
+    """:func:`close_selection` for callers that fit next: (closed support
+    (n,) bool, closed handles, the result).  Handle splats outside the given
+    support stay in their handle (the fit refuses them with its own error);
+    keyword arguments go to :func:`close_selection`."""
+    n = len(cloud.positions)
+    if isinstance(handles, np.ndarray) and handles.ndim == 1 and handles.dtype == bool:
+        handles = [handles]
+
+    def as_bool(sel):    # a mask, or an index array within range; else left to the fit's checks
+        a = np.asarray(sel)
+        if a.dtype != bool and a.ndim == 1 and np.issubdtype(a.dtype, np.integer) and \
+                (not a.size or (a.min() >= 0 and a.max() < n)):
+            m = np.zeros(n, bool)
+            m[a] = True
+            return m
+        return a
+
+    sup = as_bool(support)
+    hs = [as_bool(h) for h in handles]
+    if any(m.dtype != bool or m.shape != (n,) for m in [sup] + hs):
+        return sup, hs, ClosureResult(sup.copy(), [h.copy() for h in hs], np.zeros(n, bool), np.zeros(n, bool))
+    res = close_selection(cloud, sup, [h & sup for h in hs], **kw)
+    return res.support, [c | (h & ~sup) for c, h in zip(res.handles, hs)], res
 
 
 def _box_region(graph: NeighbourGraph, pos: np.ndarray, touched: np.ndarray, reach: float) -> np.ndarray:

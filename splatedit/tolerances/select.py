@@ -19,6 +19,14 @@ GRAPH_EDGE_MAX_REL = 3.0
 #: far from the surface (closure's rays deep inside a thick part): 500 queries
 #: 0.05 inside a 1M-splat bunny took 51 ms in the full tree
 GRAPH_COARSE_STRIDE = 16
+#: closure rule 1 for a handle: its thickness bound T is this times the
+#: handle's RMS radius (the support bounds it).  A handle painted from one
+#: view over a head's face: the front hemisphere of a sphere of radius R has
+#: RMS radius sqrt(3/4) R = 0.87 R and the back lies 2 R behind its pole
+#: (2.3 RMS radii); 3.0 leaves a margin for a face painted short of the
+#: silhouette.  A 1.0 bound (the support's) left the back of the head out of
+#: the handle: turning the head smeared it (22x in the tester's session)
+CLOSURE_HANDLE_THIN_MAX_REL = 3.0
 #: closure rule 1: normals of a thin part's two sides face opposite ways
 #: within acos(-0.5) = 120 degrees
 CLOSURE_OPPOSITE_COS = 0.0

@@ -64,13 +64,14 @@ def test_3d_brush_paints_the_ear_through_and_the_grab_does_not_tear(xvfb, tmp_pa
         w, h = s["window"]
         cam = _camera(s)
         px, depth = cam.project(src.positions, w, h)
-        # the ear on screen: from its base (lowest tenth) to the tip; the brush as wide as the ear
+        # the ear on screen: from its base (lowest tenth) to the tip; the brush as wide as the
+        # ear (closure adds only inside what the stroke covered on screen: its reach)
         ep, ey = px[ear], src.positions[ear, 1]
         base = ep[ey < np.quantile(ey, 0.1)].mean(axis=0)
         tip = ep[ey > np.quantile(ey, 0.97)].mean(axis=0)
         axis = (tip - base) / np.linalg.norm(tip - base)
         across = np.abs((ep - base) @ np.array([-axis[1], axis[0]]))
-        want = float(np.quantile(across, 0.9))
+        want = float(np.quantile(across, 0.99))
         presses = max(0, round(math.log(want / 24.0) / math.log(1.2)))
         key = "bracketright" if want > 24 else "bracketleft"
         presses = abs(presses)
@@ -165,10 +166,11 @@ def test_3d_brush_paints_the_ear_through_and_the_grab_does_not_tear(xvfb, tmp_pa
     assert_replay_reproduces(script_path, out, tmp_path)
 
 
-def test_an_erase_stroke_in_a_support_never_grows_it_and_says_when_closure_refills(xvfb, tmp_path):
+def test_an_erase_stroke_in_a_support_stays_erased_and_says_so(xvfb, tmp_path):
     """Ctrl+drag across the middle of a painted support: the support ends up
-    no bigger than before the stroke (the tester saw 9158 -> 9209), and the
-    status line says whether closure refilled the erased splats."""
+    smaller than before the stroke (the tester saw 9158 -> 9209, and a
+    small hole refilled by closure), and the status line counts the erased
+    splats."""
     from tests.app.window_harness import _foreground_centre
     ed = EditorProcess(xvfb, tmp_path)
     try:
@@ -184,9 +186,9 @@ def test_an_erase_stroke_in_a_support_never_grows_it_and_says_when_closure_refil
         ed.xdo("mousemove", cx - 15, cy, "keydown", "ctrl", "mousedown", "1", "mousemove", cx, cy,
                "mousemove", cx + 15, cy, "sleep", "0.1", "mouseup", "1", "keyup", "ctrl")
         s = ed.idle(lambda s: s["history"] == 3, "erase stroke")
-        assert s["support"] <= before
+        assert s["support"] < before
         msg = s["message"]
-        assert msg.startswith("closure refilled") or msg.startswith("erased "), msg
+        assert msg == f"erased {before - s['support']:,} splats from the support", msg
         assert s["validation_messages"] == 0
     finally:
         ed.close()

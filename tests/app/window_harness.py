@@ -20,7 +20,11 @@ WINDOW = (960, 600)
 
 class EditorProcess:
     def __init__(self, xvfb, tmp: Path, *args):
-        self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1")
+        # the editor runs in ``tmp``: put this checkout first on its path, or a worktree's tests
+        # would drive the package the virtual environment has installed (another checkout)
+        root = str(Path(__file__).resolve().parents[2])
+        path = os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH", "")) if p)
+        self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1", PYTHONPATH=path)
         self.screen = xvfb["screen"]
         self.status_path = tmp / "status.json"
         self.stderr_path = tmp / "editor.stderr"

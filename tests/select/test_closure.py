@@ -20,7 +20,7 @@ from splatedit.data import default_model_path
 from splatedit.deform import DeformationBasis, transform
 from splatedit.deform.distortion import count_tears
 from splatedit.io import read
-from splatedit.select.closure import close_selection
+from splatedit.select.closure import close_selection, closed_masks
 from splatedit.select.graph import NeighbourGraph
 from splatedit.select.view import one_view_disc, view_axes
 
@@ -69,8 +69,9 @@ def test_one_view_ear_strokes_edit_without_tears_needles_or_fragments(bunny):
     total_moved = total_stretched = 0
     for view in VIEWS:
         sup, hnd = stroke(cloud, graph, view, tip)
-        basis = DeformationBasis.fit(cloud, sup, [hnd], graph=graph)
-        assert basis.closure.n_added > 0.3 * sup.sum()          # the ear's back side and rim
+        csup, chs, closure = closed_masks(cloud, sup, [hnd], graph=graph)
+        basis = DeformationBasis.fit(cloud, csup, chs)
+        assert closure.n_added > 0.3 * sup.sum()          # the ear's back side and rim
         for name, out in user_edits(cloud, graph, view, basis):
             moved = np.linalg.norm(out.positions - cloud.positions, axis=1) > 0
             stretched = int((axis_stretch(cloud, out) > 4).sum())
@@ -92,7 +93,7 @@ def test_the_same_strokes_without_closure_tear(bunny):
     cloud, graph = bunny
     tip = cloud.positions[np.argmax(cloud.positions[:, 1])]
     sup, hnd = stroke(cloud, graph, (1, 0, 0), tip)
-    basis = DeformationBasis.fit(cloud, sup, [hnd], fill_holes=False)
+    basis = DeformationBasis.fit(cloud, sup, [hnd])
     _, out = next(user_edits(cloud, graph, (1, 0, 0), basis))
     assert count_tears(cloud.positions, out.positions, graph.spacing) > 1000
 
@@ -108,30 +109,43 @@ def test_a_patch_on_a_thick_part_keeps_the_far_side_fixed(bunny):
     far = p[:, 2] > target[2] + 0.3                             # the other half of the body
     assert not (r.support & far).any()
     assert r.support.sum() < 1.5 * sup.sum()
-    basis = DeformationBasis.fit(cloud, sup, [hnd], graph=graph)
+    basis = DeformationBasis.fit(cloud, r.support, r.handles)
     for name, out in user_edits(cloud, graph, (0, 0, 1), basis):
         assert count_tears(p, out.positions, graph.spacing) == 0, name
         assert (axis_stretch(cloud, out) > 4).sum() == 0, name
 
 
-def test_script_indices_with_holes_are_filled(bunny):
+def test_script_indices_with_holes_fill_the_holes_inside_and_keep_the_rim(bunny):
     """An edit script whose support has holes (every 7th splat left out) and
-    whose handle touches the support's edge still edits cleanly."""
+    whose handle touches the support's edge still edits cleanly: the holes
+    inside are filled, the list's outer rim stays where the user put it."""
     from splatedit.script import parse_script, run_script
+    from splatedit.script.run import close_edit, resolve_edit_inputs
     cloud, graph = bunny
     p = cloud.positions
     tip = p[np.argmax(p[:, 1])]
-    sup = np.flatnonzero(np.linalg.norm(p - tip, axis=1) < 0.25)
-    holes = sup[::7]
-    hnd = np.flatnonzero(np.linalg.norm(p - tip, axis=1) < 0.05)
+    d = np.linalg.norm(p - tip, axis=1)
+    sup = np.flatnonzero(d < 0.25)
+    holes = np.setdiff1d(sup[::7], np.flatnonzero(d < 0.05))
+    hnd = np.flatnonzero(d < 0.05)
     doc = {"version": 1, "edits": [{"support": {"indices": [int(i) for i in sorted(set(sup) - set(holes) | set(hnd))]},
                                     "handle": {"indices": hnd.tolist()},
                                     "transform": {"translate": [0.1, 0.05, 0.0]}}]}
-    out, reps = run_script(cloud, parse_script(doc))
-    assert reps[0].closure_added >= len(holes) - len(set(holes) & set(hnd))
+    script = parse_script(doc)
+    closed, _, res, _ = close_edit(cloud, resolve_edit_inputs(cloud, script.edits[0]))
+    unsel = np.flatnonzero(~np.isin(np.arange(len(p)), script.edits[0].support.indices))
+    _, labels = graph.components(unsel)                          # holes joined to the outside: notches
+    open_ = np.zeros(labels.max() + 1, bool)
+    open_[labels[d[unsel] >= 0.25]] = True
+    inner = holes[~open_[labels[np.searchsorted(unsel, holes)]]]
+    assert len(inner) > 0.8 * len(holes) and closed[inner].all()  # every hole inside is filled
+    assert np.isin(np.flatnonzero(res.added), holes).all()       # and nothing else: the rim stays
+    out, reps = run_script(cloud, script)
+    assert reps[0].closure_added == res.n_added
     assert count_tears(p, out.positions, graph.spacing) == 0
     moved = np.linalg.norm(out.positions - p, axis=1) > 0
     assert fragments(graph, moved) == 0
+    assert not moved[d >= 0.25].any()
     doc["edits"][0]["support"]["fill_holes"] = False
     out2, reps2 = run_script(cloud, parse_script(doc))
     assert reps2[0].closure_added == 0
@@ -197,7 +211,7 @@ def test_one_view_strokes_on_scans_do_not_tear(shared_data, name):
         sup, hnd = stroke(cloud, graph, view, top)
         if hnd.sum() < 5:
             continue
-        basis = DeformationBasis.fit(cloud, sup, [hnd], graph=graph)
+        basis = DeformationBasis.fit(cloud, *closed_masks(cloud, sup, [hnd], graph=graph)[:2])
         for name_t, out in user_edits(cloud, graph, view, basis):
             assert count_tears(cloud.positions, out.positions, graph.spacing) == 0, (view, name_t)
 

@@ -156,7 +156,9 @@ class BrushTool(Tool):
                 idx = seltools.splats_in_sphere(graph.tree, sph) if sph is not None else np.zeros(0, np.int64)
             else:
                 idx = picker.query(x, y, self.radius)
-            changed |= s.paint(idx, erase=erase)
+            # the dab's 3D reach (its circle through the model): closure may add there only
+            reach = None if erase else picker.covered(x, y, self.radius)
+            changed |= s.paint(idx, erase=erase, reach=reach)
         if changed:
             self.stroke_changed = True
             ed.motion()
@@ -182,10 +184,9 @@ class BrushTool(Tool):
         before, self.stroke_before = self.stroke_before, None
         if self.stroke_changed and before is not None:
             target = lambda sel: sel.support if s.brush_target == SUPPORT else sel.handle  # noqa: E731
-            stroked = target(s.selection).copy()
             self.tools.close(s, within=before)
-            msg = seltools.erase_refill_message(target(before), stroked, target(s.selection),
-                                                "support" if s.brush_target == SUPPORT else "handle")
+            msg = seltools.erase_message(target(before), target(s.selection),
+                                         "support" if s.brush_target == SUPPORT else "handle")
             if msg:
                 self.ed.say(msg)
         elif self.stroke_changed:
