@@ -89,6 +89,10 @@ GS_ALPHA_MIN = 1.0 / 255.0
 #: what follows changes a pixel by less than 1e-4 of full scale (0.03 of an
 #: 8-bit step)
 GS_MIN_TRANSMITTANCE = 1e-4
+#: (tile, Gaussian) pairs per Gaussian the compute tile rasterizer's buffers
+#: hold at first (gs_tiles.py; a frame that wants more grows them and is drawn
+#: again).  Measured: the bench's 1M-Gaussian sphere at 1280x720 wants ~? per Gaussian
+GS_TILE_PAIRS_PER_GAUSSIAN = 4.0
 #: the 3DGS Jacobian clamps the view ray's x/z and y/z at this factor times the
 #: half field of view's tangent, so Gaussians far outside the frustum do not
 #: get unbounded screen covariances
