@@ -2,7 +2,7 @@
 against the bitonic sort it replaced and numpy, in the same run.
 
 Per pair count: uniformly random uint32 keys with their indices as values.
-Cases: ``radix`` (the device's scatter variant, :func:`subgroup_scatter_supported`),
+Cases: ``radix`` (the device's scatter variant, :func:`default_scatter`),
 ``radix_<other variant>``, ``bitonic`` (padded to a power of two with
 0xFFFFFFFF keys), ``numpy_stable`` (``np.argsort(kind="stable")``, what the
 radix sort equals) and ``numpy`` (the default introsort, the renderer's CPU
@@ -20,7 +20,7 @@ import numpy as np
 
 from splatedit.bench.render import _loadavg
 from splatedit.render import vk as V
-from splatedit.render.gpu_sort import BitonicSort, RadixSort, subgroup_scatter_supported
+from splatedit.render.gpu_sort import BitonicSort, RadixSort, default_scatter, subgroup_scatter_supported
 
 
 def _gpu_times(dev, record, restore, repeats: int) -> float:
@@ -53,7 +53,7 @@ def bench_gpu_sort(counts=(100_000, 1_000_000, 4_000_000), repeats: int = 3, dev
     with V.Device(device_name=device_name, validation=False) as dev:
         cache = V.PipelineCache(dev)
         try:
-            auto = "subgroup" if subgroup_scatter_supported(dev) else "shared"
+            auto = default_scatter(dev)
             modes = [auto] + [m for m in ("subgroup", "shared") if m != auto and
                               (m == "shared" or subgroup_scatter_supported(dev))]
             for n in counts:
