@@ -438,6 +438,9 @@ class GaussianRenderer:
         Then :meth:`record_draw` records the draw into any command buffer (the
         editor's frame); :meth:`render` does both."""
         self._check()
+        if self.path == "compute" and self._tiles.pairs_wanted() > self._tiles.capacity:
+            # the last frame (e.g. the editor's, drawn by record_draw) dropped pairs: room for this one
+            self._tiles.grow(self._tiles.pairs_wanted())
         self._targets_for(width, height)
         self._write_ubo(camera, width, height, srgb_target)
         self.epoch += 1
