@@ -135,3 +135,21 @@ def test_compute_path_frees_every_vulkan_object(bunny):
     r.render(cam, 40, 30)
     r.close()
     assert V.live_handles() == before
+
+
+def test_compute_path_with_nothing_visible_draws_the_background(dev, bunny):
+    """Every Gaussian culled: every indirect dispatch has zero workgroups and
+    the image is the background, as on the quad path."""
+    lo, hi = gaussian_bounds(bunny)
+    c = 0.5 * (lo + hi)
+    d = float(np.linalg.norm(hi - lo))
+    away = Camera(c + (0.0, 0.0, 2.0 * d), c + (0.0, 0.0, 4.0 * d), up=(0.0, 1.0, 0.0), fov_deg=40.0)
+    imgs = []
+    for path, sort in (("raster", "cpu"), ("compute", "cpu"), ("compute", "gpu")):
+        with GaussianRenderer(path=path, sort=sort, device=dev) as r:
+            r.set_gaussians(bunny)
+            imgs.append(r.render(away, 48, 32))
+            assert r.last_timings_ms["visible"] == 0
+    assert (imgs[0] == imgs[0][0, 0]).all()
+    for img in imgs[1:]:
+        np.testing.assert_array_equal(img, imgs[0])
