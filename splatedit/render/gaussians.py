@@ -63,20 +63,22 @@ from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, 
 
 
 def choose_path(dev: V.Device) -> str:
-    """The draw path of ``path="auto"``, a documented rule from measurements
-    (docs/PERFORMANCE.md, "Gaussian splatting: radix sort and tile
-    rasterizer"): on a CPU device (lavapipe) the path measured faster there,
-    "raster" ... "compute" on every GPU: compute shaders use the whole chip
-    (on an H100/H200 only 2 of 66 TPCs run vertex and fragment shaders) and
-    the tile rasterizer skips the quad path's per-fragment blending of the
-    Gaussians behind an opaque pixel."""
+    """The draw path of ``path="auto"``, a documented rule: on a CPU device
+    (lavapipe) the path measured faster there (:data:`CPU_DEVICE_PATH`,
+    docs/PERFORMANCE.md, "Gaussian splatting: radix sort and tile
+    rasterizer"); "compute" on every GPU, by argument, not yet measured:
+    compute shaders use the whole chip (on an H100/H200 only 2 of 66 TPCs run
+    vertex and fragment shaders) and the tile rasterizer stops blending a
+    pixel once its transmittance is used up, where the quad path still
+    shades and blends every fragment behind it."""
     return CPU_DEVICE_PATH if V.is_cpu_device(dev) else "compute"
 
 
 def choose_sort(dev: V.Device) -> str:
     """The depth sort of ``sort="auto"``: on a CPU device the sort measured
-    faster there (:data:`CPU_DEVICE_SORT`), on a GPU the GPU radix sort (no
-    read-back, no second submission)."""
+    faster there (:data:`CPU_DEVICE_SORT`), on a GPU the GPU radix sort (the
+    keys never leave the GPU and the CPU waits for no sort between the
+    pre-pass and the draw)."""
     return CPU_DEVICE_SORT if V.is_cpu_device(dev) else "gpu"
 
 
