@@ -47,10 +47,16 @@ def _render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
         yield {"bench": "render", **bench_upload_lod(int(n), size=size)}
 
 
-def _gaussian_render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+def _gaussian_render(quick: bool, progress=None, counts=None, size=None, path=None) -> Iterator[dict]:
     from splatedit.bench.gs_render import bench_gaussians
     yield from bench_gaussians(counts=counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)),
-                               size=(640, 360) if quick else (1280, 720))
+                               size=size or ((640, 360) if quick else (1280, 720)),
+                               paths=(path,) if path else ("raster", "compute"))
+
+
+def _gpu_sort(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.gs_sort import bench_gpu_sort
+    yield from bench_gpu_sort(counts=counts or ((10_000, 100_000) if quick else (100_000, 1_000_000, 4_000_000)))
 
 
 def _gaussian_editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
@@ -139,19 +145,27 @@ BENCHES = {
     "gui": _gui,
     "gaussians": _gaussians,
     "gaussian-render": _gaussian_render,
+    "gpu-sort": _gpu_sort,
     "gaussian-editor": _gaussian_editor,
 }
 
 
+#: benchmarks that take an image size and a draw path (``--size``, ``--path``)
+SIZED = ("gaussian-render",)
+
+
 def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
-              large: bool = False) -> Iterator[dict]:
+              large: bool = False, size=None, path=None) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
     ``counts``: splat/point counts for ``estimate``, ``render``, ``editor``, ``closure`` and
     support splats for ``basis``
-    (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``."""
+    (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``;
+    ``size`` (width, height) and ``path`` ("raster" / "compute") apply to :data:`SIZED`."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
         if name == "io":
             yield from _io(quick, progress, counts, large=large)
+        elif name in SIZED:
+            yield from BENCHES[name](quick, progress, counts, size=size, path=path)
         else:
             yield from BENCHES[name](quick, progress, counts)

@@ -51,6 +51,9 @@ def cmd_render(args) -> int:
     from splatedit.model.gaussians import GaussianCloud
     if isinstance(cloud, GaussianCloud):
         return _render_gaussians(args, cloud)
+    if getattr(args, "path", None) is not None:
+        raise ParameterError("--path", "chooses the Gaussian renderer's draw path; this model is not a "
+                                       "Gaussian splatting scene")
     camera = _camera_from_args(args, cloud)
     basis_rows = d_c = None
     if args.edit is not None:
@@ -102,7 +105,8 @@ def _render_gaussians(args, cloud) -> int:
                                             progress=args.progress)
             basis_rows = d_c = None
             on_cpu = True
-    render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c)
+    render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
+                            path=getattr(args, "path", None) or "auto")
     how = ", deformed on the CPU" if on_cpu else ", deformed on the GPU" if basis_rows is not None else ""
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {len(cloud)} Gaussians, SH degree "
           f"{cloud.sh_degree}{how})")

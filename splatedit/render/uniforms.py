@@ -146,10 +146,17 @@ BASIS_GROUP = np.dtype([
     ("Bz", "<f4", (4,)),
 ])
 
-#: push constants (std430) of gs_prepare.comp: basis groups per row, polar iterations
-GS_PREP_PUSH = np.dtype([("groups", "<u4"), ("polar_iterations", "<u4")])
-#: push constants of gs_sort.comp: bitonic stage k, step j
-GS_SORT_PUSH = np.dtype([("k", "<u4"), ("j", "<u4")])
+#: push constants (std430) of gs_prepare.comp: basis groups per row, polar
+#: iterations, compact (1: append the visible keys for the GPU radix sort)
+GS_PREP_PUSH = np.dtype([("groups", "<u4"), ("polar_iterations", "<u4"), ("compact", "<u4")])
+#: push constants of gs_sort.comp: bitonic stage k, step j, sort length n (a power of two)
+GS_SORT_PUSH = np.dtype([("k", "<u4"), ("j", "<u4"), ("n", "<u4")])
+#: push constants of the radix sort (gs_radix.glsl): digit shift, index of the
+#: count in the count buffer, capacity of the buffers
+RADIX_PUSH = np.dtype([("shift", "<u4"), ("count_index", "<u4"), ("capacity", "<u4"), ("pad", "<u4")])
+#: push constants of the tile rasterizer (gs_tile.glsl): pair capacity, tiles
+#: per row, tile rows, the transmittance where blending stops
+TILE_PUSH = np.dtype([("capacity", "<u4"), ("tiles_x", "<u4"), ("tiles_y", "<u4"), ("t_min", "<f4")])
 #: push constants of prepare_cs.glsl: basis window (base, count), record slots
 #: n, first splat wbase of the per-splat window
 PREP_PUSH = np.dtype([("base", "<u4"), ("count", "<u4"), ("n", "<u4"), ("wbase", "<u4")])
