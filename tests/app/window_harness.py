@@ -20,7 +20,12 @@ WINDOW = (960, 600)
 
 class EditorProcess:
     def __init__(self, xvfb, tmp: Path, *args):
-        self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1")
+        import splatedit
+        # the editor process imports the splatedit these tests import (it runs in ``tmp``,
+        # where ``python -m`` would otherwise find whichever checkout is installed)
+        root = str(Path(splatedit.__file__).resolve().parents[1])
+        path = os.pathsep.join([root] + ([os.environ["PYTHONPATH"]] if os.environ.get("PYTHONPATH") else []))
+        self.env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1", PYTHONPATH=path)
         self.screen = xvfb["screen"]
         self.status_path = tmp / "status.json"
         self.stderr_path = tmp / "editor.stderr"
