@@ -215,6 +215,9 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         if self.fit.current(key) or self.committing:    # a landing commit refits
             return
         self.fit.clear()
+        if self.fit.recall(key):      # undo / redo back to a fitted selection: no refit
+            self.on_change()
+            return
         hidx = self.selection.nonempty()
         curve = self.curve()
         if not hidx and curve is None:
