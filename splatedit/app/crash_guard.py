@@ -85,8 +85,6 @@ class CrashGuard:
         if s is not None and s.manip is not None:
             s.cancel()
         self.drag, self.drag_tool = DragMode.NONE, None
-        if self.gui is not None:
-            self.gui.recover()
 
     # -------------------------------------------------------------- recovery
     def write_recovery(self, reason: str):

@@ -351,10 +351,11 @@ class Editor(EventRouting, FileActions, CrashGuard):
             except SplatEditError as exc:       # e.g. a Vulkan error: report, keep the document
                 self.say(f"drawing failed: {exc}")
                 failed = True
-                if self.gui is not None:
-                    self.gui.recover()
         if not failed and self.internal_errors == errors:
             return
+        if self.gui is not None:        # a frame left half laid out is closed (no-op after a whole one)
+            with self.guarded("closing the interrupted frame"):
+                self.gui.recover()
         fr.scene_key = fr.state() if self.session is not None else None
         time.sleep(0.2)
 

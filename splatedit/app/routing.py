@@ -207,6 +207,9 @@ class EventRouting:
             return
         manip = s is not None and s.manip is not None
         table = self.manip_actions if manip and action in self.manip_actions else self.actions
-        table[action]()
+        # guarded here too: a GUI button runs its action while the frame is laid out, and
+        # an error there must neither abandon the frame nor take the window down
+        with self.guarded(f"running '{action.value}'"):
+            table[action]()
         if s is not None:
             self.motion()

@@ -147,13 +147,27 @@ def test_an_exception_in_a_key_handler_is_shown_the_document_kept_and_a_recovery
     ed.loop_once()
     assert s.cloud is cloud and s.edits == edits                     # the document is kept
     assert s.brush_target == HANDLE                                 # the next event was handled
-    assert_recovered(ed, s, "handling a key event")
+    assert_recovered(ed, s, "running 'colour_mode'")
     assert "RuntimeError: boom in a handler" in capsys.readouterr().err    # the traceback on stderr
     assert ed.frames.drawn == 1                                     # the loop went on to draw
     # the same error again: no second recovery copy of the same state, the window stays
     ed.window.events = [key_event(glfw.KEY_M)]
     ed.loop_once()
     assert len(recovery.entries()) == 1 and ed.internal_errors == 2
+
+
+def test_an_exception_in_an_event_handler_outside_the_actions_is_caught(ed):
+    s = ed.session
+    edited(s)
+
+    def broken(e):
+        raise ValueError("bad scroll")
+    ed.on_scroll = broken
+    ed.window.events = [types.SimpleNamespace(kind="scroll", dx=0.0, dy=1.0, mods=0, x=1.0, y=1.0),
+                        key_event(glfw.KEY_2)]
+    ed.loop_once()
+    assert_recovered(ed, s, "handling a scroll event")
+    assert s.brush_target == HANDLE
 
 
 def test_an_exception_in_a_commit_cancels_the_move_and_keeps_the_document(ed, monkeypatch):
@@ -171,7 +185,7 @@ def test_an_exception_in_a_commit_cancels_the_move_and_keeps_the_document(ed, mo
     ed.window.events = [key_event(k) for k in (glfw.KEY_G, glfw.KEY_X, glfw.KEY_1, glfw.KEY_ENTER)]
     ed.loop_once()
     assert s.manip is None and s.cloud is cloud and s.edits == edits
-    assert_recovered(ed, s, "handling a key event")
+    assert_recovered(ed, s, "running '")
 
 
 def test_exceptions_landing_a_job_polling_the_session_and_drawing_are_caught(ed, monkeypatch):
