@@ -19,7 +19,7 @@ for name, c, frac in (("bunny", read(str(default_model_path())), 92), ("bunny300
         s.begin(GRAB, v, (100,100)); s.manip.set_axis(0); [s.manip.type_char(ch) for ch in "0.01"]; s.finish()
         s.wait_fit()
         if mode == "refit":
-            s.fit._kept.clear()
+            s.fit.drop_kept()
         t = time.perf_counter(); s.undo(); s.wait_fit(); row[mode] = time.perf_counter() - t
         assert s.basis is not None
     print(name, c.n, "support", int(s.selection.support.sum()), {k: round(v, 3) for k, v in row.items()},

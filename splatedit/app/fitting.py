@@ -125,6 +125,10 @@ class FitScheduler:
                               or sum(v[2] for v in self._kept.values()) > EDITOR_FIT_KEEP_BYTES):
             self._kept.pop(next(iter(self._kept)))
 
+    def drop_kept(self) -> None:
+        """Forget the kept bases (memory back; the next undo refits)."""
+        self._kept.clear()
+
     def recall(self, key) -> bool:
         """Take back the basis kept for ``key`` (its key includes the cloud's
         revision, the masks, the curve and the kind: it is exactly what a new
