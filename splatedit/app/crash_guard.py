@@ -46,6 +46,7 @@ class CrashGuard:
     restoring = None
     restored = None
     _recovery_key = None
+    _recovery_entry = None      # the copy this run wrote last (a newer one replaces it)
     _last_internal = None
     #: the last internal error (the status file shows it; tests wait for it)
     internal_errors = 0
@@ -100,6 +101,9 @@ class CrashGuard:
         entry = recovery.write_recovery(s, src, bundled=self.bundled, reason=reason)
         self._recovery_key = key
         if entry is not None:
+            if self._recovery_entry is not None:    # this run's older copy: the new one supersedes it
+                recovery.discard(self._recovery_entry)
+            self._recovery_entry = entry
             print(f"splatedit: recovery copy written: {entry.model} (edit script {entry.script.name})",
                   file=sys.stderr, flush=True)
         return entry

@@ -26,6 +26,7 @@ restored document is saved, or when the user discards it.
 from __future__ import annotations
 
 import contextlib
+import itertools
 import json
 import os
 import time
@@ -75,10 +76,14 @@ class RecoveryEntry:
         return self.model, self.script, self.manifest
 
 
+_serial = itertools.count(1)
+
+
 def _stem(source) -> str:
+    """``NAME-YYYYmmdd-HHMMSS-PID-N``: unique per process (N counts this process's copies)."""
     base = Path(source).stem if source else "model"
     safe = "".join(ch if ch.isalnum() or ch in "-_." else "_" for ch in base)[:80] or "model"
-    return f"{safe}-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}"
+    return f"{safe}-{time.strftime('%Y%m%d-%H%M%S')}-{os.getpid()}-{next(_serial)}"
 
 
 def write_recovery(session, source, *, bundled: bool = False, reason: str = "",

@@ -211,6 +211,17 @@ def test_exceptions_landing_a_job_polling_the_session_and_drawing_are_caught(ed,
     assert "internal error while drawing a frame" in ed.error_box
     assert ed.frames.scene_key == "scene"         # the failed scene is not redrawn at once
     assert s.cloud is cloud and recovery.entries() == [e]   # one copy per document state
+    # another edit, another error: its copy replaces this run's older one
+    ed.dismiss_error()
+    ed.frames.fail = None
+    assert s.begin(GRAB, view(), (100, 100))
+    s.manip.type_char("1")
+    assert s.finish() == "commit"
+    ed.actions[Action.COLOUR_MODE] = lambda: [][0]
+    ed.window.events = [key_event(glfw.KEY_M)]
+    ed.loop_once()
+    (e2,) = recovery.entries()
+    assert e2 != e and e2.edits == 2 and not e.model.exists()
 
 
 def test_sigterm_or_ctrl_c_with_unsaved_edits_writes_a_recovery_copy(ed):
