@@ -62,6 +62,7 @@ from splatedit.app import revision
 from splatedit.app.commit_job import CommitOutcome, CommitProgress, CommitRunner
 from splatedit.app.distortion_feed import DistortionFeed
 from splatedit.app.fitting import FitProgress, FitScheduler, FitStats, fitted_kind
+from splatedit.app.gaussian_doc import DETAIL_UNAVAILABLE, gaussians_of
 from splatedit.app.history import History
 from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.rig import Rig
@@ -281,14 +282,13 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     DEFORMATION_CYCLE = (DeformationMode.ROTATION, DeformationMode.DETAIL, DeformationMode.LINEAR)
 
     #: why the detail mode cannot be chosen for a Gaussian scene (as ``splatedit deform`` says)
-    DETAIL_UNAVAILABLE = "the detail mode is not available for Gaussian scenes (rotation and linear are)"
+    DETAIL_UNAVAILABLE = DETAIL_UNAVAILABLE
 
     @property
     def detail_available(self) -> bool:
         """The detail mode can be chosen: not for a Gaussian document (the
         Gaussians' covariance and SH transport needs the plain basis'
         Jacobians; ``splatedit deform`` and ``render --edit`` refuse it too)."""
-        from splatedit.app.gaussian_doc import gaussians_of
         return gaussians_of(self.cloud) is None
 
     def deformation_cycle(self) -> tuple:

@@ -254,3 +254,16 @@ def test_detail_mode_is_not_offered_for_a_gaussian_document_and_b_cycles_rotatio
         assert plain.detail_available and DeformationMode.DETAIL in plain.deformation_cycle()
     finally:
         plain.close()
+
+
+def test_a_detail_basis_given_to_the_gaussian_commit_is_refused_with_a_message(scene):
+    """The transport behind the issue's AttributeError: a DetailBasis reaching
+    the Gaussian commit (any caller) is one clear SplatEditError, nothing changed."""
+    from splatedit.deform.detail import DetailBasis
+    from splatedit.errors import SplatEditError
+    doc = gaussian_document(scene)
+    y = doc.positions[:, 1]
+    sup, hnd = y > np.percentile(y, 85), y > np.percentile(y, 94)
+    basis = DetailBasis.fit(doc, sup, [hnd])
+    with pytest.raises(SplatEditError, match="not available for Gaussian scenes"):
+        commit_cloud(basis, doc, np.zeros((basis.n_columns, 3)))
