@@ -137,6 +137,25 @@ class Gui:
             imgui.end_frame()
             self._in_frame = False
 
+    def recover_frame(self) -> None:
+        """End a frame left unbalanced by an exception in the middle of its
+        layout (a window's ``begin`` without ``end``): ImGui's own error
+        recovery closes what was left open (logged, not asserted), so the
+        next :meth:`new_frame` starts clean."""
+        io = self._current()
+        if not self._in_frame:
+            return
+        assert_on = io.config_error_recovery_enable_assert
+        tooltip_on = io.config_error_recovery_enable_tooltip
+        io.config_error_recovery_enable_assert = False
+        io.config_error_recovery_enable_tooltip = False
+        try:
+            imgui.end_frame()
+        finally:
+            io.config_error_recovery_enable_assert = assert_on
+            io.config_error_recovery_enable_tooltip = tooltip_on
+            self._in_frame = False
+
     def render(self, cmd, framebuffer, *, fmt: str, clear=None, final: str = "color") -> GuiFrameStats:
         """End the frame (``imgui.render``), apply ImGui's texture requests,
         upload the geometry and record the GUI pass into ``cmd`` (see
