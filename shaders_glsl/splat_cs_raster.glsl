@@ -1,0 +1,140 @@
+// Compute rasterizer of EWA splats (the compute path of the splat renderer,
+// splatedit/render/compute_raster.py): it draws the pre-pass records
+// (prepare_cs.glsl) that the raster path draws with prepared.vert, with the
+// same per-pixel test (splat_pixel.glsl).  The including file defines
+// CRAST_PASS:
+//   0 visibility: depth pushed back by epsilon and the splat index packed in
+//     64 bits, (window depth bits << 32) | (index + 1), atomicMin per pixel
+//     (Schuetz, Kerbl, Wimmer 2021, "Rendering Point Clouds with Compute
+//     Shaders and Vertex Order Optimization"); cleared to all ones;
+//   1 attributes: where the unpushed depth is at most the visible depth (the
+//     raster path's less_equal test), atomicAdd of w*rgb, w and w*normal,
+//     w*depth into two float32 RGBA buffers (VK_EXT_shader_atomic_float).
+// Coverage: the pixels whose centres lie in the record's bound (the quad of
+// prepared.vert, or the square point), top-left rule; the per-pixel test
+// discards the rest.
+// Two modes (push constant): 0 one invocation per record slot; a splat whose
+// bound holds more than BIG_PIXELS pixels is appended to a list instead;
+// 1 each workgroup takes listed splats in turn, its 64 invocations striding
+// over the bound's pixels.
+
+#include "frame.glsl"
+#include "splat_records.glsl"
+#include "splat_pixel.glsl"
+
+layout(local_size_x = 64) in;
+
+layout(push_constant) uniform Push {
+    uint n;          // record slots (quads from 0 up, points from n-1 down)
+    uint mode;       // 0 per-splat invocations, 1 cooperative over the big list
+    uint groups;     // mode 1: workgroups dispatched
+    uint pad;
+} P;
+
+layout(std430, set = 0, binding = 5) readonly buffer RecA { vec4 recA[]; };
+layout(std430, set = 0, binding = 6) readonly buffer RecB { uvec4 recB[]; };
+layout(std430, set = 0, binding = 7) readonly buffer Draws { uint draws[8]; };
+#if CRAST_PASS == 0
+layout(std430, set = 0, binding = 10) buffer Vis { uint64_t vis[]; };     // per pixel, row-major
+#else
+layout(std430, set = 0, binding = 10) readonly buffer Vis { uvec2 vis[]; }; // .y: window depth bits
+layout(std430, set = 0, binding = 11) buffer AccC { vec4 acc_c[]; };        // w*rgb, w
+layout(std430, set = 0, binding = 12) buffer AccN { vec4 acc_n[]; };        // w*normal, w*depth
+#endif
+layout(std430, set = 0, binding = 13) buffer Big { uint big_count; uint big_pad[3]; uint big[]; };
+
+const uint BIG_PIXELS = 256u;
+
+struct Rec {
+    vec4 ms_cn, mt_tc, mw_r, center;
+    vec3 color, normal;
+    uint index;
+    ivec2 lo, hi;     // inclusive pixel range
+};
+
+vec3 oct_decode(vec2 e) {
+    vec3 n = vec3(e, 1.0 - abs(e.x) - abs(e.y));
+    if (n.z < 0.0) n.xy = (1.0 - abs(n.yx)) * vec2(n.x >= 0.0 ? 1.0 : -1.0, n.y >= 0.0 ? 1.0 : -1.0);
+    return normalize(n);
+}
+
+Rec load(uint slot, bool quad) {
+    Rec R;
+    R.ms_cn = recA[RECA_STRIDE * slot + RECA_MS_CN];
+    R.mt_tc = recA[RECA_STRIDE * slot + RECA_MT_TC];
+    R.mw_r = recA[RECA_STRIDE * slot + RECA_MW_R];
+    uvec4 b0 = recB[RECB_STRIDE * slot + RECB_CENTER], b1 = recB[RECB_STRIDE * slot + RECB_PACKED];
+    float lp = F.depth_params.w;
+    R.center = vec4(uintBitsToFloat(b0.x), uintBitsToFloat(b0.y), 1.0 / (lp * lp), uintBitsToFloat(b0.z));
+    R.index = b0.w;
+    R.color = unpackUnorm4x8(b1.z).rgb;
+    R.normal = oct_decode(unpackSnorm2x16(b1.w));
+    vec2 lo, hi;
+    if (quad) {
+        lo = vec2(float(b1.x & 0xFFFFu), float(b1.x >> 16)) * (1.0 / 16.0);   // pixels, 12.4 fixed point
+        hi = vec2(float(b1.y & 0xFFFFu), float(b1.y >> 16)) * (1.0 / 16.0);
+    } else {
+        float h = 0.5 * uintBitsToFloat(b1.x);
+        lo = R.center.xy - h;
+        hi = R.center.xy + h;
+    }
+    // pixel x is covered when lo.x <= x + 0.5 < hi.x (top-left rule)
+    R.lo = max(ivec2(ceil(lo - 0.5)), ivec2(0));
+    R.hi = min(ivec2(ceil(hi - 0.5)) - 1, ivec2(F.viewport.xy) - 1);
+    return R;
+}
+
+void pixel(Rec R, ivec2 p) {
+    float r, depth, zwin;
+    vec2 fc = vec2(p) + 0.5;
+    uint k = uint(p.y) * uint(F.viewport.x) + uint(p.x);
+#if CRAST_PASS == 0
+    if (!splat_pixel(fc, R.ms_cn, R.mt_tc, R.mw_r, R.center, true, r, depth, zwin)) return;
+    atomicMin(vis[k], (uint64_t(floatBitsToUint(zwin)) << 32) | uint64_t(R.index));
+#else
+    if (!splat_pixel(fc, R.ms_cn, R.mt_tc, R.mw_r, R.center, false, r, depth, zwin)) return;
+    uint vz = vis[k].y;
+    float zv = vz == 0xFFFFFFFFu ? 1.0 : uintBitsToFloat(vz);     // cleared: the depth buffer's 1.0
+    if (!(zwin <= zv)) return;
+    float w = exp(-F.misc.x * r);
+    vec3 c = R.color * w, nn = R.normal * w;
+    atomicAdd(acc_c[k].x, c.x);
+    atomicAdd(acc_c[k].y, c.y);
+    atomicAdd(acc_c[k].z, c.z);
+    atomicAdd(acc_c[k].w, w);
+    atomicAdd(acc_n[k].x, nn.x);
+    atomicAdd(acc_n[k].y, nn.y);
+    atomicAdd(acc_n[k].z, nn.z);
+    atomicAdd(acc_n[k].w, depth * w);
+#endif
+}
+
+void main() {
+    if (P.mode == 0u) {
+        // 2D dispatch when the slots need more than maxComputeWorkGroupCount[0] groups
+        uint slot = (gl_WorkGroupID.y * gl_NumWorkGroups.x + gl_WorkGroupID.x) * 64u + gl_LocalInvocationIndex;
+        if (slot >= P.n) return;
+        bool quad = slot < draws[1];
+        if (!quad && slot < P.n - draws[5]) return;
+        Rec R = load(slot, quad);
+        ivec2 ext = R.hi - R.lo + 1;
+        if (ext.x <= 0 || ext.y <= 0) return;
+        if (uint(ext.x) * uint(ext.y) > BIG_PIXELS) {
+            big[atomicAdd(big_count, 1u)] = slot;
+            return;
+        }
+        for (int y = R.lo.y; y <= R.hi.y; ++y)
+            for (int x = R.lo.x; x <= R.hi.x; ++x)
+                pixel(R, ivec2(x, y));
+        return;
+    }
+    uint count = big_count;
+    for (uint j = gl_WorkGroupID.x; j < count; j += P.groups) {
+        uint slot = big[j];
+        Rec R = load(slot, slot < draws[1]);
+        ivec2 ext = R.hi - R.lo + 1;
+        uint total = uint(ext.x) * uint(ext.y);
+        for (uint q = gl_LocalInvocationIndex; q < total; q += 64u)
+            pixel(R, R.lo + ivec2(int(q % uint(ext.x)), int(q / uint(ext.x))));
+    }
+}
