@@ -14,7 +14,7 @@
 // prepared.vert, or the square point), top-left rule; the per-pixel test
 // discards the rest.
 // Two modes (push constant): 0 one invocation per record slot; a splat whose
-// bound holds more than BIG_PIXELS pixels is appended to a list instead;
+// bound holds more than P.big_pixels pixels is appended to a list instead;
 // 1 each workgroup takes listed splats in turn, its 64 invocations striding
 // over the bound's pixels.
 
@@ -28,7 +28,7 @@ layout(push_constant) uniform Push {
     uint n;          // record slots (quads from 0 up, points from n-1 down)
     uint mode;       // 0 per-splat invocations, 1 cooperative over the big list
     uint groups;     // mode 1: workgroups dispatched
-    uint pad;
+    uint big_pixels; // mode 0: a splat whose bound holds more pixels goes to the list
 } P;
 
 layout(std430, set = 0, binding = 5) readonly buffer RecA { vec4 recA[]; };
@@ -42,8 +42,6 @@ layout(std430, set = 0, binding = 11) buffer AccC { vec4 acc_c[]; };        // w
 layout(std430, set = 0, binding = 12) buffer AccN { vec4 acc_n[]; };        // w*normal, w*depth
 #endif
 layout(std430, set = 0, binding = 13) buffer Big { uint big_count; uint big_pad[3]; uint big[]; };
-
-const uint BIG_PIXELS = 256u;
 
 struct Rec {
     vec4 ms_cn, mt_tc, mw_r, center;
@@ -119,7 +117,7 @@ void main() {
         Rec R = load(slot, quad);
         ivec2 ext = R.hi - R.lo + 1;
         if (ext.x <= 0 || ext.y <= 0) return;
-        if (uint(ext.x) * uint(ext.y) > BIG_PIXELS) {
+        if (uint(ext.x) * uint(ext.y) > P.big_pixels) {
             big[atomicAdd(big_count, 1u)] = slot;
             return;
         }

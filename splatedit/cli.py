@@ -129,7 +129,9 @@ def cmd_bench(args) -> int:
         if what != "render":
             raise ParameterError("--gaussians", f"applies to 'bench render', not 'bench {what}'")
         what = "gaussian-render"
-    for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats, large=args.large):
+    extra = {"size": args.size, "models": args.model} if what == "render" else {}
+    for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats, large=args.large,
+                          **extra):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -198,6 +200,9 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
     s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
+    s.add_argument("--path", choices=("auto", "raster", "compute"), default=None,
+                   help="splat rasterization: raster passes or compute shaders (default: env var "
+                        "SPLATEDIT_RASTER, else auto: compute where the device allows it)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 
@@ -218,6 +223,10 @@ def build_parser() -> argparse.ArgumentParser:
                         "(e.g. --splats 1000000 10000000)")
     s.add_argument("--large", action="store_true",
                    help="io: also the 10M-splat PLY read (writes an 840 MB file to the temp folder)")
+    s.add_argument("--size", type=parse_size, default=None,
+                   help="render: image WxH (default 1280x720, 640x360 with --quick)")
+    s.add_argument("--model", action="append", default=[], metavar="FILE",
+                   help="render: also this model (e.g. a real scan); repeatable")
     s.set_defaults(func=cmd_bench)
     return p
 

@@ -56,7 +56,7 @@ def cmd_render(args) -> int:
     if args.edit is not None:
         cloud, basis_rows, d_c = _gpu_edit(args, cloud)
     render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
-                  buffers_path=args.buffers)
+                  buffers_path=args.buffers, raster_path=getattr(args, "path", None))
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))

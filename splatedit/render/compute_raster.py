@@ -59,7 +59,10 @@ CRAST_SET = (V.Binding(0, "uniform", "comp"), V.Binding(5, "storage", "comp"), V
              V.Binding(12, "storage", "comp"), V.Binding(13, "storage", "comp"),
              V.Binding(14, "storage_image", "comp"), V.Binding(15, "storage_image", "comp"))
 #: push constants of splat_cs_raster.glsl: record slots, mode, groups, -
-CRAST_PUSH = np.dtype([("n", "<u4"), ("mode", "<u4"), ("groups", "<u4"), ("pad", "<u4")])
+CRAST_PUSH = np.dtype([("n", "<u4"), ("mode", "<u4"), ("groups", "<u4"), ("big_pixels", "<u4")])
+#: a splat whose pixel bound holds more pixels than this is drawn by a whole
+#: workgroup (see the module docstring)
+BIG_PIXELS = int(os.environ.get("SPLATEDIT_CRAST_BIG", "256"))
 _WORKGROUP = 64
 #: workgroups of the cooperative big-splat dispatch (mode 1): each takes list
 #: entries j, j + groups, ...; enough to fill a large GPU, cheap when the list
@@ -92,12 +95,14 @@ def choose_path(requested: str, dev: V.Device, width: int, height: int, prepared
     ``width * height * 16`` bytes within ``maxStorageBufferRange``; otherwise
     the frame is drawn by the raster path whatever was requested.
 
-    ``"auto"`` takes the compute path wherever it can run: measured faster on
-    lavapipe at every size and count of docs/PERFORMANCE.md (the CPU's
-    tiny-primitive raster costs more than the atomics), and on GPUs by the
-    rule of issue 18 (an H100/H200 rasterizes on 3% of the chip; compute
-    point rasterizers reach 10x GL_POINTS on desktop GPUs, Schuetz et al.
-    2021).  Still unmeasured on a real GPU (none was available)."""
+    ``"auto"``: where the compute path can run, the renderer measures
+    (:meth:`Renderer.frame_path`): the first frame of each image size and
+    splat count also draws one frame on each path (GPU timestamps, no
+    shading) and keeps the faster.  On lavapipe the compute path wins for
+    dense clouds of small splats and loses for sparse scans of large splats
+    (docs/PERFORMANCE.md); on GPUs issue 18 expects compute to win (an
+    H100/H200 rasterizes on 3% of the chip; compute point rasterizers reach
+    10x GL_POINTS on desktop GPUs, Schuetz et al. 2021): not measured yet."""
     if requested == "raster":
         return "raster"
     if not (dev.compute_raster and prepared):
@@ -167,11 +172,11 @@ class ComputeRaster:
         cb.bind_descriptor_set(pipe, self.dset)
         groups = max(-(-slots // _WORKGROUP), 1)
         gx = min(groups, int(r.dev.limits.maxComputeWorkGroupCount[0]))
-        cb.push_constants(pipe, np.array((slots, 0, 0, 0), CRAST_PUSH))
+        cb.push_constants(pipe, np.array((slots, 0, 0, BIG_PIXELS), CRAST_PUSH))
         cb.dispatch(gx, -(-groups // gx))
         cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
         big = min(BIG_GROUPS, int(r.dev.limits.maxComputeWorkGroupCount[0]))
-        cb.push_constants(pipe, np.array((slots, 1, big, 0), CRAST_PUSH))
+        cb.push_constants(pipe, np.array((slots, 1, big, BIG_PIXELS), CRAST_PUSH))
         cb.dispatch(big)
         cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
 

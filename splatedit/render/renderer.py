@@ -36,7 +36,7 @@ from splatedit.render.compute_raster import ComputeRaster, choose_path, requeste
 from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.prepass import PrepassMixin
-from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
+from splatedit.render.splat_layout import (_GEOM_STRIDE, _RESOLVE_SET, _RP_POINTS, _SPLAT_SET,
                                            _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
@@ -103,6 +103,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         #: requested rasterization path, "auto" | "raster" | "compute" (see raster_path)
         self.raster_path = requested_path(raster_path)
         self._crast = None            # ComputeRaster of the current size and pre-pass
+        #: the "auto" path's measured choice per (width, height, splat count):
+        #: {"path", "ms_raster", "ms_compute"} (one probe frame of each path)
+        self.path_probes: dict = {}
         self.backface_culling = bool(backface_culling)
         self.point_splats = bool(point_splats)
         #: point path threshold (pixels), see ``point_splats``
@@ -181,7 +184,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
 
         if self.dev.device is not None:
             step(self.dev.wait_idle)
-        step(self._free_compute_raster)
+        step(lambda: self._free_compute_raster(wait=False))     # waited above
         step(self._free_cloud)
         if self._targets is not None:
             step(self._targets.destroy)
@@ -339,7 +342,24 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         now (:attr:`raster_path` and what the device and frame allow,
         :func:`~splatedit.render.compute_raster.choose_path`)."""
         self._targets_for(width, height)
-        return choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
+        path = choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
+        if path == "compute" and self.raster_path == "auto":
+            key = (width, height, self.n)
+            if key not in self.path_probes:
+                self.path_probes[key] = self._probe_paths(width, height)
+            path = self.path_probes[key]["path"]
+        return path
+
+    def _probe_paths(self, width: int, height: int) -> dict:
+        """The measured choice of ``"auto"``: one frame of each path (the
+        current frame uniforms, no shading pass), the faster by GPU time wins
+        (:attr:`path_probes`)."""
+        t = self._targets_for(width, height)
+        ms = {}
+        for path in ("raster", "compute"):
+            self.dev.submit(lambda cb, p=path: self._record(cb, splat_frame(p, resolve=False), t))
+            ms[path] = self._last_frame.read_timings(self._query)["total"]
+        return {"path": min(ms, key=ms.get), **{f"ms_{p}": round(v, 3) for p, v in ms.items()}}
 
     def _compute_raster(self, t: _Targets) -> ComputeRaster:
         """The compute rasterizer's buffers for targets ``t`` and the current pre-pass."""
@@ -350,11 +370,12 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             self._crast = ComputeRaster(self, t, prep)
         return self._crast
 
-    def _free_compute_raster(self) -> None:
+    def _free_compute_raster(self, wait: bool = True) -> None:
         if self._crast is not None:
-            self.dev.wait_idle()
-            self._crast.destroy()
-            self._crast = None
+            c, self._crast = self._crast, None
+            if wait:
+                self.dev.wait_idle()
+            c.destroy()
 
     def _record(self, cb, frame: Frame, t: _Targets, target=None) -> Frame:
         """Record ``frame`` (timestamps in the query pool) against targets ``t``."""

@@ -295,8 +295,6 @@ class Device:
         #: 64-bit buffer atomics (atomicMin of depth << 32 | id) and float32 buffer
         #: atomicAdd (VK_EXT_shader_atomic_float), both enabled at creation
         self.compute_raster = atomics
-        #: the device is a CPU implementation (lavapipe)
-        self.is_cpu = self.properties.deviceType == vk.VK_PHYSICAL_DEVICE_TYPE_CPU
         chain = None
         if atomics:
             extensions = extensions + ["VK_EXT_shader_atomic_float"]
