@@ -35,13 +35,14 @@ layout(std430, set = 0, binding = 5) readonly buffer RecA { vec4 recA[]; };
 layout(std430, set = 0, binding = 6) readonly buffer RecB { uvec4 recB[]; };
 layout(std430, set = 0, binding = 7) readonly buffer Draws { uint draws[8]; };
 #if CRAST_PASS == 0
-layout(std430, set = 0, binding = 10) buffer Vis { uint64_t vis[]; };     // per pixel, row-major
+layout(std430, set = 0, binding = 10) buffer VisMin { uint64_t vis[]; };  // per pixel, row-major
 #else
-layout(std430, set = 0, binding = 10) readonly buffer Vis { uvec2 vis[]; }; // .y: window depth bits
+layout(std430, set = 0, binding = 10) readonly buffer VisRead { uvec2 vis[]; }; // .y: window depth bits
 layout(std430, set = 0, binding = 11) buffer AccC { vec4 acc_c[]; };        // w*rgb, w
 layout(std430, set = 0, binding = 12) buffer AccN { vec4 acc_n[]; };        // w*normal, w*depth
 #endif
-layout(std430, set = 0, binding = 13) buffer Big { uint big_count; uint big_pad[3]; uint big[]; };
+// the big-splat list: big[0] the count, then record slots
+layout(std430, set = 0, binding = 13) buffer BigList { uint big[]; };
 
 struct Rec {
     vec4 ms_cn, mt_tc, mw_r, center;
@@ -118,7 +119,7 @@ void main() {
         ivec2 ext = R.hi - R.lo + 1;
         if (ext.x <= 0 || ext.y <= 0) return;
         if (uint(ext.x) * uint(ext.y) > P.big_pixels) {
-            big[atomicAdd(big_count, 1u)] = slot;
+            big[1u + atomicAdd(big[0], 1u)] = slot;
             return;
         }
         for (int y = R.lo.y; y <= R.hi.y; ++y)
@@ -126,9 +127,9 @@ void main() {
                 pixel(R, ivec2(x, y));
         return;
     }
-    uint count = big_count;
+    uint count = big[0];
     for (uint j = gl_WorkGroupID.x; j < count; j += P.groups) {
-        uint slot = big[j];
+        uint slot = big[1u + j];
         Rec R = load(slot, slot < draws[1]);
         ivec2 ext = R.hi - R.lo + 1;
         uint total = uint(ext.x) * uint(ext.y);

@@ -50,6 +50,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
+from splatedit.render.uniforms import CRAST_PUSH
 
 #: descriptor set of the compute rasterizer: frame UBO, records A/B, the
 #: pre-pass's draw counts, visibility buffer, two accumulation buffers, the
@@ -58,8 +59,6 @@ CRAST_SET = (V.Binding(0, "uniform", "comp"), V.Binding(5, "storage", "comp"), V
              V.Binding(7, "storage", "comp"), V.Binding(10, "storage", "comp"), V.Binding(11, "storage", "comp"),
              V.Binding(12, "storage", "comp"), V.Binding(13, "storage", "comp"),
              V.Binding(14, "storage_image", "comp"), V.Binding(15, "storage_image", "comp"))
-#: push constants of splat_cs_raster.glsl: record slots, mode, groups, -
-CRAST_PUSH = np.dtype([("n", "<u4"), ("mode", "<u4"), ("groups", "<u4"), ("big_pixels", "<u4")])
 #: a splat whose pixel bound holds more pixels than this is drawn by a whole
 #: workgroup (see the module docstring)
 BIG_PIXELS = int(os.environ.get("SPLATEDIT_CRAST_BIG", "256"))
@@ -126,7 +125,7 @@ class ComputeRaster:
             self.vis = self._add(V.Buffer(dev, px * VIS_BYTES, ("storage",)))
             self.acc_c = self._add(V.Buffer(dev, px * ACC_BYTES, ("storage",)))
             self.acc_n = self._add(V.Buffer(dev, px * ACC_BYTES, ("storage",)))
-            self.big = self._add(V.Buffer(dev, 16 + 4 * slots, ("storage",)))
+            self.big = self._add(V.Buffer(dev, 4 + 4 * slots, ("storage",)))
             self.dset = self._add(V.DescriptorSet(dev, r.cache.set_layout(CRAST_SET)))
             self.dset.write({0: r.ubo, 5: prep.rec_a, 6: prep.rec_b, 7: prep.draws, 10: self.vis,
                              11: self.acc_c, 12: self.acc_n, 13: self.big,
@@ -166,7 +165,7 @@ class ComputeRaster:
         made visible to compute reads before)."""
         pipe = self._pipe(r, "splat_cs_vis.comp" if visibility else "splat_cs_attr.comp")
         cb.memory_barrier("compute", "shader_read", "transfer", "transfer_write")
-        cb.fill_buffer(self.big, 0, 0, 16)                 # the big-splat list's count
+        cb.fill_buffer(self.big, 0, 0, 4)                  # the big-splat list's count
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self.dset)
