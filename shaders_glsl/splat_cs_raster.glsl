@@ -13,10 +13,10 @@
 // Coverage: the pixels whose centres lie in the record's bound (the quad of
 // prepared.vert, or the square point), top-left rule; the per-pixel test
 // discards the rest.
-// Two modes (push constant): 0 one invocation per record slot; a splat whose
-// bound holds more than P.big_pixels pixels is appended to a list instead;
-// 1 each workgroup takes listed splats in turn, its 64 invocations striding
-// over the bound's pixels.
+// Three modes (push constant), dispatched in turn: 0 one invocation per
+// record slot; a splat whose bound holds more than P.big_pixels pixels is
+// appended to a list instead; 1 binning: the listed splats into per-tile
+// lists (16x16-pixel tiles); 2 one workgroup per tile over its list.
 
 #include "frame.glsl"
 #include "splat_records.glsl"
@@ -26,7 +26,7 @@ layout(local_size_x = 64) in;
 
 layout(push_constant) uniform Push {
     uint n;          // record slots (quads from 0 up, points from n-1 down)
-    uint mode;       // 0 per-splat invocations, 1 cooperative over the big list
+    uint mode;       // 0 per-splat invocations, 1 binning of the big list, 2 tiles
     uint groups;     // mode 1: workgroups dispatched
     uint big_pixels; // mode 0: a splat whose bound holds more pixels goes to the list
 } P;
@@ -43,6 +43,8 @@ layout(std430, set = 0, binding = 12) buffer AccN { vec4 acc_n[]; };        // w
 #endif
 // the big-splat list: big[0] the count, then record slots
 layout(std430, set = 0, binding = 13) buffer BigList { uint big[]; };
+// per tile: the count of big splats overlapping it, then TILE_CAP entries per tile
+layout(std430, set = 0, binding = 16) buffer TileBins { uint bins[]; };
 
 struct Rec {
     vec4 ms_cn, mt_tc, mw_r, center;
@@ -108,6 +110,79 @@ void pixel(Rec R, ivec2 p) {
 #endif
 }
 
+// The tiles (TILE x TILE pixels) of the image, row-major.
+const int TILE = 16;
+const uint TILE_CAP = 128u;     // list entries per tile; a fuller tile scans the whole big-splat list
+ivec2 tile_grid() { return (ivec2(F.viewport.xy) + TILE - 1) / TILE; }
+
+// Mode 2: one workgroup per tile, its 64 invocations own 4 pixels each and
+// keep their nearest sample (visibility) or their sums (attributes) in
+// registers over the tile's big splats; one atomic per pixel at the end
+// (the per-splat invocations of mode 0 write the same pixels).
+void tile_pass() {
+    ivec2 grid = tile_grid();
+    ivec2 t = ivec2(gl_WorkGroupID.xy);
+    uint ti = uint(t.y * grid.x + t.x);
+    ivec2 t0 = t * TILE, t1 = min(t0 + TILE, ivec2(F.viewport.xy)) - 1;
+    ivec2 l = ivec2(gl_LocalInvocationIndex % 8u, gl_LocalInvocationIndex / 8u);
+    ivec2 px[4] = ivec2[4](t0 + l, t0 + l + ivec2(8, 0), t0 + l + ivec2(0, 8), t0 + l + ivec2(8, 8));
+    uint W = uint(F.viewport.x);
+#if CRAST_PASS == 0
+    uint64_t best[4] = uint64_t[4](~0ul, ~0ul, ~0ul, ~0ul);
+#else
+    vec4 ac[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+    vec4 an[4] = vec4[4](vec4(0.0), vec4(0.0), vec4(0.0), vec4(0.0));
+    float zv[4];
+    for (int q = 0; q < 4; ++q) {
+        uint vz = all(lessThanEqual(px[q], t1)) ? vis[uint(px[q].y) * W + uint(px[q].x)].y : 0u;
+        zv[q] = vz == 0xFFFFFFFFu ? 1.0 : uintBitsToFloat(vz);
+    }
+#endif
+    uint listed = bins[ti];
+    bool scan = listed > TILE_CAP;                 // overfull: every big splat, bounds tested
+    uint count = scan ? big[0] : listed;
+    uint base = uint(grid.x * grid.y) + ti * TILE_CAP;
+    for (uint j = 0u; j < count; ++j) {
+        uint slot = scan ? big[1u + j] : bins[base + j];
+        Rec R = load(slot, slot < draws[1]);
+        if (any(greaterThan(R.lo, t1)) || any(lessThan(R.hi, t0))) continue;
+        for (int q = 0; q < 4; ++q) {
+            ivec2 p = px[q];
+            if (any(lessThan(p, R.lo)) || any(greaterThan(p, R.hi))) continue;
+            float r, depth, zwin;
+#if CRAST_PASS == 0
+            if (!splat_pixel(vec2(p) + 0.5, R.ms_cn, R.mt_tc, R.mw_r, R.center, true, r, depth, zwin)) continue;
+            best[q] = min(best[q], (uint64_t(floatBitsToUint(zwin)) << 32) | uint64_t(R.index));
+#else
+            if (!splat_pixel(vec2(p) + 0.5, R.ms_cn, R.mt_tc, R.mw_r, R.center, false, r, depth, zwin)) continue;
+            if (!(zwin <= zv[q])) continue;
+            float w = exp(-F.misc.x * r);
+            ac[q] += vec4(R.color * w, w);
+            an[q] += vec4(R.normal * w, depth * w);
+#endif
+        }
+    }
+    for (int q = 0; q < 4; ++q) {
+        ivec2 p = px[q];
+        if (any(greaterThan(p, t1))) continue;
+        uint k = uint(p.y) * W + uint(p.x);
+#if CRAST_PASS == 0
+        if (best[q] != ~0ul) atomicMin(vis[k], best[q]);
+#else
+        if (ac[q].w > 0.0) {
+            atomicAdd(acc_c[k].x, ac[q].x);
+            atomicAdd(acc_c[k].y, ac[q].y);
+            atomicAdd(acc_c[k].z, ac[q].z);
+            atomicAdd(acc_c[k].w, ac[q].w);
+            atomicAdd(acc_n[k].x, an[q].x);
+            atomicAdd(acc_n[k].y, an[q].y);
+            atomicAdd(acc_n[k].z, an[q].z);
+            atomicAdd(acc_n[k].w, an[q].w);
+        }
+#endif
+    }
+}
+
 void main() {
     if (P.mode == 0u) {
         // 2D dispatch when the slots need more than maxComputeWorkGroupCount[0] groups
@@ -127,13 +202,21 @@ void main() {
                 pixel(R, ivec2(x, y));
         return;
     }
-    uint count = big[0];
-    for (uint j = gl_WorkGroupID.x; j < count; j += P.groups) {
-        uint slot = big[1u + j];
-        Rec R = load(slot, slot < draws[1]);
-        ivec2 ext = R.hi - R.lo + 1;
-        uint total = uint(ext.x) * uint(ext.y);
-        for (uint q = gl_LocalInvocationIndex; q < total; q += 64u)
-            pixel(R, R.lo + ivec2(int(q % uint(ext.x)), int(q / uint(ext.x))));
+    if (P.mode == 1u) {          // binning: the big splats into the lists of the tiles they overlap
+        ivec2 grid = tile_grid();
+        uint count = big[0];
+        for (uint j = gl_GlobalInvocationID.x; j < count; j += P.groups * 64u) {
+            uint slot = big[1u + j];
+            Rec R = load(slot, slot < draws[1]);
+            ivec2 a = R.lo / TILE, b = R.hi / TILE;
+            for (int ty = a.y; ty <= b.y; ++ty)
+                for (int tx = a.x; tx <= b.x; ++tx) {
+                    uint ti = uint(ty * grid.x + tx);
+                    uint e = atomicAdd(bins[ti], 1u);
+                    if (e < TILE_CAP) bins[uint(grid.x * grid.y) + ti * TILE_CAP + e] = slot;
+                }
+        }
+        return;
     }
+    tile_pass();
 }

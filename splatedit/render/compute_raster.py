@@ -22,9 +22,14 @@ Optimization"):
    :meth:`Renderer.render_buffers` and the output are shared with the raster
    path.
 
-Splats whose bound holds at most 256 pixels are drawn by one invocation
-each; larger ones go to a list that workgroups take in turn, 64 invocations
-striding over the bound's pixels.
+Splats whose bound holds at most :data:`BIG_PIXELS` pixels are drawn by one
+invocation each (a loop over the bound).  Larger ones go to a list, are
+binned into per-tile lists (16x16-pixel tiles, up to 128 splats per tile)
+and drawn by one workgroup per tile whose invocations own 4 pixels each and
+keep the nearest sample (visibility) or the sums (attributes) in registers:
+one atomic per pixel and tile instead of one per pixel and splat.  A tile
+with more than 128 listed splats tests every listed splat's bound instead
+(correct, slower: only with thousands of large splats on screen).
 
 Device features: ``shaderInt64`` + ``shaderBufferInt64Atomics`` and
 ``VK_EXT_shader_atomic_float``'s ``shaderBufferFloat32AtomicAdd`` (lavapipe
@@ -54,19 +59,22 @@ from splatedit.render.uniforms import CRAST_PUSH
 
 #: descriptor set of the compute rasterizer: frame UBO, records A/B, the
 #: pre-pass's draw counts, visibility buffer, two accumulation buffers, the
-#: big-splat list, the two accumulator images (copy pass)
+#: big-splat list, the two accumulator images (copy pass), the tile lists
 CRAST_SET = (V.Binding(0, "uniform", "comp"), V.Binding(5, "storage", "comp"), V.Binding(6, "storage", "comp"),
              V.Binding(7, "storage", "comp"), V.Binding(10, "storage", "comp"), V.Binding(11, "storage", "comp"),
              V.Binding(12, "storage", "comp"), V.Binding(13, "storage", "comp"),
-             V.Binding(14, "storage_image", "comp"), V.Binding(15, "storage_image", "comp"))
+             V.Binding(14, "storage_image", "comp"), V.Binding(15, "storage_image", "comp"),
+             V.Binding(16, "storage", "comp"))
 #: a splat whose pixel bound holds more pixels than this is drawn by a whole
 #: workgroup (see the module docstring)
 BIG_PIXELS = int(os.environ.get("SPLATEDIT_CRAST_BIG", "256"))
 _WORKGROUP = 64
-#: workgroups of the cooperative big-splat dispatch (mode 1): each takes list
-#: entries j, j + groups, ...; enough to fill a large GPU, cheap when the list
-#: is empty (one read of the count per workgroup)
-BIG_GROUPS = 1024
+#: workgroups of the binning dispatch (mode 1): invocation i takes list
+#: entries i, i + 64 * groups, ...; enough to fill a large GPU, cheap when the
+#: list is empty (one read of the count per invocation)
+BIG_GROUPS = 256
+#: tile side (pixels) and list entries per tile (splat_cs_raster.glsl TILE, TILE_CAP)
+TILE, TILE_CAP = 16, 128
 #: bytes per pixel of the visibility buffer and of each accumulation buffer
 VIS_BYTES, ACC_BYTES = 8, 16
 
@@ -126,10 +134,12 @@ class ComputeRaster:
             self.acc_c = self._add(V.Buffer(dev, px * ACC_BYTES, ("storage",)))
             self.acc_n = self._add(V.Buffer(dev, px * ACC_BYTES, ("storage",)))
             self.big = self._add(V.Buffer(dev, 4 + 4 * slots, ("storage",)))
+            self.tiles = (-(-t.width // TILE)) * (-(-t.height // TILE))
+            self.bins = self._add(V.Buffer(dev, 4 * self.tiles * (1 + TILE_CAP), ("storage",)))
             self.dset = self._add(V.DescriptorSet(dev, r.cache.set_layout(CRAST_SET)))
             self.dset.write({0: r.ubo, 5: prep.rec_a, 6: prep.rec_b, 7: prep.draws, 10: self.vis,
                              11: self.acc_c, 12: self.acc_n, 13: self.big,
-                             14: (t.accum_color, None), 15: (t.accum_normal, None)})
+                             14: (t.accum_color, None), 15: (t.accum_normal, None), 16: self.bins})
         except BaseException:
             self.destroy()
             raise
@@ -166,17 +176,22 @@ class ComputeRaster:
         pipe = self._pipe(r, "splat_cs_vis.comp" if visibility else "splat_cs_attr.comp")
         cb.memory_barrier("compute", "shader_read", "transfer", "transfer_write")
         cb.fill_buffer(self.big, 0, 0, 4)                  # the big-splat list's count
+        cb.fill_buffer(self.bins, 0, 0, 4 * self.tiles)    # the tile lists' counts
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self.dset)
         groups = max(-(-slots // _WORKGROUP), 1)
-        gx = min(groups, int(r.dev.limits.maxComputeWorkGroupCount[0]))
+        limit = int(r.dev.limits.maxComputeWorkGroupCount[0])
+        gx = min(groups, limit)
         cb.push_constants(pipe, np.array((slots, 0, 0, BIG_PIXELS), CRAST_PUSH))
-        cb.dispatch(gx, -(-groups // gx))
+        cb.dispatch(gx, -(-groups // gx))                  # small splats; big ones listed
         cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
-        big = min(BIG_GROUPS, int(r.dev.limits.maxComputeWorkGroupCount[0]))
+        big = min(BIG_GROUPS, limit)
         cb.push_constants(pipe, np.array((slots, 1, big, BIG_PIXELS), CRAST_PUSH))
-        cb.dispatch(big)
+        cb.dispatch(big)                                   # binning into the tile lists
+        cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
+        cb.push_constants(pipe, np.array((slots, 2, 0, BIG_PIXELS), CRAST_PUSH))
+        cb.dispatch(-(-self.t.width // TILE), -(-self.t.height // TILE))     # the tiles
         cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
 
     def record_copy(self, cb, r, final: str) -> None:

@@ -43,7 +43,7 @@ ROWS = [("detail.glsl", "Detail", DETAIL_ROW)]
 PLAIN = {"GsRest": "uint[]", "GsBasisRow": "uint[]", "GsBasis": "vec4[]", "GsKeys": "uint[]", "GsOrder": "uint[]",
          "GsDraws": "uint[4]", "GsFlags": "uint[]", "Colors": "uint[]", "Flags": "uint[]", "Basis": "vec4[]",
          "Draws": "uint[8]", "VisMin": "uint64_t[]", "VisRead": "uvec2[]", "AccC": "vec4[]", "AccN": "vec4[]",
-         "BigList": "uint[]"}
+         "BigList": "uint[]", "TileBins": "uint[]"}
 
 
 def _source(fname: str) -> str:
