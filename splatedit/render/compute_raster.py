@@ -55,6 +55,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
+from splatedit.render.splat_layout import _REC_A_BYTES
 from splatedit.render.uniforms import CRAST_PUSH
 
 #: descriptor set of the compute rasterizer: frame UBO, records A/B, the
@@ -65,9 +66,11 @@ CRAST_SET = (V.Binding(0, "uniform", "comp"), V.Binding(5, "storage", "comp"), V
              V.Binding(12, "storage", "comp"), V.Binding(13, "storage", "comp"),
              V.Binding(14, "storage_image", "comp"), V.Binding(15, "storage_image", "comp"),
              V.Binding(16, "storage", "comp"))
-#: a splat whose pixel bound holds more pixels than this is drawn by a whole
-#: workgroup (see the module docstring)
-BIG_PIXELS = int(os.environ.get("SPLATEDIT_CRAST_BIG", "256"))
+#: a splat whose pixel bound holds more pixels than this goes to the tile
+#: lists (see the module docstring).  On lavapipe (hippo scan at 1280x720,
+#: same run, load 12): 256 and 1024 take the same time, 64 and 16 are 2-4x
+#: slower; a tile's 256 pixels make it the bound where a splat covers a tile
+BIG_PIXELS = 256
 _WORKGROUP = 64
 #: workgroups of the binning dispatch (mode 1): invocation i takes list
 #: entries i, i + 64 * groups, ...; enough to fill a large GPU, cheap when the
@@ -127,7 +130,7 @@ class ComputeRaster:
         self.t, self.prep = t, prep
         dev = r.dev
         px = t.width * t.height
-        slots = prep.rec_a.size // 48
+        slots = prep.rec_a.size // _REC_A_BYTES
         self.objects = []
         try:
             self.vis = self._add(V.Buffer(dev, px * VIS_BYTES, ("storage",)))
@@ -202,8 +205,9 @@ class ComputeRaster:
         comp = "splat_cs_copy_16f.comp" if r.accum_format == "rgba16f" else "splat_cs_copy_32f.comp"
         layout = V.LayoutDesc(sets=(CRAST_SET,), push_bytes=0, push_stages="comp")
         pipe = r.cache.pipeline(V.ComputeDesc(comp, layout))
-        for img in (t.accum_color, t.accum_normal):
-            cb.image_barrier(img, "general", "fragment|transfer", "none", "compute", "shader_write")
+        for img in (t.accum_color, t.accum_normal):    # after earlier readers and raster-path writes
+            cb.image_barrier(img, "general", "fragment|transfer|color_output", "color_write", "compute",
+                             "shader_write")
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self.dset)
         cb.dispatch(-(-t.width // 8), -(-t.height // 8))

@@ -10,6 +10,15 @@ Three passes per frame (Botsch, Hornung, Zwicker, Kobbelt 2005):
    background, gamma; it writes a :class:`RenderTarget` (an offscreen RGBA8
    image here; a swapchain image for the editor).
 
+The frame is a list of pass objects (:mod:`splatedit.render.frame_passes`).
+Passes 1 and 2 run on one of two paths over the same accumulators and the
+same shading pass: raster (the pre-pass records drawn as quads and points)
+or compute (:mod:`splatedit.render.compute_raster`: the records rasterized
+by compute shaders, visibility by 64-bit atomicMin); ``raster_path`` and
+:meth:`Renderer.frame_path` choose.  Picking is always drawn by the raster
+path; the distortion heat map and the selection tints are in the records
+(both paths).
+
 One vertex shader (``shaders_glsl/splat_vs.glsl``) serves both splat passes
 and the picking pass; it applies the deformation p' = p + B dC, u' = J u,
 v' = J v of splats that carry a basis row.
