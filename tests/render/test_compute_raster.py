@@ -164,3 +164,26 @@ def test_frames_declare_and_check_their_inputs():
         Frame([Prepass(), ComputeAttributes()])        # attributes before any visibility pass
     with pytest.raises(ValueError, match="path"):
         splat_frame("tiles")
+
+
+def test_compute_path_equals_raster_with_float32_accumulators(renderer):
+    """With RGBA32F accumulators (no half-float blending) the two paths give
+    the same image and weights and depths within float32 summation order."""
+    _needs_compute(renderer)
+    from splatedit.render.renderer import Renderer
+    cloud = sphere(5000)
+    with Renderer(device=renderer.dev, accum_format="rgba32f") as r:
+        r.set_cloud(cloud)
+        cam = Camera.frame(*cloud.bounds(), 4 / 3)
+        out = {}
+        for path in ("raster", "compute"):
+            r.raster_path = path
+            out[path] = (r.render(cam, 128, 96), r.render_buffers(cam, 128, 96))
+    (a, ba), (b, bb) = out["raster"], out["compute"]
+    assert np.abs(a.astype(int) - b.astype(int)).max() <= 1
+    for key in ("weight", "depth"):
+        x, y = ba[key], bb[key]
+        assert (np.isfinite(x) == np.isfinite(y)).all()
+        fg = np.isfinite(x) & (x > 0)
+        assert fg.sum() > 1000
+        assert np.max(np.abs(x[fg] - y[fg]) / np.abs(x[fg])) < 1e-5, key
