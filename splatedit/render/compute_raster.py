@@ -49,6 +49,7 @@ Only :mod:`splatedit.render.vk` calls Vulkan.
 
 from __future__ import annotations
 
+import math
 import os
 
 import numpy as np
@@ -108,7 +109,8 @@ def choose_path(requested: str, dev: V.Device, width: int, height: int, prepared
     ``"auto"``: where the compute path can run, the renderer measures
     (:meth:`Renderer.frame_path`): the first frame of each image size and
     splat count also draws one frame on each path (GPU timestamps, no
-    shading) and keeps the faster.  On lavapipe the compute path wins for
+    shading) and keeps the faster, for every size and count in the same
+    half-octave buckets (:func:`probe_key`).  On lavapipe the compute path wins for
     dense clouds of small splats and loses for sparse scans of large splats
     (docs/PERFORMANCE.md); on GPUs issue 18 expects compute to win (an
     H100/H200 rasterizes on 3% of the chip; compute point rasterizers reach
@@ -120,6 +122,14 @@ def choose_path(requested: str, dev: V.Device, width: int, height: int, prepared
     if width * height * ACC_BYTES > int(dev.limits.maxStorageBufferRange):
         return "raster"
     return "compute"
+
+
+def probe_key(width: int, height: int, n: int) -> tuple[int, int]:
+    """The key of the "auto" path's measurement: the pixel count and the splat
+    count in half-octave buckets, so that a window being resized or a level
+    of detail changing its count by a few percent reuses a measurement (a
+    probe draws two extra frames)."""
+    return round(2.0 * math.log2(max(width * height, 1))), round(2.0 * math.log2(max(n, 1)))
 
 
 class ComputeRaster:

@@ -41,7 +41,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.compute_raster import ComputeRaster, choose_path, requested_path
+from splatedit.render.compute_raster import ComputeRaster, choose_path, probe_key, requested_path
 from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.prepass import PrepassMixin
@@ -112,8 +112,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         #: requested rasterization path, "auto" | "raster" | "compute" (see raster_path)
         self.raster_path = requested_path(raster_path)
         self._crast = None            # ComputeRaster of the current size and pre-pass
-        #: the "auto" path's measured choice per (width, height, splat count):
-        #: {"path", "ms_raster", "ms_compute"} (one probe frame of each path)
+        #: the "auto" path's measured choice per probe_key(width, height, splat
+        #: count): {"path", "ms_raster", "ms_compute"} (one probe frame of each path)
         self.path_probes: dict = {}
         self.backface_culling = bool(backface_culling)
         self.point_splats = bool(point_splats)
@@ -353,7 +353,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._targets_for(width, height)
         path = choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
         if path == "compute" and self.raster_path == "auto":
-            key = (width, height, self.n)
+            key = probe_key(width, height, self.n)
             if key not in self.path_probes:
                 self.path_probes[key] = self._probe_paths(width, height)
             path = self.path_probes[key]["path"]

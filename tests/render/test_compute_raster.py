@@ -11,6 +11,7 @@ import numpy as np
 import pytest
 
 from splatedit.errors import ParameterError
+from splatedit.render.compute_raster import probe_key
 from splatedit.render.camera import Camera
 from splatedit.render.frame_passes import ComputeAttributes, Frame, Prepass, pick_frame, splat_frame
 from tests.render.conftest import REF_BAD_SHARE, REF_MEAN_TOL, REF_PIXEL_TOL
@@ -137,9 +138,10 @@ def test_path_choice_follows_argument_env_and_device(renderer, monkeypatch):
         renderer.path_probes.clear()
         renderer.render(Camera.frame(*renderer.cloud.bounds(), 64 / 48), 64, 48)
         if renderer.dev.compute_raster:             # measured once per size and count
-            probe = renderer.path_probes[(64, 48, 2000)]
+            probe = renderer.path_probes[probe_key(64, 48, 2000)]
             assert probe["path"] == min(("raster", "compute"), key=lambda p: probe[f"ms_{p}"])
             assert renderer.frame_path(64, 48) == probe["path"]
+            assert renderer.frame_path(66, 48) == probe["path"] and len(renderer.path_probes) == 1
     finally:
         renderer.raster_path = saved
         renderer.prepass = True
