@@ -56,8 +56,7 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
-from splatedit.render.splat_layout import _REC_A_BYTES
-from splatedit.render.uniforms import CRAST_PUSH
+from splatedit.render.uniforms import CRAST_PUSH, SPLAT_REC_A
 
 #: descriptor set of the compute rasterizer: frame UBO, records A/B, the
 #: pre-pass's draw counts, visibility buffer, two accumulation buffers, the
@@ -140,7 +139,7 @@ class ComputeRaster:
         self.t, self.prep = t, prep
         dev = r.dev
         px = t.width * t.height
-        slots = prep.rec_a.size // _REC_A_BYTES
+        slots = prep.rec_a.size // SPLAT_REC_A.itemsize
         self.objects = []
         try:
             self.vis = self._add(V.Buffer(dev, px * VIS_BYTES, ("storage",)))
