@@ -5,8 +5,6 @@ frame's pass lists."""
 
 from __future__ import annotations
 
-from pathlib import Path
-
 import numpy as np
 import pytest
 
@@ -18,7 +16,6 @@ from tests.render.conftest import REF_BAD_SHARE, REF_MEAN_TOL, REF_PIXEL_TOL
 from tests.render.deform_util import gaussian_basis
 from tests.render.scenes import sphere
 
-DATA = Path("/work/shared/data")
 W, H = 160, 120
 
 
@@ -87,12 +84,11 @@ def test_compute_path_draws_the_heat_map(renderer):
     assert np.ptp(colours[:, 0] - colours[:, 2]) > 20       # a heat ramp, not flat grey
 
 
-@pytest.mark.skipif(not (DATA / "hippo1.ply").is_file(), reason="sample scans not present (/work/shared/data)")
-def test_compute_path_matches_raster_on_a_real_scan(renderer):
+def test_compute_path_matches_raster_on_a_real_scan(renderer, shared_data):
     """A real scan: 6,104 splats with estimated sizes, large on screen."""
     _needs_compute(renderer)
     from splatedit.io import read
-    cloud = read(DATA / "hippo1.ply")
+    cloud = read(shared_data / "hippo1.ply")
     renderer.set_cloud(cloud)
     cam = Camera.frame(*cloud.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
     _assert_same_frame(*_both(renderer, cam))
