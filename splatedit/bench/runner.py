@@ -36,12 +36,12 @@ def _qr(quick: bool, progress=None, counts=None) -> Iterator[dict]:
         yield {"bench": "qr", **bench_qr(m, repeat=1 if quick else 3)}
 
 
-def _render(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+def _render(quick: bool, progress=None, counts=None, size=None, models=()) -> Iterator[dict]:
     from splatedit.bench.render import bench_render
     counts = counts or ((20_000, 100_000) if quick else (100_000, 1_000_000, 2_000_000))
-    size = (640, 360) if quick else (1280, 720)
-    # the per-pass/point-floor/deformation cases hold a full basis: up to 2M
-    yield from bench_render(counts=[n for n in counts if n <= 2_000_000], size=size)
+    size = size or ((640, 360) if quick else (1280, 720))
+    # both paths per case; the deformation cases hold a full basis: up to 2M splats
+    yield from bench_render(counts=counts, size=size, models=models)
     from splatedit.bench.scale import bench_upload_lod
     for n in counts:
         yield {"bench": "render", **bench_upload_lod(int(n), size=size)}
@@ -265,12 +265,13 @@ SIZED = ("gaussian-render",)
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
-              large: bool = False, size=None, path=None, tiny: bool = False) -> Iterator[dict]:
+              large: bool = False, size=None, path=None, models=(), tiny: bool = False) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
     ``counts``: splat/point counts for ``estimate``, ``render``, ``editor``, ``closure`` and
     support splats for ``basis``
     (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``;
-    ``size`` (width, height) and ``path`` ("raster" / "compute") apply to :data:`SIZED`;
+    ``size`` (width, height) applies to ``render`` and :data:`SIZED`, ``path`` ("raster" /
+    "compute") to :data:`SIZED`, ``models`` (extra model files, e.g. a real scan) to ``render``;
     ``tiny``: each case's smallest form (:data:`TINY`, for the tests)."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
@@ -278,6 +279,8 @@ def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
             yield from TINY[name]()
         elif name == "io":
             yield from _io(quick, progress, counts, large=large)
+        elif name == "render":
+            yield from _render(quick, progress, counts, size=size, models=models)
         elif name in SIZED:
             yield from BENCHES[name](quick, progress, counts, size=size, path=path)
         else:

@@ -51,15 +51,12 @@ def cmd_render(args) -> int:
     from splatedit.model.gaussians import GaussianCloud
     if isinstance(cloud, GaussianCloud):
         return _render_gaussians(args, cloud)
-    if getattr(args, "path", None) is not None:
-        raise ParameterError("--path", "chooses the Gaussian renderer's draw path; this model is not a "
-                                       "Gaussian splatting scene")
     camera = _camera_from_args(args, cloud)
     basis_rows = d_c = None
     if args.edit is not None:
         cloud, basis_rows, d_c = _gpu_edit(args, cloud)
     render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
-                  buffers_path=args.buffers)
+                  buffers_path=args.buffers, raster_path=getattr(args, "path", None))
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
