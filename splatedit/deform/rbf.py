@@ -49,6 +49,8 @@ from splatedit.tolerances import (
     EVAL_CHUNK_ROWS,
     EVAL_THREADS,
     IQR_DEFAULT_TOL,
+    POLY_CHECK_FACTOR,
+    POLY_CHECK_RTOL,
     RESIDUAL_NOTE_FACTOR,
     RESIDUAL_NOTE_MIN,
 )
@@ -114,6 +116,12 @@ class TriharmonicRBF:
         self.tol = info.tol
         self.rcond = info.rcond
         self.fit_seconds = info.seconds
+        #: terms of the quadratic kept (0..10; fewer where the constraints lie
+        #: on a quadric up to their precision) and the monomial matrix's
+        #: relative singular values (None below 10 constraints)
+        self.poly_rank = info.poly_rank
+        self.poly_singular = info.poly_singular
+        self.coordinate_precision = info.precision * self.scale
         k = self.weights.shape[1]
         c = self._centers_n
         # [W, c_x W, c_y W, c_z W]: one GEMM with the distance matrix gives
@@ -147,7 +155,7 @@ class TriharmonicRBF:
     @classmethod
     def fit(cls, points, values, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
             max_centers: Optional[int] = None,
-            progress: Optional[ProgressFn] = None) -> "TriharmonicRBF":
+            progress: Optional[ProgressFn] = None, probe=None) -> "TriharmonicRBF":
         """Fit ``f`` with ``f(points[i]) = values[i]`` (exactly or to ``tol``).
 
         Parameters
@@ -201,7 +209,21 @@ class TriharmonicRBF:
         e.g. a single constraint point, whose kernel matrix is [0]).
         """
         t_start = time.perf_counter()
-        sol: FitSolution = solve_constraints(points, values, method, tol, max_centers, progress)
+        args = (points, values, method, tol, max_centers, progress)
+        sol: FitSolution = solve_constraints(*args)
+        f = cls._from_solution(sol)
+        info = sol.info
+        if info.poly_rank and info.poly_singular[info.poly_rank - 1] < POLY_CHECK_RTOL:
+            # weak polynomial directions: check the fit against the one without
+            # them rather than trusting it (near-quadric constraints with more
+            # relief than their rounding, e.g. noisy float64 data)
+            g = cls._from_solution(solve_constraints(*args, poly_rtol=POLY_CHECK_RTOL))
+            f = _checked_choice(f, g, sol.points, probe)
+        f.fit_seconds = time.perf_counter() - t_start
+        return f
+
+    @classmethod
+    def _from_solution(cls, sol: FitSolution) -> "TriharmonicRBF":
         f = cls(centers_n=sol.centers_n, weights=sol.weights, poly_coeffs=sol.poly_coeffs,
                 shift=sol.shift, scale=sol.scale, center_indices=sol.center_indices,
                 info=sol.info)
@@ -209,8 +231,11 @@ class TriharmonicRBF:
         # constraint (the solver's own figure is blind to rounding, e.g. when
         # near-duplicate points with different values make the system singular)
         f._set_achieved(achieved_residuals(f, sol.points, sol.values), sol.info.residuals)
-        f.fit_seconds = time.perf_counter() - t_start
         return f
+
+    def _residual_limit(self) -> float:
+        """The achieved residual above which a note calls the fit ill-conditioned."""
+        return max(self.tol if self.method == "iqr" else 0.0, RESIDUAL_NOTE_MIN) * RESIDUAL_NOTE_FACTOR
 
     def _set_achieved(self, achieved: np.ndarray, solver: np.ndarray) -> None:
         self.residuals = achieved
@@ -218,8 +243,7 @@ class TriharmonicRBF:
         self.solver_residual = float(np.max(solver)) if solver.size else 0.0
         self.notes.append(f"residual {self.residual:.2g} (||f(x_i) - b_i|| / ||b|| over all "
                           f"{self.n_input_constraints} constraints)")
-        limit = max(self.tol if self.method == "iqr" else 0.0, RESIDUAL_NOTE_MIN) * RESIDUAL_NOTE_FACTOR
-        if self.residual > limit:
+        if self.residual > self._residual_limit():
             self.notes.append(
                 f"the fitted field misses its constraints by {self.residual:.2g} relative "
                 f"(the solver's own figure: {self.solver_residual:.2g}): the system is "
@@ -323,3 +347,36 @@ def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarr
         d = f(points[s:s + step]) - values[s:s + step]
         res_sq += np.einsum("ij,ij->j", d, d)
     return _relative_residuals(np.sqrt(res_sq), values)
+
+
+def field_roughness(f: "TriharmonicRBF", points: np.ndarray) -> float:
+    """The largest Frobenius norm of the fitted field's Jacobian (k, 3) over
+    ``points`` (N, 3), model units: how steep the field gets, the quantity a
+    wild polynomial term (a quadric's coefficient fitted to rounding) blows
+    up in the directions the constraints do not see (a surface's normal)."""
+    out = 0.0
+    step = max(1, f._chunk_rows())
+    for s in range(0, len(points), step):
+        g = f.gradient(points[s:s + step])
+        out = max(out, float(np.sqrt(np.max(np.einsum("nkd,nkd->n", g, g)))))
+    return out
+
+
+def _checked_choice(f: "TriharmonicRBF", g: "TriharmonicRBF", points: np.ndarray,
+                    probe) -> "TriharmonicRBF":
+    """``f`` (the polynomial with weak directions) or ``g`` (without them):
+    ``g`` when ``f`` is POLY_CHECK_FACTOR times steeper (:func:`field_roughness`
+    at the constraints and the ``probe`` points) and ``g`` meets its
+    constraints as well (achieved residual within its note limit or ``f``'s)."""
+    pts = points if probe is None else np.vstack([points, _as_float_array("probe", probe).reshape(-1, 3)])
+    rf, rg = field_roughness(f, pts), field_roughness(g, pts)
+    ok = g.residual <= max(f.residual, g._residual_limit())
+    weak = f.poly_rank - g.poly_rank
+    what = (f"checked against the fit without its {weak} weak polynomial direction(s) "
+            f"(s/s_max < {POLY_CHECK_RTOL:g}): largest Jacobian {rf:.3g} vs {rg:.3g}")
+    if ok and rf > POLY_CHECK_FACTOR * rg:
+        g.notes.append(what + f": the polynomial's weak directions make the field "
+                       f"{rf / rg:.3g}x steeper, dropped")
+        return g
+    f.notes.append(what + ": kept")
+    return f

@@ -35,7 +35,10 @@ from splatedit.tolerances import (
     IQR_R_DIAG_RTOL,
     LU_MAX_CONSTRAINTS,
     LU_MIN_RCOND,
+    POLY_NOISE_FACTOR,
     POLY_RANK_RTOL,
+    COORD_FLOAT32_REL_PRECISION,
+    COORD_GRID_MAX_DECIMALS,
 )
 
 METHODS = ("auto", "iqr", "lu")
@@ -139,6 +142,9 @@ class _FitInfo:
     tol: float = IQR_DEFAULT_TOL
     rcond: Optional[float] = None
     seconds: float = 0.0
+    poly_rank: int = 0
+    poly_singular: Optional[np.ndarray] = None
+    precision: float = 0.0
 
 
 @dataclass
@@ -168,6 +174,103 @@ class FitSolution:
     info: _FitInfo
 
 
+def coordinate_precision(pts: np.ndarray) -> float:
+    """The precision (model units) to which the coordinates ``pts`` (m, 3) are
+    known: half the step of the coarsest decimal grid they all lie on (files
+    written with 3 to 8 decimals, LAS-style integer coordinates), at least
+    the rounding of float32 storage at their largest magnitude
+    (COORD_FLOAT32_REL_PRECISION of it: every 3DGS file and most scans).
+    """
+    mag = float(np.max(np.abs(pts))) if pts.size else 0.0
+    eps32 = COORD_FLOAT32_REL_PRECISION * mag
+    if mag == 0.0:
+        return 0.0
+    # a decimal value stored in float32 is off its grid by up to one float32
+    # ulp of its magnitude; grids finer than that cannot be told apart
+    allowed = 2.0 * eps32 + 8.0 * np.finfo(np.float64).eps * mag
+    for d in range(COORD_GRID_MAX_DECIMALS + 1):
+        step = 10.0 ** -d
+        if step <= 2.0 * allowed:
+            break
+        k = pts / step
+        if float(np.max(np.abs(k - np.rint(k)))) * step <= allowed:
+            return max(0.5 * step, eps32)
+    return eps32
+
+
+@dataclass
+class PolyBasis:
+    """The part of the quadratic polynomial space Pi_2 that the constraint
+    points determine numerically (rank-revealing SVD of the column-scaled
+    monomial matrix).
+
+    Attributes:
+        matrix: (m, r) the retained polynomial columns at the constraints
+            (orthogonal, each of norm sqrt(m)).
+        coeffs: (10, r) their monomial coefficients (normalised coordinates):
+            ``matrix = poly_matrix(pts_n) @ coeffs``.
+        rank: r, 0..10.
+        singular: (10,) singular values of the column-scaled monomial matrix.
+        cut: singular values at or below this were dropped.
+        noise: first-order bound on how far the coordinates' rounding
+            (``precision``) moves those singular values.
+        note: what was dropped and why ("" when nothing was).
+    """
+
+    matrix: np.ndarray
+    coeffs: np.ndarray
+    rank: int
+    singular: np.ndarray
+    cut: float
+    noise: float
+    note: str = ""
+
+
+def polynomial_basis(pts_n: np.ndarray, precision: float,
+                     rtol: Optional[float] = None) -> PolyBasis:
+    """The numerically independent part of Pi_2 at the points ``pts_n``
+    (m, 3), normalised coordinates known to ``precision`` (normalised units).
+
+    The monomial matrix P (m, 10) is scaled to unit columns and factored by
+    an SVD.  A direction whose singular value is within POLY_NOISE_FACTOR
+    times the rounding bound of the coordinates (first order:
+    ``||dP_j|| <= precision ||grad p_j||`` per column) or below
+    POLY_RANK_RTOL of the largest is a quadric the points lie on up to their
+    precision (a sphere, a cylinder, a plane): its coefficient would be fitted
+    to the rounding noise, with wild normal derivatives, so it is left out.
+    ``rtol`` (the fit's check, see :meth:`TriharmonicRBF.fit`) cuts at
+    ``rtol`` times the largest singular value as well.
+    """
+    m = pts_n.shape[0]
+    p = poly_matrix(pts_n)
+    norms = np.linalg.norm(p, axis=0)
+    x2 = np.sum(pts_n * pts_n, axis=0)  # ||x||^2, ||y||^2, ||z||^2 over the points
+    gx, gy, gz = x2
+    grad = np.sqrt(np.array([0.0, m, m, m, 4 * gx, gx + gy, gx + gz, 4 * gy, gy + gz, 4 * gz]))
+    safe = np.where(norms > 0, norms, 1.0)
+    noise = float(precision * np.sqrt(np.sum((grad / safe) ** 2)))
+    ps = p / safe
+    u, s, vt = np.linalg.svd(ps, full_matrices=False)
+    cut = max(POLY_RANK_RTOL * s[0], POLY_NOISE_FACTOR * noise)
+    if rtol is not None:
+        cut = max(cut, rtol * s[0])
+    r = int(np.count_nonzero(s > cut))
+    coeffs = (vt[:r].T / safe[:, None]) * (np.sqrt(m) / s[:r])
+    matrix = p @ coeffs
+    note = ""
+    if r == 0:
+        note = "polynomial dropped: no direction of it is determined by the constraints"
+    elif r < N_POLY:
+        why = "rounding bound" if POLY_NOISE_FACTOR * noise >= max(
+            POLY_RANK_RTOL * s[0], rtol * s[0] if rtol is not None else 0.0) else "cut"
+        note = (f"polynomial reduced to {r} of {N_POLY} terms: the constraints lie on a "
+                f"quadric up to their precision (dropped s/s_max "
+                f"{', '.join(f'{v / s[0]:.1e}' for v in s[r:])} <= {cut / s[0]:.1e}, the {why}; "
+                f"coordinate precision {precision:.1e} of the half extent)")
+    return PolyBasis(matrix=matrix, coeffs=coeffs, rank=r, singular=s, cut=cut, noise=noise,
+                     note=note)
+
+
 class SingularSystemError(SolverError):
     """The exact LU system cannot be solved; ``reason`` says how it is singular
     (``method="auto"`` then falls back to the incremental QR)."""
@@ -179,7 +282,8 @@ class SingularSystemError(SolverError):
 
 def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
                       max_centers: Optional[int] = None,
-                      progress: Optional[ProgressFn] = None) -> FitSolution:
+                      progress: Optional[ProgressFn] = None,
+                      poly_rtol: Optional[float] = None) -> FitSolution:
     """Validate, normalise, merge duplicates and solve ``f(points) = values``.
 
     The arguments, the duplicate, polynomial and method rules are those of
@@ -208,18 +312,19 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
         notes.append(f"merged {n_merged} duplicate constraint point(s) with identical values")
     m = pts_n.shape[0]
 
-    # polynomial or not
-    use_poly = True
+    # polynomial: its numerically independent part on the constraint set
+    precision = coordinate_precision(pts) / scale
     if m < N_POLY:
-        use_poly = False
+        poly = None
         notes.append(f"polynomial dropped: {m} < {N_POLY} constraints cannot determine a quadratic")
     else:
-        s = np.linalg.svd(poly_matrix(pts_n), compute_uv=False)
-        ratio = s[-1] / s[0]
-        if not ratio > POLY_RANK_RTOL:
-            use_poly = False
-            notes.append(f"polynomial dropped: constraints lie on a quadric "
-                         f"(monomial matrix s_min/s_max = {ratio:.1e} < {POLY_RANK_RTOL:g})")
+        poly = polynomial_basis(pts_n, precision, rtol=poly_rtol)
+        poly_sv = poly.singular / poly.singular[0]
+        if poly.note:
+            notes.append(poly.note)
+        if poly.rank == 0:
+            poly = None
+    use_poly = poly is not None
     if not use_poly and m == 1:
         raise SolverError(
             "a single (distinct) constraint point cannot be fitted: without the "
@@ -250,7 +355,7 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     report(progress, PROGRESS_STAGE, 0.0)
     if used == "lu":
         try:
-            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, use_poly)
+            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, poly)
         except SingularSystemError as exc:
             if method != "auto":
                 raise
@@ -266,14 +371,16 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     else:
         rcond = None
         w, q, idx, residuals, history, iqr_notes = _fit_iqr(
-            pts_n, vals, use_poly, tol, max_centers, progress)
+            pts_n, vals, poly, tol, max_centers, progress)
         head.extend(iqr_notes)
     notes = head + notes
     report(progress, PROGRESS_STAGE, 1.0)
 
     info = _FitInfo(method=used, polynomial=use_poly, residuals=residuals,
                     residual_history=history, notes=notes, n_constraints=m,
-                    n_input_constraints=m_in, tol=tol, rcond=rcond)
+                    n_input_constraints=m_in, tol=tol, rcond=rcond,
+                    poly_rank=poly.rank if use_poly else 0,
+                    poly_singular=None if m < N_POLY else poly_sv, precision=precision)
     return FitSolution(points=pts, values=vals_in, centers_n=pts_n[idx], weights=w,
                        poly_coeffs=q, shift=shift, scale=scale, center_indices=keep[idx],
                        info=info)
@@ -294,14 +401,15 @@ def _relative_residuals(res_norm: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _fit_lu(pts_n, vals, use_poly):
+def _fit_lu(pts_n, vals, poly):
     m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
+    use_poly = poly is not None
+    npoly = poly.rank if use_poly else 0
     size = m + npoly
     a = np.zeros((size, size), order="F")
     kernel_matrix(pts_n, pts_n, out=a[:m, :m])
     if use_poly:
-        p = poly_matrix(pts_n)
+        p = poly.matrix
         a[:m, m:] = p
         a[m:, :m] = p.T
     rhs = np.zeros((size, k))
@@ -319,13 +427,14 @@ def _fit_lu(pts_n, vals, use_poly):
     res = np.linalg.norm(a @ x - rhs, axis=0)
     residuals = _relative_residuals(res, vals)
     w = x[:m]
-    q = x[m:] if use_poly else None
+    q = poly.coeffs @ x[m:] if use_poly else None
     return w, q, np.arange(m), residuals, float(rcond)
 
 
-def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
+def _fit_iqr(pts_n, vals, poly, tol, max_centers, progress):
     m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
+    use_poly = poly is not None
+    npoly = poly.rank if use_poly else 0
     n_rows = m + npoly
     cap = m if max_centers is None else min(max_centers, m)
     max_cols = npoly + cap
@@ -333,7 +442,7 @@ def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
     rhs[:m] = vals
     qr = IncrementalQR(n_rows, max_cols, rhs)
     sampler = FarthestPointSampler(pts_n)
-    p_all = poly_matrix(pts_n) if use_poly else None
+    p_all = poly.matrix if use_poly else None
     order_parts = []
     hist_parts = []  # residuals for center counts 0, 1, ...
     bn = np.linalg.norm(vals, axis=0)
@@ -377,7 +486,7 @@ def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
     x = qr.solve(stop_cols)
     order = np.concatenate(order_parts)[:n_centers] if order_parts else np.zeros(0, np.intp)
     w = x[npoly:]
-    q = x[:npoly] if use_poly else None
+    q = poly.coeffs @ x[:npoly] if use_poly else None
     summary = (f"iqr: {n_centers} of {m} constraints as centers, residual "
                f"{np.max(residuals):.2g}")
     if np.max(residuals) < tol:

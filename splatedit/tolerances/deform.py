@@ -24,8 +24,27 @@ EVAL_CHUNK_ROWS = 8192
 #: threads that evaluate chunks of a fitted RBF in parallel (numpy releases the GIL)
 EVAL_THREADS = 2
 #: relative singular-value cutoff that declares the polynomial block rank
-#: deficient (constraints on a quadric)
+#: deficient (constraints on a quadric) whatever the coordinates' precision
 POLY_RANK_RTOL = 1e-9
+#: float32 storage rounds a coordinate to 2^-24 of its magnitude (half an ulp):
+#: the precision assumed for every input, whatever its type
+COORD_FLOAT32_REL_PRECISION = 2.0 ** -24
+#: coordinates that all lie on a grid of 10^-d (d <= this) are known to half
+#: that step (files written with d decimals); finer grids are float32 noise
+COORD_GRID_MAX_DECIMALS = 8
+#: a polynomial direction whose singular value (column-scaled monomial matrix)
+#: is below this many times the first-order bound of the coordinates'
+#: rounding on it is dropped (the constraints lie on a quadric up to their
+#: precision)
+POLY_NOISE_FACTOR = 10.0
+#: a fit whose polynomial keeps a direction with s/s_max below this is
+#: checked against the fit without those weak directions (a second fit).
+#: Measured: one-view edits of the bunny, kitten and hippo have smallest
+#: s/s_max 9e-3 .. 0.2 (never checked)
+POLY_CHECK_RTOL = 1e-3
+#: ... and falls back to it when its largest Jacobian (constraints and probe
+#: splats) is this many times that of the fit without the weak directions
+POLY_CHECK_FACTOR = 2.0
 #: cap on the bytes of one (chunk rows x n_centers) float64 work matrix when
 #: evaluating a fitted RBF; the chunk is min(EVAL_CHUNK_ROWS, this / (8 n))
 #: rows, so evaluation memory stays bounded even for thousands of centers.
