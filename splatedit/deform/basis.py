@@ -42,7 +42,7 @@ from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
 from splatedit.select.closure import close_selection
-from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
+from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL, POLY_CHECK_PROBE_SPLATS
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
@@ -141,8 +141,10 @@ class DeformationBasis:
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
         t_con = time.perf_counter()
+        free = con.free_index
         rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
-                                 max_centers=max_centers, progress=progress)
+                                 max_centers=max_centers, progress=progress,
+                                 probe=cloud.positions[free[::max(1, len(free) // POLY_CHECK_PROBE_SPLATS)]])
         t1 = time.perf_counter()
 
         pos = cloud.positions

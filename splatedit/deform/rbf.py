@@ -199,10 +199,31 @@ class TriharmonicRBF:
         values agree within DUPLICATE_VALUE_RTOL, and raise SolverError
         otherwise (the interpolation problem has no solution).
 
-        Polynomial: dropped (as in the paper, Sect. 4) when m < 10 or the
-        normalised 10-column monomial matrix P has
-        ``s_min / s_max < POLY_RANK_RTOL`` (all constraints on a quadric,
-        e.g. a sphere or a plane); ``polynomial`` is False and a note says why.
+        Polynomial: by its numerical rank on the constraint set.  The paper
+        (Sect. 4) drops it when all constraints lie on a quadric (system (3)
+        is singular then); a decision on exact singularity fails for points a
+        rounding away from a quadric (spheres, cylinders, cones, planes stored
+        in float32 or with a few decimals): the quadric's coefficient is then
+        fitted to the rounding, and the field's normal derivative explodes
+        (a 2,000-point sphere at 7 decimals: 3x3 Jacobian stretch 218x, PCA
+        splat axes 4.9x; docs/PERFORMANCE.md).  So the column-scaled monomial
+        matrix is factored by an SVD (:func:`~splatedit.deform.rbf_fit.polynomial_basis`)
+        and only the directions whose singular value stands above
+        POLY_NOISE_FACTOR times the first-order effect of the coordinates'
+        precision (:func:`~splatedit.deform.rbf_fit.coordinate_precision`:
+        a decimal grid they lie on, at least float32 rounding) and above
+        POLY_RANK_RTOL are kept: ``poly_rank`` of 10 terms (9 on a sphere,
+        cylinder or cone, 6 on a plane, 0 below 10 constraints), the side
+        conditions ``P_r^T w = 0`` on those only, in every method.  Then the
+        fit is checked rather than trusted: when a kept direction is weak
+        (s/s_max < POLY_CHECK_RTOL) the fit without the weak directions is
+        computed too, and taken when the polynomial one's largest Jacobian
+        (at the constraints and the ``probe`` points) is POLY_CHECK_FACTOR
+        times steeper and it meets its constraints as well; a note says
+        which.  ``polynomial`` is False when no term is kept.
+
+        probe : optional (p, 3) points (e.g. free support splats) where that
+            check also measures the Jacobian.
 
         Raises ParameterError for bad arguments and SolverError when the
         system cannot be solved (conflicting duplicates; a singular system,
