@@ -2,8 +2,10 @@
 
 :func:`solve_constraints` validates the constraints, normalises them into
 [-1, 1]^3 (bounding-box centre and half its largest extent), merges
-(near-)duplicates, decides whether the quadratic polynomial can be kept and
-which solver runs, and solves for the weights either exactly (dense LU of
+(near-)duplicates, decides which part of the quadratic polynomial the
+constraints determine numerically (:func:`polynomial_basis`, with the
+coordinates' precision from :func:`coordinate_precision`) and which solver
+runs, and solves for the weights either exactly (dense LU of
 system (3), :func:`_fit_lu`) or by the incremental least-squares QR of
 Sect. 5 (:func:`_fit_iqr`, farthest-point centres, lazily built columns in a
 :class:`~splatedit.deform.qr.IncrementalQR`).  The result is the raw
@@ -287,7 +289,10 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     """Validate, normalise, merge duplicates and solve ``f(points) = values``.
 
     The arguments, the duplicate, polynomial and method rules are those of
-    :meth:`splatedit.deform.rbf.TriharmonicRBF.fit` (documented there).
+    :meth:`splatedit.deform.rbf.TriharmonicRBF.fit` (documented there);
+    ``poly_rtol`` additionally drops polynomial directions with singular value
+    below ``poly_rtol`` times the largest (the fit's check, see
+    :func:`polynomial_basis`).
     Raises ParameterError for bad arguments and SolverError when the system
     cannot be solved.
     """
