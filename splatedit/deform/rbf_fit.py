@@ -178,25 +178,31 @@ class FitSolution:
 
 def coordinate_precision(pts: np.ndarray) -> float:
     """The precision (model units) to which the coordinates ``pts`` (m, 3) are
-    known: half the step of the coarsest decimal grid they all lie on (files
-    written with 3 to 8 decimals, LAS-style integer coordinates), at least
-    the rounding of float32 storage at their largest magnitude
-    (COORD_FLOAT32_REL_PRECISION of it: every 3DGS file and most scans).
+    known.  Coordinates that all lie on a decimal grid of 10^-d (d <=
+    COORD_GRID_MAX_DECIMALS: text files written with d decimals, LAS-style
+    scaled integers) are known to half its step, at least to their storage's
+    own rounding (float32 when every value is a float32).  Otherwise they are
+    assumed to come from float32 storage (every 3DGS file and most scans,
+    possibly moved since): COORD_FLOAT32_REL_PRECISION of their largest
+    magnitude.
     """
     mag = float(np.max(np.abs(pts))) if pts.size else 0.0
-    eps32 = COORD_FLOAT32_REL_PRECISION * mag
     if mag == 0.0:
         return 0.0
-    # a decimal value stored in float32 is off its grid by up to one float32
-    # ulp of its magnitude; grids finer than that cannot be told apart
-    allowed = 2.0 * eps32 + 8.0 * np.finfo(np.float64).eps * mag
+    eps32 = COORD_FLOAT32_REL_PRECISION * mag
+    eps64 = float(np.finfo(np.float64).eps) * mag
+    is32 = bool(np.array_equal(pts.astype(np.float32).astype(np.float64), pts))
+    own = eps32 if is32 else eps64
+    # a value of the grid, stored, is off it by its storage's rounding (plus
+    # the rounding of pts / step); grids not coarser than that are not seen
+    allowed = 2.0 * own + 8.0 * eps64
     for d in range(COORD_GRID_MAX_DECIMALS + 1):
         step = 10.0 ** -d
-        if step <= 2.0 * allowed:
+        if step <= 4.0 * allowed:
             break
         k = pts / step
         if float(np.max(np.abs(k - np.rint(k)))) * step <= allowed:
-            return max(0.5 * step, eps32)
+            return max(0.5 * step, own)
     return eps32
 
 

@@ -27,11 +27,13 @@ EVAL_THREADS = 2
 #: deficient (constraints on a quadric) whatever the coordinates' precision
 POLY_RANK_RTOL = 1e-9
 #: float32 storage rounds a coordinate to 2^-24 of its magnitude (half an ulp):
-#: the precision assumed for every input, whatever its type
+#: the precision assumed for coordinates on no decimal grid, whatever their
+#: type (a float32 scan moved in float64 keeps its float32 noise)
 COORD_FLOAT32_REL_PRECISION = 2.0 ** -24
 #: coordinates that all lie on a grid of 10^-d (d <= this) are known to half
-#: that step (files written with d decimals); finer grids are float32 noise
-COORD_GRID_MAX_DECIMALS = 8
+#: that step (files written with d decimals); 12: the finest rounding the
+#: issue's tests use (a unit object's float64 coordinates carry 16 digits)
+COORD_GRID_MAX_DECIMALS = 12
 #: a polynomial direction whose singular value (column-scaled monomial matrix)
 #: is below this many times the first-order bound of the coordinates'
 #: rounding on it is dropped (the constraints lie on a quadric up to their

@@ -102,13 +102,17 @@ def test_coordinate_precision_finds_decimal_grids_and_float32():
     p, _, _ = quadric_points("sphere", 500)
     assert coordinate_precision(np.round(p, 3)) == pytest.approx(5e-4)
     assert coordinate_precision(np.round(p, 6)) == pytest.approx(5e-7)
-    # finer than float32 at magnitude 1: only the float32 bound is known
+    assert coordinate_precision(np.round(p, 10)) == pytest.approx(5e-11)
+    # float32 storage, or on no grid at all: the float32 bound
     f32 = COORD_FLOAT32_REL_PRECISION * np.abs(p).max()
-    assert coordinate_precision(np.round(p, 8)) == pytest.approx(f32)
+    assert coordinate_precision(p.astype(np.float32).astype(np.float64)) == pytest.approx(f32, rel=1e-6)
     assert coordinate_precision(p) == pytest.approx(f32)
-    # a decimal grid stored in float32 far from the origin is still found
-    far = np.round(p * 10 + 1000.0, 2).astype(np.float32).astype(np.float64)
+    # a decimal grid far from the origin: in float64 its own step (a scan in
+    # georeferenced metres), in float32 at least the float32 rounding
+    far = np.round(p * 10 + 5e5, 2)
     assert coordinate_precision(far) == pytest.approx(5e-3)
+    far32 = np.round(p * 10 + 1000.0, 2).astype(np.float32).astype(np.float64)
+    assert coordinate_precision(far32) == pytest.approx(5e-3)
 
 
 @pytest.mark.parametrize("shape,rank", [("sphere", 9), ("cylinder", 9), ("cone", 9), ("plane", 6)])
