@@ -211,7 +211,7 @@ class TriharmonicRBF:
         and only the directions whose singular value stands above
         POLY_NOISE_FACTOR times the first-order effect of the coordinates'
         precision (:func:`~splatedit.deform.rbf_fit.coordinate_precision`:
-        a decimal grid they lie on, at least float32 rounding) and above
+        half the decimal grid they lie on, else float32 rounding) and above
         POLY_RANK_RTOL are kept: ``poly_rank`` of 10 terms (9 on a sphere,
         cylinder or cone, 6 on a plane, 0 below 10 constraints), the side
         conditions ``P_r^T w = 0`` on those only, in every method.  Then the
