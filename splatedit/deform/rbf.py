@@ -117,10 +117,12 @@ class TriharmonicRBF:
         self.rcond = info.rcond
         self.fit_seconds = info.seconds
         #: terms of the quadratic kept (0..10; fewer where the constraints lie
-        #: on a quadric up to their precision) and the monomial matrix's
-        #: relative singular values (None below 10 constraints)
+        #: on a quadric up to their precision), the relative singular values
+        #: of its affine and quadratic blocks (None below 10 constraints) and
+        #: the smallest one kept
         self.poly_rank = info.poly_rank
         self.poly_singular = info.poly_singular
+        self.poly_weakest = info.poly_weakest
         self.coordinate_precision = info.precision * self.scale
         k = self.weights.shape[1]
         c = self._centers_n
@@ -234,7 +236,7 @@ class TriharmonicRBF:
         sol: FitSolution = solve_constraints(*args)
         f = cls._from_solution(sol)
         info = sol.info
-        if info.poly_rank and info.poly_singular[info.poly_rank - 1] < POLY_CHECK_RTOL:
+        if info.poly_rank and info.poly_weakest < POLY_CHECK_RTOL:
             # weak polynomial directions: check the fit against the one without
             # them rather than trusting it (near-quadric constraints with more
             # relief than their rounding, e.g. noisy float64 data)

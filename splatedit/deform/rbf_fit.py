@@ -146,6 +146,7 @@ class _FitInfo:
     seconds: float = 0.0
     poly_rank: int = 0
     poly_singular: Optional[np.ndarray] = None
+    poly_weakest: float = 1.0
     precision: float = 0.0
 
 
@@ -209,29 +210,50 @@ def coordinate_precision(pts: np.ndarray) -> float:
 @dataclass
 class PolyBasis:
     """The part of the quadratic polynomial space Pi_2 that the constraint
-    points determine numerically (rank-revealing SVD of the column-scaled
-    monomial matrix).
+    points determine numerically (see :func:`polynomial_basis`).
 
     Attributes:
         matrix: (m, r) the retained polynomial columns at the constraints
             (orthogonal, each of norm sqrt(m)).
         coeffs: (10, r) their monomial coefficients (normalised coordinates):
             ``matrix = poly_matrix(pts_n) @ coeffs``.
-        rank: r, 0..10.
-        singular: (10,) singular values of the column-scaled monomial matrix.
-        cut: singular values at or below this were dropped.
-        noise: first-order bound on how far the coordinates' rounding
-            (``precision``) moves those singular values.
+        rank: r, 0..10 (the affine part first: ``n_affine`` of its 4 terms).
+        n_affine: how many of r span affine functions (4; 3 on a plane).
+        singular: (10,) the singular values of the affine block and of the
+            quadratic block beyond it, relative to the largest, each block
+            in descending order.
+        weakest: the smallest relative singular value kept (1.0 when r = 0).
+        cut: (2,) the relative cuts of the two blocks (values at or below
+            them were dropped).
         note: what was dropped and why ("" when nothing was).
     """
 
     matrix: np.ndarray
     coeffs: np.ndarray
     rank: int
+    n_affine: int
     singular: np.ndarray
-    cut: float
-    noise: float
+    weakest: float
+    cut: np.ndarray
     note: str = ""
+
+
+def _monomial_gradient_norms(pts_n: np.ndarray) -> np.ndarray:
+    """(10,) ``||grad p_j||`` (2-norm over the points) of the monomials."""
+    m = pts_n.shape[0]
+    gx, gy, gz = np.sum(pts_n * pts_n, axis=0)
+    return np.sqrt(np.array([0.0, m, m, m, 4 * gx, gx + gy, gx + gz, 4 * gy, gy + gz, 4 * gz]))
+
+
+def _independent_block(cols: np.ndarray, noise: float, cut_rel: float):
+    """SVD of ``cols`` (m, c), unit-scaled columns: (u_kept (m, r), map (c, r)
+    with ``cols @ map = u_kept``, all singular values, the absolute cut)."""
+    if cols.shape[1] == 0:
+        return np.zeros((cols.shape[0], 0)), np.zeros((0, 0)), np.zeros(0), 0.0
+    u, s, vt = np.linalg.svd(cols, full_matrices=False)
+    cut = max(cut_rel, POLY_NOISE_FACTOR * noise)
+    r = int(np.count_nonzero(s > cut))
+    return u[:, :r], vt[:r].T / s[:r], s, cut
 
 
 def polynomial_basis(pts_n: np.ndarray, precision: float,
@@ -239,44 +261,63 @@ def polynomial_basis(pts_n: np.ndarray, precision: float,
     """The numerically independent part of Pi_2 at the points ``pts_n``
     (m, 3), normalised coordinates known to ``precision`` (normalised units).
 
-    The monomial matrix P (m, 10) is scaled to unit columns and factored by
-    an SVD.  A direction whose singular value is within POLY_NOISE_FACTOR
-    times the rounding bound of the coordinates (first order:
-    ``||dP_j|| <= precision ||grad p_j||`` per column) or below
-    POLY_RANK_RTOL of the largest is a quadric the points lie on up to their
-    precision (a sphere, a cylinder, a plane): its coefficient would be fitted
-    to the rounding noise, with wild normal derivatives, so it is left out.
-    ``rtol`` (the fit's check, see :meth:`TriharmonicRBF.fit`) cuts at
-    ``rtol`` times the largest singular value as well.
+    A rank-revealing factorisation in two blocks, so that affine functions
+    stay exactly reproduced wherever the points determine them: the affine
+    monomials (1, x, y, z), scaled to unit columns, by an SVD; then the 6
+    quadratic monomials, scaled, with their affine part projected out (the
+    quadratic directions the points see beyond the affine ones), by an SVD.
+    In each block a direction is dropped when its singular value is within
+    POLY_NOISE_FACTOR times the first-order bound of the coordinates'
+    rounding on the block (``||dP_j|| <= precision ||grad p_j||`` per
+    column), or below POLY_RANK_RTOL (or ``rtol``, the fit's check, see
+    :meth:`TriharmonicRBF.fit`) of the largest singular value.  Such a
+    direction is a quadric (a sphere, cylinder or cone: one quadratic
+    direction; a plane: its normal coordinate and 3 quadratic ones) the points
+    lie on up to their precision: its coefficient would be fitted to the
+    rounding, with wild derivatives off the surface, so it is left out.
     """
     m = pts_n.shape[0]
     p = poly_matrix(pts_n)
     norms = np.linalg.norm(p, axis=0)
-    x2 = np.sum(pts_n * pts_n, axis=0)  # ||x||^2, ||y||^2, ||z||^2 over the points
-    gx, gy, gz = x2
-    grad = np.sqrt(np.array([0.0, m, m, m, 4 * gx, gx + gy, gx + gz, 4 * gy, gy + gz, 4 * gz]))
     safe = np.where(norms > 0, norms, 1.0)
-    noise = float(precision * np.sqrt(np.sum((grad / safe) ** 2)))
+    rel_noise = precision * _monomial_gradient_norms(pts_n) / safe
     ps = p / safe
-    u, s, vt = np.linalg.svd(ps, full_matrices=False)
-    cut = max(POLY_RANK_RTOL * s[0], POLY_NOISE_FACTOR * noise)
-    if rtol is not None:
-        cut = max(cut, rtol * s[0])
-    r = int(np.count_nonzero(s > cut))
-    coeffs = (vt[:r].T / safe[:, None]) * (np.sqrt(m) / s[:r])
+    scale_s = float(np.linalg.norm(ps, 2))
+    cut_rel = max(POLY_RANK_RTOL, rtol or 0.0) * scale_s
+    # affine block
+    n1 = 4
+    u1, map1, s1, cut1 = _independent_block(ps[:, :n1], float(np.linalg.norm(rel_noise[:n1])), cut_rel)
+    r1 = u1.shape[1]
+    # quadratic block beyond the affine span
+    quad = ps[:, n1:]
+    proj = u1.T @ quad  # (r1, 6)
+    quad_rest = quad - u1 @ proj
+    u2, map2, s2, cut2 = _independent_block(quad_rest, float(np.linalg.norm(rel_noise[n1:])), cut_rel)
+    r2 = u2.shape[1]
+    # monomial coefficients of the kept columns (scaled columns -> monomials)
+    coef = np.zeros((N_POLY, r1 + r2))
+    coef[:n1, :r1] = map1
+    coef[n1:, r1:] = map2
+    # quad_rest @ map2 = quad @ map2 - u1 @ (proj @ map2), u1 = affine @ map1
+    coef[:n1, r1:] = -map1 @ (proj @ map2)
+    coeffs = coef / safe[:, None] * np.sqrt(m)
     matrix = p @ coeffs
+    sv = np.concatenate([s1, s2]) / scale_s
+    kept = np.concatenate([s1[:r1], s2[:r2]]) / scale_s
+    weakest = float(kept.min()) if kept.size else 1.0
+    r = r1 + r2
     note = ""
     if r == 0:
         note = "polynomial dropped: no direction of it is determined by the constraints"
     elif r < N_POLY:
-        why = "rounding bound" if POLY_NOISE_FACTOR * noise >= max(
-            POLY_RANK_RTOL * s[0], rtol * s[0] if rtol is not None else 0.0) else "cut"
-        note = (f"polynomial reduced to {r} of {N_POLY} terms: the constraints lie on a "
-                f"quadric up to their precision (dropped s/s_max "
-                f"{', '.join(f'{v / s[0]:.1e}' for v in s[r:])} <= {cut / s[0]:.1e}, the {why}; "
-                f"coordinate precision {precision:.1e} of the half extent)")
-    return PolyBasis(matrix=matrix, coeffs=coeffs, rank=r, singular=s, cut=cut, noise=noise,
-                     note=note)
+        dropped = np.concatenate([s1[r1:], s2[r2:]]) / scale_s
+        note = (f"polynomial reduced to {r} of {N_POLY} terms ({r1} affine): the constraints lie "
+                f"on a quadric up to their precision (dropped s/s_max "
+                f"{', '.join(f'{v:.1e}' for v in dropped)}; cuts {cut1 / scale_s:.1e} affine, "
+                f"{cut2 / scale_s:.1e} quadratic; coordinate precision {precision:.1e} of the "
+                f"half extent)")
+    return PolyBasis(matrix=matrix, coeffs=coeffs, rank=r, n_affine=r1, singular=sv,
+                     weakest=weakest, cut=np.array([cut1, cut2]) / scale_s, note=note)
 
 
 class SingularSystemError(SolverError):
@@ -330,7 +371,7 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
         notes.append(f"polynomial dropped: {m} < {N_POLY} constraints cannot determine a quadratic")
     else:
         poly = polynomial_basis(pts_n, precision, rtol=poly_rtol)
-        poly_sv = poly.singular / poly.singular[0]
+        poly_sv, poly_weakest = poly.singular, poly.weakest
         if poly.note:
             notes.append(poly.note)
         if poly.rank == 0:
@@ -391,7 +432,8 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
                     residual_history=history, notes=notes, n_constraints=m,
                     n_input_constraints=m_in, tol=tol, rcond=rcond,
                     poly_rank=poly.rank if use_poly else 0,
-                    poly_singular=None if m < N_POLY else poly_sv, precision=precision)
+                    poly_singular=None if m < N_POLY else poly_sv,
+                    poly_weakest=poly.weakest if use_poly else 1.0, precision=precision)
     return FitSolution(points=pts, values=vals_in, centers_n=pts_n[idx], weights=w,
                        poly_coeffs=q, shift=shift, scale=scale, center_indices=keep[idx],
                        info=info)

@@ -150,11 +150,7 @@ def test_fixed_band_sits_on_the_base_surface():
     lies at radius 0.85-0.9), so the fixed band's constraints are put on the
     smoothed surface too: the handle's weight field is then ~0 next to the
     band.  With the band left on the original surface the fields are fitted
-    across a radial step and come out wrong there: measured 1.02 instead of 0
-    with the whole quadratic polynomial (the step excites the cylinder's
-    near-null quadric direction); since the fit checks weak polynomial
-    directions (issue 20) it falls back to the fit without it and gives 0.095,
-    still 15x the proper fit's 0.006."""
+    across a radial step and come out wrong there (measured: 1.02 instead of 0)."""
     import copy
     from splatedit.bench.bars import open_cylinder
     c = open_cylinder(spacing=0.1)
@@ -164,12 +160,10 @@ def test_fixed_band_sits_on_the_base_surface():
     assert len(det.layer.outer_index) and not np.isin(det.layer.outer_index, det.indices).any()
     near = z[det.indices] < 1.4
     s = det.base_basis.B[:, :4].sum(axis=1)
-    proper = np.abs(s[near]).max()
-    assert proper < 0.1          # measured 0.006 (0.067 with all 10 polynomial terms)
+    assert np.abs(s[near]).max() < 0.1          # measured 0.006 (0.067 before the fit checked weak polynomial directions)
     naive = copy.copy(c)
     pos = c.positions.copy()
     pos[det.layer.index] = det.layer.base
     naive.positions = pos
     b = DeformationBasis.fit(naive, sup, [hnd], fill_holes=False, method="lu")
-    assert np.abs(b.B[:, :4].sum(axis=1)[near]).max() > 5 * proper
-    assert "steeper, dropped" in b.rbf.message
+    assert np.abs(b.B[:, :4].sum(axis=1)[near]).max() > 0.3
