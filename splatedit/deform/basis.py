@@ -41,7 +41,7 @@ from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
-from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
+from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL, POLY_CHECK_PROBE_SPLATS
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
@@ -127,8 +127,10 @@ class DeformationBasis:
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
         t_con = time.perf_counter()
+        free = con.free_index
         rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
-                                 max_centers=max_centers, progress=progress)
+                                 max_centers=max_centers, progress=progress,
+                                 probe=cloud.positions[free[::max(1, len(free) // POLY_CHECK_PROBE_SPLATS)]])
         t1 = time.perf_counter()
 
         pos = cloud.positions
