@@ -31,6 +31,7 @@ import time
 import numpy as np
 
 from splatedit.deform.apply_plan import APPLY_STAGE, CHECK_STAGE, apply_hot_path, build_hot_path
+from splatedit.deform.curve_frames import CurveFrameDisplacement, curve_frame_displacement, frames_terms
 from splatedit.deform.constraints import Constraints, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
@@ -93,6 +94,7 @@ class DeformationBasis:
         self.stats = stats
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
         self.stretch_probe = None  # free splats where rotation centres are compared (fit() sets it)
+        self.support_positions = None  # (N, 3) positions of the support splats (fit() sets it; curve frames)
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -169,6 +171,7 @@ class DeformationBasis:
             spacing=float(con.spacing), message=getattr(rbf, "message", ""),
         )
         out = cls(con, rbf, pack, stats)
+        out.support_positions = pos[idx].copy()
         if len(free_rows):
             out.stretch_probe = StretchProbe.sample(pack, free_rows, cloud.u[idx[free_rows]],
                                                     cloud.v[idx[free_rows]])
@@ -273,6 +276,8 @@ class DeformationBasis:
             transforms = [transforms]
         transforms = list(transforms)
         if mode is DeformationMode.ROTATION and len(transforms) == self.n_groups:
+            if "curve" in self.group_kinds:     # moved curves carry their frames
+                return curve_frame_displacement(self, transforms)
             return rotation_displacement(self, transforms)
         if len(transforms) != self.n_groups:
             raise ParameterError("transforms", f"need one matrix per handle and one (k + 1, 3) "
@@ -307,7 +312,11 @@ class DeformationBasis:
 
     def displacements(self, dC) -> np.ndarray:
         """(N, 3) displacements of the support splats: ``B dC`` (plus the
-        blended rotations of a RotationDisplacement)."""
+        blended rotations of a RotationDisplacement, the curves' frame terms
+        of a CurveFrameDisplacement)."""
+        if isinstance(dC, CurveFrameDisplacement):
+            pos = self._support_positions()
+            return self.displacements(dC.base()) + frames_terms(dC, self, self._pack, pos)[0]
         d, rot = split_displacement(dC)
         out = self.B @ self._check_dc(d)
         if rot is not None:
@@ -317,6 +326,12 @@ class DeformationBasis:
     def jacobians(self, dC) -> np.ndarray:
         """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats
         (dC: (K, 3) or a RotationDisplacement)."""
+        if isinstance(dC, CurveFrameDisplacement):
+            out = self.jacobians(dC.base())
+            pos = self._support_positions()
+            cols = frames_terms(dC, self, self._pack, pos, list(np.eye(3)[:, None, :].repeat(len(pos), 1)))[1]
+            out += np.stack(cols, axis=2)
+            return out
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
         blocks = None if rot is None else handle_blocks(self)
@@ -330,6 +345,18 @@ class DeformationBasis:
             if rot is not None:
                 o += blend_jacobians(rot, self._pack[s:s + _BASIS_CHUNK], blocks)
         return out
+
+    def fixed_tree(self):
+        """KD-tree of the fixed band's positions (built once; curve frames)."""
+        if getattr(self, "_fixed_tree", None) is None:
+            from scipy.spatial import cKDTree
+            self._fixed_tree = cKDTree(self.constraints.points[:len(self.constraints.fixed_index)])
+        return self._fixed_tree
+
+    def _support_positions(self) -> np.ndarray:
+        if self.support_positions is None:
+            raise ParameterError("dC", "curve frames need the support's positions (a basis made by fit())")
+        return self.support_positions
 
     def _check_cloud(self, cloud):
         n = self.constraints.n_points
@@ -358,6 +385,14 @@ class DeformationBasis:
         optional ``progress(APPLY_STAGE, fraction of the support's rows done)``
         after each chunk of the run plan (a commit in the editor's background)."""
         self._check_cloud(cloud)
+        if isinstance(dC, CurveFrameDisplacement):    # residual and handles, then the curves' frames
+            outs = self.apply_arrays(cloud, dC.base(), progress=progress)
+            idx = self.indices
+            dp, (du, dv) = frames_terms(dC, self, self._pack, cloud.positions[idx],
+                                        (cloud.u[idx], cloud.v[idx]))
+            for o, x in zip(outs, (dp, du, dv)):
+                o[idx] += x
+            return outs
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
         srcs = (cloud.positions, cloud.u, cloud.v)

@@ -1,0 +1,403 @@
+"""Frame-carrying control curves (issue 19 item 4): a curve edit that bends.
+
+The paper's curve edit (:mod:`splatedit.deform.curves`) interpolates the
+picked points' displacements linearly: dragging the tip of a curve laid
+along a trunk pulls the splats next to the curve and leaves the rest of the
+cross-section behind (a beak at the tip, a knob at the old end).  Curve
+deformers (a curve modifier, a wire deformer) instead carry a *frame* along
+the curve.  In ``DeformationMode.ROTATION`` a moved curve does that:
+
+* the old shape ``c(t)`` is the centripetal Catmull-Rom spline through the
+  picked points ``q_j``; the new shape ``c'(t)`` is the same spline (same
+  knots) through the moved points ``q'_j = q_j + dq_j``, so it passes
+  through them and its tangent turns with them;
+* along both, a **rotation-minimising frame** (tangent, normal, binormal)
+  by the double-reflection method (W. Wang, B. Jüttler, D. Zheng, Y. Liu,
+  "Computation of rotation minimizing frames", ACM TOG 27(1), 2008) on a
+  table of :data:`FRAME_TABLE_PER_SPAN` points per segment; the new frame
+  starts from the old one turned by the smallest rotation taking the old
+  start tangent to the new.  ``R(t) = F'(t) F(t)^T`` takes the old frame to
+  the new one; its rotation vector ``omega(t)`` is tabulated (each picked
+  point's rotation is ``R(t_j)``);
+* each support splat gets a **curve parameter** and an **influence** from the
+  curve's basis columns (the fitted weight fields ``b_j``, 1 at their own
+  picked point, 0 at the fixed band): ``s = sum_j b_j``,
+  ``t~ = sum_j b_j t_j / s`` (clamped to [0, 1]); its displacement is
+
+      D(p) = s (c'(t~) - c(t~)) + (exp(s [omega(t~)]x) - I)(p - c(t~))
+
+  i.e. where ``s = 1`` the splat keeps its offset from the curve point
+  ``c(t~)`` in the moving frame (``p' = c'(t~) + R(t~)(p - c(t~))``: a
+  rigid placement, so cross-sections turn instead of shearing), and both
+  parts fade out with ``s`` towards the fixed band;
+* the Jacobian is exact (chain rule through ``s`` and ``t~`` with the
+  basis gradients; the derivatives of the rotation in ``s`` and ``t`` by
+  central differences of Rodrigues' formula, step :data:`_ROT_STEP`):
+  axes follow ``u' = J u``;
+* the **residual** goes through the basis: the curve's columns of ``dC``
+  are solved (a (k + 1) x (k + 1) system of the basis at the picked points,
+  nearly the identity) so that the whole deformation -- frame term, other
+  groups' columns, rotating handles -- moves every picked point exactly to
+  ``q'_j`` (up to round-off).
+
+A curve none of whose points moves keeps the linear path.  The linear mode
+keeps the paper's curve edit unchanged.  The detail mode's base deformation
+keeps the linear curve edit (not done here).
+
+The GPU draws the paper's linear curve displacement of the same picked-point
+moves while dragging (:attr:`CurveFrameDisplacement.dC` is that preview);
+the committed result (``DeformationBasis.apply``, scripts, the editor's
+commit) is the frame-carrying one.
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.spatial import cKDTree
+
+from splatedit.deform.curves import ControlCurve, catmull_rom_weights
+from splatedit.tolerances import CURVE_FRAME_MIN_RAMP_SPACINGS
+from splatedit.deform.rotation import (RotationDisplacement, blend_terms, handle_blocks,
+                                       rotation_displacement)
+
+#: frame table points per curve segment (the rotation between them is
+#: interpolated linearly in its rotation vector)
+FRAME_TABLE_PER_SPAN = 64
+#: step of the central differences of the rotation in s and t
+_ROT_STEP = 1e-6
+#: below this |s| a splat has no curve parameter (t~ = 0; every term is
+#: scaled by s there)
+_MIN_INFLUENCE = 1e-9
+
+
+# ------------------------------------------------------------------ frames
+def _unit(x: np.ndarray) -> np.ndarray:
+    return x / np.maximum(np.linalg.norm(x, axis=-1, keepdims=True), 1e-300)
+
+
+def double_reflection(points: np.ndarray, tangents: np.ndarray, r0: np.ndarray) -> np.ndarray:
+    """(n, 3) reference vectors of the rotation-minimising frame along a
+    polyline (Wang et al. 2008, double reflection).
+
+    Args:
+        points: (n, 3) curve points; tangents: (n, 3) unit tangents there;
+        r0: (3,) unit vector normal to ``tangents[0]`` (the first frame).
+    """
+    n = len(points)
+    r = np.empty((n, 3))
+    r[0] = r0
+    for i in range(n - 1):
+        v1 = points[i + 1] - points[i]
+        c1 = float(v1 @ v1)
+        ri, ti = r[i], tangents[i]
+        if c1 > 0.0:
+            rl = ri - (2.0 / c1) * float(v1 @ ri) * v1
+            tl = ti - (2.0 / c1) * float(v1 @ ti) * v1
+        else:
+            rl, tl = ri, ti
+        v2 = tangents[i + 1] - tl
+        c2 = float(v2 @ v2)
+        rn = rl - (2.0 / c2) * float(v2 @ rl) * v2 if c2 > 1e-300 else rl
+        rn = rn - float(rn @ tangents[i + 1]) * tangents[i + 1]     # round-off drift
+        r[i + 1] = rn / np.linalg.norm(rn)
+    return r
+
+
+def _align(a: np.ndarray, b: np.ndarray) -> np.ndarray:
+    """(3, 3) smallest rotation taking unit vector a to unit vector b."""
+    axis = np.cross(a, b)
+    sn, cs = float(np.linalg.norm(axis)), float(a @ b)
+    if sn < 1e-12:
+        if cs > 0.0:
+            return np.eye(3)
+        p = np.eye(3)[int(np.argmin(np.abs(a)))]
+        axis = _unit(np.cross(a, p))
+        return 2.0 * np.outer(axis, axis) - np.eye(3)        # half turn
+    return rotvec_matrix(axis / sn * np.arctan2(sn, cs))
+
+
+def rotvec_matrix(w: np.ndarray) -> np.ndarray:
+    """(3, 3) rotation of rotation vector w (Rodrigues)."""
+    th = float(np.linalg.norm(w))
+    if th < 1e-12:
+        return np.eye(3)
+    k = np.array([[0.0, -w[2], w[1]], [w[2], 0.0, -w[0]], [-w[1], w[0], 0.0]]) / th
+    return np.eye(3) + np.sin(th) * k + (1.0 - np.cos(th)) * (k @ k)
+
+
+def matrix_rotvec(r: np.ndarray) -> np.ndarray:
+    """(3,) rotation vector of a (3, 3) rotation (angle in [0, pi])."""
+    from scipy.spatial.transform import Rotation
+    return Rotation.from_matrix(r).as_rotvec()
+
+
+def rotate_rows(w: np.ndarray, x: np.ndarray) -> np.ndarray:
+    """Row-wise ``exp([w_i]x) x_i`` for (N, 3) rotation vectors and vectors
+    (Rodrigues, Taylor series of its coefficients below 1e-4 radians)."""
+    th = np.linalg.norm(w, axis=1)
+    small = th < 1e-4
+    ths = np.where(small, 1.0, th)
+    a = np.where(small, 1.0 - th * th / 6.0, np.sin(ths) / ths)
+    b = np.where(small, 0.5 - th * th / 24.0, (1.0 - np.cos(ths)) / (ths * ths))
+    wx = np.cross(w, x)
+    return x + a[:, None] * wx + b[:, None] * np.cross(w, wx)
+
+
+def _tangents(curve: ControlCurve, points: np.ndarray, t: np.ndarray) -> np.ndarray:
+    """(n, 3) derivatives dc/dt of the Catmull-Rom shape through ``points``
+    (knots of ``curve``) at t (central differences, one-sided at the ends)."""
+    h = 1e-6
+    ta, tb = np.clip(t - h, 0.0, 1.0), np.clip(t + h, 0.0, 1.0)
+    return (catmull_rom_weights(curve.params, tb) - catmull_rom_weights(curve.params, ta)) @ points \
+        / (tb - ta)[:, None]
+
+
+@dataclass(frozen=True, eq=False)
+class CurveFrame:
+    """The old and new frames of one moved curve (see the module docstring).
+
+    Attributes:
+        group: the curve's group index in the basis.
+        curve: the :class:`~splatedit.deform.curves.ControlCurve` (old points).
+        moved: (k + 1, 3) the moved picked points ``q'``.
+        table_t: (n,) table parameters, increasing, 0 .. 1.
+        omega: (n, 3) rotation vectors of ``R(t)`` at the table parameters.
+        omega_t: (n, 3) their derivative in t (central differences).
+        table_c: (n, 3) the old curve at the table parameters; tree: their KD-tree.
+    """
+    group: int
+    curve: ControlCurve
+    moved: np.ndarray
+    table_t: np.ndarray
+    omega: np.ndarray
+    omega_t: np.ndarray
+    table_c: np.ndarray
+    tree: cKDTree
+
+    @classmethod
+    def build(cls, group: int, curve: ControlCurve, moves: np.ndarray) -> "CurveFrame":
+        """Frames of ``curve`` moved by ``moves`` (k + 1, 3)."""
+        q, qn = curve.points, curve.points + np.asarray(moves, dtype=np.float64)
+        p = curve.params
+        f = np.linspace(0.0, 1.0, FRAME_TABLE_PER_SPAN + 1)[:-1]
+        t = np.concatenate([p[j] + f * (p[j + 1] - p[j]) for j in range(len(p) - 1)] + [[1.0]])
+        s = catmull_rom_weights(p, t)
+        c, cn = s @ q, s @ qn
+        tg, tgn = _unit(_tangents(curve, q, t)), _unit(_tangents(curve, qn, t))
+        r0 = _unit(np.cross(tg[0], np.eye(3)[int(np.argmin(np.abs(tg[0])))]))
+        r = double_reflection(c, tg, r0)
+        rn = double_reflection(cn, tgn, _align(tg[0], tgn[0]) @ r0)
+        old = np.stack([tg, r, np.cross(tg, r)], axis=2)          # columns: t, r, b
+        new = np.stack([tgn, rn, np.cross(tgn, rn)], axis=2)
+        rel = new @ old.transpose(0, 2, 1)
+        omega = np.array([matrix_rotvec(m) for m in rel])
+        for i in range(1, len(omega)):                              # continuous past pi
+            th = np.linalg.norm(omega[i])
+            if th > 0.0 and omega[i] @ omega[i - 1] < 0.0 and th > 0.5 * np.pi:
+                omega[i] = omega[i] * (1.0 - 2.0 * np.pi / th)
+        omega_t = np.gradient(omega, t, axis=0)
+        return cls(group, curve, qn, t, omega, omega_t, c, cKDTree(c))
+
+    @property
+    def rotations(self) -> np.ndarray:
+        """(k + 1, 3) rotation vectors of the picked points' frames (old to new)."""
+        return self._interp(self.omega, self.curve.params)
+
+    def _interp(self, table: np.ndarray, t: np.ndarray) -> np.ndarray:
+        return np.column_stack([np.interp(t, self.table_t, table[:, i]) for i in range(3)])
+
+    def fields(self, t: np.ndarray):
+        """At parameters t (N,): ``(c, c_t, d, d_t, omega, omega_t)``, each (N, 3):
+        old curve point and its derivative, the move ``c' - c`` and its
+        derivative, the frame rotation vector and its derivative."""
+        p = self.curve.params
+        s = catmull_rom_weights(p, t)
+        c = s @ self.curve.points
+        d = s @ (self.moved - self.curve.points)
+        ct = _tangents(self.curve, self.curve.points, t)
+        dt = _tangents(self.curve, self.moved, t) - ct
+        return c, ct, d, dt, self._interp(self.omega, t), self._interp(self.omega_t, t)
+
+
+# ------------------------------------------------------------ the frame
+@dataclass(frozen=True)
+class CurveFrameDisplacement(RotationDisplacement):
+    """A rotation-mode frame with moved curves (``DeformationBasis.displacement``
+    returns it).  It is a :class:`~splatedit.deform.rotation.RotationDisplacement`
+    whose ``dC`` is the paper's linear displacement of the same moves (what
+    code unaware of curve frames, the GPU preview, draws); ``residual`` is the
+    dC the frame-carrying deformation adds (:meth:`base`), ``curves`` the
+    moved curves' frames."""
+    residual: np.ndarray | None = None
+    curves: tuple = ()
+
+    def base(self):
+        """The residual displacement: a RotationDisplacement with the handles'
+        rotations, or the plain (K, 3) residual when no handle rotates."""
+        if self.rotating:
+            return RotationDisplacement(self.residual, self.rotations)
+        return self.residual
+
+    def any(self) -> bool:
+        return True
+
+    def tobytes(self) -> bytes:
+        return super().tobytes() + np.asarray(self.residual).tobytes() + b"".join(
+            f.moved.tobytes() for f in self.curves)
+
+
+def project(frame: "CurveFrame", positions: np.ndarray):
+    """Curve parameters of the points nearest to ``positions`` (N, 3) on the
+    old curve and their gradients: ``(t (N,), grad t (N, 3))``.  The nearest
+    table point, refined on its two table segments; past the ends t is 0 or 1
+    (gradient 0); inside ``grad t = c_t / (|c_t|^2 - (p - c) . c_tt)``."""
+    tab_t, tab_c = frame.table_t, frame.table_c
+    _, i = frame.tree.query(positions, workers=-1)
+    best_t = tab_t[i].copy()
+    best_d = np.full(len(positions), np.inf)
+    for lo in (np.maximum(i - 1, 0), i):
+        hi = np.minimum(lo + 1, len(tab_t) - 1)
+        a, e = tab_c[lo], tab_c[hi] - tab_c[lo]
+        ee = np.maximum((e * e).sum(1), 1e-300)
+        f = np.clip(((positions - a) * e).sum(1) / ee, 0.0, 1.0)
+        dist = np.linalg.norm(a + f[:, None] * e - positions, axis=1)
+        better = dist < best_d
+        best_d[better] = dist[better]
+        best_t[better] = (tab_t[lo] + f * (tab_t[hi] - tab_t[lo]))[better]
+    h = 1e-5
+    c_m, c_0, c_p = (catmull_rom_weights(frame.curve.params, np.clip(best_t + k * h, 0.0, 1.0)) @ frame.curve.points
+                     for k in (-1, 0, 1))
+    ct = (c_p - c_m) / (2.0 * h)
+    ctt = (c_p - 2.0 * c_0 + c_m) / (h * h)
+    den = (ct * ct).sum(1) - ((positions - c_0) * ctt).sum(1)
+    inside = (best_t > 0.0) & (best_t < 1.0) & (den > 1e-3 * (ct * ct).sum(1))
+    grad = np.where(inside[:, None], ct / np.where(inside, den, 1.0)[:, None], 0.0)
+    return best_t, grad
+
+
+def frame_terms(frame: CurveFrame, influence, positions: np.ndarray, vectors=()):
+    """Displacement ``D`` of one moved curve at N points and ``(J_D) u`` of
+    each (N, 3) array ``u`` in ``vectors``.
+
+    Args:
+        frame: the curve's frames.
+        influence: ``(s (N,), grad s (N, 3))`` the fade towards the fixed band.
+        positions: (N, 3) the points (model units).
+    Returns:
+        ``(D (N, 3), [J_D u ...])``.
+    """
+    s, gs = influence
+    tt, gt = project(frame, positions)
+    c, ct, d, dt, om, om_t = frame.fields(tt)
+    o = positions - c
+    w = s[:, None] * om
+    eo = rotate_rows(w, o)
+    disp = s[:, None] * d + (eo - o)
+    if not vectors:
+        return disp, []
+    h = _ROT_STEP
+    a_s = (rotate_rows(w + h * om, o) - rotate_rows(w - h * om, o)) / (2.0 * h)       # d(E o)/ds
+    dw_t = s[:, None] * om_t
+    a_t = (rotate_rows(w + h * dw_t, o) - rotate_rows(w - h * dw_t, o)) / (2.0 * h)   # d(E o)/dt
+    out = []
+    for u in vectors:
+        su = (gs * u).sum(axis=1)[:, None]
+        tu = (gt * u).sum(axis=1)[:, None]
+        x = u - ct * tu                                     # d o / dx applied to u
+        out.append(d * su + s[:, None] * dt * tu + (rotate_rows(w, x) - x) + a_s * su + a_t * tu)
+    return disp, out
+
+
+def influence(basis, frames, positions: np.ndarray):
+    """``(s (N,), grad s (N, 3))``: how much of the curves' frame motion the
+    points take: ``smoothstep(d / ramp)`` of their distance d to the nearest
+    fixed-band splat, ``ramp`` the distance from the fixed band to the
+    nearest first picked point of the moved curves (at least
+    CURVE_FRAME_MIN_RAMP_SPACINGS point spacings); 1 without a fixed band."""
+    con = basis.constraints
+    n = len(positions)
+    if not con.has_fixed_band:
+        return np.ones(n), np.zeros((n, 3))
+    tree = basis.fixed_tree()
+    q0 = np.array([f.curve.points[0] for f in frames])
+    ramp = max(float(tree.query(q0)[0].min()), CURVE_FRAME_MIN_RAMP_SPACINGS * con.spacing)
+    dist, j = tree.query(positions, workers=-1)
+    x = np.clip(dist / ramp, 0.0, 1.0)
+    s = x * x * (3.0 - 2.0 * x)
+    ds = np.where((x > 0.0) & (x < 1.0), 6.0 * x * (1.0 - x) / ramp, 0.0)
+    direction = (positions - tree.data[j]) / np.maximum(dist, 1e-300)[:, None]
+    return s, ds[:, None] * direction
+
+
+def frames_terms(disp: CurveFrameDisplacement, basis, pack: np.ndarray, positions: np.ndarray, vectors=()):
+    """Sum of :func:`frame_terms` over the moved curves of ``disp``."""
+    total = np.zeros_like(positions)
+    outs = [np.zeros_like(positions) for _ in vectors]
+    if not disp.curves:
+        return total, outs
+    inf = influence(basis, disp.curves, positions)
+    for f in disp.curves:
+        dp, dv = frame_terms(f, inf, positions, vectors)
+        total += dp
+        for o, x in zip(outs, dv):
+            o += x
+    return total, outs
+
+
+def _pack_at(basis, points: np.ndarray) -> np.ndarray:
+    """(P, 4, K) basis rows (B, Bx, By, Bz) evaluated by the RBF at points."""
+    val, grad = basis.rbf.value_and_gradient(points)
+    pack = np.empty((len(points), 4, val.shape[1]))
+    pack[:, 0, :] = val
+    pack[:, 1:, :] = grad.transpose(0, 2, 1)
+    return pack
+
+
+def deform_points(basis, dC, points) -> np.ndarray:
+    """(P, 3) the deformation of ``dC`` (any form ``displacement`` returns) at
+    points of the free region that need not be splats (the basis rows by the
+    RBF there); the check that picked points land."""
+    x = np.asarray(points, dtype=np.float64).reshape(-1, 3)
+    pack = _pack_at(basis, x)
+    frames = dC if isinstance(dC, CurveFrameDisplacement) else None
+    d = dC.base() if frames is not None else dC
+    if isinstance(d, RotationDisplacement):
+        out = x + pack[:, 0, :] @ d.dC
+        if d.rotating:
+            out += blend_terms(d, pack, handle_blocks(basis))[0]
+    else:
+        out = x + pack[:, 0, :] @ np.asarray(d, dtype=np.float64)
+    if frames is not None:
+        out += frames_terms(frames, basis, pack, x)[0]
+    return out
+
+
+def curve_frame_displacement(basis, transforms: list):
+    """``DeformationBasis.displacement(transforms, mode=ROTATION)`` with control
+    curves: the handles as :func:`~splatedit.deform.rotation.rotation_displacement`
+    does; each curve whose points move gets its :class:`CurveFrame` and its
+    columns of the residual are solved so that every moved curve's picked
+    points land on their targets.  Returns what ``rotation_displacement``
+    returns when no curve moves, else a :class:`CurveFrameDisplacement`."""
+    linear = rotation_displacement(basis, transforms)
+    frames = []
+    for g, (t, grp) in enumerate(zip(transforms, basis.constraints.groups)):
+        if grp.kind == "curve" and t is not None and np.any(t):
+            frames.append(CurveFrame.build(g, grp.curve, np.asarray(t, dtype=np.float64)))
+    if not frames:
+        return linear
+    rot = linear if isinstance(linear, RotationDisplacement) else None
+    dc_lin = rot.dC if rot is not None else linear
+    res = dc_lin.copy()
+    cols = np.concatenate([np.arange(basis.n_columns)[basis.columns_for_group(f.group)] for f in frames])
+    res[cols] = 0.0
+    q = np.concatenate([f.curve.points for f in frames])
+    target = np.concatenate([f.moved - f.curve.points for f in frames])
+    probe = CurveFrameDisplacement(dC=dc_lin, rotations=() if rot is None else rot.rotations,
+                                   residual=res, curves=tuple(frames))
+    got = deform_points(basis, probe, q) - q
+    bq = _pack_at(basis, q)[:, 0, :][:, cols]                # (P, P), nearly the identity
+    res[cols] = np.linalg.lstsq(bq, target - got, rcond=None)[0]
+    return CurveFrameDisplacement(dC=dc_lin, rotations=probe.rotations, residual=res, curves=tuple(frames))
