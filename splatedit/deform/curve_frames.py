@@ -164,7 +164,7 @@ class CurveFrame:
         moved: (k + 1, 3) the moved picked points ``q'``.
         table_t: (n,) table parameters, increasing, 0 .. 1.
         omega: (n, 3) rotation vectors of ``R(t)`` at the table parameters.
-        omega_t: (n, 3) their derivative in t (central differences).
+        omega_t: (n - 1, 3) the slope of their linear interpolation per table interval.
         table_c: (n, 3) the old curve at the table parameters; tree: their KD-tree.
     """
     group: int
@@ -197,7 +197,7 @@ class CurveFrame:
             th = np.linalg.norm(omega[i])
             if th > 0.0 and omega[i] @ omega[i - 1] < 0.0 and th > 0.5 * np.pi:
                 omega[i] = omega[i] * (1.0 - 2.0 * np.pi / th)
-        omega_t = np.gradient(omega, t, axis=0)
+        omega_t = np.diff(omega, axis=0) / np.diff(t)[:, None]     # slope of the interpolation
         return cls(group, curve, qn, t, omega, omega_t, c, cKDTree(c))
 
     @property
@@ -218,7 +218,8 @@ class CurveFrame:
         d = s @ (self.moved - self.curve.points)
         ct = _tangents(self.curve, self.curve.points, t)
         dt = _tangents(self.curve, self.moved, t) - ct
-        return c, ct, d, dt, self._interp(self.omega, t), self._interp(self.omega_t, t)
+        seg = np.clip(np.searchsorted(self.table_t, t, side="right") - 1, 0, len(self.table_t) - 2)
+        return c, ct, d, dt, self._interp(self.omega, t), self.omega_t[seg]
 
 
 # ------------------------------------------------------------ the frame
@@ -257,6 +258,7 @@ def project(frame: "CurveFrame", positions: np.ndarray):
     _, i = frame.tree.query(positions, workers=-1)
     best_t = tab_t[i].copy()
     best_d = np.full(len(positions), np.inf)
+    grad = np.zeros_like(positions)
     for lo in (np.maximum(i - 1, 0), i):
         hi = np.minimum(lo + 1, len(tab_t) - 1)
         a, e = tab_c[lo], tab_c[hi] - tab_c[lo]
@@ -266,14 +268,8 @@ def project(frame: "CurveFrame", positions: np.ndarray):
         better = dist < best_d
         best_d[better] = dist[better]
         best_t[better] = (tab_t[lo] + f * (tab_t[hi] - tab_t[lo]))[better]
-    h = 1e-5
-    c_m, c_0, c_p = (catmull_rom_weights(frame.curve.params, np.clip(best_t + k * h, 0.0, 1.0)) @ frame.curve.points
-                     for k in (-1, 0, 1))
-    ct = (c_p - c_m) / (2.0 * h)
-    ctt = (c_p - 2.0 * c_0 + c_m) / (h * h)
-    den = (ct * ct).sum(1) - ((positions - c_0) * ctt).sum(1)
-    inside = (best_t > 0.0) & (best_t < 1.0) & (den > 1e-3 * (ct * ct).sum(1))
-    grad = np.where(inside[:, None], ct / np.where(inside, den, 1.0)[:, None], 0.0)
+        slope = ((tab_t[hi] - tab_t[lo]) * ((f > 0.0) & (f < 1.0)) / ee)[:, None] * e
+        grad[better] = slope[better]
     return best_t, grad
 
 
