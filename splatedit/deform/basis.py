@@ -346,12 +346,17 @@ class DeformationBasis:
                 o += blend_jacobians(rot, self._pack[s:s + _BASIS_CHUNK], blocks)
         return out
 
-    def fixed_tree(self):
-        """KD-tree of the fixed band's positions (built once; curve frames)."""
-        if getattr(self, "_fixed_tree", None) is None:
+    def still_tree(self):
+        """KD-tree of the splats that do not follow a curve's frame: the fixed
+        band and the handles' splats (built once; curve frames), None if none."""
+        if not hasattr(self, "_still_tree"):
             from scipy.spatial import cKDTree
-            self._fixed_tree = cKDTree(self.constraints.points[:len(self.constraints.fixed_index)])
-        return self._fixed_tree
+            con = self.constraints
+            pts = [con.points[:len(con.fixed_index)]]
+            pts += [self._support_positions()[np.searchsorted(self.indices, h)] for h in con.handle_index]
+            pts = np.concatenate(pts)
+            self._still_tree = cKDTree(pts) if len(pts) else None
+        return self._still_tree
 
     def _support_positions(self) -> np.ndarray:
         if self.support_positions is None:

@@ -308,23 +308,36 @@ def frame_terms(frame: CurveFrame, influence, positions: np.ndarray, vectors=())
 
 def influence(basis, frames, positions: np.ndarray):
     """``(s (N,), grad s (N, 3))``: how much of the curves' frame motion the
-    points take: ``smoothstep(d / ramp)`` of their distance d to the nearest
-    fixed-band splat, ``ramp`` the distance from the fixed band to the
-    nearest first picked point of the moved curves (at least
-    CURVE_FRAME_MIN_RAMP_SPACINGS point spacings); 1 without a fixed band."""
-    con = basis.constraints
+    points take: ``smoothstep(d_f / max(ramp, d_c))`` of their distance d_f
+    to the nearest splat that does not follow the curves (the fixed band and
+    the handles' splats, which move by their own maps) and d_c to the nearest
+    moved curve (so a part of the support far from the curve, nearer to the
+    fixed part, takes less of it); ``ramp`` is the distance from there to the
+    nearest first picked point of the moved curves, at least
+    CURVE_FRAME_MIN_RAMP_SPACINGS point spacings.  1 with neither."""
     n = len(positions)
-    if not con.has_fixed_band:
+    tree = basis.still_tree()
+    if tree is None:
         return np.ones(n), np.zeros((n, 3))
-    tree = basis.fixed_tree()
     q0 = np.array([f.curve.points[0] for f in frames])
-    ramp = max(float(tree.query(q0)[0].min()), CURVE_FRAME_MIN_RAMP_SPACINGS * con.spacing)
+    ramp = max(float(tree.query(q0)[0].min()), CURVE_FRAME_MIN_RAMP_SPACINGS * basis.constraints.spacing)
     dist, j = tree.query(positions, workers=-1)
-    x = np.clip(dist / ramp, 0.0, 1.0)
+    gd = (positions - tree.data[j]) / np.maximum(dist, 1e-300)[:, None]
+    dc = np.full(n, np.inf)
+    gc = np.zeros((n, 3))
+    for f in frames:
+        d, k = f.tree.query(positions, workers=-1)
+        better = d < dc
+        dc[better] = d[better]
+        gc[better] = ((positions - f.table_c[k]) / np.maximum(d, 1e-300)[:, None])[better]
+    far = dc > ramp
+    den = np.where(far, dc, ramp)
+    x = dist / den
+    gx = gd / den[:, None] - np.where(far, x / den, 0.0)[:, None] * gc
+    inside = (x > 0.0) & (x < 1.0)
+    x = np.clip(x, 0.0, 1.0)
     s = x * x * (3.0 - 2.0 * x)
-    ds = np.where((x > 0.0) & (x < 1.0), 6.0 * x * (1.0 - x) / ramp, 0.0)
-    direction = (positions - tree.data[j]) / np.maximum(dist, 1e-300)[:, None]
-    return s, ds[:, None] * direction
+    return s, np.where(inside, 6.0 * x * (1.0 - x), 0.0)[:, None] * gx
 
 
 def frames_terms(disp: CurveFrameDisplacement, basis, pack: np.ndarray, positions: np.ndarray, vectors=()):
