@@ -244,3 +244,10 @@ def test_rotation_mode_draws_the_frame_curve_and_carries_the_samples_onto_it(ses
     moved = deform_points(s.basis, dc, g.points)
     gap = np.min(np.linalg.norm(moved[:, None, :] - poly[None], axis=2), axis=1)
     assert gap.max() < 0.01 * s.cloud.diagonal
+    # the viewport draws the pose as committed: a CPU-deformed copy (the GPU pass has no frames)
+    shown, basis, shown_dc = s.display_state(False)
+    assert basis is None and shown_dc is None
+    np.testing.assert_array_equal(shown.positions, s.basis.apply(s.cloud, dc).positions)
+    assert s.display_state(False)[0] is shown                  # kept while nothing moves
+    assert s.commit()
+    np.testing.assert_array_equal(s.cloud.positions, shown.positions)
