@@ -11,7 +11,8 @@ moved picked points miss their targets, and the *knob*: how far the tip's
 cross-section ring moved compared with the tip point itself (1 = the whole
 tip follows the curve; the linear mode leaves the far side behind).
 
-    python -m splatedit.bench.trunk      # one JSON line per mode
+    python -m splatedit.bench.trunk                 # one JSON line per mode
+    python -m splatedit.bench.trunk --images DIR    # and PNGs: before, linear, rotation
 """
 
 from __future__ import annotations
@@ -104,10 +105,32 @@ def measure(cloud, basis, q, moves, mode) -> dict:
                 curve_point_miss_rel=miss, n_splats=int(cloud.n))
 
 
+def render_figures(out_dir, cloud, basis, moves, size=(480, 480)) -> list:
+    """PNGs of the trunk seen from the curve's side: undeformed, the linear
+    mode and the rotation mode (curve frames).  Returns their paths."""
+    from pathlib import Path
+
+    from splatedit.render.camera import Camera
+    from splatedit.render.headless import render_to_png
+    out_dir = Path(out_dir)
+    out_dir.mkdir(parents=True, exist_ok=True)
+    cam = Camera((0.2, 3.2, 0.45), (0.2, 0.0, 0.45), up=(0.0, 0.0, 1.0), fov_deg=30.0)
+    paths = [render_to_png(cloud, out_dir / "trunk-before.png", size=size, camera=cam)]
+    for mode in (DeformationMode.LINEAR, DeformationMode.ROTATION):
+        moved = basis.apply(cloud, basis.displacement([moves], mode=mode))
+        paths.append(render_to_png(moved, out_dir / f"trunk-{mode.value}.png", size=size, camera=cam))
+    return paths
+
+
 def main(argv=None) -> int:
+    """``python -m splatedit.bench.trunk [--images DIR]``."""
+    argv = sys.argv[1:] if argv is None else argv
     cloud, basis, q, moves = trunk_edit()
     for mode in (DeformationMode.LINEAR, DeformationMode.ROTATION):
         print(json.dumps(measure(cloud, basis, q, moves, mode)))
+    if argv[:1] == ["--images"] and len(argv) == 2:
+        for p in render_figures(argv[1], cloud, basis, moves):
+            print(f"wrote {p}")
     return 0
 
 

@@ -95,6 +95,8 @@ class DeformationBasis:
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
         self.stretch_probe = None  # free splats where rotation centres are compared (fit() sets it)
         self.support_positions = None  # (N, 3) positions of the support splats (fit() sets it; curve frames)
+        #: move-independent terms of curve frames at the support (splatedit.deform.curve_frames)
+        self.frame_cache: dict = {}
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -316,7 +318,7 @@ class DeformationBasis:
         of a CurveFrameDisplacement)."""
         if isinstance(dC, CurveFrameDisplacement):
             pos = self._support_positions()
-            return self.displacements(dC.base()) + frames_terms(dC, self, self._pack, pos)[0]
+            return self.displacements(dC.base()) + frames_terms(dC, self, pos)[0]
         d, rot = split_displacement(dC)
         out = self.B @ self._check_dc(d)
         if rot is not None:
@@ -329,7 +331,7 @@ class DeformationBasis:
         if isinstance(dC, CurveFrameDisplacement):
             out = self.jacobians(dC.base())
             pos = self._support_positions()
-            cols = frames_terms(dC, self, self._pack, pos, list(np.eye(3)[:, None, :].repeat(len(pos), 1)))[1]
+            cols = frames_terms(dC, self, pos, list(np.eye(3)[:, None, :].repeat(len(pos), 1)))[1]
             out += np.stack(cols, axis=2)
             return out
         d, rot = split_displacement(dC)
@@ -393,8 +395,10 @@ class DeformationBasis:
         if isinstance(dC, CurveFrameDisplacement):    # residual and handles, then the curves' frames
             outs = self.apply_arrays(cloud, dC.base(), progress=progress)
             idx = self.indices
-            dp, (du, dv) = frames_terms(dC, self, self._pack, cloud.positions[idx],
-                                        (cloud.u[idx], cloud.v[idx]))
+            pos = cloud.positions[idx]
+            if self.support_positions is not None and np.array_equal(pos, self.support_positions):
+                pos = self.support_positions        # the base cloud: its move-independent terms are kept
+            dp, (du, dv) = frames_terms(dC, self, pos, (cloud.u[idx], cloud.v[idx]))
             for o, x in zip(outs, (dp, du, dv)):
                 o[idx] += x
             return outs
