@@ -377,9 +377,11 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         if last is not None:
             return last.cloud, last.basis, last.dc
         dc = self.current_dc() if self.basis is not None else None
-        if getattr(dc, "curves", ()):
+        if getattr(dc, "curves", ()) and gaussians_of(self.cloud) is None:
             # moved curves in the rotation mode carry frames, which the GPU pass
-            # cannot draw: the pose is shown as a CPU-deformed copy (as committed)
+            # cannot draw: the pose is shown as a CPU-deformed copy (as committed).
+            # A Gaussian scene keeps its GPU preview (the linear curve edit): its
+            # CPU deformation re-decomposes every Gaussian
             return self._frame_preview(dc), None, None
         return self.cloud, self.basis, dc
 
