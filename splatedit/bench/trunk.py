@@ -13,6 +13,7 @@ tip follows the curve; the linear mode leaves the far side behind).
 
     python -m splatedit.bench.trunk                 # one JSON line per mode
     python -m splatedit.bench.trunk --images DIR    # and PNGs: before, linear, rotation
+    python -m splatedit.bench.trunk --cost          # per-frame milliseconds, 31k splats
 """
 
 from __future__ import annotations
@@ -122,9 +123,41 @@ def render_figures(out_dir, cloud, basis, moves, size=(480, 480)) -> list:
     return paths
 
 
+def cost(spacing: float = 0.005, repeats: int = 5) -> dict:
+    """Milliseconds (best of ``repeats``, same process) of one frame of the
+    trunk edit at ``spacing``: ``displacement`` in the rotation mode (frame
+    tables and residual solve), ``apply_arrays`` and ``jacobians`` with the
+    curve frames and, side by side, with the linear mode's dC."""
+    import os
+    import time
+    cloud, basis, _, moves = trunk_edit(trunk_cloud(spacing), method="auto")
+
+    def best(f):
+        ts = []
+        for _ in range(repeats):
+            t0 = time.perf_counter()
+            f()
+            ts.append(time.perf_counter() - t0)
+        return round(1e3 * min(ts), 2)
+    lin = basis.displacement([moves], mode=DeformationMode.LINEAR)
+    fr = basis.displacement([moves], mode=DeformationMode.ROTATION)
+    basis.apply_arrays(cloud, lin)
+    basis.apply_arrays(cloud, fr)
+    return dict(splats=int(cloud.n), support=int(len(basis.indices)),
+                displacement_ms=best(lambda: basis.displacement([moves], mode=DeformationMode.ROTATION)),
+                apply_linear_ms=best(lambda: basis.apply_arrays(cloud, lin)),
+                apply_frames_ms=best(lambda: basis.apply_arrays(cloud, fr)),
+                jacobians_linear_ms=best(lambda: basis.jacobians(lin)),
+                jacobians_frames_ms=best(lambda: basis.jacobians(fr)),
+                load_average=round(os.getloadavg()[0], 1))
+
+
 def main(argv=None) -> int:
-    """``python -m splatedit.bench.trunk [--images DIR]``."""
+    """``python -m splatedit.bench.trunk [--images DIR | --cost]``."""
     argv = sys.argv[1:] if argv is None else argv
+    if argv == ["--cost"]:
+        print(json.dumps(cost()))
+        return 0
     cloud, basis, q, moves = trunk_edit()
     for mode in (DeformationMode.LINEAR, DeformationMode.ROTATION):
         print(json.dumps(measure(cloud, basis, q, moves, mode)))
