@@ -71,7 +71,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
-from splatedit.deform.curves import ControlCurve, catmull_rom_weights
+from splatedit.deform.curves import ControlCurve, catmull_rom_weights, segment_index
 from splatedit.deform.rotation import (RotationDisplacement, blend_terms, handle_blocks,
                                        rotation_displacement)
 from splatedit.tolerances import CURVE_FRAME_MIN_RAMP_SPACINGS
@@ -82,9 +82,8 @@ FRAME_TABLE_PER_SPAN = 32
 #: step of the forward differences of the rotation in s and t (error about
 #: the step times the second derivative plus 1e-16 / step: about 1e-8 here)
 _ROT_STEP = 1e-7
-#: below this |s| a splat has no curve parameter (t~ = 0; every term is
-#: scaled by s there)
-_MIN_INFLUENCE = 1e-9
+#: rows per chunk of the dense shape weights when a curve's static terms are built
+_STATIC_CHUNK = 65536
 
 
 # ------------------------------------------------------------------ frames
@@ -232,8 +231,8 @@ class CurveFrame:
         """At the points of ``st``: ``(d, d_t, omega, omega_t)``, each (N, 3):
         the move ``c' - c`` and its derivative in t, the frame rotation vector
         and its derivative."""
-        dq = self.moved - self.curve.points
-        return st.shape @ dq, st.shape_t @ dq, self._interp(self.omega, st.t), self.omega_t[st.seg]
+        d, dt = st.combine(self.moved - self.curve.points)
+        return d, dt, self._interp(self.omega, st.t), self.omega_t[st.seg]
 
 
 # ------------------------------------------------------------ the frame
@@ -291,13 +290,17 @@ def project(frame: "CurveFrame", positions: np.ndarray):
 class CurveStatic:
     """What a curve's frame terms need at N points that does not depend on
     the move: the projection ``t`` (N,) and its gradient (N, 3), the old
-    curve point ``c`` and derivative ``c_t`` (N, 3), the shape weights
-    ``shape`` and their t-derivative ``shape_t`` (N, k + 1) (``c' - c =
-    shape @ dq``), and the frame table interval ``seg`` (N,) of each t."""
+    curve point ``c`` and derivative ``c_t`` (N, 3), the shape weights in a
+    window of m = min(4, k + 1) consecutive picked points (a Catmull-Rom
+    segment depends on at most 4): ``first`` (N,) the window's first point,
+    ``shape`` and their t-derivative ``shape_t`` (N, m) (``c' - c =
+    sum_i shape[:, i] dq[first + i]``; 8 m bytes per point each instead of
+    8 (k + 1)), and the frame table interval ``seg`` (N,) of each t."""
     t: np.ndarray
     grad_t: np.ndarray
     c: np.ndarray
     c_t: np.ndarray
+    first: np.ndarray
     shape: np.ndarray
     shape_t: np.ndarray
     seg: np.ndarray
@@ -306,12 +309,32 @@ class CurveStatic:
     def at(cls, frame: CurveFrame, positions: np.ndarray) -> "CurveStatic":
         t, gt = project(frame, positions)
         cv = frame.curve
-        shape = catmull_rom_weights(cv.params, t)
+        k = cv.n_controls - 1
+        m = min(4, k + 1)
+        n = len(t)
+        span = segment_index(cv.params, t)
+        first = np.clip(span - 1, 0, k + 1 - m)
+        cols = first[:, None] + np.arange(m)
+        shape, shape_t = np.empty((n, m)), np.empty((n, m))
         h = 1e-6
-        ta, tb = np.clip(t - h, 0.0, 1.0), np.clip(t + h, 0.0, 1.0)
-        shape_t = (catmull_rom_weights(cv.params, tb) - catmull_rom_weights(cv.params, ta)) / (tb - ta)[:, None]
+        for a in range(0, n, _STATIC_CHUNK):          # the dense (rows, k + 1) weights per chunk
+            b = min(n, a + _STATIC_CHUNK)
+            tc = t[a:b]
+            ta, tb = np.clip(tc - h, 0.0, 1.0), np.clip(tc + h, 0.0, 1.0)
+            w = catmull_rom_weights(cv.params, tc)
+            wt = (catmull_rom_weights(cv.params, tb) - catmull_rom_weights(cv.params, ta)) / (tb - ta)[:, None]
+            shape[a:b] = np.take_along_axis(w, cols[a:b], axis=1)
+            shape_t[a:b] = np.take_along_axis(wt, cols[a:b], axis=1)
+        pts = cv.points[cols]                           # (N, m, 3)
+        c = np.einsum("nm,nmk->nk", shape, pts)
+        ct = np.einsum("nm,nmk->nk", shape_t, pts)
         seg = np.clip(np.searchsorted(frame.table_t, t, side="right") - 1, 0, len(frame.table_t) - 2)
-        return cls(t, gt, shape @ cv.points, shape_t @ cv.points, shape, shape_t, seg)
+        return cls(t, gt, c, ct, first, shape, shape_t, seg)
+
+    def combine(self, dq: np.ndarray):
+        """``(shape @ dq, shape_t @ dq)`` (N, 3) each for moves dq (k + 1, 3)."""
+        d = dq[self.first[:, None] + np.arange(self.shape.shape[1])]     # (N, m, 3)
+        return np.einsum("nm,nmk->nk", self.shape, d), np.einsum("nm,nmk->nk", self.shape_t, d)
 
 
 def frame_terms(frame: CurveFrame, influence, st: CurveStatic, positions: np.ndarray, vectors=()):
