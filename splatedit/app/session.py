@@ -374,7 +374,9 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         edit's cloud, basis and dC (:meth:`shown_edit`: the same deformed
         surface, its stretch coloured)."""
         last = self.shown_edit() if heat_map else None
-        if last is not None:
+        if last is not None and not getattr(last.dc, "curves", ()):
+            # (a curve-frame edit is not redrawn from its base on the GPU, which has
+            # no frames: the document itself is shown, without the heat colours)
             return last.cloud, last.basis, last.dc
         dc = self.current_dc() if self.basis is not None else None
         if getattr(dc, "curves", ()) and gaussians_of(self.cloud) is None:

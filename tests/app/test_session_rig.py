@@ -251,3 +251,6 @@ def test_rotation_mode_draws_the_frame_curve_and_carries_the_samples_onto_it(ses
     assert s.display_state(False)[0] is shown                  # kept while nothing moves
     assert s.commit()
     np.testing.assert_array_equal(s.cloud.positions, shown.positions)
+    # the heat map redraws a committed edit from its base on the GPU; a curve-frame edit is shown as committed
+    shown, basis, _ = s.display_state(True)
+    assert shown is s.cloud and basis is s.basis
