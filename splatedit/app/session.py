@@ -374,9 +374,27 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         edit's cloud, basis and dC (:meth:`shown_edit`: the same deformed
         surface, its stretch coloured)."""
         last = self.shown_edit() if heat_map else None
-        if last is not None:
+        if last is not None and not getattr(last.dc, "curves", ()):
+            # (a curve-frame edit is not redrawn from its base on the GPU, which has
+            # no frames: the document itself is shown, without the heat colours)
             return last.cloud, last.basis, last.dc
-        return self.cloud, self.basis, self.current_dc() if self.basis is not None else None
+        dc = self.current_dc() if self.basis is not None else None
+        if getattr(dc, "curves", ()) and gaussians_of(self.cloud) is None:
+            # moved curves in the rotation mode carry frames, which the GPU pass
+            # cannot draw: the pose is shown as a CPU-deformed copy (as committed).
+            # A Gaussian scene keeps its GPU preview (the linear curve edit): its
+            # CPU deformation re-decomposes every Gaussian
+            return self._frame_preview(dc), None, None
+        return self.cloud, self.basis, dc
+
+    def _frame_preview(self, dc):
+        """The document deformed by ``dc`` (a CurveFrameDisplacement) on the
+        CPU, kept while the cloud, basis and pose stay the same."""
+        key = (self.cloud, self.basis, dc.tobytes())
+        cached = getattr(self, "_frame_preview_cache", None)
+        if cached is None or cached[0][0] is not key[0] or cached[0][1] is not key[1] or cached[0][2] != key[2]:
+            cached = self._frame_preview_cache = (key, self.basis.apply(self.cloud, dc))
+        return cached[1]
 
     # ---------------------------------------------------------------- export
     def edit_script(self):

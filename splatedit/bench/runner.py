@@ -129,6 +129,15 @@ def _io(quick: bool, progress=None, counts=None, large: bool = False) -> Iterato
     yield from bench_io(quick=quick, large=large)
 
 
+def _curves(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.trunk import cost, measure, trunk_edit
+    from splatedit.deform.modes import DeformationMode
+    edit = trunk_edit()
+    for mode in (DeformationMode.LINEAR, DeformationMode.ROTATION):
+        yield {"bench": "curves", **measure(*edit, mode)}
+    yield {"bench": "curves", **cost(0.01 if quick else 0.005)}
+
+
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
@@ -147,6 +156,7 @@ BENCHES = {
     "gaussian-render": _gaussian_render,
     "gpu-sort": _gpu_sort,
     "gaussian-editor": _gaussian_editor,
+    "curves": _curves,
 }
 
 
@@ -252,12 +262,20 @@ def _tiny_gpu_sort():
     yield from bench_gpu_sort(counts=(3000,), repeats=1)
 
 
+def _tiny_curves():
+    from splatedit.bench.trunk import cost, measure, trunk_cloud, trunk_edit
+    from splatedit.deform.modes import DeformationMode
+    edit = trunk_edit(trunk_cloud(0.04))
+    yield {"bench": "curves", **measure(*edit, DeformationMode.ROTATION)}
+    yield {"bench": "curves", **cost(0.04, repeats=1)}
+
+
 #: the tiny form of every case of BENCHES (same keys)
 TINY = {"solve": _tiny_solve, "basis": _tiny_basis, "groups": _tiny_groups, "qr": _tiny_qr,
         "accuracy": _tiny_accuracy, "closure": _tiny_closure, "render": _tiny_render,
         "editor": _tiny_editor, "estimate": _tiny_estimate, "io": _tiny_io, "detail": _tiny_detail,
         "gui": _tiny_gui, "gaussians": _tiny_gaussians, "gaussian-render": _tiny_gaussian_render,
-        "gaussian-editor": _tiny_gaussian_editor, "gpu-sort": _tiny_gpu_sort}
+        "gaussian-editor": _tiny_gaussian_editor, "gpu-sort": _tiny_gpu_sort, "curves": _tiny_curves}
 
 
 #: benchmarks that take an image size and a draw path (``--size``, ``--path``)

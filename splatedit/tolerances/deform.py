@@ -99,6 +99,11 @@ AFFINE_MIN_SINGULAR_REL = 1e-9
 #: consecutive picked curve points closer than this (relative to the points'
 #: extent) coincide
 CURVE_MIN_CHORD_REL = 1e-9
+#: rotation mode, moved curves (splatedit.deform.curve_frames): the frame
+#: motion fades in over at least this many point spacings from the fixed band
+#: (the band itself is BAND_RINGS = 3 thick; 3 more keep the fade's gradient
+#: below 1/2 per spacing: the trunk bend of splatedit.bench.trunk)
+CURVE_FRAME_MIN_RAMP_SPACINGS = 3.0
 
 
 # --- constraints --------------------------------------------------------
