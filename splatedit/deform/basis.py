@@ -42,14 +42,17 @@ from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
 from splatedit.select.closure import close_selection
-from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
+from splatedit.tolerances import BAND_RINGS, FAST_EVAL_TOL, IQR_DEFAULT_TOL
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
 #: progress stage name of the selection closure
 CLOSURE_STAGE = "closing the selection"
-#: support splats per chunk when evaluating the RBF for the basis and the Jacobians
+#: support splats per chunk when computing the Jacobians
 _BASIS_CHUNK = 65536
+#: free splats per call of the far-field basis evaluation (its (rows, 4K)
+#: float64 result and box tree; larger calls make larger far-field boxes)
+_FAST_CHUNK = 1 << 18
 
 
 def _wrap(cloud, arrays, validate: bool, progress=None):
@@ -82,7 +85,10 @@ class DeformationBasis:
             ``closure_added`` (splats the closure added), ``n_conflicts``
             (fixed splats dropped next to handle bands), ``constraints_seconds``
             (bands and control frames), ``fit_seconds`` (the RBF solve),
-            ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
+            ``basis_seconds``, ``n_support``, ``n_free``, ``eval_tol``,
+            ``eval_pairs`` (splat-centre pairs the basis evaluation computed;
+            exact evaluation: n_free * n_centers), ``eval_interpolated`` (free
+            splats whose far field was interpolated), ``n_fixed_band``,
             ``n_handle_band``, ``n_curve_samples``, ``n_curve_dropped``,
             ``spacing``, ``message``.
     """
@@ -102,7 +108,8 @@ class DeformationBasis:
     def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
             tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
             rings: float = BAND_RINGS, spacing: float | None = None,
-            fill_holes: bool = True, graph=None, progress=None) -> "DeformationBasis":
+            fill_holes: bool = True, graph=None, progress=None,
+            eval_tol: float = FAST_EVAL_TOL) -> "DeformationBasis":
         """Build constraints, fit one RBF to all group columns, evaluate bases.
 
         Args:
@@ -120,6 +127,11 @@ class DeformationBasis:
             graph: the cloud's :class:`~splatedit.select.graph.NeighbourGraph`
                 for the closure (built when None).
             progress: optional ``progress(stage, fraction)``.
+            eval_tol: the basis values and gradients at the free splats are
+                evaluated by far-field interpolation
+                (:mod:`splatedit.deform.fast_eval`) within about this times
+                the largest constraint value of the exact float64 RBF (checked
+                per box); 0 evaluates them exactly (every splat, every centre).
         Raises:
             ParameterError / SolverError from the constraints and the fit.
         """
@@ -163,9 +175,15 @@ class DeformationBasis:
         free_rows = np.searchsorted(idx, con.free_index)
         n_free = len(free_rows)
         report(progress, PROGRESS_STAGE, 0.0)
-        for s in range(0, n_free, _BASIS_CHUNK):
-            r = free_rows[s:s + _BASIS_CHUNK]
-            val, grad = rbf.value_and_gradient(pos[idx[r]])
+        # far-field interpolation within eval_tol of the largest constraint value
+        # (splatedit.deform.fast_eval); chunks bound the (rows, 4K) temporaries
+        value_scale = float(np.max(np.abs(con.values))) if con.values.size else 1.0
+        eval_stats = []
+        for s in range(0, n_free, _FAST_CHUNK):
+            r = free_rows[s:s + _FAST_CHUNK]
+            val, grad, est = rbf.value_and_gradient_fast(pos[idx[r]], tol=eval_tol,
+                                                         value_scale=value_scale)
+            eval_stats.append(est)
             pack[r, 0, :] = val
             pack[r, 1:, :] = grad.transpose(0, 2, 1)
             report(progress, PROGRESS_STAGE, (s + len(r)) / n_free)
@@ -176,7 +194,10 @@ class DeformationBasis:
             closure_seconds=t_closure - t0,
             closure_added=0 if closure is None else closure.n_added,
             n_conflicts=sum(c.count for c in con.conflicts),
-            constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
+            constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1,
+            n_support=int(n_sup), n_free=int(n_free), eval_tol=float(eval_tol),
+            eval_pairs=int(sum(e.pairs for e in eval_stats)),
+            eval_interpolated=int(sum(e.n_interpolated for e in eval_stats)),
             n_fixed_band=int(len(con.fixed_index)),
             n_handle_band=[int(len(b)) for b in con.handle_band_index],
             n_curve_samples=[int(len(c.points)) for c in con.curves],
