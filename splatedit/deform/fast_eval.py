@@ -185,10 +185,15 @@ def _lagrange(t: np.ndarray, nodes: np.ndarray, bw: np.ndarray) -> np.ndarray:
 
 
 class _Box:
-    __slots__ = ("idx", "lo", "hi")
+    """Rows ``a:b`` of the permuted points and their bounding box."""
 
-    def __init__(self, idx, lo, hi):
-        self.idx, self.lo, self.hi = idx, lo, hi
+    __slots__ = ("a", "b", "lo", "hi")
+
+    def __init__(self, a, b, lo, hi):
+        self.a, self.b, self.lo, self.hi = a, b, lo, hi
+
+    def __len__(self) -> int:
+        return self.b - self.a
 
     @property
     def half_diag(self) -> float:
@@ -199,22 +204,22 @@ class _Box:
         return 0.5 * (self.lo + self.hi)
 
 
-def _make_box(x, idx):
-    p = x[idx]
-    return _Box(idx, p.min(axis=0), p.max(axis=0))
-
-
-def _split(x, box):
-    """Two boxes: ``box`` cut at the middle of its longest side."""
-    a = int(np.argmax(box.hi - box.lo))
-    mid = 0.5 * (box.lo[a] + box.hi[a])
-    p = x[box.idx]
-    left = p[:, a] <= mid
+def _split(xp, perm, box):
+    """Two boxes: ``box`` cut at the middle of its longest side; its rows of
+    ``xp`` and ``perm`` are reordered in place (left part first)."""
+    ax = int(np.argmax(box.hi - box.lo))
+    mid = 0.5 * (box.lo[ax] + box.hi[ax])
+    seg = xp[box.a:box.b]
+    left = seg[:, ax] <= mid
+    order = np.concatenate([np.flatnonzero(left), np.flatnonzero(~left)])
+    xp[box.a:box.b] = seg[order]
+    perm[box.a:box.b] = perm[box.a:box.b][order]
+    cut = box.a + int(left.sum())
     out = []
-    for sel in (left, ~left):
-        part = p[sel]
-        if len(part):
-            out.append(_Box(box.idx[sel], part.min(axis=0), part.max(axis=0)))
+    for a, b in ((box.a, cut), (cut, box.b)):
+        if b > a:
+            part = xp[a:b]
+            out.append(_Box(a, b, part.min(axis=0), part.max(axis=0)))
     return out
 
 
@@ -286,6 +291,10 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
     pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
     rng = np.random.default_rng(0)
     all_src = np.arange(n_src)
+    xp = x.copy()                  # points, permuted so that every box is a row range
+    perm = np.arange(n_pts)        # xp = x[perm]
+    outp = np.empty((n_pts, 4 * k))
+    direct = []                    # boxes evaluated directly
 
     def run(fn, items):
         return list(map(fn, items)) if pool is None else list(pool.map(fn, items))
@@ -296,45 +305,43 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
         b, near, chk = item
         far = all_src if near is None else np.setdiff1d(all_src, near, assume_unique=True)
         g, c, h = _box_nodes(b, nodes1d)
-        fv = field_.rbf_at(np.concatenate([g, x[chk]]), far)
-        ip = _interpolate(x[chk], c, h, nodes1d, bw,
-                          fv[:n_nodes].reshape(nodes, nodes, -1).astype(np.float32))
-        err = float(np.max(np.abs(ip - fv[n_nodes:])))
+        xc = xp[chk]
+        fv = field_.rbf_at(np.concatenate([g, xc]), far)
+        fv32 = fv[:n_nodes].reshape(nodes, nodes, -1).astype(np.float32)
+        err = float(np.max(np.abs(_interpolate(xc, c, h, nodes1d, bw, fv32) - fv[n_nodes:])))
         pairs = (n_nodes + len(chk)) * len(far)
         if err > limit:
             return False, err, pairs
-        fv32 = fv[:n_nodes].reshape(nodes, nodes, -1).astype(np.float32)
-        res = _interpolate(x[b.idx], c, h, nodes1d, bw, fv32)
+        xb = xp[b.a:b.b]
+        res = outp[b.a:b.b]
+        res[:] = _interpolate(xb, c, h, nodes1d, bw, fv32)
         if near is not None and len(near):
-            res += field_.rbf_at(x[b.idx], near)
-            pairs += len(b.idx) * len(near)
-        out[b.idx] = res
+            res += field_.rbf_at(xb, near)
+            pairs += len(xb) * len(near)
         return True, err, pairs
 
     with single_blas_thread():
         try:
-            direct_idx = []
             if far_field and n_src and n_pts >= min_interp:
                 from scipy.spatial import cKDTree
                 tree = cKDTree(field_.centers)
-                todo = [_make_box(x, np.arange(n_pts))]
+                todo = [_Box(0, n_pts, xp.min(axis=0), xp.max(axis=0))]
                 while todo:
                     cand, nxt = [], []
                     dist = tree.query(np.array([b.centre for b in todo]))[0]
                     for b, d in zip(todo, dist):
                         reach = (1.0 + separation) * b.half_diag
-                        if len(b.idx) < min_interp:
-                            direct_idx.append(b.idx)
+                        if len(b) < min_interp:
+                            direct.append(b)
                         elif d >= reach:
                             cand.append((b, None))
-                        elif len(b.idx) > leaf:
-                            nxt.extend(_split(x, b))
+                        elif len(b) > leaf:
+                            nxt.extend(_split(xp, perm, b))
                         else:
                             near = np.sort(np.asarray(tree.query_ball_point(b.centre, reach),
                                                       dtype=np.intp))
                             cand.append((b, near))
-                    items = [(b, near, b.idx[rng.choice(len(b.idx), min(checks, len(b.idx)),
-                                                        replace=False)])
+                    items = [(b, near, b.a + rng.choice(len(b), min(checks, len(b)), replace=False))
                              for b, near in cand]
                     for (b, near, _), (ok, err, pairs) in zip(items, run(box_task, items)):
                         stats.pairs += pairs
@@ -342,33 +349,32 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
                         if ok:
                             stats.n_boxes += 1
                             stats.n_nodes += n_nodes
-                            stats.n_interpolated += len(b.idx)
+                            stats.n_interpolated += len(b)
                             stats.max_check_error = max(stats.max_check_error,
                                                         err / max(value_scale, 1e-300))
                         else:
                             stats.n_rejected += 1
-                            if len(b.idx) >= 2 * min_interp:
-                                nxt.extend(_split(x, b))
+                            if len(b) >= 2 * min_interp:
+                                nxt.extend(_split(xp, perm, b))
                             else:
-                                direct_idx.append(b.idx)
+                                direct.append(b)
                     todo = nxt
             else:
-                direct_idx.append(np.arange(n_pts))
-            if direct_idx:
-                di = np.sort(np.concatenate(direct_idx))
-                stats.n_direct = len(di)
-                stats.pairs += len(di) * n_src
-                step = FAST_EVAL_CHUNK_ROWS
-                parts = [di[s:s + step] for s in range(0, len(di), step)]
+                direct.append(_Box(0, n_pts, None, None))
+            step = FAST_EVAL_CHUNK_ROWS
+            parts = [(a, min(a + step, b.b)) for b in direct for a in range(b.a, b.b, step)]
+            stats.n_direct = int(sum(len(b) for b in direct))
+            stats.pairs += stats.n_direct * n_src
 
-                def direct(rows):
-                    out[rows] = field_.rbf_at(x[rows])
+            def direct_rows(ab):
+                outp[ab[0]:ab[1]] = field_.rbf_at(xp[ab[0]:ab[1]])
 
-                run(direct, parts)
+            run(direct_rows, parts)
             # the polynomial, exactly, everywhere
             step = 65536
-            run(lambda s: field_.add_polynomial(x[s:s + step], out[s:s + step]),
+            run(lambda s: field_.add_polynomial(xp[s:s + step], outp[s:s + step]),
                 range(0, n_pts, step))
+            out[perm] = outp
         finally:
             if pool is not None:
                 pool.shutdown()
