@@ -340,7 +340,10 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
                         else:
                             near = np.sort(np.asarray(tree.query_ball_point(b.centre, reach),
                                                       dtype=np.intp))
-                            cand.append((b, near))
+                            if len(near) < n_src:
+                                cand.append((b, near))
+                            else:              # nothing far: direct
+                                direct.append(b)
                     items = [(b, near, b.a + rng.choice(len(b), min(checks, len(b)), replace=False))
                              for b, near in cand]
                     for (b, near, _), (ok, err, pairs) in zip(items, run(box_task, items)):
