@@ -204,22 +204,24 @@ class _Box:
         return 0.5 * (self.lo + self.hi)
 
 
-def _split(xp, perm, box):
-    """Two boxes: ``box`` cut at the middle of its longest side; its rows of
-    ``xp`` and ``perm`` are reordered in place (left part first)."""
+def _split(xt, perm, box):
+    """Two boxes: ``box`` cut at the middle of its longest side; its columns
+    of the (3, N) coordinates ``xt`` and its entries of ``perm`` are
+    reordered in place (left part first).  (Coordinates by rows: the bounding
+    boxes are contiguous reductions, 30x faster than over (n, 3) columns.)"""
     ax = int(np.argmax(box.hi - box.lo))
     mid = 0.5 * (box.lo[ax] + box.hi[ax])
-    seg = xp[box.a:box.b]
-    left = seg[:, ax] <= mid
+    seg = xt[:, box.a:box.b]
+    left = seg[ax] <= mid
     order = np.concatenate([np.flatnonzero(left), np.flatnonzero(~left)])
-    xp[box.a:box.b] = seg[order]
+    xt[:, box.a:box.b] = seg[:, order]
     perm[box.a:box.b] = perm[box.a:box.b][order]
     cut = box.a + int(left.sum())
     out = []
     for a, b in ((box.a, cut), (cut, box.b)):
         if b > a:
-            part = xp[a:b]
-            out.append(_Box(a, b, part.min(axis=0), part.max(axis=0)))
+            part = xt[:, a:b]
+            out.append(_Box(a, b, part.min(axis=1), part.max(axis=1)))
     return out
 
 
@@ -291,8 +293,9 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
     pool = ThreadPoolExecutor(max_workers=workers) if workers > 1 else None
     rng = np.random.default_rng(0)
     all_src = np.arange(n_src)
-    xp = x.copy()                  # points, permuted so that every box is a row range
-    perm = np.arange(n_pts)        # xp = x[perm]
+    xt = np.ascontiguousarray(x.T)  # (3, N) points, permuted so that every box is a range
+    xp = xt.T                      # (N, 3) view of them; xp = x[perm]
+    perm = np.arange(n_pts)
     outp = np.empty((n_pts, 4 * k))
     direct = []                    # boxes evaluated directly
 
@@ -325,7 +328,7 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
             if far_field and n_src and n_pts >= min_interp:
                 from scipy.spatial import cKDTree
                 tree = cKDTree(field_.centers)
-                todo = [_Box(0, n_pts, xp.min(axis=0), xp.max(axis=0))]
+                todo = [_Box(0, n_pts, xt.min(axis=1), xt.max(axis=1))]
                 while todo:
                     cand, nxt = [], []
                     dist = tree.query(np.array([b.centre for b in todo]))[0]
@@ -336,7 +339,7 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
                         elif d >= reach:
                             cand.append((b, None))
                         elif len(b) > leaf:
-                            nxt.extend(_split(xp, perm, b))
+                            nxt.extend(_split(xt, perm, b))
                         else:
                             near = np.sort(np.asarray(tree.query_ball_point(b.centre, reach),
                                                       dtype=np.intp))
@@ -358,7 +361,7 @@ def evaluate(field_: RBFField, x: np.ndarray, *, tol: float, value_scale: float,
                         else:
                             stats.n_rejected += 1
                             if len(b) >= 2 * min_interp:
-                                nxt.extend(_split(xp, perm, b))
+                                nxt.extend(_split(xt, perm, b))
                             else:
                                 direct.append(b)
                     todo = nxt
