@@ -52,7 +52,7 @@ CLOSURE_STAGE = "closing the selection"
 _BASIS_CHUNK = 65536
 #: free splats per call of the far-field basis evaluation (its (rows, 4K)
 #: float64 result and box tree; larger calls make larger far-field boxes)
-_FAST_CHUNK = 1 << 19
+_FAST_CHUNK = 1 << 18
 
 
 def _wrap(cloud, arrays, validate: bool, progress=None):
