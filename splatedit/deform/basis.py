@@ -39,6 +39,7 @@ from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_bloc
                                        rotation_displacement, split_displacement)
 from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
+from splatedit.blas import single_blas_thread
 from splatedit.errors import ParameterError
 from splatedit.progress import report
 from splatedit.select.closure import close_selection
@@ -153,8 +154,14 @@ class DeformationBasis:
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
         t_con = time.perf_counter()
-        rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
-                                 max_centers=max_centers, progress=progress)
+        # the fit's LAPACK calls are small (QR panels of 128 columns, an LU of
+        # m <= 3000): OpenBLAS's own threads cost far more than they gain on the
+        # shared 2-core machine (load 10: an IQR fit of m = 2069, 1100 centres
+        # 8.0 s wall / 3.7 s CPU with them, 0.48 / 0.25 s on one thread; the LU
+        # at m = 2900 2.9 s against 1.3-1.9 s), so they are held to one thread
+        with single_blas_thread():
+            rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
+                                     max_centers=max_centers, progress=progress)
         t1 = time.perf_counter()
 
         pos = cloud.positions

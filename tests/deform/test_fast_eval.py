@@ -166,3 +166,32 @@ def test_precompute_bench_quick_case_reports_every_path():
         assert key in out, key
     assert out["support"] == 8_000 and out["dev_rel"] <= BUDGET
     assert out["exact_pairs_fraction"] == 1.0
+
+
+def test_basis_fit_and_far_field_hold_blas_to_one_thread_and_restore_it(monkeypatch):
+    """The RBF solve (small LAPACK calls: OpenBLAS's threads made an IQR fit
+    16x slower on the loaded 2-core machine) and the far-field box tasks run
+    with BLAS on one thread; the library's own setting is back afterwards."""
+    from splatedit import blas
+    from splatedit.deform import fast_eval
+    from splatedit.deform import rbf as rbf_module
+    seen = {"fit": [], "rbf_at": []}
+    fit = rbf_module.TriharmonicRBF.fit.__func__
+    rbf_at = fast_eval.RBFField.rbf_at
+
+    def spy_fit(cls, *a, **kw):
+        seen["fit"].append(blas.blas_threads())
+        return fit(cls, *a, **kw)
+
+    def spy_at(self, *a, **kw):
+        seen["rbf_at"].append(blas.blas_threads())
+        return rbf_at(self, *a, **kw)
+
+    monkeypatch.setattr(rbf_module.TriharmonicRBF, "fit", classmethod(spy_fit))
+    monkeypatch.setattr(fast_eval.RBFField, "rbf_at", spy_at)
+    cloud = sphere_cloud(8_000)
+    sup, hnd = _grab(cloud, 0.4, 0.03)
+    before = blas.blas_threads()
+    DeformationBasis.fit(cloud, sup, [hnd], fill_holes=False)
+    assert seen["fit"] == [1] and seen["rbf_at"] and set(seen["rbf_at"]) == {1}
+    assert blas.blas_threads() == before
