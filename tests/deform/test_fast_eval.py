@@ -195,3 +195,17 @@ def test_basis_fit_and_far_field_hold_blas_to_one_thread_and_restore_it(monkeypa
     DeformationBasis.fit(cloud, sup, [hnd], fill_holes=False)
     assert seen["fit"] == [1] and seen["rbf_at"] and set(seen["rbf_at"]) == {1}
     assert blas.blas_threads() == before
+
+
+def test_a_rejected_box_of_coincident_points_is_evaluated_directly():
+    """Thousands of copies of one point form a box that cannot be split; when
+    its interpolant fails the check (an impossible tolerance here) it is
+    evaluated directly instead of being split forever."""
+    f, fld, vs = _field(4)
+    x = np.concatenate([np.repeat(f.centers[:1] * 0.5, 12_000, axis=0),
+                        np.random.default_rng(5).uniform(-0.5, 0.5, (12_000, 3)) * [1, 1, 0.4]])
+    xn = (x - f.shift) / f.scale
+    ref, _ = evaluate(fld, xn, tol=0.0, value_scale=vs, far_field=False)
+    out, st = evaluate(fld, xn, tol=1e-300, value_scale=vs)
+    assert st.n_rejected > 0 and st.n_direct == len(x)
+    np.testing.assert_allclose(out, ref, rtol=0, atol=1e-12)
