@@ -56,6 +56,17 @@ _BASIS_CHUNK = 65536
 _FAST_CHUNK = 1 << 18
 
 
+def _spatial_chunks(rows: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``rows`` reordered by a coarse 16^3 grid over ``points`` (x-major), so
+    that consecutive evaluation chunks are compact slabs of the support
+    whatever the file order (a shuffled 400k support evaluated in two chunks
+    computed 20% of the splat-centre pairs instead of 12%)."""
+    lo = points.min(axis=0)
+    ext = float(np.max(points.max(axis=0) - lo)) or 1.0
+    g = np.minimum((points - lo) * (16.0 / ext), 15.0).astype(np.int64)
+    return rows[np.argsort((g[:, 0] * 16 + g[:, 1]) * 16 + g[:, 2], kind="stable")]
+
+
 def _wrap(cloud, arrays, validate: bool, progress=None):
     """A copy of ``cloud`` with the deformed ``(positions, u, v)`` arrays
     (no ``__init__``: skips the O(n) validation on the hot path), checked
@@ -186,8 +197,9 @@ class DeformationBasis:
         # (splatedit.deform.fast_eval); chunks bound the (rows, 4K) temporaries
         value_scale = float(np.max(np.abs(con.values))) if con.values.size else 1.0
         eval_stats = []
+        rows = _spatial_chunks(free_rows, pos[idx[free_rows]]) if n_free > _FAST_CHUNK else free_rows
         for s in range(0, n_free, _FAST_CHUNK):
-            r = free_rows[s:s + _FAST_CHUNK]
+            r = rows[s:s + _FAST_CHUNK]
             val, grad, est = rbf.value_and_gradient_fast(pos[idx[r]], tol=eval_tol,
                                                          value_scale=value_scale)
             eval_stats.append(est)
