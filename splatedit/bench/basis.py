@@ -20,6 +20,8 @@ Fields of one case (times in seconds, memory in MB):
   keeps (its (N, 4, K) rows plus the CPU apply's cached arrays);
 * ``constraints_s`` / ``fit_s`` / ``basis_s`` (the RBF values and gradients
   at every free splat) and ``basis_ns_per_pair`` (per splat and centre);
+  ``basis_pairs_fraction``: the splat-centre pairs the far-field evaluation
+  computed, of n_free x centres;
 * ``hot_build_s``: building the apply's cached arrays (the first apply);
   ``apply_s``: one more apply (best of ``repeats``); ``copy_s``: a plain copy
   of the cloud's positions and axes; ``jacobians_s``: the (N, 3, 3) Jacobians;
@@ -150,6 +152,7 @@ def basis_case(support_splats: int, *, scipy_max: int = 1_000_000, repeats: int 
                constraints_s=round(st["constraints_seconds"], 2), fit_s=round(st["fit_seconds"], 2),
                basis_s=round(st["basis_seconds"], 2),
                basis_ns_per_pair=round(1e9 * st["basis_seconds"] / max(1, n_free * centers), 2),
+               basis_pairs_fraction=round(st["eval_pairs"] / max(1, n_free * centers), 4),
                constraints_peak_mb=round(stages.mb["constraints"], 1),
                fit_peak_mb=round(stages.mb["fit"], 1),
                basis_peak_mb=round(stages.mb["basis"], 1), basis_kept_mb=round(pack_mb, 1),

@@ -12,13 +12,21 @@ from typing import Iterator
 
 
 def _solve(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    """The Table-1 cases, then the handle-to-first-frame grabs of
+    :mod:`splatedit.bench.precompute` (``counts``: only grabs, of these
+    support sizes, on clouds 2.5 times as large)."""
+    from splatedit.bench.precompute import CASES, QUICK_CASES, bench_precompute
     from splatedit.bench.solve import bench_solve, standard_cases
+    if counts:
+        yield from bench_precompute([(int(2.5 * c), int(c)) for c in counts])
+        return
     for name, cloud, support, handles in standard_cases(large=not quick):
         if quick and cloud.n > 300_000:
             continue
         out = {"bench": "solve"}
         out.update(bench_solve(cloud, support, handles, name=name))
         yield out
+    yield from bench_precompute(QUICK_CASES if quick else CASES, gemm_size=1024 if quick else 4096)
 
 
 def _groups(quick: bool, progress=None, counts=None) -> Iterator[dict]:
@@ -286,7 +294,7 @@ def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
               large: bool = False, size=None, path=None, models=(), tiny: bool = False) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
     ``counts``: splat/point counts for ``estimate``, ``render``, ``editor``, ``closure`` and
-    support splats for ``basis``
+    support splats for ``basis`` and ``solve`` (its grab cases)
     (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``;
     ``size`` (width, height) applies to ``render`` and :data:`SIZED`, ``path`` ("raster" /
     "compute") to :data:`SIZED`, ``models`` (extra model files, e.g. a real scan) to ``render``;

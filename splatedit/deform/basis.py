@@ -40,14 +40,29 @@ from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_bloc
                                        rotation_displacement, split_displacement)
 from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
+from splatedit.blas import single_blas_thread
 from splatedit.errors import ParameterError
 from splatedit.progress import report
-from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL, POLY_CHECK_PROBE_SPLATS
+from splatedit.tolerances import BAND_RINGS, FAST_EVAL_TOL, IQR_DEFAULT_TOL, POLY_CHECK_PROBE_SPLATS
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
-#: support splats per chunk when evaluating the RBF for the basis and the Jacobians
+#: support splats per chunk when computing the Jacobians
 _BASIS_CHUNK = 65536
+#: free splats per call of the far-field basis evaluation (its (rows, 4K)
+#: float64 result and box tree; larger calls make larger far-field boxes)
+_FAST_CHUNK = 1 << 18
+
+
+def _spatial_chunks(rows: np.ndarray, points: np.ndarray) -> np.ndarray:
+    """``rows`` reordered by a coarse 16^3 grid over ``points`` (x-major), so
+    that consecutive evaluation chunks are compact slabs of the support
+    whatever the file order (a shuffled 400k support evaluated in two chunks
+    computed 20% of the splat-centre pairs instead of 12%)."""
+    lo = points.min(axis=0)
+    ext = float(np.max(points.max(axis=0) - lo)) or 1.0
+    g = np.minimum((points - lo) * (16.0 / ext), 15.0).astype(np.int64)
+    return rows[np.argsort((g[:, 0] * 16 + g[:, 1]) * 16 + g[:, 2], kind="stable")]
 
 
 def _wrap(cloud, arrays, validate: bool, progress=None):
@@ -81,7 +96,10 @@ class DeformationBasis:
             first fills both in), ``n_conflicts``
             (fixed splats dropped next to handle bands), ``constraints_seconds``
             (bands and control frames), ``fit_seconds`` (the RBF solve),
-            ``basis_seconds``, ``n_support``, ``n_free``, ``n_fixed_band``,
+            ``basis_seconds``, ``n_support``, ``n_free``, ``eval_tol``,
+            ``eval_pairs`` (splat-centre pairs the basis evaluation computed;
+            exact evaluation: n_free * n_centers), ``eval_interpolated`` (free
+            splats whose far field was interpolated), ``n_fixed_band``,
             ``n_handle_band``, ``n_curve_samples``, ``n_curve_dropped``,
             ``spacing``, ``message``.
     """
@@ -103,7 +121,8 @@ class DeformationBasis:
     def fit(cls, cloud, support, handles=(), *, curves=(), method: str = "auto",
             tol: float = IQR_DEFAULT_TOL, max_centers: int | None = None,
             rings: float = BAND_RINGS, spacing: float | None = None,
-            fill_holes: bool = False, graph=None, progress=None) -> "DeformationBasis":
+            fill_holes: bool = False, graph=None, progress=None,
+            eval_tol: float = FAST_EVAL_TOL) -> "DeformationBasis":
         """Build constraints, fit one RBF to all group columns, evaluate bases.
 
         Args:
@@ -120,6 +139,11 @@ class DeformationBasis:
                 is the caller's, e.g. ``closed_masks(cloud, support, handles)``.
             graph: unused (the closure's graph belonged here before).
             progress: optional ``progress(stage, fraction)``.
+            eval_tol: the basis values and gradients at the free splats are
+                evaluated by far-field interpolation
+                (:mod:`splatedit.deform.fast_eval`) within about this times
+                the largest constraint value of the exact float64 RBF (checked
+                per box); 0 evaluates them exactly (every splat, every centre).
         Raises:
             ParameterError / SolverError from the constraints and the fit.
         """
@@ -132,9 +156,15 @@ class DeformationBasis:
                                 spacing=spacing)
         t_con = time.perf_counter()
         free = con.free_index
-        rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
-                                 max_centers=max_centers, progress=progress,
-                                 probe=cloud.positions[free[::max(1, len(free) // POLY_CHECK_PROBE_SPLATS)]])
+        # the fit's LAPACK calls are small (QR panels of 128 columns, an LU of
+        # m <= 3000): OpenBLAS's own threads cost far more than they gain on the
+        # shared 2-core machine (load 10: an IQR fit of m = 2069, 1100 centres
+        # 8.0 s wall / 3.7 s CPU with them, 0.48 / 0.25 s on one thread; the LU
+        # at m = 2900 2.9 s against 1.3-1.9 s), so they are held to one thread
+        with single_blas_thread():
+            rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
+                                     max_centers=max_centers, progress=progress,
+                                     probe=cloud.positions[free[::max(1, len(free) // POLY_CHECK_PROBE_SPLATS)]])
         t1 = time.perf_counter()
 
         pos = cloud.positions
@@ -155,9 +185,16 @@ class DeformationBasis:
         free_rows = np.searchsorted(idx, con.free_index)
         n_free = len(free_rows)
         report(progress, PROGRESS_STAGE, 0.0)
-        for s in range(0, n_free, _BASIS_CHUNK):
-            r = free_rows[s:s + _BASIS_CHUNK]
-            val, grad = rbf.value_and_gradient(pos[idx[r]])
+        # far-field interpolation within eval_tol of the largest constraint value
+        # (splatedit.deform.fast_eval); chunks bound the (rows, 4K) temporaries
+        value_scale = float(np.max(np.abs(con.values))) if con.values.size else 1.0
+        eval_stats = []
+        rows = _spatial_chunks(free_rows, pos[idx[free_rows]]) if n_free > _FAST_CHUNK else free_rows
+        for s in range(0, n_free, _FAST_CHUNK):
+            r = rows[s:s + _FAST_CHUNK]
+            val, grad, est = rbf.value_and_gradient_fast(pos[idx[r]], tol=eval_tol,
+                                                         value_scale=value_scale)
+            eval_stats.append(est)
             pack[r, 0, :] = val
             pack[r, 1:, :] = grad.transpose(0, 2, 1)
             report(progress, PROGRESS_STAGE, (s + len(r)) / n_free)
@@ -167,7 +204,10 @@ class DeformationBasis:
             residual=float(rbf.residual), method=rbf.method, polynomial=bool(rbf.polynomial),
             closure_seconds=0.0, closure_added=0,
             n_conflicts=sum(c.count for c in con.conflicts),
-            constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1, n_support=int(n_sup), n_free=int(n_free),
+            constraints_seconds=t_con - t_closure, fit_seconds=t1 - t_con, basis_seconds=t2 - t1,
+            n_support=int(n_sup), n_free=int(n_free), eval_tol=float(eval_tol),
+            eval_pairs=int(sum(e.pairs for e in eval_stats)),
+            eval_interpolated=int(sum(e.n_interpolated for e in eval_stats)),
             n_fixed_band=int(len(con.fixed_index)),
             n_handle_band=[int(len(b)) for b in con.handle_band_index],
             n_curve_samples=[int(len(c.points)) for c in con.curves],

@@ -71,7 +71,8 @@ from scipy.spatial import cKDTree
 from splatedit.deform.frames import affine_coordinates, handle_frame
 from splatedit.errors import ParameterError, SolverError
 from splatedit.model.spacing import point_spacing
-from splatedit.tolerances import BAND_RINGS, BAND_SLACK_REL, CONFLICT_RINGS, CURVE_MAX_SAMPLES_FLOOR
+from splatedit.tolerances import (BAND_RINGS, BAND_SLACK_REL, CONFLICT_RINGS, CURVE_MAX_SAMPLES_FLOOR,
+                                  SPACING_SAMPLE)
 
 
 class CurveSamplesError(SolverError):
@@ -273,6 +274,22 @@ def _unique_rows(index: np.ndarray, points: np.ndarray) -> np.ndarray:
     return index[np.sort(first)]
 
 
+def _support_spacing(sup_pts: np.ndarray, tree: cKDTree) -> float:
+    """:func:`point_spacing` of the support; above SPACING_SAMPLE splats the
+    median is taken over an evenly strided sample of them (nearest neighbours
+    still among all support splats): the median of 65k samples is within
+    about 1% of the full one, and a 400k-splat support's k-NN query over every
+    splat took 0.26 s of CPU of its 0.62 s constraints."""
+    n = len(sup_pts)
+    if n <= SPACING_SAMPLE:
+        return point_spacing(sup_pts, tree=tree)
+    sample = sup_pts[::-(-n // SPACING_SAMPLE)]
+    d, _ = tree.query(sample, k=2, workers=-1)
+    if (d[:, 1] > 0).mean() < 0.5:   # mostly duplicates: the full rule
+        return point_spacing(sup_pts, tree=tree)
+    return point_spacing(sample, nearest=d[:, 1])
+
+
 def _near(query: np.ndarray, reference: np.ndarray, width: float,
           tree: cKDTree | None = None) -> np.ndarray:
     """Mask of ``query`` points within ``width`` of any ``reference`` point."""
@@ -357,7 +374,7 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
     sup_pts = pos[support_index]
     sup_tree = cKDTree(sup_pts)
     if spacing is None:
-        h = point_spacing(sup_pts, tree=sup_tree) if len(sup_pts) > 1 else 0.0
+        h = _support_spacing(sup_pts, sup_tree) if len(sup_pts) > 1 else 0.0
         if h <= 0.0:
             h = point_spacing(pos)
         if h <= 0.0:
@@ -374,14 +391,19 @@ def build_constraints(cloud, support, handles=(), *, curves=(), rings: float = B
     fixed_index = out_index[_near(pos[out_index], sup_pts, w_query, sup_tree)]
     fixed_index = _unique_rows(fixed_index, pos[fixed_index])
 
-    # handle bands: handle splats within the width of a free splat
+    # handle bands: handle splats within the width of a free splat (the free
+    # splats' tree is built only when curves need it; a handle's band needs
+    # only the free splats within its bounding box grown by the width)
     free_pts = pos[free_index]
-    free_tree = cKDTree(free_pts)
+    free_tree = cKDTree(free_pts) if curve_objs else None
     groups = []
     for i, m in enumerate(hmasks):
         hidx = np.flatnonzero(m)
         frame = handle_frame(pos[hidx], h)
-        band = hidx[_near(pos[hidx], free_pts, w_query, free_tree)]
+        hp = pos[hidx]
+        lo, hi = hp.min(axis=0) - w_query, hp.max(axis=0) + w_query
+        near_free = free_pts[np.all((free_pts >= lo) & (free_pts <= hi), axis=1)]
+        band = hidx[_near(hp, near_free, w_query)]
         band = _unique_rows(band, pos[band])
         if len(band) == 0:
             raise SolverError(f"handle {i} has no splat within {rings:g} point spacings "

@@ -353,6 +353,20 @@ class TriharmonicRBF:
         """``(values (N, k), gradients (N, k, 3))`` with one distance matrix per chunk."""
         return self._eval(x, True, True)
 
+    def value_and_gradient_fast(self, x, *, tol: float, value_scale: float):
+        """``(values (N, k), gradients (N, k, 3), stats)`` by far-field
+        interpolation (:func:`splatedit.deform.fast_eval.evaluate`): within
+        about ``tol * value_scale`` of :meth:`value_and_gradient` (values, and
+        gradients times the normalisation ``scale``), checked per box.
+        ``tol = 0`` evaluates every point directly (exact)."""
+        from splatedit.deform.fast_eval import RBFField, evaluate
+        xn = self._normalise_query(x)
+        fld = RBFField(self._centers_n, self.weights, self.poly_coeffs)
+        out, stats = evaluate(fld, xn, tol=tol, value_scale=value_scale, far_field=tol > 0)
+        k = self._k
+        grads = out[:, k:].reshape(len(xn), 3, k).transpose(0, 2, 1) / self.scale
+        return out[:, :k], grads, stats
+
 
 def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarray) -> np.ndarray:
     """(k,) ``||f(points) - values|| / ||values||`` per column: the residual

@@ -58,16 +58,21 @@ def free_rows(basis):
 
 # ------------------------------------------------------------- the field
 def test_basis_equals_the_fitted_field_and_its_gradient(one):
-    cloud, sup, hnd, b = one
+    """With ``eval_tol=0`` every free splat is evaluated directly: the basis
+    is the fitted field to rounding."""
+    cloud, sup, hnd, _ = one
+    b = DeformationBasis.fit(cloud, sup, [hnd], method="lu", fill_holes=False, eval_tol=0.0)
+    assert b.stats["eval_interpolated"] == 0
     assert b.B.shape == b.Bx.shape == (sup.sum(), 4)
     np.testing.assert_array_equal(b.indices, np.flatnonzero(sup))
     dc = b.displacement([lift_and_tilt(cloud, hnd)])
     rows = free_rows(b)
     p = cloud.positions[b.indices[rows]]
     field = b.rbf(p)
-    np.testing.assert_allclose(b.B[rows], field, rtol=0, atol=1e-12)
+    # (the direct path sums in another order than rbf(): 2e-12 seen with cancelling weights)
+    np.testing.assert_allclose(b.B[rows], field, rtol=0, atol=1e-11)
     out = b.apply(cloud, dc)
-    np.testing.assert_allclose(out.positions[b.indices[rows]], p + field @ dc, rtol=0, atol=1e-12)
+    np.testing.assert_allclose(out.positions[b.indices[rows]], p + field @ dc, rtol=0, atol=1e-11)
     # Jacobian bases = central finite differences of the field
     eps = 1e-4 * b.constraints.spacing
     sel = rows[:: max(1, len(rows) // 200)]
@@ -421,15 +426,17 @@ def test_gap_filling_leaves_scattered_indices_alone():
 def test_basis_precompute_memory_does_not_grow_with_the_support(monkeypatch):
     """The basis evaluation (values and gradients at every free splat) needs,
     beyond the (N, 4, K) rows it fills, only chunk buffers: the same peak
-    (tracemalloc, from the stage's start) for a 31k- and a 125k-splat support
-    (4x), and below the two threads' two 4-MiB work matrices each (measured
-    11.4 MB at both).  A support-sized temporary (one (N, K, 3) gradient array
+    (tracemalloc, from the stage's start to its end) for a 31k- and a 125k-splat
+    support (4x) in 8192-splat chunks, and below the two threads' two 4-MiB
+    work matrices each (measured 11.4 MB at both with the exact evaluation; the
+    far-field one's 256-row chunks need less).  A support-sized temporary (one (N, K, 3) gradient array
     is 12 MB at 125k) would break both."""
     import tracemalloc
 
     import splatedit.deform.basis as basis_module
     from splatedit.tolerances import EVAL_CHUNK_MAX_BYTES, EVAL_THREADS
     monkeypatch.setattr(basis_module, "_BASIS_CHUNK", 8192)
+    monkeypatch.setattr(basis_module, "_FAST_CHUNK", 8192)
     extra = []
     for n in (250, 500):
         cloud = wavy_plane_cloud(n)
@@ -440,15 +447,20 @@ def test_basis_precompute_memory_does_not_grow_with_the_support(monkeypatch):
             if stage == basis_module.PROGRESS_STAGE and fraction == 0.0:
                 tracemalloc.reset_peak()
                 base["bytes"] = tracemalloc.get_traced_memory()[0]
+            elif stage == basis_module.PROGRESS_STAGE and fraction == 1.0:
+                # the stage's end (the stretch probe's samples come after it)
+                base["peak"] = tracemalloc.get_traced_memory()[1]
 
         tracemalloc.start()
         try:
             b = DeformationBasis.fit(cloud, r < 0.8, [r < 0.2], method="iqr", max_centers=60,
                                      fill_holes=False, progress=progress)
-            extra.append(tracemalloc.get_traced_memory()[1] - base["bytes"])
+            extra.append(base["peak"] - base["bytes"])
         finally:
             tracemalloc.stop()
         assert len(b.constraints.free_index) > 3 * 8192
     print(f"peak beyond the basis rows: {extra[0] / 2**20:.2f} / {extra[1] / 2**20:.2f} MB")
-    assert extra[1] <= 1.05 * extra[0]
+    # the far-field boxes of a chunk differ with the support (4.5 / 6.2 MB
+    # measured); a support-sized temporary would be 4x
+    assert extra[1] <= 1.5 * extra[0]
     assert max(extra) < 2 * EVAL_THREADS * EVAL_CHUNK_MAX_BYTES
