@@ -53,7 +53,7 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
 from splatedit.render.frame_passes import FrameContext, RasterSplats, Resolve
-from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
+from splatedit.render.splat_layout import RESOLVE_SET, WORKGROUP
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
 
 #: splats per box of the shading rect (:meth:`ProgressiveFrame._chunk_rect`)
@@ -62,7 +62,7 @@ _BOX_BLOCK = 4096
 #: the shading pass over the shown image: loads it, writes covered pixels ("over":
 #: the intermediate uniforms give uncovered pixels alpha 0, so they keep what is there)
 _RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
-_OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(_RESOLVE_SET,)),
+_OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(RESOLVE_SET,)),
                             topology="triangle_list", blend_alpha=True)
 
 
@@ -136,7 +136,7 @@ class ProgressiveFrame:
         if not prepared:
             return first, min(self.chunk, self.n - first)
         end = next(w0 + wn for w0, wn, _ in self.r._prep_objects().windows if w0 <= first < w0 + wn)
-        size = -(-self.chunk // _WORKGROUP) * _WORKGROUP
+        size = -(-self.chunk // WORKGROUP) * WORKGROUP
         return first, min(size, end - first)
 
     def step(self, readback: bool = True) -> np.ndarray | None:

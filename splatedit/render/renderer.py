@@ -45,9 +45,9 @@ from splatedit.render.compute_raster import ComputeRaster, choose_path, probe_ke
 from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.prepass import PrepassMixin
-from splatedit.render.splat_layout import (_GEOM_STRIDE, _RESOLVE_SET, _RP_POINTS, _SPLAT_SET,
-                                           _UBO_BYTES, _rp_attr, _splat_desc)
-from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
+from splatedit.render.splat_layout import (GEOM_STRIDE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
+                                           UBO_BYTES, rp_attr, splat_desc)
+from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
@@ -162,8 +162,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._query = None
         self._max_point_size = float(self.dev.limits.pointSizeRange[1]) if self.dev.features.largePoints else 1.0
         try:
-            create_frame_objects(self, _UBO_BYTES)
-            self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
+            create_frame_objects(self, UBO_BYTES)
+            self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(SPLAT_SET))
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 16)
         except BaseException:
@@ -247,7 +247,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):
         g = self._basis_groups
-        bindings = (V.VertexBinding(0, _GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
+        bindings = (V.VertexBinding(0, GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
                     V.VertexBinding(3, basis_stride))
         off = {f: SPLAT_GEOM.fields[f][1] for f in ("center", "u", "v")}    # splatedit/render/uniforms.py
         attrs = [V.VertexAttribute(0, 0, "vec3", off["center"]), V.VertexAttribute(1, 0, "vec3", off["u"]),
@@ -260,22 +260,22 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         g = self._basis_groups
         deformed = self._basis_buf is not None and len(self._basis_rows) > 0
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
-        layout = V.LayoutDesc(sets=(_SPLAT_SET,))
+        layout = V.LayoutDesc(sets=(SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
-        return self.cache.pipeline(_splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
+        return self.cache.pipeline(splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
                                                attributes=attrs, spec=((0, mode),),
                                                topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _resolve_pipeline(self, target: RenderTarget):
-        return self.cache.pipeline(resolve_desc(target, "resolve.frag", _RESOLVE_SET))
+        return self.cache.pipeline(resolve_desc(target, "resolve.frag", RESOLVE_SET))
 
-    def _record_resolve(self, cb, t: _Targets, target: RenderTarget) -> None:
+    def _record_resolve(self, cb, t: SplatTargets, target: RenderTarget) -> None:
         """The shading pass: normalise the accumulators of ``t``, shade, write ``target``."""
-        t.record_resolve(cb, target, "resolve.frag", _RESOLVE_SET)
+        t.record_resolve(cb, target, "resolve.frag", RESOLVE_SET)
 
     # ------------------------------------------------------------- frames
-    def _targets_for(self, width: int, height: int) -> _Targets:
-        return targets_for(self, width, height, _Targets)
+    def _targets_for(self, width: int, height: int) -> SplatTargets:
+        return targets_for(self, width, height, SplatTargets)
 
     def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         # everything on the GPU is in model units relative to origin, divided
@@ -336,15 +336,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.bind_vertex_buffers(0, bufs)
             cb.draw(verts, count, 0, first)
 
-    def _fb_attr_readback(self, t: _Targets):
+    def _fb_attr_readback(self, t: SplatTargets):
         if getattr(t, "fb_attr_rb", None) is None:
-            rp = self.cache.render_pass(_rp_attr(self.accum_format, "transfer_src"))
+            rp = self.cache.render_pass(rp_attr(self.accum_format, "transfer_src"))
             t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
         return t.fb_attr_rb
 
     # ------------------------------------------------- frames as pass lists
-    #: the resolve pass's descriptor-set layout (frame_passes.Resolve)
-    _resolve_set_layout = _RESOLVE_SET
+    #: the resolve pass's shader and descriptor-set layout (frame.Resolve)
+    resolve_shader = "resolve.frag"
+    resolve_set_layout = RESOLVE_SET
 
     def frame_path(self, width: int, height: int) -> str:
         """``"compute"`` or ``"raster"``: the path a frame of this size takes
@@ -370,7 +371,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             ms[path] = self._last_frame.read_timings(self._query)["total"]
         return {"path": min(ms, key=ms.get), **{f"ms_{p}": round(v, 3) for p, v in ms.items()}}
 
-    def _compute_raster(self, t: _Targets) -> ComputeRaster:
+    def _compute_raster(self, t: SplatTargets) -> ComputeRaster:
         """The compute rasterizer's buffers for targets ``t`` and the current pre-pass."""
         prep = self._prep_objects()
         c = self._crast
@@ -386,7 +387,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                 self.dev.wait_idle()
             c.destroy()
 
-    def _record(self, cb, frame: Frame, t: _Targets, target=None) -> Frame:
+    def _record(self, cb, frame: Frame, t: SplatTargets, target=None) -> Frame:
         """Record ``frame`` (timestamps in the query pool) against targets ``t``."""
         if frame.outputs & {"depth", "accum", "vis_buffer", "accum_buffers"}:
             self.frames_recorded += 1      # the shared targets a progressive frame draws into
@@ -490,9 +491,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if getattr(t, "fb_points", None) is None:
             t.points_color = t._add(V.Image(self.dev, width, height, "rgba8", ("color",)))
             t.points_depth = t._add(V.Image(self.dev, width, height, "d32f", ("depth",)))
-            t.fb_points = t._fb(self.cache.render_pass(_RP_POINTS), [t.points_color, t.points_depth])
-        desc = V.GraphicsDesc("points.vert", "points.frag", _RP_POINTS, V.LayoutDesc(sets=(_SPLAT_SET,)),
-                              topology="point_list", bindings=(V.VertexBinding(0, _GEOM_STRIDE, per_instance=False),),
+            t.fb_points = t._fb(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
+        desc = V.GraphicsDesc("points.vert", "points.frag", RP_POINTS, V.LayoutDesc(sets=(SPLAT_SET,)),
+                              topology="point_list", bindings=(V.VertexBinding(0, GEOM_STRIDE, per_instance=False),),
                               attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),
                               depth_test=True, depth_write=True)
         pipe = self.cache.pipeline(desc)
@@ -501,7 +502,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             self._write_ubo(camera, width, height)
             cb.reset_queries(self._query)
             cb.timestamp(self._query, 0, bottom=False)
-            cb.begin_render_pass(self.cache.render_pass(_RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
+            cb.begin_render_pass(self.cache.render_pass(RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
             cb.bind_pipeline(pipe)
             cb.bind_descriptor_set(pipe, self.splat_set)
             cb.bind_vertex_buffers(0, [self._geom])

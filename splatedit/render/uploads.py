@@ -19,7 +19,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
 from splatedit.render.gpu_units import (MAX_GROUPS, pack_basis_rows, pack_deform_block, selection_flags,
                                         unit_scale)
-from splatedit.render.splat_layout import FLAG_DEFORMED, _GEOM_STRIDE
+from splatedit.render.splat_layout import FLAG_DEFORMED, GEOM_STRIDE
 from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
 from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
                                   RENDER_VISIBILITY_EPS_RADII)
@@ -67,7 +67,7 @@ class SceneUploadsMixin:
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
         self.scale = unit_scale(float(np.linalg.norm(hi - lo)), rmax)
-        self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
+        self._geom = V.Buffer(self.dev, n * GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self._geom)
         self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
         self._cloud_bufs.append(self._color)
@@ -91,19 +91,19 @@ class SceneUploadsMixin:
         splats they were 360 MB each on top of the 360 MB device buffer)."""
         n = cloud.n
         chunk = min(n, RENDER_UPLOAD_CHUNK_SPLATS)
-        staging = V.Buffer(self.dev, chunk * _GEOM_STRIDE, ("transfer_src",), host_visible=True)
+        staging = V.Buffer(self.dev, chunk * GEOM_STRIDE, ("transfer_src",), host_visible=True)
         try:
             inv = 1.0 / self.scale                   # an exact power of two
             default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
             for lo in range(0, n, chunk):
                 m = min(chunk, n - lo)
-                geom = staging.view(np.uint8)[:m * _GEOM_STRIDE].view(SPLAT_GEOM)   # m records
+                geom = staging.view(np.uint8)[:m * GEOM_STRIDE].view(SPLAT_GEOM)   # m records
                 np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom["center"],
                             casting="same_kind")
                 np.multiply(cloud.u[lo:lo + m], inv, out=geom["u"], casting="same_kind")
                 np.multiply(cloud.v[lo:lo + m], inv, out=geom["v"], casting="same_kind")
-                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
-                                                          lo * _GEOM_STRIDE))
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * GEOM_STRIDE, 0,
+                                                          lo * GEOM_STRIDE))
                 col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
                 col[:] = default if cloud.colors is None else cloud.colors[lo:lo + m]
                 self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
