@@ -414,6 +414,11 @@ class GaussianRenderer:
         self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
         self._near_far = (near * sc, far * sc)
 
+    #: the :class:`~splatedit.render.scene.SceneRenderer` capabilities: no detail
+    #: mode rows; the viewport reads Gaussian frames back (no resident presentation yet)
+    supports_detail = False
+    resident_frames = False
+
     # ------------------------------------------------ pieces the passes record
     #: the resolve pass's shader and descriptor-set layout (frame.Resolve)
     resolve_shader = "gs_resolve.frag"
@@ -566,6 +571,19 @@ class GaussianRenderer:
         self.last_timings_ms["resolve"] = ts["resolve"]
         self.last_timings_ms["visible"] = float(self._n_visible)
         return out
+
+    def render_resident(self, camera: Camera, width: int, height: int):
+        """Render without reading back: the rgba8 output image (TRANSFER_SRC
+        layout), valid until the next frame of this renderer (the interface of
+        :meth:`Renderer.render_resident`)."""
+        self.prepare_frame(camera, width, height)
+        t = self._targets
+        self.dev.submit(lambda cb: self.record_draw(cb, t.offscreen))
+        if self._check_tile_pairs():
+            self.dev.submit(lambda cb: self.record_draw(cb, t.offscreen))
+        ts = self._last_draw.read_timings(self._query, self._DRAW_QUERY)
+        self.last_timings_ms.update(draw=ts["draw"], resolve=ts["resolve"], visible=float(self._n_visible))
+        return t.out
 
     def pick(self, camera: Camera, width: int, height: int, rect=None):
         """Gaussian index per pixel (-1 background) and view-axis depth of its

@@ -343,6 +343,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         return t.fb_attr_rb
 
     # ------------------------------------------------- frames as pass lists
+    #: the :class:`~splatedit.render.scene.SceneRenderer` capabilities: the detail
+    #: mode's rows (set_detail) and frames the presenter blits (render_resident)
+    supports_detail = True
+    resident_frames = True
+
+    @property
+    def targets(self):
+        """The per-size images of the last frame size (None before a frame)."""
+        return self._targets
+
     #: the resolve pass's shader and descriptor-set layout (frame.Resolve)
     resolve_shader = "resolve.frag"
     resolve_set_layout = RESOLVE_SET
