@@ -48,14 +48,14 @@ class Prepass(Pass):
 
     def record(self, cb, ctx):
         if ctx.prepared and ctx.windows == 1:
-            ctx.r._record_prepass(cb)
+            ctx.r.record_prepass(cb)
 
 
 class RasterSplats(Pass):
     """A raster splat pass: ``kind`` ``"depth"`` (visibility), ``"attr"``
     (attribute accumulation into the accumulator images, left in layout
     ``attr_final``) or ``"pick"``.  ``chunk`` = (first splat, count, pre-pass
-    window, descriptor sets from :meth:`Renderer._prep_range` or None) draws
+    window, descriptor sets from :meth:`Renderer.prep_range` or None) draws
     only those splats (preparing them first on the pre-pass path), loading
     what earlier chunks left unless ``first`` is 0."""
 
@@ -74,7 +74,7 @@ class RasterSplats(Pass):
         if self.kind == "depth":
             return RP_DEPTH, t.fb_depth, [1.0]
         if self.kind == "attr":
-            fb = t.fb_attr if self.attr_final == "shader_read" else r._fb_attr_readback(t)
+            fb = t.fb_attr if self.attr_final == "shader_read" else r.fb_attr_readback(t)
             return rp_attr(r.accum_format, self.attr_final), fb, [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None]
         t.ensure_pick()
         return RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0]
@@ -83,19 +83,19 @@ class RasterSplats(Pass):
         desc, fb, clears = self._target(ctx)
         r = ctx.r
         if self.chunk is None:
-            r._record_splat_pass(cb, self.kind, desc, fb, clears, ctx.prepared)
+            r.record_splat_pass(cb, self.kind, desc, fb, clears, ctx.prepared)
             return
         first, count, window, sets = self.chunk
         if first > 0:
             desc = {"depth": _RP_DEPTH_LOAD, "attr": _rp_attr_load(r.accum_format), "pick": _RP_PICK_LOAD}[self.kind]
             clears = [None] * len(clears)
         if ctx.prepared:
-            r._record_prepass(cb, window, sets)
+            r.record_prepass(cb, window, sets)
         cb.begin_render_pass(r.cache.render_pass(desc), fb, clears)
         if ctx.prepared:
-            r._record_splats(cb, self.kind, True, window)
+            r.record_splats(cb, self.kind, True, window)
         else:
-            r._record_vertex_splats(cb, self.kind, first, count)
+            r.record_vertex_splats(cb, self.kind, first, count)
         cb.end_render_pass()
 
 
@@ -107,13 +107,13 @@ class _ComputeSplats(Pass):
 
     def record(self, cb, ctx):
         r = ctx.r
-        crast = r._compute_raster(ctx.t)
+        crast = r.compute_rasterizer(ctx.t)
         crast.record_clear(cb, self.visibility)
-        prep = r._prep_objects()
+        prep = r.prep_objects()
         for k, (_, wn, _) in enumerate(prep.windows):
             if ctx.windows > 1:
                 cb.memory_barrier("compute", "shader_read", "compute", "none")
-                r._record_prepass(cb, k)
+                r.record_prepass(cb, k)
             cb.memory_barrier("compute", "shader_write", "compute", "shader_read")
             crast.record_draw(cb, r, self.visibility, wn)
 
@@ -143,7 +143,7 @@ class AccumulatorCopy(Pass):
         self.final = final
 
     def record(self, cb, ctx):
-        ctx.r._compute_raster(ctx.t).record_copy(cb, ctx.r, self.final)
+        ctx.r.compute_rasterizer(ctx.t).record_copy(cb, ctx.r, self.final)
 
 
 def splat_frame(path: str, attr_final: str = "shader_read", resolve: bool = True) -> Frame:

@@ -150,7 +150,7 @@ class GaussianRenderer:
         self._cols = 4
         self._basis_idx = np.zeros(0, np.int64)
         self._reach = 0.0
-        self._near_far = (1.0, 2.0)
+        self.near_far = (1.0, 2.0)
         self._n_visible = 0
         self.last_timings_ms: dict[str, float] = {}
         #: the editor's distortion heat map: support Gaussians coloured by the principal
@@ -383,7 +383,7 @@ class GaussianRenderer:
         """The per-size images for width x height (re-created when the size changes)."""
         return targets_for(self, width, height, GaussianTargets)
 
-    def _write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
+    def write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
         o, sc = self.origin, self.scale
         gpu_cam = gpu_camera(camera, o, sc)
         lo, hi = self.bounds
@@ -412,7 +412,7 @@ class GaussianRenderer:
                         1.0 if self.distortion_map else 0.0, 0.0)
         self.ubo.write(u.reshape(1).view(np.float32))
         self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
-        self._near_far = (near * sc, far * sc)
+        self.near_far = (near * sc, far * sc)
 
     #: the :class:`~splatedit.render.scene.SceneRenderer` capabilities: no detail
     #: mode rows; the viewport reads Gaussian frames back (no resident presentation yet)
@@ -496,7 +496,7 @@ class GaussianRenderer:
             # the last frame (e.g. the editor's, drawn by record_draw) dropped pairs: room for this one
             self._tiles.grow(self._tiles.pairs_wanted())
         t = self.targets_for(width, height)
-        self._write_ubo(camera, width, height, srgb_target)
+        self.write_ubo(camera, width, height, srgb_target)
         self.epoch += 1
         dv = self._draws.view(np.uint32)
         dv[:] = (4, 0, 0, 0)
@@ -596,7 +596,7 @@ class GaussianRenderer:
         self.epoch += 1
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
             # records of culled Gaussians are stale: draw in index order those the
             # pre-pass wrote this frame (order = identity, count = all; the

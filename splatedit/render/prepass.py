@@ -52,7 +52,7 @@ class PrepassMixin:
                 obj.destroy()
             self._prep = None
 
-    def _use_prepass(self) -> bool:
+    def use_prepass(self) -> bool:
         t = self._targets
         if self._detail_buf is not None:   # the detail mode has no vertex-path variant
             if t is not None and max(t.width, t.height) > PREP_MAX_SIZE:
@@ -70,7 +70,7 @@ class PrepassMixin:
         """Splat windows the compute pre-pass prepares and draws the cloud in at
         the current image size: 1 when the cloud fits one storage binding, 0 for
         the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
-        if self.cloud is None or not self._use_prepass():
+        if self.cloud is None or not self.use_prepass():
             return 0
         return len(self._prep_windows())
 
@@ -110,7 +110,7 @@ class PrepassMixin:
             out.append((base, cnt, base * row_bytes, cnt * row_bytes))
         return out
 
-    def _prep_objects(self):
+    def prep_objects(self):
         if self._prep is None:
             objs = []
             try:
@@ -158,12 +158,12 @@ class PrepassMixin:
             sets.append((dset, base, cnt))
         return sets
 
-    def _prep_range(self, first: int, count: int) -> tuple[int, list, list]:
+    def prep_range(self, first: int, count: int) -> tuple[int, list, list]:
         """Descriptor sets that prepare only splats ``first`` .. ``first + count - 1``
         (inside one splat window; ``first`` a multiple of the workgroup size):
         (window index, [(set, first splat, count)], the sets to destroy).
         :mod:`splatedit.render.progressive` draws its chunks so."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         k = next(i for i, (w0, wn, _) in enumerate(prep.windows) if w0 <= first < w0 + wn)
         w0, wn, _ = prep.windows[k]
         if first % WORKGROUP or first + count > w0 + wn:
@@ -179,13 +179,13 @@ class PrepassMixin:
             raise
         return k, sets, objs
 
-    def _record_prepass(self, cb, window: int = 0, sets: list | None = None):
+    def record_prepass(self, cb, window: int = 0, sets: list | None = None):
         """Compute pre-pass of splat window ``window``: records + indirect draw
         counts for this frame's camera (one dispatch per basis window); only
-        the splats of ``sets`` (from :meth:`_prep_range`) when given. Before
+        the splats of ``sets`` (from :meth:`prep_range`) when given. Before
         any window but the first of a frame, it waits for the draws that read
         the previous window's records."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         w0, wn, chunks = prep.windows[window]
         partial = sets is not None
         chunks = sets if partial else chunks
@@ -222,20 +222,20 @@ class PrepassMixin:
 
     def _prep_window_count(self, prepared: bool) -> int:
         """Pre-pass windows of this frame (1 for the vertex path)."""
-        return len(self._prep_objects().windows) if prepared else 1
+        return len(self.prep_objects().windows) if prepared else 1
 
-    def _record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
+    def record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
         """One splat pass (``kind`` depth, attr or pick) into ``fb``. With several
         pre-pass windows: per window, its pre-pass then its draws (in a render
         pass that keeps the previous windows' results)."""
         count = self._prep_window_count(prepared)
         if count == 1:
             cb.begin_render_pass(self.cache.render_pass(desc), fb, clears)
-            self._record_splats(cb, kind, prepared)
+            self.record_splats(cb, kind, prepared)
             cb.end_render_pass()
             return
         for k in range(count):
-            self._record_prepass(cb, k)
+            self.record_prepass(cb, k)
             cb.begin_render_pass(self.cache.render_pass(rp_window(desc, k == 0, k == count - 1)), fb, clears)
-            self._record_splats(cb, kind, True, k)
+            self.record_splats(cb, kind, True, k)
             cb.end_render_pass()

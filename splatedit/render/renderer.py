@@ -218,25 +218,22 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             if exc_type is None:
                 raise            # else: let the exception of the with-block propagate
 
-    def _check_open(self):
+    def check_open(self):
+        """Raise ParameterError when the renderer is closed."""
         if self._closed:
             raise ParameterError("renderer", "is closed")
 
     # -------------------------------------------------------------- scene
-    def _require_cloud(self):
-        if self.cloud is None:
-            raise ParameterError("cloud", "no cloud set (call set_cloud first)")
-
     def _clip_bounds(self):
         """The box that near/far are chosen from: the undeformed bounds grown
         by a bound on any splat's displacement (see :meth:`_reach`), so that
         geometry moved outside the model (a handle dragged towards the eye)
         is not clipped."""
         lo, hi = self.bounds
-        grow = self._displacement_reach()
+        grow = self.displacement_reach()
         return lo - grow, hi + grow
 
-    def _displacement_reach(self) -> float:
+    def displacement_reach(self) -> float:
         """A bound (model units) on how far any splat is moved from its uploaded
         position by the current basis and displacement (0 without a basis)."""
         if not len(self._basis_rows):
@@ -274,10 +271,10 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         t.record_resolve(cb, target, "resolve.frag", RESOLVE_SET)
 
     # ------------------------------------------------------------- frames
-    def _targets_for(self, width: int, height: int) -> SplatTargets:
+    def targets_for(self, width: int, height: int) -> SplatTargets:
         return targets_for(self, width, height, SplatTargets)
 
-    def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
+    def write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         # everything on the GPU is in model units relative to origin, divided
         # by scale: so is the camera (a similarity: the image is the same)
         o, sc = self.origin, self.scale
@@ -305,13 +302,13 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
             self._dC_dirty = False
-        self._near_far = (near * sc, far * sc)     # model units
+        self.near_far = (near * sc, far * sc)     # model units
 
-    def _record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
+    def record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
         """Draw every splat: as quads, or (point_splats) tiny ones as points +
         the others as quads; ``prepared``: the records of pre-pass window ``window``."""
         if prepared:
-            prep = self._prep_objects()
+            prep = self.prep_objects()
             dset, draws = prep.dset, prep.draws
             n = np.array((prep.windows[window][1],), PREPARED_PUSH)
             for mode, offset in ((1, 0), (2, 16)):
@@ -321,9 +318,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                 cb.push_constants(pipeline, n)
                 cb.draw_indirect(draws, offset)
             return
-        self._record_vertex_splats(cb, kind, 0, self.n)
+        self.record_vertex_splats(cb, kind, 0, self.n)
 
-    def _record_vertex_splats(self, cb, kind: str, first: int, count: int) -> None:
+    def record_vertex_splats(self, cb, kind: str, first: int, count: int) -> None:
         """Vertex path: draw splats ``first`` .. ``first + count - 1`` (one
         instance each) as quads, or (point_splats) tiny ones as points + the
         others as quads (:mod:`splatedit.render.progressive` draws its chunks so)."""
@@ -336,7 +333,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.bind_vertex_buffers(0, bufs)
             cb.draw(verts, count, 0, first)
 
-    def _fb_attr_readback(self, t: SplatTargets):
+    def fb_attr_readback(self, t: SplatTargets):
         if getattr(t, "fb_attr_rb", None) is None:
             rp = self.cache.render_pass(rp_attr(self.accum_format, "transfer_src"))
             t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
@@ -361,8 +358,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """``"compute"`` or ``"raster"``: the path a frame of this size takes
         now (:attr:`raster_path` and what the device and frame allow,
         :func:`~splatedit.render.compute_raster.choose_path`)."""
-        self._targets_for(width, height)
-        path = choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
+        self.targets_for(width, height)
+        path = choose_path(self.raster_path, self.dev, width, height, self.use_prepass())
         if path == "compute" and self.raster_path == "auto":
             key = probe_key(width, height, self.n)
             if key not in self.path_probes:
@@ -374,16 +371,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """The measured choice of ``"auto"``: one frame of each path (the
         current frame uniforms, no shading pass), the faster by GPU time wins
         (:attr:`path_probes`)."""
-        t = self._targets_for(width, height)
+        t = self.targets_for(width, height)
         ms = {}
         for path in ("raster", "compute"):
             self.dev.submit(lambda cb, p=path: self._record(cb, splat_frame(p, resolve=False), t))
             ms[path] = self._last_frame.read_timings(self._query)["total"]
         return {"path": min(ms, key=ms.get), **{f"ms_{p}": round(v, 3) for p, v in ms.items()}}
 
-    def _compute_raster(self, t: SplatTargets) -> ComputeRaster:
+    def compute_rasterizer(self, t: SplatTargets) -> ComputeRaster:
         """The compute rasterizer's buffers for targets ``t`` and the current pre-pass."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         c = self._crast
         if c is None or c.t is not t or c.prep is not prep:
             self._free_compute_raster()
@@ -401,7 +398,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """Record ``frame`` (timestamps in the query pool) against targets ``t``."""
         if frame.outputs & {"depth", "accum", "vis_buffer", "accum_buffers"}:
             self.frames_recorded += 1      # the shared targets a progressive frame draws into
-        prepared = self._use_prepass()
+        prepared = self.use_prepass()
         ctx = FrameContext(self, t, target, prepared, self._prep_window_count(prepared))
         cb.reset_queries(self._query)
         frame.record(cb, ctx, self._query)
@@ -416,9 +413,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def record_frame(self, cb, camera: Camera, target: RenderTarget):
         """Record the frame (:meth:`splat_frame`) into ``cb`` writing ``target``
         (used by :meth:`render`; the editor calls it with a swapchain target)."""
-        self._require_cloud()
-        t = self._targets_for(target.width, target.height)
-        self._write_ubo(camera, target.width, target.height, target.apply_gamma)
+        self.require_cloud()
+        t = self.targets_for(target.width, target.height)
+        self.write_ubo(camera, target.width, target.height, target.apply_gamma)
         self._record(cb, self.splat_frame(target.width, target.height), t, target)
 
     def _read_timings(self):
@@ -430,9 +427,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     # ---------------------------------------------------------- public API
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen; returns (height, width, 4) uint8 RGBA (sRGB)."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         out = t.read_output(lambda cb: self.record_frame(cb, camera, t.offscreen))
         self._read_timings()
         return out
@@ -443,9 +440,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         valid until the next frame of this renderer (the editor blits it into
         the swapchain image, :meth:`SwapchainPresenter.render_frame`).  The
         caller must not re-render while a submitted frame still reads it."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         self.dev.submit(lambda cb: self.record_frame(cb, camera, t.offscreen))
         self._read_timings()
         return t.out
@@ -462,15 +459,15 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
           log(stretch) / log(DISTORTION_HEAT_MAX_STRETCH), g = support share,
           b = luminance.
         """
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         texel = 8 if self.accum_format == "rgba16f" else 16
         plane = width * height * texel
         rb = V.Buffer(self.dev, 2 * plane, ("transfer_dst",), host_visible=True)
         try:
             def rec(cb):
-                self._write_ubo(camera, width, height)
+                self.write_ubo(camera, width, height)
                 self._record(cb, self.splat_frame(width, height, "transfer_src", resolve=False), t)
                 cb.copy_image_to_buffer(t.accum_color, rb)
                 cb.copy_image_to_buffer(t.accum_normal, rb, buf_offset=plane)
@@ -495,9 +492,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def render_points_floor(self, camera: Camera, width: int, height: int) -> float:
         """Benchmark floor: draw the splat centres as one-pixel POINT_LIST points
         (colour + depth test, no splatting); returns the GPU time in ms."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         if getattr(t, "fb_points", None) is None:
             t.points_color = t._add(V.Image(self.dev, width, height, "rgba8", ("color",)))
             t.points_depth = t._add(V.Image(self.dev, width, height, "d32f", ("depth",)))
@@ -509,7 +506,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         pipe = self.cache.pipeline(desc)
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             cb.reset_queries(self._query)
             cb.timestamp(self._query, 0, bottom=False)
             cb.begin_render_pass(self.cache.render_pass(RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
@@ -528,12 +525,12 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """Splat index per pixel (-1 background) and eye-space depth along the
         view axis (NaN background) of the nearest splat, for the whole image
         or ``rect`` = (x, y, w, h) in pixels (clipped to the image)."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             self._record(cb, pick_frame(), t)
         out = t.read_pick(rect, rec)
         self._read_timings()

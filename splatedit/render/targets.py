@@ -144,7 +144,7 @@ class SizedTargets:
         """Index (h, w) int64 (-1 background) and view-axis depth (h, w)
         float64 (model units, NaN background) of the pixels ``rect`` (see
         :func:`clip_rect`): submits ``record(cb)`` (the renderer's pick pass
-        into :attr:`fb_pick`, which sets its ``_near_far``) and reads back."""
+        into :attr:`fb_pick`, which sets its ``near_far``) and reads back."""
         self.ensure_pick()
         x, y, w, h = clip_rect(rect, self.width, self.height)
         nbytes = w * h * 4
@@ -160,7 +160,7 @@ class SizedTargets:
             raw = rb.read()
         finally:
             rb.destroy()
-        return decode_pick(raw, w, h, self._r._near_far)
+        return decode_pick(raw, w, h, self._r.near_far)
 
     def destroy(self):
         for o in reversed(self.objects):
