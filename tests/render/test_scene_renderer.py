@@ -10,7 +10,8 @@ from splatedit.data import gaussian_scene_path
 from splatedit.io import read_gaussians
 from splatedit.render.camera import Camera
 from splatedit.render.frame import Frame, Resolve
-from splatedit.render.gs_passes import GsPick, GsPrepare, GsQuads, GsSort, GsTiles, draw_frame, pick_frame, prepare_frame
+from splatedit.render.gs_passes import (GsPick, GsPrepare, GsQuads, GsSort, GsTiles, draw_frame, pick_frame,
+                                       prepare_frame)
 from splatedit.render.gs_resources import gaussian_bounds
 from splatedit.render.scene import SceneRenderer
 from tests.render.scenes import sphere
