@@ -356,6 +356,10 @@ class GaussianRenderer:
         self._reach = float((np.abs(mats[0]).sum(axis=1) + 3.0 * self._sigma_max[idx] * grad).max(initial=0.0))
         self._write_dset()
 
+    def set_detail(self, indices, detail) -> None:
+        """Gaussians have no detail mode (``supports_detail`` is False): raises ParameterError."""
+        raise ParameterError("detail", "the Gaussian renderer has no detail mode")
+
     def clear_basis(self) -> None:
         """Every Gaussian undeformed."""
         self.require_scene()

@@ -55,6 +55,10 @@ class SceneRenderer(Protocol):
     def set_basis(self, indices, B, Bx, By, Bz) -> None:
         """Deformation basis rows (N, K) of the elements ``indices`` (N,)."""
 
+    def set_detail(self, indices, detail) -> None:
+        """The detail mode's rows (n_b, lambda) of the elements ``indices``,
+        where ``supports_detail``; others raise ParameterError."""
+
     def clear_basis(self) -> None:
         """Nothing deformed."""
 
