@@ -42,7 +42,7 @@ def bench_upload_lod(n: int, size=(1280, 720), cloud=None) -> dict:
         r.render(cam, w, h)
         out["frame_s"] = round(time.perf_counter() - t0, 2)
         out["frame_gpu_ms"] = {k: round(v, 1) for k, v in r.last_timings_ms.items()}
-        out["prepass"] = r._use_prepass()
+        out["prepass"] = r.use_prepass()
         out["prepass_windows"] = r.prepass_windows
         t0 = time.perf_counter()
         pyr = LodPyramid(cloud)

@@ -71,7 +71,7 @@ CRAST_SET = (V.Binding(0, "uniform", "comp"), V.Binding(5, "storage", "comp"), V
 #: same run, load 12): 256 and 1024 take the same time, 64 and 16 are 2-4x
 #: slower; a tile's 256 pixels make it the bound where a splat covers a tile
 BIG_PIXELS = 256
-_WORKGROUP = 64
+WORKGROUP = 64
 #: workgroups of the binning dispatch (mode 1): invocation i takes list
 #: entries i, i + 64 * groups, ...; enough to fill a large GPU, cheap when the
 #: list is empty (one read of the count per invocation)
@@ -192,7 +192,7 @@ class ComputeRaster:
         cb.memory_barrier("transfer", "transfer_write", "compute", "shader_read|shader_write")
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self.dset)
-        groups = max(-(-slots // _WORKGROUP), 1)
+        groups = max(-(-slots // WORKGROUP), 1)
         limit = int(r.dev.limits.maxComputeWorkGroupCount[0])
         gx = min(groups, limit)
         cb.push_constants(pipe, np.array((slots, 0, 0, BIG_PIXELS), CRAST_PUSH))

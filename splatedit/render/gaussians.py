@@ -51,9 +51,14 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_camera,
                                         pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
+from splatedit.render.frame import Frame, FrameContext
 from splatedit.render.gpu_sort import BitonicSort, RadixSort
-from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _UBO_BYTES, PATHS,
-                                           SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
+from splatedit.render.gs_passes import draw_frame as gs_draw_frame
+from splatedit.render.gs_passes import pick_frame as gs_pick_frame
+from splatedit.render.gs_passes import prepare_frame as gs_prepare_frame
+from splatedit.render.gs_resources import (GS_PREP_WG, GS_REC_BYTES, GS_RESOLVE_SET, GS_SET, GS_UBO_BYTES,
+                                           NO_BASIS_ROW, PATHS, SORTS, GaussianTargets, gaussian_bounds,
+                                           pack_geometry, rp_accum)
 from splatedit.render.gs_tiles import TileRasterizer
 from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
 from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH
@@ -145,7 +150,7 @@ class GaussianRenderer:
         self._cols = 4
         self._basis_idx = np.zeros(0, np.int64)
         self._reach = 0.0
-        self._near_far = (1.0, 2.0)
+        self.near_far = (1.0, 2.0)
         self._n_visible = 0
         self.last_timings_ms: dict[str, float] = {}
         #: the editor's distortion heat map: support Gaussians coloured by the principal
@@ -156,7 +161,7 @@ class GaussianRenderer:
         self.splat_scale = 1.0
         self.grey_shading = False
         try:
-            create_frame_objects(self, _UBO_BYTES)
+            create_frame_objects(self, GS_UBO_BYTES)
             self._query = V.QueryPool(self.dev, 8)
         except BaseException:
             self.close()
@@ -188,7 +193,8 @@ class GaussianRenderer:
     def __exit__(self, *exc):
         self.close()
 
-    def _check(self):
+    def require_scene(self):
+        """Raise ParameterError when closed or without a scene."""
         if self._closed:
             raise ParameterError("renderer", "is closed")
         if self.cloud is None:
@@ -231,9 +237,9 @@ class GaussianRenderer:
             raise ParameterError("cloud", "has no Gaussians")
         limit = int(self.dev.limits.maxStorageBufferRange)
         n2 = 1 << max(int(math.ceil(math.log2(n))), 0)
-        if n * _REC_BYTES > limit or n2 * 4 > limit:
+        if n * GS_REC_BYTES > limit or n2 * 4 > limit:
             raise ParameterError("cloud", f"{n} Gaussians exceed the device's storage-buffer range "
-                                          f"({limit // _REC_BYTES} at most)")
+                                          f"({limit // GS_REC_BYTES} at most)")
         self.dev.wait_idle()
         self._free_scene()
         lo, hi = gaussian_bounds(cloud)
@@ -253,8 +259,8 @@ class GaussianRenderer:
         self._flags = self._buf(4 * n, ("storage",), host_visible=True)
         self._flags.view(np.uint32)[:] = 0
         self._brow = self._buf(4 * n, ("storage",), host_visible=True)
-        self._brow.view(np.uint32)[:] = _NONE
-        self._rec = self._buf(n * _REC_BYTES)
+        self._brow.view(np.uint32)[:] = NO_BASIS_ROW
+        self._rec = self._buf(n * GS_REC_BYTES)
         self._keys = self._buf(4 * n2, host_visible=True)
         self._order = self._buf(4 * n2, host_visible=True)
         self._draws = self._buf(16, ("storage", "indirect"), host_visible=True)
@@ -271,12 +277,12 @@ class GaussianRenderer:
         elif self.sort == "bitonic":
             self._bitonic = BitonicSort(self.dev, self.cache, self._keys, self._order)
         if self.path == "compute":
-            self._tiles = TileRasterizer(self.dev, self.cache, self._dset, _GS_SET, n,
+            self._tiles = TileRasterizer(self.dev, self.cache, self._dset, GS_SET, n,
                                          int(GS_TILE_PAIRS_PER_GAUSSIAN * n) + 4096, self.accum_format)
 
     def _write_dset(self):
         if self._dset is None:
-            self._dset = V.DescriptorSet(self.dev, self.cache.set_layout(_GS_SET))
+            self._dset = V.DescriptorSet(self.dev, self.cache.set_layout(GS_SET))
             self._bufs.append(self._dset)
         basis = self._basis_buf if self._basis_buf is not None else self._dummy_basis
         self._dset.write({0: self.ubo, 1: self._geom, 2: self._rest, 3: self._brow, 4: basis, 5: self._rec,
@@ -296,7 +302,7 @@ class GaussianRenderer:
         """Draw (and pick) only the first ``count`` Gaussians of the scene (a
         budgeted level of detail uploaded in importance order,
         :mod:`splatedit.model.gaussian_lod`); None or >= n: all of them."""
-        self._check()
+        self.require_scene()
         c = self.n if count is None else int(count)
         if c < 1:
             raise ParameterError("count", f"must be >= 1, got {count!r}")
@@ -305,7 +311,7 @@ class GaussianRenderer:
     def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
         """Tint the support (blue) and handle (green) Gaussians as the splat
         renderer does; boolean masks (n,) or index arrays; None clears."""
-        self._check()
+        self.require_scene()
         flags = selection_flags(self.n, support_mask, handle_mask, inactive_mask)
         self._flags.view(np.uint32)[:] = flags
 
@@ -315,7 +321,7 @@ class GaussianRenderer:
         Bz (N, K), K in 1..RENDER_MAX_BASIS_COLUMNS, as
         :meth:`Renderer.set_basis`.  Other Gaussians are not deformed.  A new
         K resets the displacement to zeros (K, 3)."""
-        self._check()
+        self.require_scene()
         idx = np.asarray(indices, dtype=np.int64).reshape(-1)
         mats = [np.asarray(m, dtype=np.float64) for m in (B, Bx, By, Bz)]
         for name, a in zip(("B", "Bx", "By", "Bz"), mats):
@@ -340,7 +346,7 @@ class GaussianRenderer:
         self._basis_buf = V.Buffer(self.dev, rows.nbytes, ("storage",), host_visible=True)
         self._basis_buf.write(rows)
         brow = self._brow.view(np.uint32)
-        brow[:] = _NONE
+        brow[:] = NO_BASIS_ROW
         brow[idx] = np.arange(len(idx), dtype=np.uint32)
         self._groups = g
         if k != self._cols:
@@ -350,10 +356,14 @@ class GaussianRenderer:
         self._reach = float((np.abs(mats[0]).sum(axis=1) + 3.0 * self._sigma_max[idx] * grad).max(initial=0.0))
         self._write_dset()
 
+    def set_detail(self, indices, detail) -> None:
+        """Gaussians have no detail mode (``supports_detail`` is False): raises ParameterError."""
+        raise ParameterError("detail", "the Gaussian renderer has no detail mode")
+
     def clear_basis(self) -> None:
         """Every Gaussian undeformed."""
-        self._check()
-        self._brow.view(np.uint32)[:] = _NONE
+        self.require_scene()
+        self._brow.view(np.uint32)[:] = NO_BASIS_ROW
         self._basis_idx = np.zeros(0, np.int64)
         self._reach = 0.0
 
@@ -362,7 +372,7 @@ class GaussianRenderer:
         (model units), or a :class:`~splatedit.deform.rotation.RotationDisplacement`
         (rotation-aware handles: its residual dC plus each handle's rotation,
         blended on the GPU as by :class:`~splatedit.render.renderer.Renderer`)."""
-        self._check()
+        self.require_scene()
         a, rot = split_displacement(dC)
         if rot is not None and len(rot.rotations) > MAX_GROUPS:
             raise ParameterError("dC", f"the renderer blends at most {MAX_GROUPS} handle rotations")
@@ -373,10 +383,11 @@ class GaussianRenderer:
         self._rot = rot
 
     # -------------------------------------------------------------- frame
-    def _targets_for(self, width: int, height: int) -> _Targets:
-        return targets_for(self, width, height, _Targets)
+    def targets_for(self, width: int, height: int) -> GaussianTargets:
+        """The per-size images for width x height (re-created when the size changes)."""
+        return targets_for(self, width, height, GaussianTargets)
 
-    def _write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
+    def write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
         o, sc = self.origin, self.scale
         gpu_cam = gpu_camera(camera, o, sc)
         lo, hi = self.bounds
@@ -405,73 +416,110 @@ class GaussianRenderer:
                         1.0 if self.distortion_map else 0.0, 0.0)
         self.ubo.write(u.reshape(1).view(np.float32))
         self.dC_ubo.write(pack_deform_block(self._dC, self._rot, sc))
-        self._near_far = (near * sc, far * sc)
+        self.near_far = (near * sc, far * sc)
+
+    #: the :class:`~splatedit.render.scene.SceneRenderer` capabilities: no detail
+    #: mode rows; the viewport reads Gaussian frames back (no resident presentation yet)
+    supports_detail = False
+    resident_frames = False
+
+    # ------------------------------------------------ pieces the passes record
+    #: the resolve pass's shader and descriptor-set layout (frame.Resolve)
+    resolve_shader = "gs_resolve.frag"
+    resolve_set_layout = GS_RESOLVE_SET
+
+    @property
+    def targets(self) -> GaussianTargets | None:
+        """The per-size images of the last frame (None before one)."""
+        return self._targets
+
+    @property
+    def scene_set(self):
+        """The scene's descriptor set 0 (``GS_SET``: frame block, geometry, records, keys, order, draws...)."""
+        return self._dset
+
+    @property
+    def draws(self):
+        """The indirect draw arguments (instance count = visible Gaussians after the pre-pass)."""
+        return self._draws
+
+    @property
+    def tiles(self):
+        """The compute tile rasterizer (``path="compute"``), else None."""
+        return self._tiles
 
     def _bind_compute(self, cb, shader: str, push: np.dtype):
-        """Bind compute shader ``shader`` with the scene's set (``_GS_SET``) and
+        """Bind compute shader ``shader`` with the scene's set (``GS_SET``) and
         push constants of layout ``push``; returns the pipeline."""
-        layout = V.LayoutDesc(sets=(_GS_SET,), push_bytes=push.itemsize, push_stages="comp")
+        layout = V.LayoutDesc(sets=(GS_SET,), push_bytes=push.itemsize, push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(shader, layout))
         cb.bind_pipeline(pipe)
         cb.bind_descriptor_set(pipe, self._dset)
         return pipe
 
-    def _record_prepass(self, cb, compact: bool = False):
-        """The pre-pass; ``compact``: append the visible keys (the radix sort's input)."""
+    def record_prepass(self, cb, compact: bool = False):
+        """Record the pre-pass (:class:`~splatedit.render.gs_passes.GsPrepare`);
+        ``compact``: append the visible keys (the radix sort's input)."""
         pipe = self._bind_compute(cb, "gs_prepare.comp", GS_PREP_PUSH)
         groups = self._groups if len(self._basis_idx) else 1
         cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS, int(compact)), GS_PREP_PUSH))
         count = self._sort_length() if self.sort == "bitonic" else self.count
-        cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
+        cb.dispatch((count + GS_PREP_WG - 1) // GS_PREP_WG)
 
-    def _record_gpu_sort(self, cb):
+    def record_sort(self, cb):
+        """Record the GPU depth sort (:class:`~splatedit.render.gs_passes.GsSort`)."""
         if self.sort == "gpu":
             self._radix.record(cb, bits=32)
         else:
             self._bitonic.record(cb, self._sort_length())
 
-    def _draw_pipeline(self):
-        layout = V.LayoutDesc(sets=(_GS_SET,))
-        return self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs.frag", _rp_accum(self.accum_format), layout,
+    def draw_pipeline(self):
+        """The quad pass's pipeline (front-to-back blending into the accumulator)."""
+        layout = V.LayoutDesc(sets=(GS_SET,))
+        return self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs.frag", rp_accum(self.accum_format), layout,
                                                   blend_under=(True,), spec=((0, 0),)))
 
+    def pick_pipeline(self):
+        """The pick pass's pipeline (index + depth, depth test)."""
+        layout = V.LayoutDesc(sets=(GS_SET,))
+        return self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
+                                                  depth_write=True, depth_compare="less", spec=((0, 1),)))
+
+    @property
+    def visible(self) -> int:
+        """Gaussians the last :meth:`prepare_frame` kept (its sorted order's length)."""
+        return self._n_visible
+
     def prepare_frame(self, camera: Camera, width: int, height: int, *, srgb_target: bool = False) -> None:
-        """Pre-pass and sort for this camera and image size (submits and waits).
-        Then :meth:`record_draw` records the draw into any command buffer (the
+        """Pre-pass and sort for this camera and image size (submits and waits;
+        :func:`~splatedit.render.gs_passes.prepare_frame`).  Then
+        :meth:`record_draw` records the draw into any command buffer (the
         editor's frame); :meth:`render` does both."""
-        self._check()
+        self.require_scene()
         if self.path == "compute" and self._tiles.pairs_wanted() > self._tiles.capacity:
             # the last frame (e.g. the editor's, drawn by record_draw) dropped pairs: room for this one
             self._tiles.grow(self._tiles.pairs_wanted())
-        self._targets_for(width, height)
-        self._write_ubo(camera, width, height, srgb_target)
+        t = self.targets_for(width, height)
+        self.write_ubo(camera, width, height, srgb_target)
         self.epoch += 1
         dv = self._draws.view(np.uint32)
         dv[:] = (4, 0, 0, 0)
+        frame = gs_prepare_frame(self.sort)
+        ctx = FrameContext(self, t)
         t0 = time.perf_counter()
 
         def rec(cb):
             cb.reset_queries(self._query)
-            cb.timestamp(self._query, 0, bottom=False)
-            self._record_prepass(cb, compact=self.sort == "gpu")
-            # the barrier first: lavapipe writes a timestamp without waiting for a
-            # dispatch still running (the pass measured ~0 ms without it)
-            cb.memory_barrier("compute", "shader_write", "compute|host", "shader_read|shader_write|host_read")
-            cb.timestamp(self._query, 1)
-            if self.sort != "cpu":
-                self._record_gpu_sort(cb)
-                cb.memory_barrier("compute", "shader_write", "compute", "shader_read")
-                cb.timestamp(self._query, 2)
+            frame.record(cb, ctx, self._query)
         self.dev.submit(rec)
         gpu_sort = self.sort != "cpu"
-        ts = self._query.results_ns(3 if gpu_sort else 2)
+        ts = frame.read_timings(self._query)
         # lavapipe's timestamps around a lone dispatch read ~0 after the first
         # frame: the CPU-sort path reports the pre-pass submission's wall time
-        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6 if gpu_sort
-                   else (time.perf_counter() - t0) * 1e3}
+        timings = {"prepass": ts["prepass"] if gpu_sort else (time.perf_counter() - t0) * 1e3}
         nvis = int(dv[1])
         if gpu_sort:
-            timings["sort"] = float(ts[2] - ts[1]) * 1e-6
+            timings["sort"] = ts["sort"]
             timings["prepass"] = max((time.perf_counter() - t0) * 1e3 - timings["sort"], 0.0)
         else:
             t1 = time.perf_counter()
@@ -486,27 +534,22 @@ class GaussianRenderer:
         self._n_visible = nvis
         self.last_timings_ms = timings
 
+    #: the query slots of the draw submission (after the prepare submission's)
+    _DRAW_QUERY = 3
+
+    def draw_frame(self) -> Frame:
+        """The draw submission's pass list on :attr:`path`
+        (:func:`~splatedit.render.gs_passes.draw_frame`)."""
+        return gs_draw_frame(self.path)
+
     def record_draw(self, cb, target: RenderTarget) -> None:
         """Record the Gaussians' draw and the resolve into ``target`` (after
-        :meth:`prepare_frame` for the same size)."""
-        t = self._targets_for(target.width, target.height)
-        if self.path == "compute":
-            self._tiles.record(cb, t)
-            cb.timestamp(self._query, 3)
-            t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
-            cb.timestamp(self._query, 4)
-            return
-        cb.memory_barrier("host", "host_write", "draw_indirect|vertex", "indirect_read|shader_read")
-        pipe = self._draw_pipeline()
-        cb.begin_render_pass(self.cache.render_pass(_rp_accum(self.accum_format)), t.fb_accum,
-                             [(0.0, 0.0, 0.0, 0.0)])
-        cb.bind_pipeline(pipe)
-        cb.bind_descriptor_set(pipe, self._dset)
-        cb.draw_indirect(self._draws, 0)
-        cb.end_render_pass()
-        cb.timestamp(self._query, 3)
-        t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
-        cb.timestamp(self._query, 4)
+        :meth:`prepare_frame` for the same size), with timestamps."""
+        t = self.targets_for(target.width, target.height)
+        frame = self.draw_frame()
+        cb.reset_queries(self._query, self._DRAW_QUERY, frame.query_count)
+        frame.record(cb, FrameContext(self, t, target), self._query, self._DRAW_QUERY)
+        self._last_draw = frame
 
     def _check_tile_pairs(self) -> bool:
         """After a compute-path frame: when it wanted more (tile, Gaussian)
@@ -523,42 +566,44 @@ class GaussianRenderer:
         t = self._targets
 
         def rec(cb):
-            cb.reset_queries(self._query, 2, 3)
-            cb.timestamp(self._query, 2, bottom=False)
             self.record_draw(cb, t.offscreen)
         out = t.read_output(rec)
         if self._check_tile_pairs():
             out = t.read_output(rec)
-        ts = self._query.results_ns(5)
-        self.last_timings_ms["draw"] = float(ts[3] - ts[2]) * 1e-6
-        self.last_timings_ms["resolve"] = float(ts[4] - ts[3]) * 1e-6
+        ts = self._last_draw.read_timings(self._query, self._DRAW_QUERY)
+        self.last_timings_ms["draw"] = ts["draw"]
+        self.last_timings_ms["resolve"] = ts["resolve"]
         self.last_timings_ms["visible"] = float(self._n_visible)
         return out
+
+    def render_resident(self, camera: Camera, width: int, height: int):
+        """Render without reading back: the rgba8 output image (TRANSFER_SRC
+        layout), valid until the next frame of this renderer (the interface of
+        :meth:`Renderer.render_resident`)."""
+        self.prepare_frame(camera, width, height)
+        t = self._targets
+        self.dev.submit(lambda cb: self.record_draw(cb, t.offscreen))
+        if self._check_tile_pairs():
+            self.dev.submit(lambda cb: self.record_draw(cb, t.offscreen))
+        ts = self._last_draw.read_timings(self._query, self._DRAW_QUERY)
+        self.last_timings_ms.update(draw=ts["draw"], resolve=ts["resolve"], visible=float(self._n_visible))
+        return t.out
 
     def pick(self, camera: Camera, width: int, height: int, rect=None):
         """Gaussian index per pixel (-1 background) and view-axis depth of its
         centre (model units, NaN background) of the nearest pickable Gaussian
         (opacity >= GS_PICK_MIN_OPACITY, within GS_PICK_SIGMAS), for the image
         or ``rect`` = (x, y, w, h) (clipped): the API of Renderer.pick."""
-        self._check()
-        t = self._targets_for(width, height)
-        layout = V.LayoutDesc(sets=(_GS_SET,))
-        pipe = self.cache.pipeline(V.GraphicsDesc("gs.vert", "gs_pick.frag", RP_PICK, layout, depth_test=True,
-                                                  depth_write=True, depth_compare="less", spec=((0, 1),)))
-
+        self.require_scene()
+        t = self.targets_for(width, height)
+        frame = gs_pick_frame()
         self.epoch += 1
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             self._draws.view(np.uint32)[:] = (4, 0, 0, 0)
             # records of culled Gaussians are stale: draw in index order those the
             # pre-pass wrote this frame (order = identity, count = all; the
             # vertex shader drops the culled through their zeroed opacity)
-            self._record_prepass(cb)
-            cb.memory_barrier("compute", "shader_write", "vertex", "shader_read")
-            cb.begin_render_pass(self.cache.render_pass(RP_PICK), t.fb_pick, [(0, 0, 0, 0), 1.0])
-            cb.bind_pipeline(pipe)
-            cb.bind_descriptor_set(pipe, self._dset)
-            cb.draw(4, self.count)
-            cb.end_render_pass()
+            frame.record(cb, FrameContext(self, t))
         return t.read_pick(rect, rec)

@@ -23,33 +23,22 @@ from __future__ import annotations
 import numpy as np
 
 from splatedit.errors import ParameterError
-from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.gs_resources import _RESOLVE_SET, _rp_accum
+from splatedit.render.frame import Frame, FrameContext, Resolve
+from splatedit.render.gs_passes import GsQuads
 
 
 def draw_chunk(r, first: int, count: int, clear: bool) -> None:
     """Draw Gaussians ``first`` .. ``first + count`` of the sorted order of
     the last :meth:`GaussianRenderer.prepare_frame` of ``r`` into its
     accumulation target (cleared first with ``clear``, else blended over what
-    it holds); submits and waits.  Consecutive chunks from 0 give
+    it holds; the pass :class:`~splatedit.render.gs_passes.GsQuads` with a
+    chunk); submits and waits.  Consecutive chunks from 0 give
     :meth:`GaussianRenderer.record_draw`'s sums (front-to-back blending in the
     same order)."""
-    t = r._targets
-    fmt = r.accum_format
-    rp = _rp_accum(fmt) if clear else V.RenderPassDesc(
-        colors=(V.Attachment(fmt, "load", initial="shader_read", final="shader_read"),))
-    pipe = r._draw_pipeline()
-
-    def rec(cb):
-        cb.memory_barrier("host", "host_write", "vertex", "shader_read")
-        cb.begin_render_pass(r.cache.render_pass(rp), t.fb_accum, [(0.0, 0.0, 0.0, 0.0) if clear else None])
-        if count > 0:
-            cb.bind_pipeline(pipe)
-            cb.bind_descriptor_set(pipe, r._dset)
-            cb.draw(4, int(count), 0, int(first))
-        cb.end_render_pass()
-    r.dev.submit(rec)
+    frame = Frame([GsQuads(chunk=(int(first), int(count)), clear=clear)], inputs=("cloud", "records", "order"))
+    ctx = FrameContext(r, r.targets)
+    r.dev.submit(lambda cb: frame.record(cb, ctx))
 
 
 class GaussianProgressiveFrame:
@@ -68,7 +57,7 @@ class GaussianProgressiveFrame:
     def __init__(self, renderer, camera: Camera, width: int, height: int, chunk: int):
         if chunk < 1:
             raise ParameterError("chunk", f"must be >= 1, got {chunk}")
-        renderer._check()
+        renderer.require_scene()
         self.r = renderer
         self.camera = camera
         self.width, self.height = int(width), int(height)
@@ -109,7 +98,7 @@ class GaussianProgressiveFrame:
         if self.phase == "sort":
             r.prepare_frame(self.camera, self.width, self.height)
             self._epoch = r.epoch
-            self._visible = r._n_visible
+            self._visible = r.visible
             self.phase = "attr"
             if self._visible == 0:
                 self._finish()
@@ -122,10 +111,11 @@ class GaussianProgressiveFrame:
 
     def _finish(self) -> None:
         r = self.r
-        t = r._targets_for(self.width, self.height)
+        t = r.targets_for(self.width, self.height)
         if self._visible == 0:
             draw_chunk(r, 0, 0, clear=True)
-        self._image = t.read_output(lambda cb: t.record_resolve(cb, t.offscreen, "gs_resolve.frag", _RESOLVE_SET))
+        frame = Frame([Resolve()], inputs=("accum",))
+        self._image = t.read_output(lambda cb: frame.record(cb, FrameContext(r, t, t.offscreen)))
         self.next = self.n
         self.phase = "done"
 

@@ -13,21 +13,21 @@ from splatedit.render import vk as V
 from splatedit.render.targets import RenderTarget, SizedTargets
 from splatedit.render.uniforms import GS_FRAME_UBO, GS_GEOM, GS_REC
 
-_UBO_BYTES = GS_FRAME_UBO.itemsize
-_GEOM_FLOATS = GS_GEOM.itemsize // 4
-_REC_BYTES = GS_REC.itemsize
-_PREP_WG = 64
-_SORT_WG = 256
-_NONE = 0xFFFFFFFF
+GS_UBO_BYTES = GS_FRAME_UBO.itemsize
+GS_GEOM_FLOATS = GS_GEOM.itemsize // 4
+GS_REC_BYTES = GS_REC.itemsize
+GS_PREP_WG = 64
+GS_SORT_WG = 256
+NO_BASIS_ROW = 0xFFFFFFFF
 #: set 0 of the pre-pass, the sort and the draws: frame UBO, geometry, SH
 #: bands 1-3, basis row per Gaussian, basis rows, records, keys, order,
 #: indirect draw, deformation UBO (shaders_glsl/gs_common.glsl)
-_GS_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
+GS_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "comp"),
            V.Binding(2, "storage", "comp"), V.Binding(3, "storage", "comp"), V.Binding(4, "storage", "comp"),
            V.Binding(5, "storage", "vert|comp"), V.Binding(6, "storage", "comp"),
            V.Binding(7, "storage", "vert|comp"), V.Binding(8, "storage", "comp"), V.Binding(9, "uniform", "comp"),
            V.Binding(11, "storage", "comp"))
-_RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(10, "sampled", "frag"))
+GS_RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(10, "sampled", "frag"))
 #: depth sorts: "auto" (:func:`splatedit.render.gaussians.choose_sort`), "cpu"
 #: (numpy), "gpu" (the GPU radix sort), "bitonic" (the GPU sort it replaced)
 SORTS = ("auto", "cpu", "gpu", "bitonic")
@@ -36,7 +36,7 @@ SORTS = ("auto", "cpu", "gpu", "bitonic")
 PATHS = ("auto", "raster", "compute")
 
 
-def _rp_accum(fmt: str) -> V.RenderPassDesc:
+def rp_accum(fmt: str) -> V.RenderPassDesc:
     return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final="shader_read"),))
 
 
@@ -48,17 +48,17 @@ def gaussian_bounds(cloud: GaussianCloud, sigmas: float = 3.0) -> tuple[np.ndarr
     return (p - r[:, None]).min(axis=0), (p + r[:, None]).max(axis=0)
 
 
-class _Targets(SizedTargets):
+class GaussianTargets(SizedTargets):
     """Per-size images: the RGBA accumulator, pick index + depth, framebuffers."""
 
     def _create(self, r):       # r: the GaussianRenderer
         dev = r.dev
         # storage: the compute tile rasterizer (gs_tiles.py) writes it instead of the quad draw
         self.accum = self._add(V.Image(dev, self.width, self.height, r.accum_format, ("color", "sampled", "storage")))
-        self.fb_accum = self._fb(r.cache.render_pass(_rp_accum(r.accum_format)), [self.accum])
+        self.fb_accum = self._fb(r.cache.render_pass(rp_accum(r.accum_format)), [self.accum])
         self.out = self._add(V.Image(dev, self.width, self.height, "rgba8", ("color", "transfer_src")))
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
-        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET)))
+        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(GS_RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 10: (self.accum, r.sampler)})
 
 
@@ -76,7 +76,7 @@ def pack_geometry(cloud: GaussianCloud, origin: np.ndarray, scale: float):
     rec["sh_dc"] = cloud.sh[:, 0, :]
     shortest = np.argmin(cloud.scales(), axis=1)          # the heat map's normal (2DGS: the third axis)
     rec["normal"] = cloud.rotation_matrices()[np.arange(n), :, shortest]
-    geom = rec.view(np.float32).reshape(n, _GEOM_FLOATS)
+    geom = rec.view(np.float32).reshape(n, GS_GEOM_FLOATS)
     rest = np.ascontiguousarray(cloud.sh[:, 1:, :], np.float32).reshape(n, -1).astype(np.float16)
     if rest.shape[1] % 2:
         rest = np.concatenate([rest, np.zeros((n, 1), np.float16)], axis=1)

@@ -21,8 +21,8 @@ import numpy as np
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
-from splatedit.render.splat_layout import (_GEOM_STRIDE, _PREP_MAX_SIZE, _PREP_SET, _PREP_SET_DETAIL, _REC_A_BYTES,
-                                           _REC_B_BYTES, _WORKGROUP, _rp_window, _splat_desc)
+from splatedit.render.splat_layout import (GEOM_STRIDE, PREP_MAX_SIZE, PREP_SET, PREP_SET_DETAIL, REC_A_BYTES,
+                                           REC_B_BYTES, WORKGROUP, rp_window, splat_desc)
 from splatedit.render.uniforms import PREP_PUSH, PREPARED_PUSH
 from splatedit.tolerances import RENDER_PREPASS_WINDOW_SPLATS
 
@@ -52,25 +52,25 @@ class PrepassMixin:
                 obj.destroy()
             self._prep = None
 
-    def _use_prepass(self) -> bool:
+    def use_prepass(self) -> bool:
         t = self._targets
         if self._detail_buf is not None:   # the detail mode has no vertex-path variant
-            if t is not None and max(t.width, t.height) > _PREP_MAX_SIZE:
-                raise ParameterError("size", f"the detail mode renders images up to {_PREP_MAX_SIZE} "
+            if t is not None and max(t.width, t.height) > PREP_MAX_SIZE:
+                raise ParameterError("size", f"the detail mode renders images up to {PREP_MAX_SIZE} "
                                              f"pixels wide and high, got {t.width}x{t.height}")
             return True
         if not self.prepass:
             return False
         # any size: clouds whose records (48 bytes per splat) or geometry do
         # not fit one storage binding are drawn in splat windows
-        return not (t is not None and max(t.width, t.height) > _PREP_MAX_SIZE)
+        return not (t is not None and max(t.width, t.height) > PREP_MAX_SIZE)
 
     @property
     def prepass_windows(self) -> int:
         """Splat windows the compute pre-pass prepares and draws the cloud in at
         the current image size: 1 when the cloud fits one storage binding, 0 for
         the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
-        if self.cloud is None or not self._use_prepass():
+        if self.cloud is None or not self.use_prepass():
             return 0
         return len(self._prep_windows())
 
@@ -81,14 +81,14 @@ class PrepassMixin:
         RENDER_PREPASS_WINDOW_SPLATS (or fewer where the device limit is
         smaller), each prepared and drawn in turn."""
         limit = int(self.dev.limits.maxStorageBufferRange)
-        per_splat = max(_REC_A_BYTES, _GEOM_STRIDE, 16 if self._detail_buf is not None else 0)
+        per_splat = max(REC_A_BYTES, GEOM_STRIDE, 16 if self._detail_buf is not None else 0)
         if self.n * per_splat <= limit:
             return [(0, self.n)]
         align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
-        per = min(RENDER_PREPASS_WINDOW_SPLATS, limit // per_splat) // _WORKGROUP * _WORKGROUP
-        while per > _WORKGROUP and (per * 4) % align:       # 4: the smallest per-splat stride
-            per -= _WORKGROUP
-        per = max(per, _WORKGROUP)
+        per = min(RENDER_PREPASS_WINDOW_SPLATS, limit // per_splat) // WORKGROUP * WORKGROUP
+        while per > WORKGROUP and (per * 4) % align:       # 4: the smallest per-splat stride
+            per -= WORKGROUP
+        per = max(per, WORKGROUP)
         return [(b, min(per, self.n - b)) for b in range(0, self.n, per)]
 
     def _basis_chunks(self, basis, first: int = 0, count: int | None = None) -> list[tuple[int, int, int, int]]:
@@ -101,24 +101,24 @@ class PrepassMixin:
             return [(first, count, 0, basis.size)]
         limit = int(self.dev.limits.maxStorageBufferRange)
         align = max(int(self.dev.limits.minStorageBufferOffsetAlignment), 1)
-        per = max(limit // row_bytes // _WORKGROUP * _WORKGROUP, _WORKGROUP)
+        per = max(limit // row_bytes // WORKGROUP * WORKGROUP, WORKGROUP)
         while (per * row_bytes) % align:
-            per -= _WORKGROUP
+            per -= WORKGROUP
         out = []
         for base in range(first, first + count, per):
             cnt = min(per, first + count - base)
             out.append((base, cnt, base * row_bytes, cnt * row_bytes))
         return out
 
-    def _prep_objects(self):
+    def prep_objects(self):
         if self._prep is None:
             objs = []
             try:
                 spans = self._prep_windows()
                 slots = max(cnt for _, cnt in spans)
-                rec_a = V.Buffer(self.dev, slots * _REC_A_BYTES, ("storage",))
+                rec_a = V.Buffer(self.dev, slots * REC_A_BYTES, ("storage",))
                 objs.append(rec_a)
-                rec_b = V.Buffer(self.dev, slots * _REC_B_BYTES, ("storage",))
+                rec_b = V.Buffer(self.dev, slots * REC_B_BYTES, ("storage",))
                 objs.append(rec_b)
                 draws = V.Buffer(self.dev, 32, ("storage", "indirect"))
                 objs.append(draws)
@@ -147,9 +147,9 @@ class PrepassMixin:
         rec_a, rec_b, draws = records
         sets = []
         for base, cnt, off, rng in self._basis_chunks(basis, first, count):
-            dset = V.DescriptorSet(self.dev, self.cache.set_layout(_PREP_SET if detail is None else _PREP_SET_DETAIL))
+            dset = V.DescriptorSet(self.dev, self.cache.set_layout(PREP_SET if detail is None else PREP_SET_DETAIL))
             objs.append(dset)
-            writes = {0: self.ubo, 1: span(self._geom, _GEOM_STRIDE), 2: span(self._color, 4),
+            writes = {0: self.ubo, 1: span(self._geom, GEOM_STRIDE), 2: span(self._color, 4),
                       3: span(self._flags, 4), 4: (basis, off, rng),
                       5: rec_a, 6: rec_b, 7: draws, 8: self.dC_ubo}
             if detail is not None:
@@ -158,15 +158,15 @@ class PrepassMixin:
             sets.append((dset, base, cnt))
         return sets
 
-    def _prep_range(self, first: int, count: int) -> tuple[int, list, list]:
+    def prep_range(self, first: int, count: int) -> tuple[int, list, list]:
         """Descriptor sets that prepare only splats ``first`` .. ``first + count - 1``
         (inside one splat window; ``first`` a multiple of the workgroup size):
         (window index, [(set, first splat, count)], the sets to destroy).
         :mod:`splatedit.render.progressive` draws its chunks so."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         k = next(i for i, (w0, wn, _) in enumerate(prep.windows) if w0 <= first < w0 + wn)
         w0, wn, _ = prep.windows[k]
-        if first % _WORKGROUP or first + count > w0 + wn:
+        if first % WORKGROUP or first + count > w0 + wn:
             raise ParameterError("chunk", f"splats {first}..{first + count - 1} do not start a workgroup "
                                           f"inside pre-pass window {w0}..{w0 + wn - 1}")
         objs = []
@@ -179,13 +179,13 @@ class PrepassMixin:
             raise
         return k, sets, objs
 
-    def _record_prepass(self, cb, window: int = 0, sets: list | None = None):
+    def record_prepass(self, cb, window: int = 0, sets: list | None = None):
         """Compute pre-pass of splat window ``window``: records + indirect draw
         counts for this frame's camera (one dispatch per basis window); only
-        the splats of ``sets`` (from :meth:`_prep_range`) when given. Before
+        the splats of ``sets`` (from :meth:`prep_range`) when given. Before
         any window but the first of a frame, it waits for the draws that read
         the previous window's records."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         w0, wn, chunks = prep.windows[window]
         partial = sets is not None
         chunks = sets if partial else chunks
@@ -193,7 +193,7 @@ class PrepassMixin:
         detail = self._detail_buf is not None
         stem = "prepare_detail" if detail else "prepare"
         comp = f"{stem}.comp" if g == 1 else f"{stem}_k{4 * g}.comp"
-        layout = V.LayoutDesc(sets=(_PREP_SET_DETAIL if detail else _PREP_SET,), push_bytes=PREP_PUSH.itemsize,
+        layout = V.LayoutDesc(sets=(PREP_SET_DETAIL if detail else PREP_SET,), push_bytes=PREP_PUSH.itemsize,
                               push_stages="comp")
         pipe = self.cache.pipeline(V.ComputeDesc(comp, layout))
         if len(prep.windows) > 1 or partial:     # earlier draws read records and counts
@@ -210,32 +210,32 @@ class PrepassMixin:
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
             cb.bind_descriptor_set(pipe, dset)
             cb.push_constants(pipe, np.array((base, cnt, wn, w0), PREP_PUSH))
-            cb.dispatch((cnt + _WORKGROUP - 1) // _WORKGROUP)
+            cb.dispatch((cnt + WORKGROUP - 1) // WORKGROUP)
         cb.memory_barrier("compute", "shader_write", "draw_indirect|vertex",
                           "indirect_read|shader_read")
 
     def _prepared_pipeline(self, kind: str, mode: int):
-        layout = V.LayoutDesc(sets=(_PREP_SET if self._detail_buf is None else _PREP_SET_DETAIL,),
+        layout = V.LayoutDesc(sets=(PREP_SET if self._detail_buf is None else PREP_SET_DETAIL,),
                               push_bytes=PREPARED_PUSH.itemsize, push_stages="vert")
-        return self.cache.pipeline(_splat_desc("prepared.vert", kind, self.accum_format, layout, spec=((0, mode),),
+        return self.cache.pipeline(splat_desc("prepared.vert", kind, self.accum_format, layout, spec=((0, mode),),
                                                topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _prep_window_count(self, prepared: bool) -> int:
         """Pre-pass windows of this frame (1 for the vertex path)."""
-        return len(self._prep_objects().windows) if prepared else 1
+        return len(self.prep_objects().windows) if prepared else 1
 
-    def _record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
+    def record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
         """One splat pass (``kind`` depth, attr or pick) into ``fb``. With several
         pre-pass windows: per window, its pre-pass then its draws (in a render
         pass that keeps the previous windows' results)."""
         count = self._prep_window_count(prepared)
         if count == 1:
             cb.begin_render_pass(self.cache.render_pass(desc), fb, clears)
-            self._record_splats(cb, kind, prepared)
+            self.record_splats(cb, kind, prepared)
             cb.end_render_pass()
             return
         for k in range(count):
-            self._record_prepass(cb, k)
-            cb.begin_render_pass(self.cache.render_pass(_rp_window(desc, k == 0, k == count - 1)), fb, clears)
-            self._record_splats(cb, kind, True, k)
+            self.record_prepass(cb, k)
+            cb.begin_render_pass(self.cache.render_pass(rp_window(desc, k == 0, k == count - 1)), fb, clears)
+            self.record_splats(cb, kind, True, k)
             cb.end_render_pass()

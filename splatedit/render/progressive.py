@@ -12,7 +12,7 @@ each) so a window stays responsive and the image sharpens while it is drawn:
    readback, below) :meth:`show` composes it on the device when asked.
 
 Each chunk goes through the compute pre-pass when the renderer uses it
-(:meth:`Renderer._use_prepass`): a step runs the pre-pass of the chunk's
+(:meth:`Renderer.use_prepass`): a step runs the pre-pass of the chunk's
 splats only (a whole number of workgroups inside one pre-pass window, so
 ``chunk`` is rounded up to a multiple of 64 and a chunk never crosses a
 window) and then draws their records, in the same submit.  Otherwise (pre-pass
@@ -46,6 +46,8 @@ Drop the frame on any camera or scene change.
 
 from __future__ import annotations
 
+import weakref
+
 import numpy as np
 
 from splatedit.errors import ParameterError
@@ -53,8 +55,11 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
 from splatedit.render.frame_passes import FrameContext, RasterSplats, Resolve
-from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
+from splatedit.render.splat_layout import RESOLVE_SET, WORKGROUP
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
+
+#: the chunk boxes of a renderer's cloud: renderer -> (cloud, lo, hi, radius)
+_BOXES: weakref.WeakKeyDictionary = weakref.WeakKeyDictionary()
 
 #: splats per box of the shading rect (:meth:`ProgressiveFrame._chunk_rect`)
 _BOX_BLOCK = 4096
@@ -62,7 +67,7 @@ _BOX_BLOCK = 4096
 #: the shading pass over the shown image: loads it, writes covered pixels ("over":
 #: the intermediate uniforms give uncovered pixels alpha 0, so they keep what is there)
 _RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
-_OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(_RESOLVE_SET,)),
+_OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(RESOLVE_SET,)),
                             topology="triangle_list", blend_alpha=True)
 
 
@@ -91,8 +96,8 @@ class ProgressiveFrame:
     """
 
     def __init__(self, renderer: Renderer, camera: Camera, width: int, height: int, chunk: int):
-        renderer._check_open()
-        renderer._require_cloud()
+        renderer.check_open()
+        renderer.require_cloud()
         if int(chunk) < 1:
             raise ParameterError("chunk", f"must be at least 1, got {chunk!r}")
         self.r = renderer
@@ -135,8 +140,8 @@ class ProgressiveFrame:
         first = self.next if first is None else first
         if not prepared:
             return first, min(self.chunk, self.n - first)
-        end = next(w0 + wn for w0, wn, _ in self.r._prep_objects().windows if w0 <= first < w0 + wn)
-        size = -(-self.chunk // _WORKGROUP) * _WORKGROUP
+        end = next(w0 + wn for w0, wn, _ in self.r.prep_objects().windows if w0 <= first < w0 + wn)
+        size = -(-self.chunk // WORKGROUP) * WORKGROUP
         return first, min(size, end - first)
 
     def step(self, readback: bool = True) -> np.ndarray | None:
@@ -146,20 +151,20 @@ class ProgressiveFrame:
         ``readback=False`` the chunk is only drawn (no shading pass, no
         readback; None): :meth:`show` composes what has been drawn."""
         r = self.r
-        r._check_open()
+        r.check_open()
         if self.done:
             return None
         if r.frames_recorded != self._serial or r.n != self.n:
             self.n = r.n
             self._restart()
-        t = r._targets_for(self.width, self.height)
-        prepared = r._use_prepass()
+        t = r.targets_for(self.width, self.height)
+        prepared = r.use_prepass()
         #: the path of the last step: True for the compute pre-pass
         self.prepared = prepared
         first, count = self._span(prepared)
         objs, sets, window = [], None, 0
         if prepared:
-            window, sets, objs = r._prep_range(first, count)
+            window, sets, objs = r.prep_range(first, count)
 
         ctx = FrameContext(r, t, t.offscreen, prepared)
 
@@ -168,14 +173,14 @@ class ProgressiveFrame:
 
         try:
             if self.phase == "depth":
-                r._write_ubo(self.camera, self.width, self.height)
+                r.write_ubo(self.camera, self.width, self.height)
 
                 def rec(cb):
                     draw(cb, "depth")
                 r.dev.submit(rec)
                 out = None
             else:
-                self._write_ubo(0.0)
+                self.write_ubo(0.0)
 
                 def rec(cb):
                     draw(cb, "attr")
@@ -208,18 +213,18 @@ class ProgressiveFrame:
         :meth:`Renderer.pick` draws it whole); :meth:`pick_result` once
         :attr:`pick_done`."""
         r = self.r
-        r._check_open()
+        r.check_open()
         if not self.done or self.pick_done:
             raise ParameterError("pick", "the frame is not done, or its pick map is")
-        t = r._targets_for(self.width, self.height)
+        t = r.targets_for(self.width, self.height)
         t.ensure_pick()
-        prepared = r._use_prepass()
+        prepared = r.use_prepass()
         first, count = self._span(prepared, self._pick_next)
         objs, sets, window = [], None, 0
         if prepared:
-            window, sets, objs = r._prep_range(first, count)
+            window, sets, objs = r.prep_range(first, count)
         try:
-            r._write_ubo(self.camera, self.width, self.height)
+            r.write_ubo(self.camera, self.width, self.height)
 
             def rec(cb):
                 RasterSplats("pick", chunk=(first, count, window, sets)).record(cb, FrameContext(r, t, None, prepared))
@@ -234,10 +239,10 @@ class ProgressiveFrame:
         NaN background) of the complete pick map, as :meth:`Renderer.pick`."""
         if not (self.done and self.pick_done):
             raise ParameterError("pick", "the pick map is not complete")
-        self.r._write_ubo(self.camera, self.width, self.height)      # its near/far decode the depth
-        return self.r._targets_for(self.width, self.height).read_pick(None, lambda cb: None)
+        self.r.write_ubo(self.camera, self.width, self.height)      # its near/far decode the depth
+        return self.r.targets_for(self.width, self.height).read_pick(None, lambda cb: None)
 
-    def _write_ubo(self, background_alpha: float) -> None:
+    def write_ubo(self, background_alpha: float) -> None:
         """The frame uniforms with this alpha for background pixels (0: the
         intermediate images, uncovered pixels told apart; the renderer's own
         for the last)."""
@@ -245,7 +250,7 @@ class ProgressiveFrame:
         alpha = r.background_alpha
         r.background_alpha = background_alpha
         try:
-            r._write_ubo(self.camera, self.width, self.height)
+            r.write_ubo(self.camera, self.width, self.height)
         finally:
             r.background_alpha = alpha
 
@@ -275,11 +280,11 @@ class ProgressiveFrame:
         (rgba8, TRANSFER_SRC layout, ``width`` x ``height``; valid until the
         next step or show) or, with ``readback``, its (h, w, 4) uint8 pixels."""
         r = self.r
-        r._check_open()
+        r.check_open()
         if self.done:
-            t = r._targets_for(self.width, self.height)
+            t = r.targets_for(self.width, self.height)
             if not self._final:
-                self._write_ubo(r.background_alpha)
+                self.write_ubo(r.background_alpha)
 
                 def rec(cb):
                     Resolve().record(cb, FrameContext(r, t, t.offscreen))
@@ -297,12 +302,12 @@ class ProgressiveFrame:
                                               f"got {under.shape} {under.dtype}")
             staging = V.Buffer(r.dev, under.nbytes, ("transfer_src",), host_visible=True)
             staging.write(np.ascontiguousarray(under))
-        t = r._targets_for(self.width, self.height)
+        t = r.targets_for(self.width, self.height)
         rect = self._dirty
         if shade and rect is None:        # the chunks since the last image are all off screen
             shade = self._unshown = False
         if shade:
-            self._write_ubo(0.0)
+            self.write_ubo(0.0)
             #: the pixel rect (x, y, w, h) the last shading pass covered
             self.shaded_rect = rect
         img = self._shown
@@ -344,23 +349,23 @@ class ProgressiveFrame:
         splats); the whole image when a box reaches the camera plane; None
         when the chunk is off screen."""
         r = self.r
-        cached = getattr(r, "_progressive_boxes", None)     # per cloud: shared by its refinements
+        cached = _BOXES.get(r)     # per renderer and cloud: shared by its refinements
         if cached is None or cached[0] is not r.cloud:
             c = r.cloud
             starts = np.arange(0, c.n, _BOX_BLOCK)
             reach = np.sqrt(np.maximum(np.einsum("ij,ij->i", c.u, c.u), np.einsum("ij,ij->i", c.v, c.v)))
             rad = np.maximum.reduceat(reach, starts)
-            cached = r._progressive_boxes = (c, np.minimum.reduceat(c.positions, starts, axis=0) - rad[:, None],
+            cached = _BOXES[r] = (c, np.minimum.reduceat(c.positions, starts, axis=0) - rad[:, None],
                                              np.maximum.reduceat(c.positions, starts, axis=0) + rad[:, None], rad)
         _, lo, hi, rad = cached
         b0, b1 = first // _BOX_BLOCK, -(-(first + count) // _BOX_BLOCK)
-        grow = rad[b0:b1, None] * max(r.splat_scale - 1.0, 0.0) + r._displacement_reach()
+        grow = rad[b0:b1, None] * max(r.splat_scale - 1.0, 0.0) + r.displacement_reach()
         lo, hi = lo[b0:b1] - grow, hi[b0:b1] + grow
         corners = np.stack([np.where(np.array([i & 1, i & 2, i & 4], bool), hi, lo) for i in range(8)], axis=1)
         view = self.camera.view_matrix()
         e = corners.reshape(-1, 3) @ view[:3, :3].T + view[:3, 3]
         depth = -e[:, 2]
-        near = self.r._near_far[0]
+        near = self.r.near_far[0]
         if (depth <= 0.5 * near).any():
             return 0, 0, self.width, self.height
         f = 1.0 / np.tan(np.radians(self.camera.fov_deg) / 2.0)

@@ -45,9 +45,9 @@ from splatedit.render.compute_raster import ComputeRaster, choose_path, probe_ke
 from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.prepass import PrepassMixin
-from splatedit.render.splat_layout import (_GEOM_STRIDE, _RESOLVE_SET, _RP_POINTS, _SPLAT_SET,
-                                           _UBO_BYTES, _rp_attr, _splat_desc)
-from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
+from splatedit.render.splat_layout import (GEOM_STRIDE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
+                                           UBO_BYTES, rp_attr, splat_desc)
+from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
@@ -162,8 +162,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._query = None
         self._max_point_size = float(self.dev.limits.pointSizeRange[1]) if self.dev.features.largePoints else 1.0
         try:
-            create_frame_objects(self, _UBO_BYTES)
-            self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
+            create_frame_objects(self, UBO_BYTES)
+            self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(SPLAT_SET))
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 16)
         except BaseException:
@@ -218,25 +218,22 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             if exc_type is None:
                 raise            # else: let the exception of the with-block propagate
 
-    def _check_open(self):
+    def check_open(self):
+        """Raise ParameterError when the renderer is closed."""
         if self._closed:
             raise ParameterError("renderer", "is closed")
 
     # -------------------------------------------------------------- scene
-    def _require_cloud(self):
-        if self.cloud is None:
-            raise ParameterError("cloud", "no cloud set (call set_cloud first)")
-
     def _clip_bounds(self):
         """The box that near/far are chosen from: the undeformed bounds grown
         by a bound on any splat's displacement (see :meth:`_reach`), so that
         geometry moved outside the model (a handle dragged towards the eye)
         is not clipped."""
         lo, hi = self.bounds
-        grow = self._displacement_reach()
+        grow = self.displacement_reach()
         return lo - grow, hi + grow
 
-    def _displacement_reach(self) -> float:
+    def displacement_reach(self) -> float:
         """A bound (model units) on how far any splat is moved from its uploaded
         position by the current basis and displacement (0 without a basis)."""
         if not len(self._basis_rows):
@@ -247,7 +244,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):
         g = self._basis_groups
-        bindings = (V.VertexBinding(0, _GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
+        bindings = (V.VertexBinding(0, GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
                     V.VertexBinding(3, basis_stride))
         off = {f: SPLAT_GEOM.fields[f][1] for f in ("center", "u", "v")}    # splatedit/render/uniforms.py
         attrs = [V.VertexAttribute(0, 0, "vec3", off["center"]), V.VertexAttribute(1, 0, "vec3", off["u"]),
@@ -260,24 +257,24 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         g = self._basis_groups
         deformed = self._basis_buf is not None and len(self._basis_rows) > 0
         bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
-        layout = V.LayoutDesc(sets=(_SPLAT_SET,))
+        layout = V.LayoutDesc(sets=(SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
-        return self.cache.pipeline(_splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
+        return self.cache.pipeline(splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
                                                attributes=attrs, spec=((0, mode),),
                                                topology="point_list" if mode == 2 else "triangle_strip"))
 
     def _resolve_pipeline(self, target: RenderTarget):
-        return self.cache.pipeline(resolve_desc(target, "resolve.frag", _RESOLVE_SET))
+        return self.cache.pipeline(resolve_desc(target, "resolve.frag", RESOLVE_SET))
 
-    def _record_resolve(self, cb, t: _Targets, target: RenderTarget) -> None:
+    def _record_resolve(self, cb, t: SplatTargets, target: RenderTarget) -> None:
         """The shading pass: normalise the accumulators of ``t``, shade, write ``target``."""
-        t.record_resolve(cb, target, "resolve.frag", _RESOLVE_SET)
+        t.record_resolve(cb, target, "resolve.frag", RESOLVE_SET)
 
     # ------------------------------------------------------------- frames
-    def _targets_for(self, width: int, height: int) -> _Targets:
-        return targets_for(self, width, height, _Targets)
+    def targets_for(self, width: int, height: int) -> SplatTargets:
+        return targets_for(self, width, height, SplatTargets)
 
-    def _write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
+    def write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         # everything on the GPU is in model units relative to origin, divided
         # by scale: so is the camera (a similarity: the image is the same)
         o, sc = self.origin, self.scale
@@ -305,13 +302,13 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
             self._dC_dirty = False
-        self._near_far = (near * sc, far * sc)     # model units
+        self.near_far = (near * sc, far * sc)     # model units
 
-    def _record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
+    def record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
         """Draw every splat: as quads, or (point_splats) tiny ones as points +
         the others as quads; ``prepared``: the records of pre-pass window ``window``."""
         if prepared:
-            prep = self._prep_objects()
+            prep = self.prep_objects()
             dset, draws = prep.dset, prep.draws
             n = np.array((prep.windows[window][1],), PREPARED_PUSH)
             for mode, offset in ((1, 0), (2, 16)):
@@ -321,9 +318,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                 cb.push_constants(pipeline, n)
                 cb.draw_indirect(draws, offset)
             return
-        self._record_vertex_splats(cb, kind, 0, self.n)
+        self.record_vertex_splats(cb, kind, 0, self.n)
 
-    def _record_vertex_splats(self, cb, kind: str, first: int, count: int) -> None:
+    def record_vertex_splats(self, cb, kind: str, first: int, count: int) -> None:
         """Vertex path: draw splats ``first`` .. ``first + count - 1`` (one
         instance each) as quads, or (point_splats) tiny ones as points + the
         others as quads (:mod:`splatedit.render.progressive` draws its chunks so)."""
@@ -336,22 +333,33 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.bind_vertex_buffers(0, bufs)
             cb.draw(verts, count, 0, first)
 
-    def _fb_attr_readback(self, t: _Targets):
+    def fb_attr_readback(self, t: SplatTargets):
         if getattr(t, "fb_attr_rb", None) is None:
-            rp = self.cache.render_pass(_rp_attr(self.accum_format, "transfer_src"))
+            rp = self.cache.render_pass(rp_attr(self.accum_format, "transfer_src"))
             t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
         return t.fb_attr_rb
 
     # ------------------------------------------------- frames as pass lists
-    #: the resolve pass's descriptor-set layout (frame_passes.Resolve)
-    _resolve_set_layout = _RESOLVE_SET
+    #: the :class:`~splatedit.render.scene.SceneRenderer` capabilities: the detail
+    #: mode's rows (set_detail) and frames the presenter blits (render_resident)
+    supports_detail = True
+    resident_frames = True
+
+    @property
+    def targets(self):
+        """The per-size images of the last frame size (None before a frame)."""
+        return self._targets
+
+    #: the resolve pass's shader and descriptor-set layout (frame.Resolve)
+    resolve_shader = "resolve.frag"
+    resolve_set_layout = RESOLVE_SET
 
     def frame_path(self, width: int, height: int) -> str:
         """``"compute"`` or ``"raster"``: the path a frame of this size takes
         now (:attr:`raster_path` and what the device and frame allow,
         :func:`~splatedit.render.compute_raster.choose_path`)."""
-        self._targets_for(width, height)
-        path = choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
+        self.targets_for(width, height)
+        path = choose_path(self.raster_path, self.dev, width, height, self.use_prepass())
         if path == "compute" and self.raster_path == "auto":
             key = probe_key(width, height, self.n)
             if key not in self.path_probes:
@@ -363,16 +371,16 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """The measured choice of ``"auto"``: one frame of each path (the
         current frame uniforms, no shading pass), the faster by GPU time wins
         (:attr:`path_probes`)."""
-        t = self._targets_for(width, height)
+        t = self.targets_for(width, height)
         ms = {}
         for path in ("raster", "compute"):
             self.dev.submit(lambda cb, p=path: self._record(cb, splat_frame(p, resolve=False), t))
             ms[path] = self._last_frame.read_timings(self._query)["total"]
         return {"path": min(ms, key=ms.get), **{f"ms_{p}": round(v, 3) for p, v in ms.items()}}
 
-    def _compute_raster(self, t: _Targets) -> ComputeRaster:
+    def compute_rasterizer(self, t: SplatTargets) -> ComputeRaster:
         """The compute rasterizer's buffers for targets ``t`` and the current pre-pass."""
-        prep = self._prep_objects()
+        prep = self.prep_objects()
         c = self._crast
         if c is None or c.t is not t or c.prep is not prep:
             self._free_compute_raster()
@@ -386,11 +394,11 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
                 self.dev.wait_idle()
             c.destroy()
 
-    def _record(self, cb, frame: Frame, t: _Targets, target=None) -> Frame:
+    def _record(self, cb, frame: Frame, t: SplatTargets, target=None) -> Frame:
         """Record ``frame`` (timestamps in the query pool) against targets ``t``."""
         if frame.outputs & {"depth", "accum", "vis_buffer", "accum_buffers"}:
             self.frames_recorded += 1      # the shared targets a progressive frame draws into
-        prepared = self._use_prepass()
+        prepared = self.use_prepass()
         ctx = FrameContext(self, t, target, prepared, self._prep_window_count(prepared))
         cb.reset_queries(self._query)
         frame.record(cb, ctx, self._query)
@@ -405,9 +413,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def record_frame(self, cb, camera: Camera, target: RenderTarget):
         """Record the frame (:meth:`splat_frame`) into ``cb`` writing ``target``
         (used by :meth:`render`; the editor calls it with a swapchain target)."""
-        self._require_cloud()
-        t = self._targets_for(target.width, target.height)
-        self._write_ubo(camera, target.width, target.height, target.apply_gamma)
+        self.require_cloud()
+        t = self.targets_for(target.width, target.height)
+        self.write_ubo(camera, target.width, target.height, target.apply_gamma)
         self._record(cb, self.splat_frame(target.width, target.height), t, target)
 
     def _read_timings(self):
@@ -419,9 +427,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     # ---------------------------------------------------------- public API
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen; returns (height, width, 4) uint8 RGBA (sRGB)."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         out = t.read_output(lambda cb: self.record_frame(cb, camera, t.offscreen))
         self._read_timings()
         return out
@@ -432,9 +440,9 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         valid until the next frame of this renderer (the editor blits it into
         the swapchain image, :meth:`SwapchainPresenter.render_frame`).  The
         caller must not re-render while a submitted frame still reads it."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         self.dev.submit(lambda cb: self.record_frame(cb, camera, t.offscreen))
         self._read_timings()
         return t.out
@@ -451,15 +459,15 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
           log(stretch) / log(DISTORTION_HEAT_MAX_STRETCH), g = support share,
           b = luminance.
         """
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         texel = 8 if self.accum_format == "rgba16f" else 16
         plane = width * height * texel
         rb = V.Buffer(self.dev, 2 * plane, ("transfer_dst",), host_visible=True)
         try:
             def rec(cb):
-                self._write_ubo(camera, width, height)
+                self.write_ubo(camera, width, height)
                 self._record(cb, self.splat_frame(width, height, "transfer_src", resolve=False), t)
                 cb.copy_image_to_buffer(t.accum_color, rb)
                 cb.copy_image_to_buffer(t.accum_normal, rb, buf_offset=plane)
@@ -484,24 +492,24 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def render_points_floor(self, camera: Camera, width: int, height: int) -> float:
         """Benchmark floor: draw the splat centres as one-pixel POINT_LIST points
         (colour + depth test, no splatting); returns the GPU time in ms."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
         if getattr(t, "fb_points", None) is None:
             t.points_color = t._add(V.Image(self.dev, width, height, "rgba8", ("color",)))
             t.points_depth = t._add(V.Image(self.dev, width, height, "d32f", ("depth",)))
-            t.fb_points = t._fb(self.cache.render_pass(_RP_POINTS), [t.points_color, t.points_depth])
-        desc = V.GraphicsDesc("points.vert", "points.frag", _RP_POINTS, V.LayoutDesc(sets=(_SPLAT_SET,)),
-                              topology="point_list", bindings=(V.VertexBinding(0, _GEOM_STRIDE, per_instance=False),),
+            t.fb_points = t._fb(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
+        desc = V.GraphicsDesc("points.vert", "points.frag", RP_POINTS, V.LayoutDesc(sets=(SPLAT_SET,)),
+                              topology="point_list", bindings=(V.VertexBinding(0, GEOM_STRIDE, per_instance=False),),
                               attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),
                               depth_test=True, depth_write=True)
         pipe = self.cache.pipeline(desc)
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             cb.reset_queries(self._query)
             cb.timestamp(self._query, 0, bottom=False)
-            cb.begin_render_pass(self.cache.render_pass(_RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
+            cb.begin_render_pass(self.cache.render_pass(RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
             cb.bind_pipeline(pipe)
             cb.bind_descriptor_set(pipe, self.splat_set)
             cb.bind_vertex_buffers(0, [self._geom])
@@ -517,12 +525,12 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         """Splat index per pixel (-1 background) and eye-space depth along the
         view axis (NaN background) of the nearest splat, for the whole image
         or ``rect`` = (x, y, w, h) in pixels (clipped to the image)."""
-        self._check_open()
-        self._require_cloud()
-        t = self._targets_for(width, height)
+        self.check_open()
+        self.require_cloud()
+        t = self.targets_for(width, height)
 
         def rec(cb):
-            self._write_ubo(camera, width, height)
+            self.write_ubo(camera, width, height)
             self._record(cb, pick_frame(), t)
         out = t.read_pick(rect, rec)
         self._read_timings()

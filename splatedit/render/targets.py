@@ -16,7 +16,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.gpu_units import DEFORM_UBO_BYTES
-from splatedit.render.splat_layout import RP_PICK, _RESOLVE_SET, _RP_DEPTH, _rp_attr
+from splatedit.render.splat_layout import RP_PICK, RESOLVE_SET, RP_DEPTH, rp_attr
 
 #: largest image side (pixels) either renderer accepts
 MAX_SIZE = 16384
@@ -144,7 +144,7 @@ class SizedTargets:
         """Index (h, w) int64 (-1 background) and view-axis depth (h, w)
         float64 (model units, NaN background) of the pixels ``rect`` (see
         :func:`clip_rect`): submits ``record(cb)`` (the renderer's pick pass
-        into :attr:`fb_pick`, which sets its ``_near_far``) and reads back."""
+        into :attr:`fb_pick`, which sets its ``near_far``) and reads back."""
         self.ensure_pick()
         x, y, w, h = clip_rect(rect, self.width, self.height)
         nbytes = w * h * 4
@@ -160,7 +160,7 @@ class SizedTargets:
             raw = rb.read()
         finally:
             rb.destroy()
-        return decode_pick(raw, w, h, self._r._near_far)
+        return decode_pick(raw, w, h, self._r.near_far)
 
     def destroy(self):
         for o in reversed(self.objects):
@@ -169,7 +169,7 @@ class SizedTargets:
         self.target_fbs.clear()
 
 
-class _Targets(SizedTargets):
+class SplatTargets(SizedTargets):
     """Per-size images and framebuffers of the splat renderer ``r``
     (:class:`splatedit.render.renderer.Renderer`): depth, the two attribute
     accumulators, the RGBA8 output and the resolve pass's descriptor set."""
@@ -188,11 +188,11 @@ class _Targets(SizedTargets):
         self.accum_normal = img(r.accum_format, accum_usage)
         self.out = img("rgba8", ("color", "transfer_src"))
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
-        rp_depth = r.cache.render_pass(_RP_DEPTH)
-        rp_attr = r.cache.render_pass(_rp_attr(r.accum_format, "shader_read"))
+        rp_depth = r.cache.render_pass(RP_DEPTH)
+        rp_attr_pass = r.cache.render_pass(rp_attr(r.accum_format, "shader_read"))
         self.fb_depth = self._fb(rp_depth, [self.depth])
-        self.fb_attr = self._fb(rp_attr, [self.accum_color, self.accum_normal, self.depth])
-        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(_RESOLVE_SET)))
+        self.fb_attr = self._fb(rp_attr_pass, [self.accum_color, self.accum_normal, self.depth])
+        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
 
 

@@ -19,7 +19,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
 from splatedit.render.gpu_units import (MAX_GROUPS, pack_basis_rows, pack_deform_block, selection_flags,
                                         unit_scale)
-from splatedit.render.splat_layout import FLAG_DEFORMED, _GEOM_STRIDE
+from splatedit.render.splat_layout import FLAG_DEFORMED, GEOM_STRIDE
 from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
 from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
                                   RENDER_VISIBILITY_EPS_RADII)
@@ -50,7 +50,7 @@ class SceneUploadsMixin:
         of :attr:`scale`, a power of two near its size, so that a model of
         any size from 1e-15 to 1e15 renders the same); clears selection and
         basis."""
-        self._check_open()
+        self.check_open()
         if not isinstance(cloud, SplatCloud):
             raise ParameterError("cloud", f"must be a SplatCloud, got {type(cloud).__name__}")
         self._free_cloud()
@@ -67,7 +67,7 @@ class SceneUploadsMixin:
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
         self.scale = unit_scale(float(np.linalg.norm(hi - lo)), rmax)
-        self._geom = V.Buffer(self.dev, n * _GEOM_STRIDE, ("vertex", "storage"))
+        self._geom = V.Buffer(self.dev, n * GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self._geom)
         self._color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))
         self._cloud_bufs.append(self._color)
@@ -91,19 +91,19 @@ class SceneUploadsMixin:
         splats they were 360 MB each on top of the 360 MB device buffer)."""
         n = cloud.n
         chunk = min(n, RENDER_UPLOAD_CHUNK_SPLATS)
-        staging = V.Buffer(self.dev, chunk * _GEOM_STRIDE, ("transfer_src",), host_visible=True)
+        staging = V.Buffer(self.dev, chunk * GEOM_STRIDE, ("transfer_src",), host_visible=True)
         try:
             inv = 1.0 / self.scale                   # an exact power of two
             default = np.asarray(RENDER_DEFAULT_COLOR, np.uint8)
             for lo in range(0, n, chunk):
                 m = min(chunk, n - lo)
-                geom = staging.view(np.uint8)[:m * _GEOM_STRIDE].view(SPLAT_GEOM)   # m records
+                geom = staging.view(np.uint8)[:m * GEOM_STRIDE].view(SPLAT_GEOM)   # m records
                 np.multiply(cloud.positions[lo:lo + m] - self.origin, inv, out=geom["center"],
                             casting="same_kind")
                 np.multiply(cloud.u[lo:lo + m], inv, out=geom["u"], casting="same_kind")
                 np.multiply(cloud.v[lo:lo + m], inv, out=geom["v"], casting="same_kind")
-                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * _GEOM_STRIDE, 0,
-                                                          lo * _GEOM_STRIDE))
+                self.dev.submit(lambda cb: cb.copy_buffer(staging, self._geom, m * GEOM_STRIDE, 0,
+                                                          lo * GEOM_STRIDE))
                 col = staging.view(np.uint8)[:4 * m].reshape(m, 4)
                 col[:] = default if cloud.colors is None else cloud.colors[lo:lo + m]
                 self.dev.submit(lambda cb: cb.copy_buffer(staging, self._color, 4 * m, 0, 4 * lo))
@@ -120,7 +120,8 @@ class SceneUploadsMixin:
         """Groups of 4 columns of the (zero-padded) basis."""
         return (self._basis_cols + 3) // 4
 
-    def _require_cloud(self):
+    def require_cloud(self):
+        """Raise ParameterError when no cloud is set."""
         if self.cloud is None:
             raise ParameterError("cloud", "no cloud set (call set_cloud first)")
 
@@ -128,8 +129,8 @@ class SceneUploadsMixin:
         """Tint the support region (blue) and handle (green); boolean masks of
         shape (n,) or index arrays; None clears.  ``inactive_mask``: splats
         of inactive handles, tinted green and drawn darker."""
-        self._check_open()
-        self._require_cloud()
+        self.check_open()
+        self.require_cloud()
         tint = selection_flags(self.n, support_mask, handle_mask, inactive_mask)
         f = self._flags.view(np.uint32)
         f &= np.uint32(FLAG_DEFORMED)
@@ -143,8 +144,8 @@ class SceneUploadsMixin:
         Only the given rows (and the rows of the previous basis, which are
         cleared) are written to the GPU.  A new K resets the displacement to
         zeros (K, 3).  Drops a :meth:`set_detail` (set it again after this)."""
-        self._check_open()
-        self._require_cloud()
+        self.check_open()
+        self.require_cloud()
         self._drop_detail()
         idx = np.asarray(indices, dtype=np.int64).reshape(-1)
         mats = []
@@ -217,8 +218,8 @@ class SceneUploadsMixin:
         points b = p - lambda n_b.  Uploaded once; per frame only dC changes.
         Drawn by the compute pre-pass (images up to 4095 pixels); cleared by
         :meth:`clear_basis` and :meth:`set_cloud`."""
-        self._check_open()
-        self._require_cloud()
+        self.check_open()
+        self.require_cloud()
         idx = np.asarray(indices, dtype=np.int64).reshape(-1)
         d = np.asarray(detail, dtype=np.float64)
         if d.shape != (len(idx), 4):
@@ -246,7 +247,7 @@ class SceneUploadsMixin:
 
     def clear_basis(self) -> None:
         """Drop the deformation basis (every splat undeformed)."""
-        self._check_open()
+        self.check_open()
         self._drop_detail()
         if self.cloud is None or self._basis_buf is None:
             return
@@ -263,7 +264,7 @@ class SceneUploadsMixin:
         planes are chosen from the model bounds grown by the largest possible
         splat displacement (:meth:`_clip_bounds`), so geometry moved outside
         the undeformed model is not clipped."""
-        self._check_open()
+        self.check_open()
         a, rot = split_displacement(dC)
         if rot is not None and len(rot.rotations) > MAX_GROUPS:
             raise ParameterError("dC", f"the renderer blends at most {MAX_GROUPS} handle rotations")

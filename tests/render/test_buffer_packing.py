@@ -117,7 +117,7 @@ def test_gaussian_frame_block_bytes_equal_the_hand_packing(bunny_gaussians):
         r.render(cam, w, h)
         got = r.ubo.read(GS_FRAME_UBO.itemsize)
         sc = r.scale
-        near, far = (x / sc for x in r._near_far)
+        near, far = (x / sc for x in r.near_far)
         gpu_cam = gpu_camera(cam, r.origin, sc)
         fpx = 0.5 * (1.0 / math.tan(math.radians(cam.fov_deg) / 2.0)) * h
         u = np.zeros(56, np.float32)                     # the previous hand offsets

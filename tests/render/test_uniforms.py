@@ -142,7 +142,7 @@ def test_std140_offsets_follow_the_glsl_rules():
 
 def test_renderer_buffer_size_is_the_dtype_size():
     from splatedit.render import renderer
-    assert renderer._UBO_BYTES == FRAME_UBO.itemsize
+    assert renderer.UBO_BYTES == FRAME_UBO.itemsize
 
 
 def _coverage(img):

@@ -278,7 +278,7 @@ def _texel_region(image, rect, buf_offset: int):
 
 
 class QueryPool:
-    """A timestamp query pool; :meth:`results_ns` returns times relative to query 0."""
+    """A timestamp query pool; :meth:`results_ns` returns times relative to its first query read."""
 
     def __init__(self, device: Device, count: int):
         self.dev = device
@@ -287,10 +287,11 @@ class QueryPool:
         self.handle = call(vk.vkCreateQueryPool, device.device, info, None)
         track("query_pool", 1)
 
-    def results_ns(self, count: int | None = None) -> np.ndarray:
-        count = self.count if count is None else count
+    def results_ns(self, count: int | None = None, first: int = 0) -> np.ndarray:
+        """Queries ``first`` .. ``first + count`` (waits for them), in ns relative to query ``first``."""
+        count = self.count - first if count is None else count
         data = np.zeros(count, dtype=np.uint64)
-        call(vk.vkGetQueryPoolResults, self.dev.device, self.handle, 0, count, data.nbytes,
+        call(vk.vkGetQueryPoolResults, self.dev.device, self.handle, first, count, data.nbytes,
              vk.ffi.from_buffer(data), 8, vk.VK_QUERY_RESULT_64_BIT | vk.VK_QUERY_RESULT_WAIT_BIT)
         return (data.astype(np.float64) - float(data[0])) * self.dev.timestamp_period_ns
 
