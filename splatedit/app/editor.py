@@ -53,6 +53,8 @@ from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
 from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
+from splatedit.app.tools.mirror import MirrorTool
+from splatedit.app.tools.region import RegionSelectTool
 from splatedit.errors import ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
                                   IQR_DEFAULT_TOL)
@@ -139,7 +141,9 @@ class Editor(EventRouting, FileActions, CrashGuard):
         self.brush = BrushTool(self)
         self.gizmo = GizmoTool(self)
         self.curve = CurveTool(self)
-        self.tools = (self.camera, self.curve, self.gizmo, self.brush)
+        self.region = RegionSelectTool(self)
+        self.mirror = MirrorTool(self)
+        self.tools = (self.camera, self.region, self.curve, self.gizmo, self.brush, self.mirror)
         self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()

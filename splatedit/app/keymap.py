@@ -78,6 +78,12 @@ class Action(enum.Enum):
     CONNECTED = "connected"
     CONNECTED_ALL = "connected_all"
     INVERT = "invert"
+    SELECT_ALL = "select_all"
+    BOX_SELECT = "box_select"
+    LASSO_SELECT = "lasso_select"
+    MIRROR_SELECTION = "mirror_selection"
+    MIRROR_PAINT = "mirror_paint"
+    MIRROR_AXIS = "mirror_axis"
     # deformation
     GRAB = "grab"
     ROTATE = "rotate"
@@ -235,7 +241,20 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.SELECTION, "", "", Action.CONNECTED_ALL, ("shift+l",)),
     Binding(S.SELECTION, "Ctrl + I", "invert the brush target (support: handles cleared; handle: within the support)",
             Action.INVERT, ("ctrl+i",)),
-    Binding(S.SELECTION, "", "After each stroke or tool the selection is closed (holes, back sides); "
+    Binding(S.SELECTION, "A", "select all: the whole model as support (handle brush: the free support)",
+            Action.SELECT_ALL, ("a",)),
+    Binding(S.SELECTION, "Ctrl+B / Ctrl+Shift+B", "box / lasso select: the next left drag draws it; the splats inside\n"
+            "join the brush target (Ctrl held: erased); V decides: 3D = every centre inside\n"
+            "(through), visible = only what is seen; right click or the key again: cancel",
+            Action.BOX_SELECT, ("ctrl+b",)),
+    Binding(S.SELECTION, "", "", Action.LASSO_SELECT, ("ctrl+shift+b",)),
+    Binding(S.SELECTION, "Ctrl+M", "mirror: add the brush target's mirror image across the model's middle plane",
+            Action.MIRROR_SELECTION, ("ctrl+m",)),
+    Binding(S.SELECTION, "Shift+M", "symmetric painting on / off (each dab also paints its mirror image)",
+            Action.MIRROR_PAINT, ("shift+m",)),
+    Binding(S.SELECTION, "Ctrl+Shift+M", "mirror plane: X / Y / Z (through the middle of the bounding box)",
+            Action.MIRROR_AXIS, ("ctrl+shift+m",)),
+    Binding(S.SELECTION, "", "The Select menu has all of these.  After each stroke or tool the selection is closed (holes, back sides); "
             "additions flash yellow"),
     # ---- deformation
     Binding(S.DEFORMATION, "Left drag on a handle", "make it active and move it in the view plane", mouse=True),
