@@ -4,7 +4,9 @@ The plane is ``x[axis] = c`` with ``c`` the centre of the bounding box along
 ``axis`` (0 = X, the usual symmetry of a figure, an animal or a vehicle);
 a splat's mirror is the splat nearest to its reflection, when that one is
 within :data:`~splatedit.tolerances.MIRROR_MATCH_SPACINGS` median spacings
-(a part with no counterpart has no mirror).  Pure numpy/scipy.
+(a part with no counterpart has no mirror), and a splat whose own
+reflection lands nearest to a selected splat is in the mirror image too (so
+a region mirrors whole where the two sides are sampled differently).  Pure numpy/scipy.
 """
 
 from __future__ import annotations
@@ -45,7 +47,21 @@ def mirror_indices(positions: np.ndarray, idx, tree, spacing: float, axis: int =
     idx = np.asarray(idx, np.int64).ravel()
     if not len(idx):
         return np.zeros(0, np.int64)
-    c = plane_centre(positions, axis) if centre is None else float(centre)
-    q = reflect(np.asarray(positions)[idx], axis, c)
-    d, j = tree.query(q, distance_upper_bound=MIRROR_MATCH_SPACINGS * max(float(spacing), 1e-300))
-    return np.unique(j[np.isfinite(d)].astype(np.int64))
+    pos = np.asarray(positions)
+    c = plane_centre(pos, axis) if centre is None else float(centre)
+    tol = MIRROR_MATCH_SPACINGS * max(float(spacing), 1e-300)
+    # push: the splat nearest to each reflected one
+    d, j = tree.query(reflect(pos[idx], axis, c), distance_upper_bound=tol)
+    push = j[np.isfinite(d)].astype(np.int64)
+    # pull: every splat near a reflection whose own reflection lands nearest to a
+    # selected splat (the nearest-sample map is many-to-one: push alone leaves holes
+    # where the other side is sampled more densely)
+    chosen = np.zeros(len(pos), bool)
+    chosen[idx] = True
+    near = tree.query_ball_point(reflect(pos[idx], axis, c), tol)
+    cand = np.unique(np.concatenate([np.asarray(r, np.int64) for r in near] + [np.zeros(0, np.int64)]))
+    if len(cand):
+        d2, k = tree.query(reflect(pos[cand], axis, c), distance_upper_bound=tol)
+        ok = np.isfinite(d2)
+        cand = cand[ok][chosen[k[ok]]]
+    return np.union1d(push, cand)

@@ -148,9 +148,12 @@ class ToolContext:
         from splatedit.app.selection_tools import BRUSH_3D
         return self._ed.brush.mode == BRUSH_3D
 
-    def erasing(self) -> bool:
-        """Ctrl held or the erase toggle (E) on: a stroke erases."""
-        return self._ed.brush.erasing()
+    def erasing(self, mods: int | None = None) -> bool:
+        """Ctrl held (in ``mods``, an input event's modifier bits; None: the
+        keyboard now) or the erase toggle (E) on: a stroke erases."""
+        if mods is None:
+            return self._ed.brush.erasing()
+        return self._ed.brush.erase_toggle or bool(mods & self._ed.g.MOD_CONTROL)
 
     def busy(self) -> bool:
         """A move is running or an edit is being applied (selections wait)."""

@@ -125,7 +125,7 @@ class RegionSelectTool(Tool):
         if e.button != g.MOUSE_BUTTON_LEFT or self.ctx.busy():
             return None
         self.points = [(float(e.x), float(e.y))]
-        self.erase = self.ctx.erasing()
+        self.erase = self.ctx.erasing(e.mods)
         return DragMode.REGION
 
     def drag(self, mode, x, y, dx, dy, last):
