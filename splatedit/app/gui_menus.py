@@ -119,8 +119,10 @@ class MenuBar:
         for e in _SELECT_ENTRIES:
             if e is None:
                 imgui.separator()
-            elif imgui.menu_item(e[0], e[1], False)[0]:
-                ed.run_action(e[2])
+            else:
+                if imgui.menu_item(e[0], e[1], False)[0]:
+                    ed.run_action(e[2])
+                self._rect(f"select_{e[2].value}")
         imgui.separator()
         if imgui.menu_item("Symmetric painting", "Shift+M", ed.mirror.painting)[0]:
             ed.run_action(Action.MIRROR_PAINT)
