@@ -53,6 +53,7 @@ from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
 from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
+from splatedit.app.tools.delete import DeleteTool
 from splatedit.app.tools.mirror import MirrorTool
 from splatedit.app.tools.region import RegionSelectTool
 from splatedit.errors import ParameterError, SplatEditError
@@ -143,7 +144,7 @@ class Editor(EventRouting, FileActions, CrashGuard):
         self.curve = CurveTool(self)
         self.region = RegionSelectTool(self)
         self.mirror = MirrorTool(self)
-        self.tools = (self.camera, self.region, self.curve, self.gizmo, self.brush, self.mirror)
+        self.tools = (self.camera, self.region, self.curve, self.gizmo, self.brush, self.mirror, DeleteTool(self))
         self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()

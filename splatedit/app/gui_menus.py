@@ -45,6 +45,9 @@ _SELECT_ENTRIES = (
     ("Connected, all of it", "Shift+L", Action.CONNECTED_ALL),
     None,
     ("Mirror", "Ctrl+M", Action.MIRROR_SELECTION),
+    None,
+    ("Delete selected splats", "Delete", Action.DELETE_SPLATS),
+    ("Crop to the selection", "Shift+Delete", Action.CROP_SPLATS),
 )
 
 

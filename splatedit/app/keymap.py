@@ -84,6 +84,8 @@ class Action(enum.Enum):
     MIRROR_SELECTION = "mirror_selection"
     MIRROR_PAINT = "mirror_paint"
     MIRROR_AXIS = "mirror_axis"
+    DELETE_SPLATS = "delete_splats"
+    CROP_SPLATS = "crop_splats"
     # deformation
     GRAB = "grab"
     ROTATE = "rotate"
@@ -228,7 +230,7 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.SELECTION, "", "", Action.PREV_HANDLE, ("shift+tab",)),
     Binding(S.SELECTION, "N", "new handle (becomes active; paint it with the handle brush)", Action.NEW_HANDLE,
             ("n",)),
-    Binding(S.SELECTION, "Delete", "remove the active handle", Action.REMOVE_HANDLE, ("delete",)),
+    Binding(S.SELECTION, "Shift+N", "remove the active handle", Action.REMOVE_HANDLE, ("shift+n",)),
     Binding(S.SELECTION, "[ / ]  or  Ctrl+wheel", "brush radius", Action.BRUSH_SMALLER, ("left_bracket",)),
     Binding(S.SELECTION, "", "", Action.BRUSH_LARGER, ("right_bracket",)),
     Binding(S.SELECTION, "C / Shift+C", "clear the selection / clear the handles", Action.CLEAR_SELECTION, ("c",)),
@@ -254,6 +256,9 @@ KEYMAP: tuple[Binding, ...] = (
             Action.MIRROR_PAINT, ("shift+m",)),
     Binding(S.SELECTION, "Ctrl+Shift+M", "mirror plane: X / Y / Z (through the middle of the bounding box)",
             Action.MIRROR_AXIS, ("ctrl+shift+m",)),
+    Binding(S.SELECTION, "Delete / Shift+Delete", "delete the support splats from the model / crop: keep only them\n"
+            "(one undo step; the edit script records it, saves replay)", Action.DELETE_SPLATS, ("delete",)),
+    Binding(S.SELECTION, "", "", Action.CROP_SPLATS, ("shift+delete",)),
     Binding(S.SELECTION, "", "The Select menu has all of these.  After each stroke or tool the selection is closed (holes, back sides); "
             "additions flash yellow"),
     # ---- deformation
