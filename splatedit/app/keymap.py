@@ -259,7 +259,7 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.SELECTION, "Delete / Shift+Delete", "delete the support splats from the model / crop: keep only them\n"
             "(one undo step; the edit script records it, saves replay)", Action.DELETE_SPLATS, ("delete",)),
     Binding(S.SELECTION, "", "", Action.CROP_SPLATS, ("shift+delete",)),
-    Binding(S.SELECTION, "", "The Select menu has all of these.  After each stroke or tool the selection is closed (holes, back sides); "
+    Binding(S.SELECTION, "", "The Select menu has all of these.\nAfter each stroke or tool the selection is closed (holes, back sides); "
             "additions flash yellow"),
     # ---- deformation
     Binding(S.DEFORMATION, "Left drag on a handle", "make it active and move it in the view plane", mouse=True),

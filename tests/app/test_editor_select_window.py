@@ -2,14 +2,17 @@
 Ctrl+B then a left drag over the bunny seen from the front draws the box
 (its white outline is on the screen while dragging) and adds every splat
 whose centre projects inside (3D mode: through, front and back) to the
-support as one undo step; Select > Invert inverts it; two undos clear it."""
+support as one undo step; Select > Invert inverts it; two undos clear it.
+Then a lasso (visible splats only, V) and Delete remove splats; the saved
+file is what ``splatedit deform`` makes of the bundled model with the
+saved edit script."""
 
 from __future__ import annotations
 
 import numpy as np
 import pytest
 
-from tests.app.window_harness import EditorProcess
+from tests.app.window_harness import EditorProcess, assert_replay_reproduces
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 pytest.importorskip("imgui_bundle")
@@ -27,7 +30,8 @@ def test_box_select_through_and_select_menu_invert(xvfb, tmp_path):
     from splatedit.io import read
 
     src = read(default_model_path())
-    ed = EditorProcess(xvfb, tmp_path)
+    out = tmp_path / "deleted.ply"
+    ed = EditorProcess(xvfb, tmp_path, "--save-as", str(out))
     try:
         ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and "menu_select" in s["gui_rects"],
                 "model loaded", 90)
@@ -69,6 +73,20 @@ def test_box_select_through_and_select_menu_invert(xvfb, tmp_path):
         assert s["support"] == s["n"] - first
         ed.xdo("key", "ctrl+z", "key", "ctrl+z")
         s = ed.idle(lambda s: s["support"] == 0, "two undos clear it")
+        # --- visible only (V): a lasso over the same area takes fewer splats (no back side)
+        ed.xdo("key", "v", "key", "ctrl+shift+b")
+        ed.idle(lambda s: s["region_armed"] == "lasso" and s["brush_mode"] == "visible", "lasso armed")
+        ed.xdo("mousemove", x0, y0, "mousedown", "1", "mousemove", x1, y0, "mousemove", x1, y1,
+               "mousemove", x0, y1, "mousemove", x0, y0 + 3, "sleep", "0.1", "mouseup", "1")
+        s = ed.idle(lambda s: s["history_label"] == "lasso select support", "lasso selected", 30)
+        assert 0.2 * first < s["support"] < 0.9 * first
+        lasso = s["support"]
+        ed.xdo("key", "Delete")
+        s = ed.idle(lambda s: s["history_label"] == "delete", "deleted")
+        assert s["n"] == src.n - lasso and s["support"] == 0 and s["edits"] == 1
+        ed.xdo("key", "ctrl+s")
+        s = ed.idle(lambda s: s["saved"] and not s["dirty"], "saved", 60)
         assert s["validation_messages"] == 0 and s["internal_errors"] == 0
     finally:
         ed.close()
+    assert_replay_reproduces(tmp_path / "deleted.edits.json", out, tmp_path)
