@@ -55,6 +55,7 @@ from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
 from splatedit.app.tools.delete import DeleteTool
 from splatedit.app.tools.mirror import MirrorTool
+from splatedit.app.tools.pivot import PivotTool
 from splatedit.app.tools.region import RegionSelectTool
 from splatedit.errors import ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
@@ -144,7 +145,8 @@ class Editor(EventRouting, FileActions, CrashGuard):
         self.curve = CurveTool(self)
         self.region = RegionSelectTool(self)
         self.mirror = MirrorTool(self)
-        self.tools = (self.camera, self.region, self.curve, self.gizmo, self.brush, self.mirror, DeleteTool(self))
+        self.pivot = PivotTool(self)
+        self.tools = (self.camera, self.pivot, self.region, self.curve, self.gizmo, self.brush, self.mirror, DeleteTool(self))
         self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()

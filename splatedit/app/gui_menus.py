@@ -1,7 +1,8 @@
 """The editor's menu bar (Dear ImGui): File (:attr:`EditorGui.file_menu`,
 rows of :class:`MenuEntry`, with Open... and the Open recent submenu), Edit
 (undo / redo), Select (all / none / invert, box / lasso, grow / shrink /
-connected, mirror and the selection toggles) and View (panels, help, frame all, the six views about the up axis).
+connected, mirror and the selection toggles), Pivot (the centre and axes of
+R / S and the gizmo) and View (panels, help, frame all, the six views about the up axis).
 
 A part of :class:`~splatedit.app.gui_panels.EditorGui` (mixed into it: it
 uses its ``ed``, ``windows``, ``rects`` and ``_rect``).  Esc closes an open
@@ -95,6 +96,11 @@ class MenuBar:
             self._select_menu()
             imgui.end_menu()
         self._rect("menu_select")
+        if imgui.begin_menu("Pivot", s is not None):
+            self._menu_open = True
+            self._pivot_menu()
+            imgui.end_menu()
+        self._rect("menu_pivot")
         if imgui.begin_menu("View"):
             self._menu_open = True
             if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
@@ -140,6 +146,24 @@ class MenuBar:
             ed.run_action(Action.BRUSH_MODE)
         if imgui.menu_item("Erase mode", "E", ed.brush.erase_toggle)[0]:
             ed.run_action(Action.ERASE_TOGGLE)
+
+    def _pivot_menu(self) -> None:
+        """Pivot: the centre of R / S and the gizmo, and the axes of X / Y / Z."""
+        from splatedit.app.tools.pivot import FRAMES, PIVOTS
+        ed = self.ed
+        pv = ed.pivot
+        acts = (Action.PIVOT_HANDLE, Action.PIVOT_RIM, Action.PIVOT_CURSOR, Action.PIVOT_VIEW)
+        for label, a in zip(PIVOTS, acts):
+            if imgui.menu_item(label.capitalize(), ".", pv.mode == label)[0]:
+                ed.run_action(a)
+            self._rect(f"pivot_{a.value}")
+        if imgui.menu_item("3D cursor to the view centre", "Shift+right click: on the model", False)[0]:
+            ed.run_action(Action.CURSOR_TO_VIEW_CENTRE)
+        imgui.separator()
+        for label, a in zip(FRAMES, (Action.AXES_GLOBAL, Action.AXES_LOCAL, Action.AXES_VIEW)):
+            if imgui.menu_item(f"Axes: {label}", ",", pv.orientation == label)[0]:
+                ed.run_action(a)
+            self._rect(f"pivot_{a.value}")
 
     def _menu_entries(self, entries: list[MenuEntry]) -> None:
         for e in entries:

@@ -169,8 +169,7 @@ def draw_gizmo(ed, dl, w: int, h: int) -> None:
     if depth.min() <= 0:
         return
     if s.manip is not None and s.manip.axis is not None:
-        a = np.zeros(3)
-        a[s.manip.axis] = cam.scene_radius
+        a = s.manip.axis_vector() * cam.scene_radius
         ends, d2 = cam.project(np.vstack([cur - a, cur + a]), w, h)
         if d2.min() > 0:
             line(dl, ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1.0)

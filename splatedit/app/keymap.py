@@ -100,6 +100,16 @@ class Action(enum.Enum):
     COMMIT_POSE = "commit_pose"
     CANCEL = "cancel"                # Esc when idle: discard pending moves / curve tool off
     DEFORMATION_MODE = "deformation_mode"
+    PIVOT_NEXT = "pivot_next"
+    PIVOT_HANDLE = "pivot_handle"
+    PIVOT_RIM = "pivot_rim"
+    PIVOT_CURSOR = "pivot_cursor"
+    PIVOT_VIEW = "pivot_view"
+    AXES_NEXT = "axes_next"
+    AXES_GLOBAL = "axes_global"
+    AXES_LOCAL = "axes_local"
+    AXES_VIEW = "axes_view"
+    CURSOR_TO_VIEW_CENTRE = "cursor_to_view_centre"
     # curve
     CURVE_TOOL = "curve_tool"
     CLEAR_CURVE = "clear_curve"
@@ -274,6 +284,12 @@ KEYMAP: tuple[Binding, ...] = (
             "surface, the relief re-attached along its normals; refits) / LINEAR (the paper's);\n"
             "a Gaussian scene: ROTATION / LINEAR (no DETAIL: B says so)",
             Action.DEFORMATION_MODE, ("b",)),
+    Binding(S.DEFORMATION, ".  (period)", "pivot of R / S and the gizmo: handle centre / support rim (where the support\n"
+            "meets the fixed part) / 3D cursor / view centre (also the Pivot menu)", Action.PIVOT_NEXT,
+            ("period",)),
+    Binding(S.DEFORMATION, ",  (comma)", "axes of the gizmo and X / Y / Z: global / local (the handle's principal axes) / view",
+            Action.AXES_NEXT, ("comma",)),
+    Binding(S.DEFORMATION, "Shift + right click", "place the 3D cursor on the model", mouse=True),
     Binding(S.DEFORMATION, "G / R / S", "grab / rotate / scale the active handle with the mouse\n"
             "(the overlay shows the distance / angle / factor while moving)", Action.GRAB, ("g",)),
     Binding(S.DEFORMATION, "", "", Action.ROTATE, ("r",)),
@@ -281,8 +297,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.DEFORMATION, "G / R / S", "", Action.GRAB, ("g",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.ROTATE, ("r",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.SCALE, ("s",), C.MANIP),
-    Binding(S.DEFORMATION, "X / Y / Z", "constrain to that world axis (again: free)", Action.AXIS_X, ("x",),
-            C.MANIP, indent=2),
+    Binding(S.DEFORMATION, "X / Y / Z", "constrain to that axis of the chosen axes (again: free)", Action.AXIS_X,
+            ("x",), C.MANIP, indent=2),
     Binding(S.DEFORMATION, "", "", Action.AXIS_Y, ("y",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.AXIS_Z, ("z",), C.MANIP),
     Binding(S.DEFORMATION, "0-9 . -", "type a value: distance, degrees or factor (G X 0.1 Enter)",

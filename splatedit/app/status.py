@@ -94,7 +94,10 @@ def status_dict(ed) -> dict:
               closure_highlight=tools.highlighted(s.cloud) is not None,
               history_label=s.history.labels[s.history.position],
               region_armed=ed.region.armed, region_points=len(ed.region.points),
-              mirror_painting=ed.mirror.painting, mirror_axis="XYZ"[ed.mirror.axis])
+              mirror_painting=ed.mirror.painting, mirror_axis="XYZ"[ed.mirror.axis],
+              pivot=ed.pivot.mode, axes=ed.pivot.orientation,
+              cursor=None if ed.pivot.cursor is None else [round(float(x), 9) for x in ed.pivot.cursor],
+              manip_pivot=None if s.manip is None else [round(float(x), 9) for x in s.manip.pivot])
     ft = field_target(s)
     st["fields"] = {"kind": ft.kind.value, "index": ft.index, "problem": ft.problem,
                     "position": None if ft.position is None else [round(float(x), 9) for x in ft.position]}
