@@ -3,11 +3,14 @@ Ctrl+B then a left drag over the bunny seen from the front draws the box
 (its white outline is on the screen while dragging) and adds every splat
 whose centre projects inside (3D mode: through, front and back) to the
 support as one undo step; Select > Invert inverts it; two undos clear it.
-Then a lasso (visible splats only, V) and Delete remove splats; the saved
+Shift + right click places the 3D cursor (drawn there) and "." makes it
+the pivot.  Then a lasso (visible splats only, V) and Delete remove splats; the saved
 file is what ``splatedit deform`` makes of the bundled model with the
 saved edit script."""
 
 from __future__ import annotations
+
+import os
 
 import numpy as np
 import pytest
@@ -41,6 +44,22 @@ def test_box_select_through_and_select_menu_invert(xvfb, tmp_path):
         px, depth = _camera(s).project(src.positions, w, h)
         on = depth > 0
         cx, cy = np.median(px[on], axis=0).astype(int)
+        # --- the 3D cursor: Shift + right click on the model, drawn there; "." twice makes it the pivot
+        before = ed.screenshot()[:h, :w].astype(int)
+        ed.xdo("mousemove", cx, cy, "keydown", "shift", "click", "3", "keyup", "shift")
+        s = ed.idle(lambda s: s["cursor"] is not None, "3D cursor placed")
+        cpx, cdepth = _camera(s).project(np.array(s["cursor"]), w, h)
+        assert cdepth[0] > 0 and np.hypot(*(cpx[0] - (cx, cy))) < 1.5
+        ed.xdo("key", "period", "key", "period")
+        s = ed.idle(lambda s: s["pivot"] == "3D cursor", "pivot: 3D cursor")
+        shown = s["frames_presented"]
+        ed.wait(lambda s: s["frames_presented"] > shown, "a frame with the cursor")
+        img = ed.screenshot()[:h, :w].astype(int)
+        ring = np.s_[cy - 12:cy + 13, cx - 12:cx + 13]
+        red = (img[ring][..., 0] > 150) & (img[ring][..., 1] < 120) & (np.abs(img[ring] - before[ring]).max(axis=2) > 40)
+        if os.environ.get("SPLATEDIT_KEEP_SHOTS"):
+            np.save(tmp_path / "cursor.npy", img[cy - 40:cy + 40, cx - 40:cx + 40])
+        assert red.sum() > 20, "the 3D cursor is not drawn (red ring and cross)"
         x0, y0, x1, y1 = cx - 60, cy - 40, cx + 50, cy + 30
         want = splats_through(polygon_mask(box_polygon((x0, y0), (x1, y1)), w, h), px, depth)
         assert len(want) > 500
