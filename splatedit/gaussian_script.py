@@ -37,9 +37,8 @@ def run_script_gaussians(scene: GaussianCloud, script: EditScript, *, method: st
     reports = []
     for i, edit in enumerate(script.edits):
         if isinstance(edit, Removal):       # delete / crop: the Gaussians left, in order
-            from splatedit.model.gaussian_lod import subset
             kept = removal_mask(scene.positions, edit, source)
-            scene = subset(scene, np.flatnonzero(kept))
+            scene = scene.take(kept)
             rep = RemovalReport(i, edit.key, int((~kept).sum()), int(kept.sum()))
             reports.append(rep)
             if on_edit is not None:

@@ -65,12 +65,10 @@ def subset_document(cloud, kept):
     delete or crop): plain splats through ``SplatCloud.subset`` (faces
     dropped), a Gaussian document as the same subset of its Gaussians (what
     ``splatedit deform`` replaying the script's delete / crop gives)."""
-    import numpy as np
     scene = gaussians_of(cloud)
     if scene is None:
         return cloud.subset(kept)
-    from splatedit.model.gaussian_lod import subset
-    return gaussian_document(subset(scene, np.flatnonzero(kept)))
+    return gaussian_document(scene.take(kept))
 
 
 def document_bytes(cloud) -> int:

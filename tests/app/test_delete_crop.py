@@ -97,3 +97,42 @@ def test_bad_delete_and_crop_items_name_their_json_path(item, path, text):
         run_script(plane_cloud(), script)
     msg = str(exc.value)
     assert path in msg and text in msg, msg
+
+
+def test_a_gaussian_scene_crops_with_its_properties_and_the_saved_file_replays(tmp_path):
+    from splatedit.app import files
+    from splatedit.app.gaussian_doc import gaussian_document, gaussians_of
+    from splatedit.data import gaussian_scene_path
+    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.io import read_gaussians
+    scene = read_gaussians(gaussian_scene_path())
+    s = Session(gaussian_document(scene), fit_sync=True)
+    y = s.cloud.positions[:, 1]
+    top = y > np.median(y)
+    s.set_selection(top, np.zeros(len(y), bool))
+    assert s.remove_splats(keep=True) == int((~top).sum())
+    g = gaussians_of(s.cloud)
+    assert len(g) == top.sum() and s.cloud.n == top.sum()
+    assert list(g.extra) == list(scene.extra) and np.array_equal(g.sh, scene.sh[top])
+
+    class Ed:            # what files.save needs of the editor
+        session, jobs, path, save_as = s, {}, gaussian_scene_path(), None
+
+        def say(self, text):
+            pass
+
+        def wake(self):
+            pass
+    ed = Ed()
+    out = tmp_path / "top.ply"
+    files.save(ed, out)
+    ed.jobs["save"].wait()
+    assert ed.jobs["save"].error is None
+    saved = read_gaussians(out)
+    replayed, reports = run_script_gaussians(scene, s.edit_script())
+    assert "crop" in reports[0].line()
+    assert np.array_equal(replayed.positions, saved.positions) and np.array_equal(replayed.sh, saved.sh)
+    assert list(saved.extra) == list(scene.extra)
+    s.undo()
+    assert len(gaussians_of(s.cloud)) == len(scene)
+    s.close()

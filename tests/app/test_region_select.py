@@ -151,3 +151,20 @@ def test_symmetric_painting_paints_each_dab_and_its_mirror(ed):
     assert np.array_equal(both, np.flatnonzero(np.abs(p[:, 0]) > 0.8))
     key(ed, glfw.KEY_M, glfw.MOD_CONTROL | glfw.MOD_SHIFT)   # the plane's normal: Y
     assert ed.mirror.axis == 1
+
+
+def test_the_select_menus_shortcuts_are_the_keymaps_keys():
+    pytest.importorskip("imgui_bundle")
+    from splatedit.app.gui_menus import _SELECT_ENTRIES
+    from splatedit.app.keymap import KEYMAP
+
+    names = {"equal": "=", "minus": "-"}
+
+    def shown(chord):
+        key = names.get(chord.key.lower(), chord.key.capitalize() if len(chord.key) > 1 else chord.key)
+        return ("Ctrl+" if chord.ctrl else "") + ("Shift+" if chord.shift else "") + key
+
+    for entry in filter(None, _SELECT_ENTRIES):
+        label, shortcut, action = entry
+        keys = {shown(c) for b in KEYMAP if b.action is action for c in b.chords}
+        assert shortcut in keys, (label, shortcut, keys)
