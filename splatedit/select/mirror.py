@@ -15,6 +15,9 @@ import numpy as np
 
 from splatedit.tolerances import MIRROR_MATCH_SPACINGS
 
+#: neighbours of each reflection looked at (the nearest, and candidates of the pull)
+MIRROR_CANDIDATES = 4
+
 AXES = "XYZ"
 
 
@@ -50,18 +53,19 @@ def mirror_indices(positions: np.ndarray, idx, tree, spacing: float, axis: int =
     pos = np.asarray(positions)
     c = plane_centre(pos, axis) if centre is None else float(centre)
     tol = MIRROR_MATCH_SPACINGS * max(float(spacing), 1e-300)
-    # push: the splat nearest to each reflected one
-    d, j = tree.query(reflect(pos[idx], axis, c), distance_upper_bound=tol)
-    push = j[np.isfinite(d)].astype(np.int64)
-    # pull: every splat near a reflection whose own reflection lands nearest to a
-    # selected splat (the nearest-sample map is many-to-one: push alone leaves holes
-    # where the other side is sampled more densely)
+    # push: the splats nearest to each reflected one (the first column), and
+    # near it (the others: candidates of the pull below)
+    d, j = tree.query(reflect(pos[idx], axis, c), k=MIRROR_CANDIDATES, distance_upper_bound=tol, workers=-1)
+    ok = np.isfinite(d)
+    push = j[:, 0][ok[:, 0]].astype(np.int64)
+    cand = np.setdiff1d(np.unique(j[ok].astype(np.int64)), push)    # the push's are in already
+    # pull: a candidate whose own reflection lands nearest to a selected splat
+    # (the nearest-sample map is many-to-one: push alone leaves holes where the
+    # other side is sampled more densely)
     chosen = np.zeros(len(pos), bool)
     chosen[idx] = True
-    near = tree.query_ball_point(reflect(pos[idx], axis, c), tol)
-    cand = np.unique(np.concatenate([np.asarray(r, np.int64) for r in near] + [np.zeros(0, np.int64)]))
     if len(cand):
-        d2, k = tree.query(reflect(pos[cand], axis, c), distance_upper_bound=tol)
-        ok = np.isfinite(d2)
-        cand = cand[ok][chosen[k[ok]]]
+        d2, k2 = tree.query(reflect(pos[cand], axis, c), distance_upper_bound=tol, workers=-1)
+        good = np.isfinite(d2)
+        cand = cand[good][chosen[k2[good]]]
     return np.union1d(push, cand)

@@ -115,13 +115,15 @@ GRAPH_ROWS_CHUNK = 1 << 16
 
 # --- mirror (X-symmetry) selection (splatedit.select.mirror) ---------------
 #: a splat's mirror image is the splat nearest to its reflection when that
-#: one is at most this many median neighbour spacings away.  A symmetric
-#: model sampled independently on each side puts the nearest sample within
-#: half a spacing of a reflected one on a regular sampling and within about
-#: one on a scan's; 1.5 leaves a margin without matching across a gap (a
-#: reflection off the surface, on a model that is not symmetric there, finds
-#: nothing).  Measured on a jittered 60x60 grid of a 2:1 rectangle (jitter
-#: 0.25 grid steps, tests/select/test_mirror.py), a strip mirrored: 42 % of
-#: the other strip found at 0.5 spacings, 94 % at 1.0, 100 % at 1.5-3.0,
-#: never a splat outside it
-MIRROR_MATCH_SPACINGS = 1.5
+#: one is at most this many median neighbour spacings away (and a splat whose
+#: reflection lands nearest to a selected one joins too).  Measured, a strip
+#: of one side mirrored (the fraction of the other side's strip found; no
+#: splat away from the strip's edge was ever taken):
+#:   jittered 60x60 grid (0.25 steps, tests/select/test_mirror.py):
+#:     0.5: 42 %, 1.0: 94 %, 1.5 - 3.0: 100 %
+#:   Poisson-sampled sphere, 100k (the worst case: random gaps):
+#:     1.0: 50 %, 1.5: 79 %, 2.0: 92 %, 2.5: 96 %, 3.0: 97 %
+#: 2.0 takes nearly all of a scan's sampling (between the two) while staying
+#: within two spacings of the reflected surface; the closure that follows
+#: fills the few holes left.
+MIRROR_MATCH_SPACINGS = 2.0
