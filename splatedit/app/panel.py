@@ -76,6 +76,10 @@ def panel_lines(ed) -> list:
     note = brush.mode_note()
     if note:
         lines.append((note, (255, 230, 120)))
+    for tool in ed.tools:           # the protocol tools' state lines
+        line = tool.status()
+        if line:
+            lines.append((line, (255, 230, 120)))
     lines.append(f"support {st.support:,}   handle {st.handle:,}   "
                  f"deformation {s.deformation.value.upper()} (B)")
     hs = s.selection.handles

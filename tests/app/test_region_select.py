@@ -168,3 +168,18 @@ def test_the_select_menus_shortcuts_are_the_keymaps_keys():
         label, shortcut, action = entry
         keys = {shown(c) for b in KEYMAP if b.action is action for c in b.chords}
         assert shortcut in keys, (label, shortcut, keys)
+
+
+def test_armed_tools_and_toggles_say_so_in_the_panel(ed):
+    from splatedit.app.panel import panel_lines
+    ed.viewport.last_info = None
+
+    def text():
+        return " | ".join(x if isinstance(x, str) else x[0] for x in panel_lines(ed))
+    assert "box select" not in text() and "symmetric" not in text() and "pivot:" not in text()
+    key(ed, glfw.KEY_B, glfw.MOD_CONTROL)
+    key(ed, glfw.KEY_M, glfw.MOD_SHIFT)
+    key(ed, glfw.KEY_PERIOD)
+    t = text()
+    assert "box select: left drag (through" in t and "symmetric painting across X" in t
+    assert "pivot: support rim" in t

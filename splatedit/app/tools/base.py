@@ -73,6 +73,11 @@ class Tool:
             c = self._ctx = ToolContext(self.ed)
         return c
 
+    def status(self) -> str | None:
+        """A short state line for the panel (an armed box, symmetric painting,
+        a chosen pivot), or None when there is nothing to say."""
+        return None
+
     def shapes(self, w: int, h: int) -> list:
         """Overlay shapes (:mod:`splatedit.app.shapes`) drawn this frame."""
         return []

@@ -29,6 +29,9 @@ class MirrorTool(Tool):
         return {Action.MIRROR_SELECTION: self.mirror_selection, Action.MIRROR_PAINT: self.toggle_painting,
                 Action.MIRROR_AXIS: self.next_axis}
 
+    def status(self):
+        return f"symmetric painting across {AXES[self.axis]} (Shift+M)" if self.painting else None
+
     def toggle_painting(self) -> None:
         self.painting = not self.painting
         self.ctx.say(f"symmetric painting {'on' if self.painting else 'off'} (across {AXES[self.axis]})")

@@ -144,6 +144,11 @@ class PivotTool(Tool):
         c.redraw()
         return True
 
+    def status(self):
+        if self.mode == HANDLE_CENTRE and self.orientation == GLOBAL:
+            return None
+        return f"pivot: {self.mode}   axes: {self.orientation}   (. ,)"
+
     # ------------------------------------------------------------ geometry
     def point(self) -> np.ndarray | None:
         """(3,) the pivot in model units, or None for the handle's centre

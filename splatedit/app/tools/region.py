@@ -182,6 +182,11 @@ class RegionSelectTool(Tool):
         c.say(f"{kind} {'erase' if erase else 'select'}: {what} {int(c.target_mask().sum()) - before:+,} splats")
         return True
 
+    def status(self):
+        if self.armed is None:
+            return None
+        return f"{self.armed} select: left drag ({'through' if self.ctx.through else 'visible only'}; right click cancels)"
+
     # -------------------------------------------------------------- drawing
     def shapes(self, w, h):
         if self.armed is None or len(self.points) < 2:
