@@ -183,3 +183,16 @@ def test_armed_tools_and_toggles_say_so_in_the_panel(ed):
     t = text()
     assert "box select: left drag (through" in t and "symmetric painting across X" in t
     assert "pivot: support rim" in t
+
+
+def test_protocol_tools_register_themselves_and_use_only_their_context(ed):
+    import inspect
+
+    from splatedit.app.tools import protocol_tools
+    names = [c.name for c in protocol_tools()]
+    assert names == ["delete", "mirror", "pivot", "region"]
+    for cls in protocol_tools():
+        assert getattr(ed, cls.name).__class__ is cls and getattr(ed, cls.name) in ed.tools
+        src = inspect.getsource(inspect.getmodule(cls))
+        # on the protocol: the narrow context, no reach into the editor or its other tools
+        assert "self.ed." not in src and "self.session" not in src, cls.__name__

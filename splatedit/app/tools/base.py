@@ -165,6 +165,12 @@ class ToolContext:
         s = self._ed.session
         return s is None or s.manip is not None or s.committing
 
+    # ---- input
+    @property
+    def keys(self):
+        """The input constants (glfw's ``MOUSE_BUTTON_*``, ``MOD_*``)."""
+        return self._ed.g
+
     # ---- feedback
     def say(self, text: str) -> None:
         self._ed.say(text)

@@ -15,6 +15,8 @@ from splatedit.app.tools.base import Tool
 
 class DeleteTool(Tool):
     section = Section.SELECTION
+    #: the editor attribute it is reachable as (``editor.delete``)
+    name = "delete"
 
     def actions(self):
         return {Action.DELETE_SPLATS: lambda: self.remove(keep=False),
@@ -39,3 +41,6 @@ class DeleteTool(Tool):
         if n:
             c.say(f"{what}: removed {n:,} splats, {doc.cloud.n:,} left (Ctrl+Z undoes it)")
         return n
+
+
+TOOL = DeleteTool

@@ -19,6 +19,8 @@ from splatedit.select.mirror import AXES, mirror_indices
 
 class MirrorTool(Tool):
     section = Section.SELECTION
+    #: the editor attribute it is reachable as (``editor.mirror``)
+    name = "mirror"
 
     def __init__(self, ed):
         super().__init__(ed)
@@ -71,3 +73,6 @@ class MirrorTool(Tool):
             return False
         c.say(f"mirror {c.target} across {AXES[self.axis]}: {int(c.target_mask().sum()) - before:+,} splats")
         return True
+
+
+TOOL = MirrorTool

@@ -85,6 +85,8 @@ def orthonormal(m: np.ndarray) -> np.ndarray:
 
 class PivotTool(Tool):
     section = Section.DEFORMATION
+    #: the editor attribute it is reachable as (``editor.pivot``)
+    name = "pivot"
 
     def __init__(self, ed):
         super().__init__(ed)
@@ -196,7 +198,7 @@ class PivotTool(Tool):
 
     # ---------------------------------------------------------------- mouse
     def press_modal(self, e):
-        g = self.ed.g
+        g = self.ctx.keys
         if e.button == g.MOUSE_BUTTON_RIGHT and (e.mods & g.MOD_SHIFT) and not self.ctx.busy():
             self.place_cursor(e.x, e.y)
             return DragMode.NONE
@@ -217,3 +219,6 @@ class PivotTool(Tool):
         return [Polyline(ring, rgb, 2.0, closed=True),
                 Polyline(np.array([[x - 2 * r, y], [x + 2 * r, y]]), rgb, 1.0),
                 Polyline(np.array([[x, y - 2 * r], [x, y + 2 * r]]), rgb, 1.0)]
+
+
+TOOL = PivotTool

@@ -92,6 +92,8 @@ def splats_visible(mask: np.ndarray, picker) -> np.ndarray:
 class RegionSelectTool(Tool):
     """Box / lasso selection on the brush target (see the module docstring)."""
     section = Section.SELECTION
+    #: the editor attribute it is reachable as (``editor.region``)
+    name = "region"
 
     def __init__(self, ed):
         super().__init__(ed)
@@ -117,13 +119,13 @@ class RegionSelectTool(Tool):
     def press_modal(self, e):
         if self.armed is None:
             return None
-        g = self.ed.g
+        g = self.ctx.keys
         if e.button == g.MOUSE_BUTTON_RIGHT:
             self.ctx.say(f"{self.armed} select cancelled")
             self.armed = None
             return DragMode.NONE
-        if e.button != g.MOUSE_BUTTON_LEFT or self.ctx.busy():
-            return None
+        if e.button != g.MOUSE_BUTTON_LEFT or (e.mods & g.MOD_ALT) or self.ctx.busy():
+            return None                          # (Alt + left drag orbits, as without the box)
         self.points = [(float(e.x), float(e.y))]
         self.erase = self.ctx.erasing(e.mods)
         return DragMode.REGION
@@ -193,3 +195,6 @@ class RegionSelectTool(Tool):
             return []
         rgb = REGION_ERASE_RGB if self.erase else REGION_RGB
         return [Polyline(self.polygon(self.armed, self.points), rgb, 2.0, closed=True)]
+
+
+TOOL = RegionSelectTool
