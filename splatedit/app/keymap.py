@@ -257,7 +257,7 @@ KEYMAP: tuple[Binding, ...] = (
             Action.SELECT_ALL, ("a",)),
     Binding(S.SELECTION, "Ctrl+B / Ctrl+Shift+B", "box / lasso select: the next left drag draws it; the splats inside\n"
             "join the brush target (Ctrl held: erased); V decides: 3D = every centre inside\n"
-            "(through), visible = only what is seen; right click or the key again: cancel",
+            "(through), visible = only what is seen; Esc, right click or the key again: cancel",
             Action.BOX_SELECT, ("ctrl+b",)),
     Binding(S.SELECTION, "", "", Action.LASSO_SELECT, ("ctrl+shift+b",)),
     Binding(S.SELECTION, "Ctrl+M", "mirror: add the brush target's mirror image across the model's middle plane",

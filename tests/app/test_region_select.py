@@ -113,6 +113,12 @@ def test_right_click_cancels_an_armed_box_and_the_brush_paints_again(ed):
     key(ed, glfw.KEY_B, glfw.MOD_CONTROL)
     key(ed, glfw.KEY_B, glfw.MOD_CONTROL)                 # the key again disarms
     assert ed.region.armed is None
+    ed.session.curve_mode = True
+    key(ed, glfw.KEY_B, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
+    key(ed, glfw.KEY_ESCAPE)                              # Esc cancels the lasso, not the curve tool
+    assert ed.region.armed is None and ed.session.curve_mode
+    key(ed, glfw.KEY_ESCAPE)
+    assert not ed.session.curve_mode
 
 
 def test_the_region_outline_is_a_closed_shape_while_dragging(ed):

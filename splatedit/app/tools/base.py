@@ -73,6 +73,12 @@ class Tool:
             c = self._ctx = ToolContext(self.ed)
         return c
 
+    def intercept(self, action: Action) -> bool:
+        """Offered every action before its handler runs (e.g. Esc while a
+        box is armed cancels the box, not the pending moves); True: handled
+        here, the bound handler does not run."""
+        return False
+
     def status(self) -> str | None:
         """A short state line for the panel (an armed box, symmetric painting,
         a chosen pivot), or None when there is nothing to say."""

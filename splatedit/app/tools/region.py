@@ -115,6 +115,15 @@ class RegionSelectTool(Tool):
         mode = "every splat inside, through" if self.ctx.through else "visible splats only (V: through)"
         self.ctx.say(f"{kind} select: {how} ({mode}; Ctrl: erase; right click: cancel)")
 
+    def intercept(self, action):
+        """Esc while a box or lasso is armed cancels it."""
+        if action is Action.CANCEL and self.armed is not None:
+            self.ctx.say(f"{self.armed} select cancelled")
+            self.armed, self.points = None, []
+            self.ctx.redraw()
+            return True
+        return False
+
     # ---------------------------------------------------------------- mouse
     def press_modal(self, e):
         if self.armed is None:
@@ -187,7 +196,7 @@ class RegionSelectTool(Tool):
     def status(self):
         if self.armed is None:
             return None
-        return f"{self.armed} select: left drag ({'through' if self.ctx.through else 'visible only'}; right click cancels)"
+        return f"{self.armed} select: left drag ({'through' if self.ctx.through else 'visible only'}; Esc cancels)"
 
     # -------------------------------------------------------------- drawing
     def shapes(self, w, h):
