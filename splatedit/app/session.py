@@ -31,7 +31,9 @@ Every user action that changes the document (a stroke, a clear, a commit)
 pushes a :class:`~splatedit.app.history.Snapshot`; undo/redo restore them
 (and restart the fit for the restored selection).  Committed edits are
 recorded as script edits (``indices`` support + ``indices`` handles +
-``matrix`` transforms + ``curves`` with ``points`` and ``move``) and :meth:`Session.edit_script` returns an
+``matrix`` transforms + ``curves`` with ``points`` and ``move``), deleted or
+cropped splats (:meth:`Session.remove_splats`) as ``delete`` / ``crop``
+items with ``indices``, and :meth:`Session.edit_script` returns an
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
 
