@@ -103,6 +103,10 @@ def test_box_select_through_and_select_menu_invert(xvfb, tmp_path):
         ed.xdo("key", "Delete")
         s = ed.idle(lambda s: s["history_label"] == "delete", "deleted")
         assert s["n"] == src.n - lasso and s["support"] == 0 and s["edits"] == 1
+        if os.environ.get("SPLATEDIT_KEEP_SHOTS"):          # for looking at: the hole the delete left
+            shown = s["frames_presented"]
+            ed.wait(lambda s: s["frames_presented"] > shown, "a frame after the delete")
+            np.save(tmp_path / "deleted.npy", ed.screenshot()[:h, :w])
         ed.xdo("key", "ctrl+s")
         s = ed.idle(lambda s: s["saved"] and not s["dirty"], "saved", 60)
         assert s["validation_messages"] == 0 and s["internal_errors"] == 0
