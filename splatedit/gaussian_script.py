@@ -20,7 +20,7 @@ from splatedit.deform.gaussians import deform_with_evaluator
 from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError
 from splatedit.model.gaussians import GaussianCloud
-from splatedit.script import EditReport, EditScript, fit_edit
+from splatedit.script import EditReport, EditScript, Removal, RemovalReport, fit_edit, removal_mask
 
 
 def run_script_gaussians(scene: GaussianCloud, script: EditScript, *, method: str | None = None,
@@ -36,6 +36,14 @@ def run_script_gaussians(scene: GaussianCloud, script: EditScript, *, method: st
     """
     reports = []
     for i, edit in enumerate(script.edits):
+        if isinstance(edit, Removal):       # delete / crop: the Gaussians left, in order
+            kept = removal_mask(scene.positions, edit, source)
+            scene = scene.take(kept)
+            rep = RemovalReport(i, edit.key, int((~kept).sum()), int(kept.sum()))
+            reports.append(rep)
+            if on_edit is not None:
+                on_edit(rep)
+            continue
         if edit.deformation is DeformationMode.DETAIL:
             # the detail mode's offsets along a smoothed base are defined for surface splats only
             raise EditScriptError("the detail mode is not available for Gaussian splatting scenes "

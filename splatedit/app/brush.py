@@ -114,6 +114,12 @@ class BrushPicker:
     def shape(self) -> tuple[int, int]:
         return self.pick.shape
 
+    def visible_centres(self) -> np.ndarray:
+        """Indices (int64) of the splats whose projected centre is visible
+        (on a pixel, at most ``tol`` behind the front surface there); empty
+        without projected centres."""
+        return self._vis_idx if self._order is not None else np.zeros(0, np.int64)
+
     def query(self, cx: float, cy: float, radius: float) -> np.ndarray:
         """Sorted unique indices of the visible splats under the brush circle."""
         out = indices_in_circle(self.pick, cx, cy, radius)

@@ -53,6 +53,7 @@ from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
 from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
+from splatedit.app.tools import protocol_tools
 from splatedit.errors import ParameterError, SplatEditError
 from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
                                   IQR_DEFAULT_TOL)
@@ -139,7 +140,12 @@ class Editor(EventRouting, FileActions, CrashGuard):
         self.brush = BrushTool(self)
         self.gizmo = GizmoTool(self)
         self.curve = CurveTool(self)
-        self.tools = (self.camera, self.curve, self.gizmo, self.brush)
+        # the tools on the protocol register themselves (app/tools/*.py with TOOL = ...):
+        # self.region, self.mirror, self.delete, self.pivot, ...
+        found = [cls(self) for cls in protocol_tools()]
+        for tool in found:
+            setattr(self, tool.name, tool)
+        self.tools = (self.camera, self.curve, self.gizmo, self.brush, *found)
         self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()

@@ -60,6 +60,17 @@ def commit_cloud(basis, cloud, dc, progress=None):
     return gaussian_document(deform_with_evaluator(scene, basis, dc, progress=progress))
 
 
+def subset_document(cloud, kept):
+    """The document with only the splats ``kept`` ((n,) bool) in order (a
+    delete or crop): plain splats through ``SplatCloud.subset`` (faces
+    dropped), a Gaussian document as the same subset of its Gaussians (what
+    ``splatedit deform`` replaying the script's delete / crop gives)."""
+    scene = gaussians_of(cloud)
+    if scene is None:
+        return cloud.subset(kept)
+    return gaussian_document(scene.take(kept))
+
+
 def document_bytes(cloud) -> int:
     """Bytes of the arrays a Gaussian document adds to its proxy (history budget)."""
     g = gaussians_of(cloud)

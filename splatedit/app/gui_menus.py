@@ -1,6 +1,8 @@
 """The editor's menu bar (Dear ImGui): File (:attr:`EditorGui.file_menu`,
 rows of :class:`MenuEntry`, with Open... and the Open recent submenu), Edit
-(undo / redo) and View (panels, help, frame all, the six views about the up axis).
+(undo / redo), Select (all / none / invert, box / lasso, grow / shrink /
+connected, mirror and the selection toggles), Pivot (the centre and axes of
+R / S and the gizmo) and View (panels, help, frame all, the six views about the up axis).
 
 A part of :class:`~splatedit.app.gui_panels.EditorGui` (mixed into it: it
 uses its ``ed``, ``windows``, ``rects`` and ``_rect``).  Esc closes an open
@@ -25,6 +27,28 @@ _VIEW_ENTRIES = (
     ("Back", "Ctrl+Numpad 1", Action.VIEW_BACK),
     ("Left", "Ctrl+Numpad 3", Action.VIEW_LEFT),
     ("Bottom", "Ctrl+Numpad 7", Action.VIEW_BOTTOM),
+)
+
+
+#: Select menu: (label, shortcut shown, action); None: a separator.  The
+#: shortcuts are the keymap's rows (a test checks they agree)
+_SELECT_ENTRIES = (
+    ("All", "A", Action.SELECT_ALL),
+    ("None", "C", Action.CLEAR_SELECTION),
+    ("Invert", "Ctrl+I", Action.INVERT),
+    None,
+    ("Box select", "Ctrl+B", Action.BOX_SELECT),
+    ("Lasso select", "Ctrl+Shift+B", Action.LASSO_SELECT),
+    None,
+    ("Grow", "Ctrl+=", Action.GROW),
+    ("Shrink", "Ctrl+-", Action.SHRINK),
+    ("Connected (under the cursor)", "L", Action.CONNECTED),
+    ("Connected, all of it", "Shift+L", Action.CONNECTED_ALL),
+    None,
+    ("Mirror", "Ctrl+M", Action.MIRROR_SELECTION),
+    None,
+    ("Delete selected splats", "Delete", Action.DELETE_SPLATS),
+    ("Crop to the selection", "Shift+Delete", Action.CROP_SPLATS),
 )
 
 
@@ -67,6 +91,16 @@ class MenuBar:
                 ed.run_action(Action.REDO)
             imgui.end_menu()
         self._rect("menu_edit")
+        if imgui.begin_menu("Select", s is not None):
+            self._menu_open = True
+            self._select_menu()
+            imgui.end_menu()
+        self._rect("menu_select")
+        if imgui.begin_menu("Pivot", s is not None):
+            self._menu_open = True
+            self._pivot_menu()
+            imgui.end_menu()
+        self._rect("menu_pivot")
         if imgui.begin_menu("View"):
             self._menu_open = True
             if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
@@ -81,6 +115,55 @@ class MenuBar:
                     ed.run_action(action)
             imgui.end_menu()
         imgui.end_main_menu_bar()
+
+    def _select_menu(self) -> None:
+        """Select: all / none / invert, box / lasso, grow / shrink / connected,
+        mirror, and the toggles (brush target, through / visible, erase,
+        symmetric painting, mirror axis)."""
+        from splatedit.app.selection_tools import BRUSH_3D
+        from splatedit.select.mirror import AXES
+        from splatedit.select.selection import HANDLE, SUPPORT
+        ed = self.ed
+        s = ed.session
+        for e in _SELECT_ENTRIES:
+            if e is None:
+                imgui.separator()
+            else:
+                if imgui.menu_item(e[0], e[1], False)[0]:
+                    ed.run_action(e[2])
+                self._rect(f"select_{e[2].value}")
+        imgui.separator()
+        if imgui.menu_item("Symmetric painting", "Shift+M", ed.mirror.painting)[0]:
+            ed.run_action(Action.MIRROR_PAINT)
+        if imgui.menu_item(f"Mirror plane: {AXES[ed.mirror.axis]}", "Ctrl+Shift+M", False)[0]:
+            ed.run_action(Action.MIRROR_AXIS)
+        imgui.separator()
+        if imgui.menu_item("Target: support", "1", s.brush_target == SUPPORT)[0]:
+            ed.run_action(Action.BRUSH_SUPPORT)
+        if imgui.menu_item("Target: active handle", "2", s.brush_target == HANDLE)[0]:
+            ed.run_action(Action.BRUSH_HANDLE)
+        if imgui.menu_item("Through (3D brush, box, lasso)", "V", ed.brush.mode == BRUSH_3D)[0]:
+            ed.run_action(Action.BRUSH_MODE)
+        if imgui.menu_item("Erase mode", "E", ed.brush.erase_toggle)[0]:
+            ed.run_action(Action.ERASE_TOGGLE)
+
+    def _pivot_menu(self) -> None:
+        """Pivot: the centre of R / S and the gizmo, and the axes of X / Y / Z."""
+        from splatedit.app.tools.pivot import FRAMES, PIVOTS
+        ed = self.ed
+        pv = ed.pivot
+        acts = (Action.PIVOT_HANDLE, Action.PIVOT_RIM, Action.PIVOT_CURSOR, Action.PIVOT_VIEW)
+        for label, a in zip(PIVOTS, acts):
+            if imgui.menu_item(label.capitalize(), ".", pv.mode == label)[0]:
+                ed.run_action(a)
+            self._rect(f"pivot_{a.value}")
+        if imgui.menu_item("3D cursor to the view centre", "Shift+right click: on the model", False)[0]:
+            ed.run_action(Action.CURSOR_TO_VIEW_CENTRE)
+        imgui.separator()
+        for label, a in zip(FRAMES, (Action.AXES_GLOBAL, Action.AXES_LOCAL, Action.AXES_VIEW)):
+            if imgui.menu_item(f"Axes: {label}", ",", pv.orientation == label)[0]:
+                ed.run_action(a)
+            self._rect(f"pivot_{a.value}")
 
     def _menu_entries(self, entries: list[MenuEntry]) -> None:
         for e in entries:

@@ -18,6 +18,7 @@ from splatedit.app import overlay as ov
 from splatedit.app.tools.curve import CURVE_RGB
 from splatedit.app.tools.gizmo import READOUT_RGB
 from splatedit.app import selection_tools as seltools
+from splatedit.app.shapes import Polyline
 from splatedit.tolerances import EDITOR_GUI_MAX_HIGHLIGHT_DOTS
 
 _SHADOW = (0, 0, 0, 160)
@@ -168,8 +169,7 @@ def draw_gizmo(ed, dl, w: int, h: int) -> None:
     if depth.min() <= 0:
         return
     if s.manip is not None and s.manip.axis is not None:
-        a = np.zeros(3)
-        a[s.manip.axis] = cam.scene_radius
+        a = s.manip.axis_vector() * cam.scene_radius
         ends, d2 = cam.project(np.vstack([cur - a, cur + a]), w, h)
         if d2.min() > 0:
             line(dl, ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1.0)
@@ -190,6 +190,16 @@ def draw_readout(ed, dl, w: int, h: int) -> None:
     label(dl, (x, y), text, READOUT_RGB)
 
 
+def draw_shapes(dl, shapes) -> None:
+    """Backend-neutral overlay shapes (:mod:`splatedit.app.shapes`) as draw-list lines."""
+    for s in shapes:
+        if not isinstance(s, Polyline):
+            raise TypeError(f"not an overlay shape: {s!r}")
+        strip = s.strip()
+        polyline(dl, strip, (0, 0, 0), s.width + 2.0)       # a dark halo, as the CPU path
+        polyline(dl, strip, s.rgb, s.width)
+
+
 def draw_tools(ed, w: int, h: int) -> None:
     """Every tool overlay of the frame into the background draw list."""
     if ed.session is None:
@@ -198,6 +208,8 @@ def draw_tools(ed, w: int, h: int) -> None:
     draw_brush(ed, dl, w, h)
     draw_curve(ed, dl, w, h)
     draw_gizmo(ed, dl, w, h)
+    for tool in ed.tools:               # the protocol's shapes, painted on the GPU
+        draw_shapes(dl, tool.shapes(w, h))
     draw_readout(ed, imgui.get_foreground_draw_list(), w, h)      # over the panels
 
 

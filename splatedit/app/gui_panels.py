@@ -353,6 +353,10 @@ class EditorGui(MenuBar):
         note = b.mode_note()
         if note:
             imgui.text_colored(YELLOW, note)
+        for tool in self.ed.tools:      # the protocol tools' state lines
+            line = tool.status()
+            if line:
+                imgui.text_colored(YELLOW, line)
 
     def _stats(self, st) -> None:
         s = self.ed.session

@@ -78,6 +78,14 @@ class Action(enum.Enum):
     CONNECTED = "connected"
     CONNECTED_ALL = "connected_all"
     INVERT = "invert"
+    SELECT_ALL = "select_all"
+    BOX_SELECT = "box_select"
+    LASSO_SELECT = "lasso_select"
+    MIRROR_SELECTION = "mirror_selection"
+    MIRROR_PAINT = "mirror_paint"
+    MIRROR_AXIS = "mirror_axis"
+    DELETE_SPLATS = "delete_splats"
+    CROP_SPLATS = "crop_splats"
     # deformation
     GRAB = "grab"
     ROTATE = "rotate"
@@ -92,6 +100,16 @@ class Action(enum.Enum):
     COMMIT_POSE = "commit_pose"
     CANCEL = "cancel"                # Esc when idle: discard pending moves / curve tool off
     DEFORMATION_MODE = "deformation_mode"
+    PIVOT_NEXT = "pivot_next"
+    PIVOT_HANDLE = "pivot_handle"
+    PIVOT_RIM = "pivot_rim"
+    PIVOT_CURSOR = "pivot_cursor"
+    PIVOT_VIEW = "pivot_view"
+    AXES_NEXT = "axes_next"
+    AXES_GLOBAL = "axes_global"
+    AXES_LOCAL = "axes_local"
+    AXES_VIEW = "axes_view"
+    CURSOR_TO_VIEW_CENTRE = "cursor_to_view_centre"
     # curve
     CURVE_TOOL = "curve_tool"
     CLEAR_CURVE = "clear_curve"
@@ -222,7 +240,7 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.SELECTION, "", "", Action.PREV_HANDLE, ("shift+tab",)),
     Binding(S.SELECTION, "N", "new handle (becomes active; paint it with the handle brush)", Action.NEW_HANDLE,
             ("n",)),
-    Binding(S.SELECTION, "Delete", "remove the active handle", Action.REMOVE_HANDLE, ("delete",)),
+    Binding(S.SELECTION, "Shift+N", "remove the active handle", Action.REMOVE_HANDLE, ("shift+n",)),
     Binding(S.SELECTION, "[ / ]  or  Ctrl+wheel", "brush radius", Action.BRUSH_SMALLER, ("left_bracket",)),
     Binding(S.SELECTION, "", "", Action.BRUSH_LARGER, ("right_bracket",)),
     Binding(S.SELECTION, "C / Shift+C", "clear the selection / clear the handles", Action.CLEAR_SELECTION, ("c",)),
@@ -235,7 +253,23 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.SELECTION, "", "", Action.CONNECTED_ALL, ("shift+l",)),
     Binding(S.SELECTION, "Ctrl + I", "invert the brush target (support: handles cleared; handle: within the support)",
             Action.INVERT, ("ctrl+i",)),
-    Binding(S.SELECTION, "", "After each stroke or tool the selection is closed (holes, back sides); "
+    Binding(S.SELECTION, "A", "select all: the whole model as support (handle brush: the free support)",
+            Action.SELECT_ALL, ("a",)),
+    Binding(S.SELECTION, "Ctrl+B / Ctrl+Shift+B", "box / lasso select: the next left drag draws it; the splats inside\n"
+            "join the brush target (Ctrl held: erased); V decides: 3D = every centre inside\n"
+            "(through), visible = only what is seen; Esc, right click or the key again: cancel",
+            Action.BOX_SELECT, ("ctrl+b",)),
+    Binding(S.SELECTION, "", "", Action.LASSO_SELECT, ("ctrl+shift+b",)),
+    Binding(S.SELECTION, "Ctrl+M", "mirror: add the brush target's mirror image across the model's middle plane",
+            Action.MIRROR_SELECTION, ("ctrl+m",)),
+    Binding(S.SELECTION, "Shift+M", "symmetric painting on / off (each dab also paints its mirror image)",
+            Action.MIRROR_PAINT, ("shift+m",)),
+    Binding(S.SELECTION, "Ctrl+Shift+M", "mirror plane: X / Y / Z (through the middle of the bounding box)",
+            Action.MIRROR_AXIS, ("ctrl+shift+m",)),
+    Binding(S.SELECTION, "Delete / Shift+Delete", "delete the support splats from the model / crop: keep only them\n"
+            "(one undo step; the edit script records it, saves replay)", Action.DELETE_SPLATS, ("delete",)),
+    Binding(S.SELECTION, "", "", Action.CROP_SPLATS, ("shift+delete",)),
+    Binding(S.SELECTION, "", "The Select menu has all of these.\nAfter each stroke or tool the selection is closed (holes, back sides); "
             "additions flash yellow"),
     # ---- deformation
     Binding(S.DEFORMATION, "Left drag on a handle", "make it active and move it in the view plane", mouse=True),
@@ -250,6 +284,12 @@ KEYMAP: tuple[Binding, ...] = (
             "surface, the relief re-attached along its normals; refits) / LINEAR (the paper's);\n"
             "a Gaussian scene: ROTATION / LINEAR (no DETAIL: B says so)",
             Action.DEFORMATION_MODE, ("b",)),
+    Binding(S.DEFORMATION, ".  (period)", "pivot of R / S and the gizmo: handle centre / support rim (where the support\n"
+            "meets the fixed part) / 3D cursor / view centre (also the Pivot menu)", Action.PIVOT_NEXT,
+            ("period",)),
+    Binding(S.DEFORMATION, ",  (comma)", "axes of the gizmo and X / Y / Z: global / local (the handle's principal axes) / view",
+            Action.AXES_NEXT, ("comma",)),
+    Binding(S.DEFORMATION, "Shift + right click", "place the 3D cursor on the model", mouse=True),
     Binding(S.DEFORMATION, "G / R / S", "grab / rotate / scale the active handle with the mouse\n"
             "(the overlay shows the distance / angle / factor while moving)", Action.GRAB, ("g",)),
     Binding(S.DEFORMATION, "", "", Action.ROTATE, ("r",)),
@@ -257,8 +297,8 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.DEFORMATION, "G / R / S", "", Action.GRAB, ("g",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.ROTATE, ("r",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.SCALE, ("s",), C.MANIP),
-    Binding(S.DEFORMATION, "X / Y / Z", "constrain to that world axis (again: free)", Action.AXIS_X, ("x",),
-            C.MANIP, indent=2),
+    Binding(S.DEFORMATION, "X / Y / Z", "constrain to that axis of the chosen axes (again: free)", Action.AXIS_X,
+            ("x",), C.MANIP, indent=2),
     Binding(S.DEFORMATION, "", "", Action.AXIS_Y, ("y",), C.MANIP),
     Binding(S.DEFORMATION, "", "", Action.AXIS_Z, ("z",), C.MANIP),
     Binding(S.DEFORMATION, "0-9 . -", "type a value: distance, degrees or factor (G X 0.1 Enter)",
@@ -280,8 +320,9 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.CURVE, "", "", Action.CLEAR_CURVE, ("shift+k",)),
     Binding(S.CURVE, "Left click on support", "add a curve point (2..16); the curve through them is drawn as it "
             "will act", mouse=True),
-    Binding(S.CURVE, "Left drag on a dot", "move that point in the view plane (X / Y / Z: along an axis)",
-            mouse=True),
+    Binding(S.CURVE, "Left drag on a dot", "move that point in the view plane (X / Y / Z: along an axis); in the\n"
+            "rotation mode (default) the part bends along the curve, its cross-sections turning with\n"
+            "the curve's frame; in the linear mode (B) the paper's curve edit", mouse=True),
     Binding(S.CURVE, "Backspace", "remove the last curve point", Action.REMOVE_CURVE_POINT, ("backspace",)),
     Binding(S.CURVE, "Enter / Esc", "apply the bent curve as an edit (the curve is consumed) / discard moves"),
     # ---- display

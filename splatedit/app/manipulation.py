@@ -15,10 +15,11 @@ GRAB, ROTATE, SCALE = "grab", "rotate", "scale"
 AXIS_NAMES = "XYZ"
 
 
-def _axis_scaling(axis: int, factor: float, center) -> np.ndarray:
-    """Scale by ``factor`` (> 0) along world axis ``axis`` about ``center``."""
+def _axis_scaling(axis: np.ndarray, factor: float, center) -> np.ndarray:
+    """Scale by ``factor`` (> 0) along the unit vector ``axis`` (3,) about ``center``."""
+    a = np.asarray(axis, float)
     s = np.eye(4)
-    s[axis, axis] = factor
+    s[:3, :3] += (factor - 1.0) * np.outer(a, a)
     c = np.asarray(center, float)
     return compose(translate(-c), s, translate(c))
 
@@ -45,6 +46,12 @@ class Manipulation:
     pixel (along the constraint axis only, if any).  A typed number replaces
     the mouse value: grab distance in model units (along the axis, X when
     none), rotate degrees, scale factor.
+
+    The X / Y / Z constraint axes are the columns of ``frame`` ((3, 3)
+    orthonormal; None: the world axes), named ``frame_name`` in the readout
+    and the history ("local", "view"; "" for the world axes).  ``pivot`` is
+    the centre of rotate and scale (the handle's centre, the support's rim,
+    the 3D cursor or the view centre: :mod:`splatedit.app.tools.pivot`).
     """
     mode: str
     pivot: np.ndarray
@@ -53,6 +60,8 @@ class Manipulation:
     mouse: tuple[float, float] = None
     axis: int | None = None
     typed: str = ""
+    frame: np.ndarray | None = None
+    frame_name: str = ""
 
     def __post_init__(self):
         if self.mouse is None:
@@ -95,15 +104,31 @@ class Manipulation:
         return None
 
     def _axis_vec(self) -> np.ndarray:
+        if self.frame is not None:
+            a = np.asarray(self.frame, float)[:, self.axis]
+            return a / np.linalg.norm(a)
         a = np.zeros(3)
         a[self.axis] = 1.0
         return a
+
+    def axis_vector(self) -> np.ndarray | None:
+        """(3,) unit vector of the constraint axis in the model, or None."""
+        return None if self.axis is None else self._axis_vec()
+
+    def axis_name(self) -> str:
+        """``X``, ``local X``, ``view Z`` ... ("" without a constraint)."""
+        if self.axis is None:
+            return ""
+        return (f"{self.frame_name} " if self.frame_name else "") + AXIS_NAMES[self.axis]
 
     def _translation(self, typed) -> np.ndarray:
         """(3,) grab displacement, model units."""
         v = self.view
         if typed is not None:
-            a = self._axis_vec() if self.axis is not None else np.array([1.0, 0.0, 0.0])
+            if self.axis is not None:
+                a = self._axis_vec()
+            else:
+                a = np.asarray(self.frame, float)[:, 0] if self.frame is not None else np.array([1.0, 0.0, 0.0])
             return a * typed
         dx = self.mouse[0] - self.start[0]
         dy = self.mouse[1] - self.start[1]
@@ -162,7 +187,7 @@ class Manipulation:
             f = self._factor(typed)
             if self.axis is None:
                 return scale(f, self.pivot)
-            return _axis_scaling(self.axis, f, self.pivot)
+            return _axis_scaling(self._axis_vec(), f, self.pivot)
         raise ValueError(self.mode)
 
     def readout(self) -> str:
@@ -171,7 +196,7 @@ class Manipulation:
         angle (degrees), scale factor; "typed" when it comes from the keys."""
         typed = self._typed_ok()
         src = "  (typed)" if typed is not None else ""
-        ax = f" {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
+        ax = f" {self.axis_name()}" if self.axis is not None else ""
         if self.mode == GRAB:
             d = self._translation(typed)
             return f"distance{ax} {_num(self._distance(d), '.4g')}   ({', '.join(_num(v) for v in d)}){src}"
@@ -181,13 +206,13 @@ class Manipulation:
 
     def _distance(self, d: np.ndarray) -> float:
         """The grab's main figure: signed along the constraint axis, else the length."""
-        return float(d[self.axis]) if self.axis is not None else float(np.linalg.norm(d))
+        return float(d @ self._axis_vec()) if self.axis is not None else float(np.linalg.norm(d))
 
     def label(self) -> str:
         """The move's name in the edit history: ``Grab 0.12``, ``Grab -0.05
         along X``, ``Rotate 45 deg about Z``, ``Scale x1.38``."""
         typed = self._typed_ok()
-        axis = AXIS_NAMES[self.axis] if self.axis is not None else None
+        axis = self.axis_name() or None
         if self.mode == GRAB:
             return f"Grab {_num(self._distance(self._translation(typed)))}" + (f" along {axis}" if axis else "")
         if self.mode == ROTATE:
@@ -197,7 +222,7 @@ class Manipulation:
     def describe(self) -> str:
         name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]
         prep = "about" if self.mode == ROTATE else "along"
-        ax = f" {prep} {AXIS_NAMES[self.axis]}" if self.axis is not None else ""
+        ax = f" {prep} {self.axis_name()}" if self.axis is not None else ""
         val = f"  value: {self.typed}" if self.typed else ""
         bad = self.problem()
         if bad:

@@ -8,6 +8,7 @@ import time
 from dataclasses import dataclass
 
 from splatedit.app import overlay as ov
+from splatedit.app.shapes import to_patches
 from splatedit.app import selection_tools as seltools
 from splatedit.app.gaussian_doc import model_summary
 from splatedit.select.selection import SUPPORT
@@ -75,6 +76,10 @@ def panel_lines(ed) -> list:
     note = brush.mode_note()
     if note:
         lines.append((note, (255, 230, 120)))
+    for tool in ed.tools:           # the protocol tools' state lines
+        line = tool.status()
+        if line:
+            lines.append((line, (255, 230, 120)))
     lines.append(f"support {st.support:,}   handle {st.handle:,}   "
                  f"deformation {s.deformation.value.upper()} (B)")
     hs = s.selection.handles
@@ -263,6 +268,8 @@ def compose_overlay(ed, w: int, h: int) -> list:
         patches += ed.brush.underlay(w, h)
         for tool in (ed.curve, ed.gizmo, ed.brush):
             patches += tool.overlay(w, h)
+        for tool in ed.tools:          # the protocol's shapes, painted on the CPU
+            patches += to_patches(tool.shapes(w, h))
     panel = ov.text_panel(tuple(panel_lines(ed))) if ed.panel_visible else None
     box = None
     if panel is not None:

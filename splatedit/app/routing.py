@@ -210,6 +210,7 @@ class EventRouting:
         # guarded here too: a GUI button runs its action while the frame is laid out, and
         # an error there must neither abandon the frame nor take the window down
         with self.guarded(f"running '{action.value}'"):
-            table[action]()
+            if not any(tool.intercept(action) for tool in self.tools):
+                table[action]()
         if s is not None:
             self.motion()

@@ -168,6 +168,14 @@ def inverted(sel: Selection, target: str) -> np.ndarray:
     return sel.support & ~sel.handle & ~sel.others()
 
 
+def everything(sel: Selection, target: str) -> np.ndarray:
+    """Select all: every splat (support), or the support splats of no other
+    handle (the active handle)."""
+    if target == SUPPORT:
+        return np.ones(sel.n, bool)
+    return sel.support & ~sel.others()
+
+
 def set_target(sel: Selection, target: str, mask: np.ndarray) -> bool:
     """Make the target's mask ``mask`` with the brush rules (a handle stays
     inside the support and disjoint from the others; removing support splats

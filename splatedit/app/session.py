@@ -31,7 +31,9 @@ Every user action that changes the document (a stroke, a clear, a commit)
 pushes a :class:`~splatedit.app.history.Snapshot`; undo/redo restore them
 (and restart the fit for the restored selection).  Committed edits are
 recorded as script edits (``indices`` support + ``indices`` handles +
-``matrix`` transforms + ``curves`` with ``points`` and ``move``) and :meth:`Session.edit_script` returns an
+``matrix`` transforms + ``curves`` with ``points`` and ``move``), deleted or
+cropped splats (:meth:`Session.remove_splats`) as ``delete`` / ``crop``
+items with ``indices``, and :meth:`Session.edit_script` returns an
 :class:`~splatedit.script.EditScript` with the session's solver settings, so
 ``splatedit deform INPUT --edit script.json`` reproduces the saved cloud.
 
@@ -202,6 +204,33 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.selection = Selection(self.cloud.n, support, handles=handles)
         self.pose = [np.eye(4)]
         self.push(label)
+
+    def remove_splats(self, keep: bool = False) -> int:
+        """Delete the support splats from the document (``keep``: crop, keep
+        only them): one undo step and one ``delete`` / ``crop`` item of the
+        edit script (indices of the current cloud), so a saved file replays.
+        The selection, the curve and the pending pose are cleared.  Returns
+        the number of splats removed; 0 (nothing done) without a support,
+        when nothing would be left, during a move, with pending moves or
+        while an edit is applied."""
+        from splatedit.app.gaussian_doc import subset_document
+        from splatedit.script import Removal
+        from splatedit.select.regions import Indices
+        if self.manip is not None or self.committing or self.pose_pending:
+            return 0
+        sup = self.selection.support
+        kept = sup.copy() if keep else ~sup
+        if not sup.any() or not kept.any():
+            return 0
+        item = Removal(Indices(tuple(int(i) for i in np.flatnonzero(sup))), keep)
+        self.cloud = subset_document(self.cloud, kept)
+        self.edits = self.edits + (item,)
+        self.fit.clear()
+        self.selection = Selection(self.cloud.n)
+        self.rig.clear_curve()
+        self.rig.reset_pose(1)
+        self.push(item.key)
+        return int((~kept).sum())
 
     # --------------------------------------------------------------- fitting
     def selection_key(self):

@@ -82,11 +82,16 @@ class PoseEditing:
         """The active handle is part of the fitted basis."""
         return self.basis is not None and self.selection.active in self.basis_groups[0]
 
-    def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float]) -> bool:
-        """Start G/R/S of the active handle (needs a basis that includes it)."""
+    def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float], pivot=None, frame=None,
+              frame_name: str = "") -> bool:
+        """Start G/R/S of the active handle (needs a basis that includes it)
+        about ``pivot`` ((3,) model units; None: the handle's posed centroid),
+        constraint axes the columns of ``frame`` ((3, 3); None: the world's)."""
         if self.manip is not None or self.committing or not self.active_fitted():
             return False
-        self.manip = Manipulation(mode, self.handle_centroid(), view, mouse)
+        piv = self.handle_centroid() if pivot is None else np.asarray(pivot, float)
+        self.manip = Manipulation(mode, piv, view, mouse, frame=None if frame is None else np.asarray(frame, float),
+                                  frame_name=frame_name)
         self.manip_target = ("handle", self.selection.active)
         return True
 

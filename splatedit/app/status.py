@@ -91,7 +91,13 @@ def status_dict(ed) -> dict:
               deformation=s.deformation.value,
               basis_kind=None if s.basis is None else type(s.basis).__name__,
               brush_mode=tools.mode, brush_note=ed.brush.mode_note(), closure_added=tools.last_added,
-              closure_highlight=tools.highlighted(s.cloud) is not None)
+              closure_highlight=tools.highlighted(s.cloud) is not None,
+              history_label=s.history.labels[s.history.position],
+              region_armed=ed.region.armed, region_points=len(ed.region.points),
+              mirror_painting=ed.mirror.painting, mirror_axis="XYZ"[ed.mirror.axis],
+              pivot=ed.pivot.mode, axes=ed.pivot.orientation,
+              cursor=None if ed.pivot.cursor is None else [round(float(x), 9) for x in ed.pivot.cursor],
+              manip_pivot=None if s.manip is None else [round(float(x), 9) for x in s.manip.pivot])
     ft = field_target(s)
     st["fields"] = {"kind": ft.kind.value, "index": ft.index, "problem": ft.problem,
                     "position": None if ft.position is None else [round(float(x), 9) for x in ft.position]}

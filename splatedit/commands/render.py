@@ -124,12 +124,19 @@ def _gpu_edit(args, cloud, on_gpu=None):
     ``on_gpu(rows, dC)``: whether the caller's renderer can draw them (else
     it deforms on the CPU, and the report says so).
 
-    Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC).
+    Returns (base cloud of the last edit, (indices, B, Bx, By, Bz), dC); a
+    script ending with a delete / crop runs wholly on the CPU: (its result,
+    None, None).
     """
     import dataclasses
     from splatedit.script import fit_edit, load_script, run_script
     script = load_script(args.edit)
     source = str(args.edit)
+    from splatedit.script import Removal
+    if isinstance(script.edits[-1], Removal):      # ends with a delete / crop: all of it on the CPU
+        cloud, _ = run_script(cloud, script, source=source, progress=args.progress,
+                              on_edit=lambda rep: _print_edit(args, rep))
+        return cloud, None, None
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,

@@ -61,6 +61,20 @@ class GaussianCloud:
     source: str | None = field(default=None, repr=False)
     layout: tuple[tuple[str, str], ...] | None = field(default=None, repr=False)
 
+    def take(self, index) -> "GaussianCloud":
+        """The Gaussians ``index`` ((m,) int indices or (n,) bool mask) in
+        order, every per-Gaussian array included (unknown properties, the
+        file layout, name and source kept: a delete or crop of a scene)."""
+        idx = np.asarray(index)
+        if idx.dtype == bool:
+            idx = np.flatnonzero(idx)
+        idx = idx.astype(np.int64)
+        return GaussianCloud(positions=self.positions[idx], log_scales=self.log_scales[idx],
+                             rotations=self.rotations[idx], opacity_logits=self.opacity_logits[idx],
+                             sh=self.sh[idx], normals=None if self.normals is None else self.normals[idx],
+                             extra={k: v[idx] for k, v in self.extra.items()}, kind=self.kind,
+                             name=self.name, source=self.source, layout=self.layout)
+
     def __len__(self) -> int:
         return len(self.positions)
 

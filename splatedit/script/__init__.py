@@ -9,7 +9,9 @@ Format (version 1)::
         "handle": REGION,                    # or "handles": [REGION, ...]
         "transform": TRANSFORM,              # or "transforms": [TRANSFORM, ...]
         "curves": [CURVE, ...],              # optional; see below
-        "deformation": "rotation"}]}         # optional: "rotation" (default) | "linear" | "detail"
+        "deformation": "rotation"},          # optional: "rotation" (default) | "linear" | "detail"
+       {"delete": REGION},                   # removes the splats of REGION
+       {"crop": REGION}]}                    # keeps only the splats of REGION
 
     REGION    = {"sphere": {"center": [x,y,z], "radius": r}}      (a support region may add
                                                                 "fill_holes": false)
@@ -33,6 +35,11 @@ the moves of the two picked points around it, so the moved curve passes
 through ``points + move`` and no part of it moves against the drags.  The curve need not lie on the surface; only its samples
 over the free part of the support constrain the edit.  Curves take the
 column blocks after the handles.
+
+``delete`` and ``crop`` items remove splats (a scan's stray points, a
+floor): the model after them has fewer splats, renumbered in order, and the
+``indices`` of later items count in it.  A delete or crop that would leave
+no splat is an error (its JSON path), as is one that selects none.
 
 A handle region is intersected with its support.  A TRS transform applies
 scale, then rotation, then translation; the rotation and scale centres default
@@ -58,11 +65,11 @@ exported here.
 """
 
 from splatedit.script.model import (METHODS, SCRIPT_VERSION, TRS, Curve, Edit, EditScript, Matrix,
-                                    SolverSettings, Transform)
+                                    Removal, SolverSettings, Transform)
 from splatedit.script.parse import decode_json, load_script, parse_script, read_limited
-from splatedit.script.run import (EditReport, ResolvedEdit, fit_edit, resolve_edit, resolve_edit_inputs,
-                                  run_script)
+from splatedit.script.run import (EditReport, RemovalReport, ResolvedEdit, fit_edit, remove_splats,
+                                  removal_mask, resolve_edit, resolve_edit_inputs, run_script)
 
-__all__ = ["METHODS", "SCRIPT_VERSION", "TRS", "Curve", "Edit", "EditScript", "Matrix", "SolverSettings",
+__all__ = ["METHODS", "SCRIPT_VERSION", "TRS", "Curve", "Edit", "EditScript", "Matrix", "Removal", "SolverSettings",
            "Transform", "decode_json", "load_script", "parse_script", "read_limited", "EditReport",
-           "ResolvedEdit", "fit_edit", "resolve_edit", "resolve_edit_inputs", "run_script"]
+           "RemovalReport", "ResolvedEdit", "fit_edit", "remove_splats", "removal_mask", "resolve_edit", "resolve_edit_inputs", "run_script"]

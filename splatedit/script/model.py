@@ -88,6 +88,26 @@ class Edit:
 
 
 @dataclass(frozen=True)
+class Removal:
+    """A ``delete`` item (``keep`` False: remove the splats of ``region``) or
+    a ``crop`` item (``keep`` True: keep only them).  The splats left keep
+    their order; later items index the smaller model."""
+    region: Region
+    keep: bool = False
+    json_path: str = "$"
+
+    @property
+    def key(self) -> str:
+        return "crop" if self.keep else "delete"
+
+    def kept(self, positions: np.ndarray) -> np.ndarray:
+        """(n,) bool: the splats left after this item on a model with
+        ``positions`` (n, 3)."""
+        m = self.region.mask(positions)
+        return m if self.keep else ~m
+
+
+@dataclass(frozen=True)
 class SolverSettings:
     method: str = "auto"
     tol: float = IQR_DEFAULT_TOL
@@ -96,7 +116,7 @@ class SolverSettings:
 
 @dataclass(frozen=True)
 class EditScript:
-    edits: tuple[Edit, ...]
+    edits: tuple[Edit | Removal, ...]
     solver: SolverSettings = field(default_factory=SolverSettings)
 
     # ---------------------------------------------------------------- output
@@ -135,6 +155,9 @@ class EditScript:
 
         edits = []
         for e in self.edits:
+            if isinstance(e, Removal):
+                edits.append({e.key: region(e.region)})
+                continue
             item: dict[str, Any] = {"support": region(e.support)}
             if not e.fill_holes:
                 item["support"]["fill_holes"] = False

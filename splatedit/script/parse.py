@@ -15,7 +15,7 @@ import numpy as np
 from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError
 from splatedit.script.model import (METHODS, SCRIPT_VERSION, TRS, Curve, Edit, EditScript, Matrix,
-                                    SolverSettings, Transform)
+                                    Removal, SolverSettings, Transform)
 from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL, MAX_COORDINATE_ABS, MAX_SCRIPT_BYTES
 
@@ -218,6 +218,11 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
     edits = []
     for i, e in enumerate(edits_in):
         jp = f"$.edits[{i}]"
+        if isinstance(e, dict) and ("delete" in e or "crop" in e):
+            kind = "delete" if "delete" in e else "crop"
+            ctx.obj(e, jp, allowed=(kind,))
+            edits.append(Removal(_region(ctx, e[kind], f"{jp}.{kind}"), kind == "crop", jp))
+            continue
         e = ctx.obj(e, jp, required=("support",),
                     allowed=("support", "handle", "handles", "transform", "transforms", "curves",
                              "deformation"))

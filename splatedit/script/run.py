@@ -13,7 +13,7 @@ import numpy as np
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
 from splatedit.deform.modes import DeformationMode
 from splatedit.errors import EditScriptError, InputError, SplatEditError
-from splatedit.script.model import Edit, EditScript, SolverSettings
+from splatedit.script.model import Edit, EditScript, Removal, SolverSettings
 from splatedit.script.parse import _Ctx
 from splatedit.select.regions import Box, Indices, Region, Sphere
 
@@ -70,6 +70,57 @@ class EditReport:
                 f"{self.constraints} constraints, {self.method} with {self.centers} centers "
                 f"(residual {self.residual:.2e}), fit {self.fit_seconds:.2f} s + basis "
                 f"{self.basis_seconds:.2f} s, max displacement {self.max_displacement:.4g}{notes}")
+
+
+@dataclass
+class RemovalReport:
+    """What a ``delete`` / ``crop`` item did (printed by the CLI like an
+    :class:`EditReport`)."""
+    index: int
+    kind: str          # "delete" or "crop"
+    removed: int
+    left: int
+    warnings: list[str] = field(default_factory=list)
+    distortion: DistortionStats | None = None
+
+    def line(self) -> str:
+        return f"edit {self.index}: {self.kind}, removed {self.removed} splats, {self.left} left"
+
+    def distortion_line(self) -> str:
+        return ""
+
+    def distortion_warning(self) -> str | None:
+        return None
+
+
+def removal_mask(positions: np.ndarray, item: Removal, source: str | None = None) -> np.ndarray:
+    """(n,) bool of the splats left after a ``delete`` / ``crop`` item on a
+    model with ``positions`` (n, 3).
+
+    Raises:
+        EditScriptError: an index past the model, a region that selects no
+            splat, or an item that would leave none (the item's JSON path).
+    """
+    ctx = _Ctx(source)
+    n = len(positions)
+    jp = f"{item.json_path}.{item.key}"
+    r = item.region
+    if isinstance(r, Indices) and max(r.indices) >= n:
+        bad = next(i for i, x in enumerate(r.indices) if x >= n)
+        raise ctx.fail(f"{jp}.indices[{bad}]", f"index {r.indices[bad]} is out of range (the model has {n} splats)")
+    inside = r.mask(positions)
+    if not inside.any():
+        raise ctx.fail(jp, "selects no splat")
+    kept = inside if item.keep else ~inside
+    if not kept.any():
+        raise ctx.fail(jp, "would remove every splat of the model")
+    return kept
+
+
+def remove_splats(cloud, item: Removal, index: int, source: str | None = None):
+    """(the cloud without the splats ``item`` removes, its RemovalReport)."""
+    kept = removal_mask(cloud.positions, item, source)
+    return cloud.subset(kept), RemovalReport(index, item.key, int((~kept).sum()), int(kept.sum()))
 
 
 def resolve_edit(cloud, edit: Edit, source: str | None = None):
@@ -254,6 +305,12 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
     """
     reports = []
     for i, edit in enumerate(script.edits):
+        if isinstance(edit, Removal):
+            cloud, rep = remove_splats(cloud, edit, i, source)
+            reports.append(rep)
+            if on_edit is not None:
+                on_edit(rep)
+            continue
         r, basis, d_c = fit_edit(cloud, edit, script.solver, method=method, tol=tol,
                                  source=source, progress=progress)
         t0 = time.perf_counter()

@@ -56,7 +56,7 @@ def test_two_handles_and_a_curve(xvfb, tmp_path):
         s = ed.idle(lambda s: s["edits"] == 1 and not s["pose_pending"] and s["state"] == "ready",
                     "two-handle edit committed")
         # --- remove both handles, then a curve: K, three clicks on the support
-        ed.xdo("key", "Delete", "Delete")
+        ed.xdo("key", "shift+n", "shift+n")
         ed.idle(lambda s: s["handles"] == 1 and s["handle"] == 0, "handles removed")
         ed.xdo("key", "k")
         ed.wait(lambda s: s["curve_mode"], "curve tool")

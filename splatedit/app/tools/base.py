@@ -6,6 +6,8 @@ from __future__ import annotations
 import enum
 from typing import Callable
 
+import numpy as np
+
 from splatedit.app.keymap import KEYMAP, Action, Binding, Section
 
 
@@ -17,6 +19,7 @@ class DragMode(enum.Enum):
     DOLLY = "dolly"
     PAINT = "paint"
     MANIP = "manip"     # a handle or curve point follows the mouse
+    REGION = "region"   # a box or lasso is being drawn
 
     @property
     def camera(self) -> bool:
@@ -32,7 +35,10 @@ class Tool:
     first to return a :class:`DragMode` owns the drag (:meth:`drag` on each
     move, :meth:`release` at the end).  Keys: :meth:`actions` maps keymap
     :class:`~splatedit.app.keymap.Action` values to handlers.  Drawing:
-    :meth:`underlay` and :meth:`overlay` return overlay patches.
+    :meth:`underlay` and :meth:`overlay` return overlay patches (CPU
+    path only); :meth:`shapes` returns backend-neutral shapes
+    (:mod:`splatedit.app.shapes`) drawn by both the GPU and the CPU path:
+    tools on the protocol use only :meth:`shapes` and :attr:`ctx`.
     """
     #: the help section of this tool's keymap rows
     section: Section | None = None
@@ -59,6 +65,29 @@ class Tool:
     def release(self, mode: DragMode) -> None:
         pass
 
+    @property
+    def ctx(self) -> "ToolContext":
+        """The narrow editor view of the tool protocol (:class:`ToolContext`)."""
+        c = getattr(self, "_ctx", None)
+        if c is None:
+            c = self._ctx = ToolContext(self.ed)
+        return c
+
+    def intercept(self, action: Action) -> bool:
+        """Offered every action before its handler runs (e.g. Esc while a
+        box is armed cancels the box, not the pending moves); True: handled
+        here, the bound handler does not run."""
+        return False
+
+    def status(self) -> str | None:
+        """A short state line for the panel (an armed box, symmetric painting,
+        a chosen pivot), or None when there is nothing to say."""
+        return None
+
+    def shapes(self, w: int, h: int) -> list:
+        """Overlay shapes (:mod:`splatedit.app.shapes`) drawn this frame."""
+        return []
+
     def underlay(self, w: int, h: int) -> list:
         return []
 
@@ -68,3 +97,89 @@ class Tool:
     def help_entries(self) -> list[Binding]:
         """The keymap rows documenting this tool (its help section)."""
         return [b for b in KEYMAP if b.section is self.section and b.help]
+
+
+class ToolContext:
+    """What a tool on the protocol may use of the editor: the document and
+    its selection edit API, the view, the brush's settings, the status line.
+
+    A tool keeps to these members (no ``ed.*`` reach-ins), so it is one file
+    plus its keymap rows (and one line in the editor's tool list).
+    """
+
+    def __init__(self, ed):
+        self._ed = ed
+
+    # ---- document and selection
+    @property
+    def document(self):
+        """The :class:`~splatedit.app.session.Session` (None: no model open)."""
+        return self._ed.session
+
+    @property
+    def target(self) -> str:
+        """The brush target: ``"support"`` or ``"handle"`` (the active one)."""
+        return self._ed.session.brush_target
+
+    def target_mask(self) -> np.ndarray:
+        """(n,) bool: the brush target's current mask (not a copy)."""
+        from splatedit.app.selection_tools import target_mask
+        s = self._ed.session
+        return target_mask(s.selection, s.brush_target)
+
+    def select(self, mask: np.ndarray, label: str) -> bool:
+        """Make the brush target's mask ``mask`` with the brush rules, close
+        the selection (:mod:`splatedit.select.closure`) and record it as one
+        undo step; False when nothing changed."""
+        s = self._ed.session
+        return self._ed.brush.tools.apply(s, s.brush_target, mask, label)
+
+    def neighbour_graph(self):
+        """The document cloud's neighbour graph, or None while it is built."""
+        return self._ed.brush.tools.graph(self._ed.session.cloud)
+
+    # ---- view
+    @property
+    def camera(self):
+        return self._ed.cam
+
+    @property
+    def size(self) -> tuple[int, int]:
+        """(w, h) of the framebuffer, pixels."""
+        return self._ed.size
+
+    def visible(self):
+        """The :class:`~splatedit.app.brush.BrushPicker` of the current view
+        (which splat is visible at each pixel)."""
+        return self._ed.brush.get_picker()
+
+    @property
+    def through(self) -> bool:
+        """The brush mode (V): True for 3D / through, False for visible only."""
+        from splatedit.app.selection_tools import BRUSH_3D
+        return self._ed.brush.mode == BRUSH_3D
+
+    def erasing(self, mods: int | None = None) -> bool:
+        """Ctrl held (in ``mods``, an input event's modifier bits; None: the
+        keyboard now) or the erase toggle (E) on: a stroke erases."""
+        if mods is None:
+            return self._ed.brush.erasing()
+        return self._ed.brush.erase_toggle or bool(mods & self._ed.g.MOD_CONTROL)
+
+    def busy(self) -> bool:
+        """A move is running or an edit is being applied (selections wait)."""
+        s = self._ed.session
+        return s is None or s.manip is not None or s.committing
+
+    # ---- input
+    @property
+    def keys(self):
+        """The input constants (glfw's ``MOUSE_BUTTON_*``, ``MOD_*``)."""
+        return self._ed.g
+
+    # ---- feedback
+    def say(self, text: str) -> None:
+        self._ed.say(text)
+
+    def redraw(self) -> None:
+        self._ed.motion()

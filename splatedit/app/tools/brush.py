@@ -46,6 +46,7 @@ class BrushTool(Tool):
                 Action.GROW: lambda: self.selection_tool("grow"),
                 Action.SHRINK: lambda: self.selection_tool("shrink"),
                 Action.INVERT: lambda: self.selection_tool("invert"),
+                Action.SELECT_ALL: lambda: self.selection_tool("all"),
                 Action.CONNECTED: lambda: self.selection_tool("connected", *self.ed.mouse),
                 Action.CONNECTED_ALL: lambda: self.selection_tool("connected", *self.ed.mouse, whole=True)}
 
@@ -158,6 +159,9 @@ class BrushTool(Tool):
                 idx = picker.query(x, y, self.radius)
             # the dab's 3D reach (its circle through the model): closure may add there only
             reach = None if erase else picker.covered(x, y, self.radius)
+            if ed.mirror.painting:             # symmetric painting: the dab's mirror image too
+                idx = ed.mirror.with_mirror(idx)
+                reach = None if reach is None else ed.mirror.with_mirror(reach)
             changed |= s.paint(idx, erase=erase, reach=reach)
         if changed:
             self.stroke_changed = True
@@ -209,7 +213,7 @@ class BrushTool(Tool):
 
     def selection_tool(self, tool: str, x: float | None = None, y: float | None = None,
                        whole: bool = False) -> None:
-        """Run ``tool`` ("grow", "shrink", "connected", "invert") on the brush
+        """Run ``tool`` ("grow", "shrink", "connected", "invert", "all") on the brush
         target (support or active handle), close the selection: one undo step."""
         ed, s = self.ed, self.session
         if s.manip is not None:
@@ -217,7 +221,7 @@ class BrushTool(Tool):
         target = s.brush_target
         what = "support" if target == SUPPORT else "handle"
         graph = self.tools.graph(s.cloud)
-        if graph is None and tool != "invert":
+        if graph is None and tool not in ("invert", "all"):
             ed.say("the neighbour graph is still being built: try again in a moment")
             return
         sel = s.selection
@@ -227,6 +231,8 @@ class BrushTool(Tool):
             mask = seltools.shrunk(sel, graph, target)
         elif tool == "invert":
             mask = seltools.inverted(sel, target)
+        elif tool == "all":
+            mask = seltools.everything(sel, target)
         elif tool == "connected":
             sph = seltools.brush_sphere(self.get_picker(), ed.cam, s.cloud.positions, x, y, self.radius, ed.size,
                                         self._displaced())

@@ -65,6 +65,23 @@ class GizmoTool(Tool):
             self._centre_key = key
         return self._centre
 
+    def pivot_point(self) -> np.ndarray | None:
+        """The gizmo's centre: the chosen pivot (:mod:`splatedit.app.tools.pivot`),
+        else the active handle's posed centroid (None without a handle)."""
+        p = self.ed.pivot.point()
+        return p if p is not None else self.handle_centre()
+
+    def frame(self) -> np.ndarray:
+        """(3, 3) the gizmo's axes (columns X, Y, Z), :meth:`PivotTool.frame`."""
+        return self.ed.pivot.frame()
+
+    def _begin(self, mode: str, mouse) -> bool:
+        """Start ``mode`` about the chosen pivot with the chosen axes."""
+        pv = self.ed.pivot
+        piv = pv.point()
+        return self.session.begin(mode, self.view_info(piv), mouse, pivot=piv, frame=pv.frame(),
+                                  frame_name=pv.frame_name())
+
     def view_info(self, pivot=None) -> ViewInfo:
         ed = self.ed
         w, h = ed.size
@@ -81,9 +98,9 @@ class GizmoTool(Tool):
         s = self.session
         if not s.active_fitted() or s.manip is not None or s.curve_mode:
             return None
-        piv = self.handle_centre()
-        if piv is None:
+        if self.handle_centre() is None:
             return None
+        piv = self.pivot_point()
         cam = self.ed.cam
         px, d = cam.project(piv, w, h)
         if d[0] <= 0:
@@ -100,14 +117,14 @@ class GizmoTool(Tool):
         if base is None:
             return []
         piv, p0, wpp = base
-        ends, de = self.ed.cam.project(piv + np.eye(3) * (wpp * EDITOR_GIZMO_PX), w, h)
+        ends, de = self.ed.cam.project(piv + self.frame().T * (wpp * EDITOR_GIZMO_PX), w, h)
         return [(k, p0, ends[k]) for k in range(3)
                 if de[k] > 0 and float(np.hypot(*(ends[k] - p0))) > EDITOR_GIZMO_MIN_PX]
 
     def rings(self, w: int, h: int) -> list:
         """Screen polylines ``(axis, pixels (m, 2))`` of the rotate rings: a
-        circle around the handle centroid in the plane normal to each world
-        axis (closed; NaN behind the eye); rings seen almost edge-on are left out."""
+        circle around the pivot in the plane normal to each of the chosen
+        axes (closed; NaN behind the eye); rings seen almost edge-on are left out."""
         base = self._base(w, h)
         if base is None:
             return []
@@ -116,11 +133,11 @@ class GizmoTool(Tool):
         t = np.linspace(0.0, 2.0 * math.pi, EDITOR_GIZMO_RING_SEGMENTS + 1)
         t[-1] = 0.0
         out = []
+        f = self.frame()
         for k in range(3):
-            if abs(float(back[k])) < EDITOR_GIZMO_RING_MIN_COS:
+            if abs(float(back @ f[:, k])) < EDITOR_GIZMO_RING_MIN_COS:
                 continue
-            e = np.eye(3)
-            u, v = e[(k + 1) % 3], e[(k + 2) % 3]
+            u, v = f[:, (k + 1) % 3], f[:, (k + 2) % 3]
             pts = piv + wpp * EDITOR_GIZMO_RING_PX * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
             px, d = self.ed.cam.project(pts, w, h)
             px = np.array(px, float)
@@ -251,7 +268,7 @@ class GizmoTool(Tool):
             return None
         x, y = e.x, e.y
         hit = self.pick(x, y)
-        if hit is not None and s.begin(hit[0], self.view_info(), (x, y)):
+        if hit is not None and self._begin(hit[0], (x, y)):
             if hit[1] is not None:
                 s.manip.set_axis(hit[1])
             ed.motion()
@@ -263,7 +280,7 @@ class GizmoTool(Tool):
         ed.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle {k}")
         if k >= 0:
             s.select_handle(k)
-            if s.begin(GRAB, self.view_info(), (x, y)):
+            if self._begin(GRAB, (x, y)):
                 ed.motion()
                 return DragMode.MANIP
         return None
@@ -282,7 +299,7 @@ class GizmoTool(Tool):
                    else f"cannot move the handle: {s.fit_error}" if s.fit_error
                    else "the active handle is not fitted yet")
             return
-        s.begin(mode, self.view_info(), ed.mouse)
+        self._begin(mode, ed.mouse)
 
     def cancel_manip(self) -> None:
         self.session.cancel()
@@ -373,8 +390,7 @@ class GizmoTool(Tool):
         if depth.min() <= 0:
             return out + self.readout_patches()
         if s.manip is not None and s.manip.axis is not None:
-            a = np.zeros(3)
-            a[s.manip.axis] = cam.scene_radius
+            a = s.manip.axis_vector() * cam.scene_radius
             ends, d2 = cam.project(np.vstack([cur - a, cur + a]), w, h)
             if d2.min() > 0:
                 p = ov.line_patch(ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1)
