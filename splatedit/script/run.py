@@ -16,6 +16,7 @@ from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.script.model import Edit, EditScript, Removal, SolverSettings
 from splatedit.script.parse import _Ctx
 from splatedit.select.regions import Box, Indices, Region, Sphere
+from splatedit.tolerances import CLOSURE_ONE_SIDED_SHARE
 
 
 @dataclass
@@ -211,9 +212,10 @@ def close_edit(cloud, r: ResolvedEdit, progress=None, regions: tuple | None = No
     off, see :mod:`splatedit.select.closure`): whatever closure adds to the
     support lies inside the support's region, and to a handle inside that
     handle's, so no splat outside a region the script gave moves.  A sphere
-    or a box selects all it covers, so closure only fills what an index list
-    encloses (its holes, :func:`~splatedit.select.closure.enclosed_holes`)
-    and closes handle index lists inside theirs.
+    or a box selects all it covers, so closure adds nothing there; an index
+    list (a one-view stroke) reaches what it encloses or hides: its holes,
+    the back side of a thin part and the rim between the two, not its outer
+    rim; handle index lists close inside the closed support.
 
     Args:
         regions: (support Region, handle Regions) of ``r``; None counts
@@ -231,11 +233,35 @@ def close_edit(cloud, r: ResolvedEdit, progress=None, regions: tuple | None = No
     graph = NeighbourGraph.build(cloud.positions)
     sup_region, h_regions = regions if regions is not None else (None, [None] * len(r.handles))
 
-    def reach_of(region, mask):     # the region the user gave, as a mask
-        return mask if isinstance(region, (Sphere, Box)) else mask | enclosed_holes(graph, mask)
+    def support_reach(region, mask):
+        """The region the user gave the support, as a mask.  A sphere or box
+        selects all it covers.  An index list painted from one view (its
+        splats all face one way, CLOSURE_ONE_SIDED_SHARE) reaches what it
+        encloses or hides: its holes and islands, the back side of a thin
+        part painted from the front and the rim between the two (rules 1-3
+        of the list alone, without a handle's margin), never its outer rim;
+        a list holding both sides of a part reaches its holes only."""
+        if isinstance(region, (Sphere, Box)):
+            return mask
+        if not one_sided(mask):
+            return mask | enclosed_holes(graph, mask)
+        return close_selection(cloud, mask, (), graph=graph).support | enclosed_holes(graph, mask)
 
-    res = close_selection(cloud, r.support, r.handles, graph=graph, reach=reach_of(sup_region, r.support),
-                          handle_reach=[reach_of(g, h) for g, h in zip(h_regions, r.handles)])
+    def one_sided(mask):
+        """All (CLOSURE_ONE_SIDED_SHARE) of the list's splats face one way:
+        painted from one view.  A list that holds both sides of a part was
+        selected through it and has nothing hidden behind it to add."""
+        nrm = cloud.normals_at(np.flatnonzero(mask))
+        mean = nrm.sum(axis=0)
+        return bool(np.linalg.norm(mean) > 0 and np.mean(nrm @ mean > 0) >= CLOSURE_ONE_SIDED_SHARE)
+
+    def handle_reach(region, mask):
+        """A handle's region: a sphere or box as given; an index list closes
+        inside the (closed) support like a painted handle (its back side)."""
+        return mask if isinstance(region, (Sphere, Box)) else None
+
+    res = close_selection(cloud, r.support, r.handles, graph=graph, reach=support_reach(sup_region, r.support),
+                          handle_reach=[handle_reach(g, h) for g, h in zip(h_regions, r.handles)])
     if progress is not None:
         progress(CLOSURE_STAGE, 1.0)
     return res.support, list(res.handles), res, time.perf_counter() - t0

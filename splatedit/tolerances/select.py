@@ -27,6 +27,12 @@ GRAPH_COARSE_STRIDE = 16
 #: silhouette.  A 1.0 bound (the support's) left the back of the head out of
 #: the handle: turning the head smeared it (22x in the tester's session)
 CLOSURE_HANDLE_THIN_MAX_REL = 3.0
+#: an edit script's index list counts as a one-view stroke (its hidden back
+#: side may join, splatedit.script.run.close_edit) when at least this share of
+#: its splats face the side of its mean normal: a stroke on the bunny's ear
+#: from one view (the team's one_view_edit.py): 99.2%; a ball of radius 0.25
+#: around the ear tip, both sides of the ear and part of the head: 66%
+CLOSURE_ONE_SIDED_SHARE = 0.95
 #: closure rule 1: normals of a thin part's two sides face opposite ways
 #: within acos(-0.5) = 120 degrees
 CLOSURE_OPPOSITE_COS = 0.0

@@ -88,6 +88,26 @@ def test_one_view_ear_strokes_edit_without_tears_needles_or_fragments(bunny):
     assert total_stretched <= 1e-3 * total_moved
 
 
+def test_one_view_strokes_as_script_index_lists_take_the_back_side(bunny):
+    """An edit script whose support and handle are index lists of one-view
+    strokes (what ../shared/tools/one_view_edit.py writes): the lists face
+    one way, so closure takes the ear's hidden back side and the rim between,
+    and the grab neither tears nor stretches; a ball-shaped list (both sides)
+    gets nothing behind it (test above)."""
+    from splatedit.script import parse_script, run_script
+    cloud, graph = bunny
+    p = cloud.positions
+    tip = p[np.argmax(p[:, 1])]
+    sup, hnd = stroke(cloud, graph, (1, 0, 0), tip)
+    doc = {"version": 1, "edits": [{"support": {"indices": np.flatnonzero(sup).tolist()},
+                                    "handle": {"indices": np.flatnonzero(hnd).tolist()},
+                                    "transform": {"translate": [0.0, 0.0, 0.08 * graph.diagonal]}}]}
+    out, reps = run_script(cloud, parse_script(doc))
+    assert reps[0].closure_added > 0.3 * sup.sum()                # the ear's back side and rim
+    assert count_tears(p, out.positions, graph.spacing) == 0
+    assert (axis_stretch(cloud, out) > 4).sum() == 0
+
+
 def test_the_same_strokes_without_closure_tear(bunny):
     """The baseline the closure fixes: fixed back sides next to the moving front."""
     cloud, graph = bunny
