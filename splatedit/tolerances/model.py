@@ -242,3 +242,17 @@ FRAMING_SAMPLE_POINTS = 20_000
 #: +-Z (|up_z| >= this), then -Y: the editor's turntable used it first; any
 #: value well away from 0 and 1 keeps the reference far from parallel to up
 FRONT_VIEW_Z_UP_COS = 0.9
+
+# ---- batch conversion of tiles (splatedit.commands.batch)
+#: a tile's normals and sizes are estimated over its own points and its
+#: neighbour tiles' points within this many *neighbourhood radii* of its box
+#: (the tile's median distance to its SIZE_NEIGHBOURS-th neighbour, 2.3 point
+#: spacings on a surface): a splat's size depends on its neighbours' sizes
+#: (the median cap of model/sizing.py), two neighbourhoods deep, plus a
+#: margin.  Measured on the terrain tiles of `splatedit bench batch`
+#: (docs/PERFORMANCE.md): see the seam figures there
+TILE_HALO_NEIGHBOURHOODS = 3.0
+#: the neighbourhood radius is the median over a seeded sample of this many
+#: of the tile's points (exact enough: a median's relative standard error is
+#: ~1/sqrt(m), 2.2 % at 2000)
+TILE_SPACING_SAMPLE = 2000
