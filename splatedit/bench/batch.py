@@ -80,6 +80,7 @@ def terrain_tiles(folder, nx: int = 5, ny: int = 2, points_per_tile: int = 200_0
             path = folder / f"tile_{i}_{j}{ext}"
             if ext == ".xyz":
                 np.savetxt(path, p, fmt="%.4f")
+                p = np.loadtxt(path).reshape(-1, 3)                # as stored (0.1 mm decimals)
             else:
                 import laspy
                 hdr = laspy.LasHeader(point_format=0, version="1.2")
@@ -142,40 +143,51 @@ def seam_check(outputs: list[Path], merged_points: np.ndarray, *, border: float)
 
 
 def bench_batch(nx: int = 5, ny: int = 2, points_per_tile: int = 200_000, *, ext: str = ".las",
-                workers=(1, 2), schedulers=("threads", "processes"), seam: bool = True):
-    """Yield one dict per case: the loop, each scheduler x worker count, and
-    the seam checks (batch with halo, loop without) against the merged cloud."""
+                workers=(1, 2), schedulers=("threads", "processes"), seam: bool = True, rounds: int = 2):
+    """Yield one dict per case: the loop, each scheduler x worker count
+    (``rounds`` times each, in turn), and the seam checks (batch with halo,
+    loop without) against the merged cloud."""
     from splatedit.io import convert
     from splatedit.commands.batch import BatchOptions, plan_jobs, run_batch
     from splatedit.tolerances import TILE_HALO_NEIGHBOURHOODS
-    load = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-batch-") as tmp:
         tmp = Path(tmp)
         paths, merged = terrain_tiles(tmp / "tiles", nx, ny, points_per_tile, ext=ext)
         base = {"bench": "batch", "tiles": len(paths), "points": int(len(merged)), "format": ext,
                 "cores": os.cpu_count()}
-        t0 = time.perf_counter()
-        loop_dir = tmp / "loop"
-        loop_dir.mkdir()
-        for p in paths:
-            convert(p, loop_dir / (p.stem + ".ply"))          # what `splatedit convert FILE OUT` does
-        loop_s = time.perf_counter() - t0
-        yield {**base, "case": "loop (convert per file, no halo)", "seconds": round(loop_s, 3),
-               "load_avg_1m": round(load, 2)}
-        last = None
-        for sched in schedulers:
-            for nw in workers:
-                out = tmp / f"dask-{sched}-{nw}"
-                jobs = plan_jobs(paths, out, ".ply", overwrite=False)
-                t0 = time.perf_counter()
-                res = run_batch(jobs, BatchOptions(scheduler=sched, workers=nw))
-                s = time.perf_counter() - t0
-                assert all(r.error is None for r in res), [r.error for r in res if r.error]
-                halo = sum(r.halo for r in res)
-                yield {**base, "case": f"dask {sched}", "workers": nw, "seconds": round(s, 3),
-                       "vs_loop": round(s / loop_s, 3), "halo_points": int(halo),
-                       "load_avg_1m": round(os.getloadavg()[0], 2)}
-                last = [j.out for j in jobs]
+        # rounds of every case in turn (the machine's load drifts: a ratio is
+        # taken within one round; the median over the rounds is reported too)
+        runs: dict = {}
+        last = loop_dir = None
+        for rnd in range(rounds):
+            loop_dir = tmp / f"loop{rnd}"
+            loop_dir.mkdir()
+            t0 = time.perf_counter()
+            for p in paths:
+                convert(p, loop_dir / (p.stem + ".ply"))          # what `splatedit convert FILE OUT` does
+            loop_s = time.perf_counter() - t0
+            runs.setdefault(("loop", 0), []).append((loop_s, loop_s, 0, os.getloadavg()[0]))
+            for sched in schedulers:
+                for nw in workers:
+                    out = tmp / f"dask-{sched}-{nw}-{rnd}"
+                    jobs = plan_jobs(paths, out, ".ply", overwrite=False)
+                    t0 = time.perf_counter()
+                    res = run_batch(jobs, BatchOptions(scheduler=sched, workers=nw))
+                    s = time.perf_counter() - t0
+                    assert all(r.error is None for r in res), [r.error for r in res if r.error]
+                    runs.setdefault((sched, nw), []).append((s, loop_s, sum(r.halo for r in res),
+                                                             os.getloadavg()[0]))
+                    last = [j.out for j in jobs]
+        for (sched, nw), rows in runs.items():
+            secs = [r[0] for r in rows]
+            line = {**base, "case": "loop (convert per file, no halo)" if sched == "loop" else f"dask {sched}",
+                    "seconds_median": round(float(np.median(secs)), 3), "seconds": [round(s, 3) for s in secs],
+                    "load_avg_1m": [round(r[3], 2) for r in rows]}
+            if sched != "loop":
+                ratios = [r[0] / r[1] for r in rows]
+                line.update(workers=nw, vs_loop_same_round=[round(x, 3) for x in ratios],
+                            vs_loop_median=round(float(np.median(ratios)), 3), halo_points=int(rows[0][2]))
+            yield line
         if seam and last is not None:
             from splatedit.commands.batch import load_tile
             reach = load_tile(str(paths[0])).reach

@@ -355,10 +355,11 @@ def _run_distributed(jobs, opts, on_result) -> list[TileResult]:
             tasks.append(client.submit(convert_tile, job, tile_f[job.index], bands, opts.remove_outliers,
                                        opts.overwrite, pure=False))
         results = {}
-        for fut in as_completed(tasks):
-            r = fut.result()
-            results[r.job.index] = r
-            on_result(r)
+        with client.as_current():
+            for fut in as_completed(tasks):
+                r = fut.result()
+                results[r.job.index] = r
+                on_result(r)
         return [results[j.index] for j in jobs]
     finally:
         client.close()
