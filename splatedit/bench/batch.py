@@ -109,7 +109,8 @@ def seam_check(outputs: list[Path], merged_points: np.ndarray, *, border: float)
     Returns:
         points compared, the largest normal angle (degrees, sign ignored),
         the fraction of opposite normals, the largest and 99th percentile
-        relative radius difference.
+        relative radius difference and the fraction of radii that differ by
+        more than 1e-6 (relative).
     """
     from scipy.spatial import cKDTree
     from splatedit.io import read
@@ -139,7 +140,16 @@ def seam_check(outputs: list[Path], merged_points: np.ndarray, *, border: float)
             "normal_deg_max": float(ang.max()) if len(ang) else 0.0,
             "normal_flipped_frac": float(np.mean(dots < 0)) if len(dots) else 0.0,
             "radius_rel_max": float(rel.max()) if len(rel) else 0.0,
-            "radius_rel_p99": float(np.quantile(rel, 0.99)) if len(rel) else 0.0}
+            "radius_rel_p99": float(np.quantile(rel, 0.99)) if len(rel) else 0.0,
+            "radius_differs_frac": float(np.mean(rel > 1e-6)) if len(rel) else 0.0}
+
+
+def _cpu() -> float:
+    """CPU seconds (user + system) of this process and its reaped children
+    (the process pool's workers are reaped when each run closes its pool)."""
+    import resource
+    own, kids = resource.getrusage(resource.RUSAGE_SELF), resource.getrusage(resource.RUSAGE_CHILDREN)
+    return own.ru_utime + own.ru_stime + kids.ru_utime + kids.ru_stime
 
 
 def bench_batch(nx: int = 5, ny: int = 2, points_per_tile: int = 200_000, *, ext: str = ".las",
@@ -162,27 +172,27 @@ def bench_batch(nx: int = 5, ny: int = 2, points_per_tile: int = 200_000, *, ext
         for rnd in range(rounds):
             loop_dir = tmp / f"loop{rnd}"
             loop_dir.mkdir()
-            t0 = time.perf_counter()
+            t0, c0 = time.perf_counter(), _cpu()
             for p in paths:
                 convert(p, loop_dir / (p.stem + ".ply"))          # what `splatedit convert FILE OUT` does
-            loop_s = time.perf_counter() - t0
-            runs.setdefault(("loop", 0), []).append((loop_s, loop_s, 0, os.getloadavg()[0]))
+            loop_s, loop_cpu = time.perf_counter() - t0, _cpu() - c0
+            runs.setdefault(("loop", 0), []).append((loop_s, loop_s, 0, os.getloadavg()[0], loop_cpu))
             for sched in schedulers:
                 for nw in workers:
                     out = tmp / f"dask-{sched}-{nw}-{rnd}"
                     jobs = plan_jobs(paths, out, ".ply", overwrite=False)
-                    t0 = time.perf_counter()
+                    t0, c0 = time.perf_counter(), _cpu()
                     res = run_batch(jobs, BatchOptions(scheduler=sched, workers=nw))
-                    s = time.perf_counter() - t0
+                    s, cpu = time.perf_counter() - t0, _cpu() - c0
                     assert all(r.error is None for r in res), [r.error for r in res if r.error]
                     runs.setdefault((sched, nw), []).append((s, loop_s, sum(r.halo for r in res),
-                                                             os.getloadavg()[0]))
+                                                             os.getloadavg()[0], cpu))
                     last = [j.out for j in jobs]
         for (sched, nw), rows in runs.items():
             secs = [r[0] for r in rows]
             line = {**base, "case": "loop (convert per file, no halo)" if sched == "loop" else f"dask {sched}",
                     "seconds_median": round(float(np.median(secs)), 3), "seconds": [round(s, 3) for s in secs],
-                    "load_avg_1m": [round(r[3], 2) for r in rows]}
+                    "cpu_seconds": [round(r[4], 2) for r in rows], "load_avg_1m": [round(r[3], 2) for r in rows]}
             if sched != "loop":
                 ratios = [r[0] / r[1] for r in rows]
                 line.update(workers=nw, vs_loop_same_round=[round(x, 3) for x in ratios],

@@ -24,7 +24,7 @@ process pool in docs/PERFORMANCE.md: the estimation's numpy and scipy calls
 release the GIL, and processes pay for moving the tiles), its process pool
 with ``--scheduler processes``, or a Dask distributed cluster with
 ``--scheduler tcp://HOST:PORT`` (every worker must see the input and output
-paths, e.g. on a shared file system).
+paths, e.g. on a shared file system, and have splatedit installed).
 
 A tile that fails (unreadable, malformed, unwritable) is reported by name
 and the others are still written; the command's exit code is then 2.

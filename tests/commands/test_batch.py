@@ -120,3 +120,19 @@ def test_scheduler_address_runs_the_batch_on_a_distributed_cluster(tiles, tmp_pa
     for p in paths:
         name = p.stem + ".ply"
         assert _digest(out / name) == _digest(local / name)
+
+
+def test_remove_outliers_drops_a_far_stray_of_one_tile_and_keeps_the_rest(tiles, tmp_path, capsys):
+    folder, paths, _ = tiles
+    src = tmp_path / "in"
+    src.mkdir()
+    for p in paths:
+        (src / p.name).write_bytes(p.read_bytes())
+    stray = np.array([[50.0, 50.0, 400.0]])
+    with open(src / paths[0].name, "a") as fh:
+        np.savetxt(fh, stray, fmt="%.4f")
+    out = tmp_path / "out"
+    assert main(["-q", "convert", str(src), str(out), "--remove-outliers"]) == 0
+    cloud = read(out / (paths[0].stem + ".ply"))
+    assert (cloud.positions + cloud.origin)[:, 2].max() < 100.0
+    assert "removed" in capsys.readouterr().out
