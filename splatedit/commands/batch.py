@@ -177,13 +177,6 @@ def load_tile(src: str) -> Tile:
         return Tile(src, error=_message(src, exc))
 
 
-def halo_width(a: Tile, b: Tile) -> float:
-    """Halo (model units) between two tiles: ``TILE_HALO_NEIGHBOURHOODS``
-    times the larger of their neighbourhood radii."""
-    from splatedit.tolerances import TILE_HALO_NEIGHBOURHOODS
-    return TILE_HALO_NEIGHBOURHOODS * max(a.reach, b.reach)
-
-
 def halo_band(tile: Tile, lo, hi) -> tuple:
     """Phase 2: ``tile``'s points inside the box ``lo``..``hi`` (world,
     already grown by the halo): ((m, 3) world positions, (m, 3) normals or
@@ -262,16 +255,21 @@ def convert_tile(job: TileJob, tile: Tile, bands: list, remove_outliers: bool, o
 def _neighbours(tiles: list[Tile]) -> list[list[tuple[int, np.ndarray, np.ndarray]]]:
     """For every tile i: (j, lo, hi) of each other tile j whose box comes
     within the halo of i's box, with i's box grown by that halo."""
-    good = [i for i, t in enumerate(tiles) if t.error is None and t.columns.needs_estimation()]
+    from splatedit.tolerances import TILE_HALO_NEIGHBOURHOODS
+    good = np.array([i for i, t in enumerate(tiles) if t.error is None and t.columns.needs_estimation()],
+                    dtype=np.int64)
     out = [[] for _ in tiles]
-    for i in good:
-        for j in good:
-            if i == j:
-                continue
-            h = halo_width(tiles[i], tiles[j])
-            lo, hi = tiles[i].lo - h, tiles[i].hi + h
-            if np.all(tiles[j].hi >= lo) and np.all(tiles[j].lo <= hi):
-                out[i].append((j, lo, hi))
+    if len(good) < 2:
+        return out
+    lo = np.array([tiles[i].lo for i in good])
+    hi = np.array([tiles[i].hi for i in good])
+    reach = np.array([tiles[i].reach for i in good])
+    for a, i in enumerate(good):                # vectorised over the other tiles j
+        h = TILE_HALO_NEIGHBOURHOODS * np.maximum(reach[a], reach)
+        near = np.all(hi >= lo[a] - h[:, None], axis=1) & np.all(lo <= hi[a] + h[:, None], axis=1)
+        near[a] = False
+        for b in np.flatnonzero(near):
+            out[i].append((int(good[b]), lo[a] - h[b], hi[a] + h[b]))
     return out
 
 
