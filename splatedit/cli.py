@@ -190,6 +190,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--scheduler", metavar="ADDRESS",
                    help="many tiles: 'threads' (default), 'processes', or a Dask distributed "
                         "scheduler's address (tcp://HOST:PORT; the workers must see the files)")
+    s.add_argument("--independent", action="store_true",
+                   help="many files: separate models, not tiles of one scan (no halo across their borders)")
     s.set_defaults(func=cmd_convert)
 
     s = sub.add_parser("deform", help="apply a JSON edit script to a model")

@@ -26,6 +26,9 @@ with ``--scheduler processes``, or a Dask distributed cluster with
 ``--scheduler tcp://HOST:PORT`` (every worker must see the input and output
 paths, e.g. on a shared file system, and have splatedit installed).
 
+Files that are separate models rather than tiles of one scan (``--independent``)
+get no halo: each is converted exactly as ``splatedit convert FILE OUT``.
+
 A tile that fails (unreadable, malformed, unwritable) is reported by name
 and the others are still written; the command's exit code is then 2.
 """
@@ -279,6 +282,8 @@ class BatchOptions:
     overwrite: bool = False
     scheduler: str = DEFAULT_SCHEDULER
     workers: Optional[int] = None
+    #: False: the files are separate models (``--independent``), no halo
+    halo: bool = True
 
 
 def run_batch(jobs: list[TileJob], opts: BatchOptions,
@@ -312,7 +317,7 @@ def _run_local(jobs, opts, on_result) -> list[TileResult]:
     held = [dask.delayed(t, name=f"tile-{i}", traverse=False) for i, t in enumerate(tiles)]
     results: dict[int, TileResult] = {}
     tasks = []
-    for job, nbs in zip(jobs, _neighbours(tiles)):
+    for job, nbs in zip(jobs, _neighbours(tiles) if opts.halo else [[] for _ in tiles]):
         bands = [dask.delayed(halo_band, pure=False)(held[j], lo, hi, dask_key_name=f"band-{job.index}-{j}")
                  for j, lo, hi in nbs]
         tasks.append(dask.delayed(convert_tile, pure=False)(job, held[job.index], bands, opts.remove_outliers,
@@ -348,7 +353,7 @@ def _run_distributed(jobs, opts, on_result) -> list[TileResult]:
         # the boxes and radii only: the points stay on the workers
         meta = client.gather([client.submit(_tile_meta, f, pure=False) for f in tile_f])
         tasks = []
-        for job, nbs in zip(jobs, _neighbours(meta)):
+        for job, nbs in zip(jobs, _neighbours(meta) if opts.halo else [[] for _ in meta]):
             bands = [client.submit(halo_band, tile_f[j], lo, hi, pure=False) for j, lo, hi in nbs]
             tasks.append(client.submit(convert_tile, job, tile_f[job.index], bands, opts.remove_outliers,
                                        opts.overwrite, pure=False))
@@ -391,7 +396,8 @@ def cmd_convert_batch(args) -> int:
     ext = args.to or DEFAULT_OUTPUT_EXTENSION
     jobs = plan_jobs(inputs, args.output, ext, overwrite=args.force)
     opts = BatchOptions(remove_outliers=args.remove_outliers, overwrite=args.force,
-                        scheduler=args.scheduler or DEFAULT_SCHEDULER, workers=args.workers)
+                        scheduler=args.scheduler or DEFAULT_SCHEDULER, workers=args.workers,
+                        halo=not args.independent)
     count = [0]
 
     def show(r: TileResult) -> None:

@@ -136,3 +136,14 @@ def test_remove_outliers_drops_a_far_stray_of_one_tile_and_keeps_the_rest(tiles,
     cloud = read(out / (paths[0].stem + ".ply"))
     assert (cloud.positions + cloud.origin)[:, 2].max() < 100.0
     assert "removed" in capsys.readouterr().out
+
+
+def test_independent_files_are_converted_each_alone_without_a_halo(tiles, tmp_path, capsys):
+    """--independent: separate models, no halo; each output equals ``convert FILE OUT``."""
+    folder, paths, _ = tiles
+    out = tmp_path / "out"
+    assert main(["-q", "convert", str(folder), str(out), "--independent"]) == 0
+    assert "(0 halo points" in capsys.readouterr().out
+    alone = tmp_path / "alone.ply"
+    assert main(["-q", "convert", str(paths[0]), str(alone)]) == 0
+    np.testing.assert_array_equal(read(out / (paths[0].stem + ".ply")).u, read(alone).u)
