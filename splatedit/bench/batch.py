@@ -158,7 +158,7 @@ def bench_batch(nx: int = 5, ny: int = 2, points_per_tile: int = 200_000, *, ext
     (``rounds`` times each, in turn), and the seam checks (batch with halo,
     loop without) against the merged cloud."""
     from splatedit.io import convert
-    from splatedit.commands.batch import BatchOptions, plan_jobs, run_batch
+    from splatedit.io.batch import BatchOptions, plan_jobs, run_batch
     from splatedit.tolerances import TILE_HALO_NEIGHBOURHOODS
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-batch-") as tmp:
         tmp = Path(tmp)
@@ -199,7 +199,7 @@ def bench_batch(nx: int = 5, ny: int = 2, points_per_tile: int = 200_000, *, ext
                             vs_loop_median=round(float(np.median(ratios)), 3), halo_points=int(rows[0][2]))
             yield line
         if seam and last is not None:
-            from splatedit.commands.batch import load_tile
+            from splatedit.io.batch import load_tile
             reach = load_tile(str(paths[0])).reach
             border = 2.0 * reach
             yield {**base, "case": "seam: batch (halo) vs merged", "halo_neighbourhoods": TILE_HALO_NEIGHBOURHOODS,

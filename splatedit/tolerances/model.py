@@ -243,7 +243,7 @@ FRAMING_SAMPLE_POINTS = 20_000
 #: value well away from 0 and 1 keeps the reference far from parallel to up
 FRONT_VIEW_Z_UP_COS = 0.9
 
-# ---- batch conversion of tiles (splatedit.commands.batch)
+# ---- batch conversion of tiles (splatedit.io.batch)
 #: a tile's normals and sizes are estimated over its own points and its
 #: neighbour tiles' points within this many *neighbourhood radii* of its box
 #: (the tile's median distance to its SIZE_NEIGHBOURS-th neighbour, about 2.3

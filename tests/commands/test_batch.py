@@ -16,7 +16,7 @@ import pytest
 import splatedit.tolerances
 from splatedit.bench.batch import seam_check, terrain_tiles
 from splatedit.cli import main
-from splatedit.commands.batch import BatchOptions, load_tile, plan_jobs, run_batch
+from splatedit.io.batch import BatchOptions, load_tile, plan_jobs, run_batch
 from splatedit.io import read
 
 
