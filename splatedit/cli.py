@@ -183,6 +183,15 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--remove-outliers", action="store_true",
                    help="drop statistical and isolated outlier points (point clouds only)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists")
+    s.add_argument("--to", metavar="EXT", help="many tiles (INPUT a folder or a quoted glob, OUTPUT a folder): "
+                                               "the output format, e.g. .laz (default .ply)")
+    s.add_argument("--workers", type=_positive_count, metavar="N",
+                   help="many tiles: parallel tasks on the local scheduler (default: one per core)")
+    s.add_argument("--scheduler", metavar="ADDRESS",
+                   help="many tiles: 'threads' (default), 'processes', or a Dask distributed "
+                        "scheduler's address (tcp://HOST:PORT; the workers must see the files)")
+    s.add_argument("--independent", action="store_true",
+                   help="many files: separate models, not tiles of one scan (no halo across their borders)")
     s.set_defaults(func=cmd_convert)
 
     s = sub.add_parser("deform", help="apply a JSON edit script to a model")

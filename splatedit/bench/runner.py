@@ -146,6 +146,12 @@ def _curves(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     yield {"bench": "curves", **cost(0.01 if quick else 0.005)}
 
 
+def _batch(quick: bool, progress=None, counts=None) -> Iterator[dict]:
+    from splatedit.bench.batch import bench_batch
+    n = int(counts[0]) if counts else (20_000 if quick else 200_000)
+    yield from bench_batch(5, 2, n)
+
+
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
@@ -158,6 +164,7 @@ BENCHES = {
     "editor": _editor,
     "estimate": _estimate,
     "io": _io,
+    "batch": _batch,
     "detail": _detail,
     "gui": _gui,
     "gaussians": _gaussians,
@@ -240,6 +247,11 @@ def _tiny_io():
     yield from bench_io(counts=(3000,), las_points=2000)
 
 
+def _tiny_batch():
+    from splatedit.bench.batch import bench_batch
+    yield from bench_batch(2, 1, 1500, ext=".xyz", workers=(2,), schedulers=("threads",), rounds=1)
+
+
 def _tiny_detail():
     from splatedit.bench.detail import bench_detail
     yield from bench_detail(sizes=((40, 40),), repeats=1)
@@ -281,7 +293,7 @@ def _tiny_curves():
 #: the tiny form of every case of BENCHES (same keys)
 TINY = {"solve": _tiny_solve, "basis": _tiny_basis, "groups": _tiny_groups, "qr": _tiny_qr,
         "accuracy": _tiny_accuracy, "closure": _tiny_closure, "render": _tiny_render,
-        "editor": _tiny_editor, "estimate": _tiny_estimate, "io": _tiny_io, "detail": _tiny_detail,
+        "editor": _tiny_editor, "estimate": _tiny_estimate, "io": _tiny_io, "batch": _tiny_batch, "detail": _tiny_detail,
         "gui": _tiny_gui, "gaussians": _tiny_gaussians, "gaussian-render": _tiny_gaussian_render,
         "gaussian-editor": _tiny_gaussian_editor, "gpu-sort": _tiny_gpu_sort, "curves": _tiny_curves}
 

@@ -12,6 +12,12 @@ from splatedit.errors import ParameterError
 
 
 def cmd_convert(args) -> int:
+    from splatedit.commands.batch import cmd_convert_batch, is_batch_input
+    if is_batch_input(args.input):
+        return cmd_convert_batch(args)
+    for opt in ("to", "workers", "scheduler", "independent"):
+        if getattr(args, opt, None) not in (None, False):
+            raise ParameterError(f"--{opt}", "applies to many tiles (INPUT a folder or a glob pattern)")
     from splatedit.io import check_output_path, is_gaussian_file, read, write
     check_output_path(args.output, overwrite=args.force, protect=args.input)
     if is_gaussian_file(args.input) and not args.to_splats and Path(args.output).suffix.lower() == ".ply":

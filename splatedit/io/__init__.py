@@ -4,6 +4,8 @@ scanner formats LAS/LAZ, E57, PCD and PTS.
 Public API::
 
     read(path, *, progress=None) -> SplatCloud
+    read_columns(path, *, progress=None) -> PointColumns   (read() before splats are derived)
+    cloud_from_columns(columns, *, progress=None) -> SplatCloud
     write(path, cloud, *, overwrite=False, binary=True, axes=True, progress=None) -> Path
     convert(in_path, out_path, *, overwrite=False, binary=True, progress=None) -> SplatCloud
     is_gaussian_file(path) -> bool
@@ -34,6 +36,7 @@ import stat
 from pathlib import Path
 
 from splatedit.errors import InputError
+from splatedit.io._build import PointColumns, cloud_from_columns, columns_only
 from splatedit.io.atomic import atomic_open, check_writable_target
 from splatedit.io.e57 import read_e57, split_scan_index, write_e57
 from splatedit.io.las import read_las, write_las
@@ -50,7 +53,7 @@ from splatedit.progress import report
 
 __all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "split_scan_index",
            "READ_EXTENSIONS", "WRITE_EXTENSIONS", "FACE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians",
-           "read_summary"]
+           "read_summary", "read_columns", "cloud_from_columns", "PointColumns"]
 
 _READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_pts,
             ".off": read_off, ".las": read_las, ".laz": read_las, ".e57": read_e57,
@@ -97,6 +100,20 @@ def read(path, *, progress=None) -> SplatCloud:
     if ext == ".ply" and is_gaussian_ply(path):
         return read_gaussian_ply(path, progress=progress).proxy_splats()
     return reader(path, progress=progress)
+
+
+def read_columns(path, *, progress=None) -> PointColumns:
+    """:func:`read` stopping before splats are derived: the file's columns
+    (:class:`PointColumns`); ``cloud_from_columns(read_columns(p))`` equals
+    ``read(p)``.  Batch conversion reads tiles this way, so that normals and
+    sizes can be estimated over a tile and its neighbours' border points.
+
+    Raises:
+        InputError: as :func:`read`.
+    """
+    with columns_only():
+        got = read(path, progress=progress)
+    return got if isinstance(got, PointColumns) else PointColumns.of_cloud(got)
 
 
 def read_summary(path, *, progress=None, lean_above: int = 0) -> CloudSummary:

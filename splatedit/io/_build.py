@@ -3,8 +3,11 @@ the rule that turns whatever attributes a file has into splats."""
 
 from __future__ import annotations
 
+import contextvars
 import math
+from dataclasses import dataclass, replace
 from pathlib import Path
+from typing import Optional
 
 import numpy as np
 
@@ -192,6 +195,88 @@ def rebase(positions, origin) -> np.ndarray:
     return positions
 
 
+#: set by :func:`columns_only`: :func:`build_cloud` returns the columns it was given
+_COLUMNS_ONLY = contextvars.ContextVar("splatedit_columns_only", default=False)
+
+
+@dataclass
+class PointColumns:
+    """What a reader found in a file, before any splat is derived (see
+    :func:`splatedit.io.read_columns`): positions relative to ``origin``
+    and whichever optional columns the file had (None where it had none).
+
+    Attributes:
+        source: the path the cloud will name (``file.e57#2`` for one scan).
+        positions: (n, 3) float64, model units, relative to ``origin``.
+        origin: (3,) float64 world offset (``world = positions + origin``).
+        normals, u, v: (n, 3) float64 or None; radius: (n,) float64 or None.
+        colors: (n, 4) uint8 or None; faces: (f, 3) int64 or None;
+        intensity, classification, quantization, point_fields: the scanner
+        attributes of :class:`SplatCloud`.
+    """
+
+    source: str
+    positions: np.ndarray
+    origin: np.ndarray
+    normals: Optional[np.ndarray] = None
+    radius: Optional[np.ndarray] = None
+    u: Optional[np.ndarray] = None
+    v: Optional[np.ndarray] = None
+    colors: Optional[np.ndarray] = None
+    faces: Optional[np.ndarray] = None
+    intensity: Optional[np.ndarray] = None
+    classification: Optional[np.ndarray] = None
+    quantization: Optional[object] = None
+    point_fields: Optional[dict] = None
+
+    @property
+    def n(self) -> int:
+        return len(self.positions)
+
+    def needs_estimation(self) -> bool:
+        """True when :func:`build_cloud` would derive splats from neighbours
+        (rules 4 and 5: no splat axes, no faces, not both normals and radii)."""
+        if self.u is not None and self.v is not None:
+            return False
+        if self.faces is not None:
+            return False
+        return not (self.normals is not None and self.radius is not None and usable_normals(self.normals))
+
+    def with_axes(self, u, v) -> "PointColumns":
+        """A copy whose splat axes are ``u``, ``v`` ((n, 3) float64, model units)."""
+        return replace(self, u=np.asarray(u, dtype=np.float64), v=np.asarray(v, dtype=np.float64))
+
+    @classmethod
+    def of_cloud(cls, cloud: SplatCloud) -> "PointColumns":
+        """The columns of a cloud that was read whole (a Gaussian scene's proxy splats)."""
+        return cls(cloud.source or cloud.name, cloud.positions, np.asarray(cloud.origin, dtype=np.float64),
+                   u=cloud.u, v=cloud.v, colors=cloud.colors, faces=cloud.faces, intensity=cloud.intensity,
+                   classification=cloud.classification, quantization=cloud.quantization,
+                   point_fields=cloud.point_fields)
+
+
+class columns_only:
+    """Context manager: inside it :func:`build_cloud` returns a
+    :class:`PointColumns` instead of deriving splats (every reader ends in it)."""
+
+    def __enter__(self):
+        self._token = _COLUMNS_ONLY.set(True)
+        return self
+
+    def __exit__(self, *exc):
+        _COLUMNS_ONLY.reset(self._token)
+        return False
+
+
+def cloud_from_columns(cols: PointColumns, *, progress=None) -> SplatCloud:
+    """:func:`build_cloud` of columns read by :func:`columns_only` (the same rule)."""
+    return build_cloud(cols.source, cols.positions, normals=cols.normals, radius=cols.radius, u=cols.u,
+                       v=cols.v, colors=cols.colors, faces=cols.faces, progress=progress,
+                       origin=np.asarray(cols.origin, dtype=np.float64), already_local=True,
+                       intensity=cols.intensity, classification=cols.classification,
+                       quantization=cols.quantization, point_fields=cols.point_fields)
+
+
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
                 faces=None, progress=None, origin=None, already_local=False, intensity=None,
                 classification=None, quantization=None, point_fields=None,
@@ -223,6 +308,11 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
                 quantization=quantization, point_fields=point_fields)
     if faces is not None and len(faces) == 0:
         faces = None
+    if _COLUMNS_ONLY.get():
+        return PointColumns(source, positions, np.asarray(origin, dtype=np.float64), normals=normals,
+                            radius=radius, u=u, v=v, colors=colors, faces=faces, **{
+                                k: scan[k] for k in ("intensity", "classification", "quantization",
+                                                     "point_fields")})
     if u is not None and v is not None:
         # every reader checks its columns (check_finite) before calling here
         return SplatCloud(positions, u, v, colors, faces, name=name, source=source,

@@ -242,3 +242,23 @@ FRAMING_SAMPLE_POINTS = 20_000
 #: +-Z (|up_z| >= this), then -Y: the editor's turntable used it first; any
 #: value well away from 0 and 1 keeps the reference far from parallel to up
 FRONT_VIEW_Z_UP_COS = 0.9
+
+# ---- batch conversion of tiles (splatedit.io.batch)
+#: a tile's normals and sizes are estimated over its own points and its
+#: neighbour tiles' points within this many *neighbourhood radii* of its box
+#: (the tile's median distance to its SIZE_NEIGHBOURS-th neighbour, about 2.3
+#: point spacings on a surface): a splat's size depends on its neighbours'
+#: sizes (the median cap of model/sizing.py), two neighbourhoods deep.
+#: Measured on 3 x 2 terrain tiles of 20k points (splatedit.bench.batch),
+#: points within 2 radii of an inner border against the merged cloud
+#: estimated at once: halo 0 (a plain per-file loop): normals up to 85 deg
+#: and radii up to 133 % off; 1: 43 deg, 12 %; 2: axes equal (2e-6 deg,
+#: rounding) and radii exact, but 0.95 % of the normals oriented the other
+#: way; 3 and 4: axes and radii equal, no normal flipped.  At 10 tiles of
+#: 200k the axes stay equal; a few orientation pieces and outlier caps still
+#: differ (global steps, see docs/PERFORMANCE.md)
+TILE_HALO_NEIGHBOURHOODS = 3.0
+#: the neighbourhood radius is the median over a seeded sample of this many
+#: of the tile's points (exact enough: a median's relative standard error is
+#: ~1/sqrt(m), 2.2 % at 2000)
+TILE_SPACING_SAMPLE = 2000
