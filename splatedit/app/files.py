@@ -80,6 +80,8 @@ def check_model_file(path) -> None:
     if ext not in READ_EXTENSIONS:
         raise InputError(f"unsupported file extension {ext or '(none)'!r} for reading; "
                          f"supported: {', '.join(READ_EXTENSIONS)}", path=str(path))
+    from splatedit.io import check_readable_file
+    check_readable_file(p)          # by stat: opening a FIFO would block before any window
     try:
         with open(p, "rb") as f:
             f.read(1)

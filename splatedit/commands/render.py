@@ -39,14 +39,16 @@ def _camera_from_args(args, cloud):
 
 
 def cmd_render(args) -> int:
-    from splatedit.io.atomic import check_writable_target
+    from splatedit.io import check_output_path
     from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
         raise ParameterError("--buffers", "must differ from the PNG path (-o)")
     check_render_memory(args.size, args.buffers is not None)    # before reading anything
-    for target in (args.output, args.buffers):
+    # what is written must be what the name says: a PNG, and numpy's .npz
+    # (`render m.ply -o m.ply --force` wrote a PNG over the model)
+    for target, ext in ((args.output, ".png"), (args.buffers, ".npz")):
         if target is not None:
-            check_writable_target(target, overwrite=args.force, protect=args.input)
+            check_output_path(target, overwrite=args.force, protect=args.input, extensions=(ext,))
     cloud = _read_model(args.input, args.progress)
     from splatedit.model.gaussians import GaussianCloud
     if isinstance(cloud, GaussianCloud):

@@ -10,7 +10,7 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud, column_bounds
-from splatedit.tolerances import (MAX_COORDINATE_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
+from splatedit.tolerances import (MAX_COORDINATE_ABS, MIN_EXTENT_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
                                   REBASE_STORED_REACH)
 
 
@@ -191,6 +191,18 @@ def rebase(positions, origin) -> np.ndarray:
     return positions
 
 
+def check_extent(lo, hi, path) -> None:
+    """Refuse a model whose bounding box ``lo``..``hi`` ((3,) each) is
+    positive but below ``MIN_EXTENT_ABS`` across: its squared distances
+    underflow float64, so sizes, normals and framing come out as nonsense
+    (a sphere 1e-300 across rendered as rings with exit 0).  All points in
+    one place (extent 0) stay valid: a single splat."""
+    side = float(np.max(np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64)))
+    if 0.0 < side < MIN_EXTENT_ABS:
+        raise InputError(f"the model is {side:.3g} across, below the smallest supported extent "
+                         f"{MIN_EXTENT_ABS:g} (rescale the model)", path=str(path))
+
+
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
                 faces=None, progress=None, origin=None, already_local=False, intensity=None,
                 classification=None, quantization=None, point_fields=None,
@@ -214,8 +226,10 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     name, source = Path(path).name, str(path)
     if len(positions) == 0:
         raise InputError("zero vertices: the file holds no points", path=source, element="vertex")
+    bounds = column_bounds(positions)
+    check_extent(*bounds, path)
     if origin is None:
-        origin = local_origin(positions, stored=stored_origin)
+        origin = local_origin(positions, bounds=bounds, stored=stored_origin)
     if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,

@@ -1,0 +1,89 @@
+"""Calls into file-format libraries (laspy/lazrs, pye57/libE57Format) made safe
+for the one-line error contract.
+
+:func:`library_call` turns whatever such a library raises (its own exception
+types, ``ValueError``, ``MemoryError``, ...) into one :class:`InputError`
+naming the file, and captures what the library prints on the process's
+standard error (libE57Format prints debug lines; a C library bypasses
+``sys.stderr``): on failure that text is folded into the error's single line,
+on success it is dropped.  Used by every reader and writer that calls such a
+library; the readers validate what they can (counts against the file size,
+finite scales) *before* the call, this is the net behind those checks.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import os
+import sys
+import tempfile
+import threading
+
+from splatedit.errors import InputError, SplatEditError
+
+_LOCK = threading.RLock()
+#: at most this many characters of a library's stderr output go into the message
+_MAX_LIBRARY_TEXT = 300
+
+
+def _one_line(text: str) -> str:
+    """``text`` as one line: its non-blank lines joined by ' / ', shortened."""
+    parts = [ln.strip() for ln in text.splitlines() if ln.strip()]
+    line = " / ".join(parts)
+    return line if len(line) <= _MAX_LIBRARY_TEXT else line[:_MAX_LIBRARY_TEXT - 3] + "..."
+
+
+@contextlib.contextmanager
+def _captured_fd2():
+    """Redirect file descriptor 2 to a temporary file for the block; yields
+    a list that holds the captured text (one str) after the block.  Without
+    a usable fd 2 (an embedded interpreter) nothing is captured."""
+    box: list[str] = []
+    try:
+        sys.stderr.flush()
+        saved = os.dup(2)
+    except (OSError, ValueError, AttributeError):
+        yield box
+        return
+    with _LOCK, tempfile.TemporaryFile() as tmp:
+        try:
+            os.dup2(tmp.fileno(), 2)
+            yield box
+        finally:
+            with contextlib.suppress(OSError, ValueError):
+                sys.stderr.flush()
+            os.dup2(saved, 2)
+            os.close(saved)
+            tmp.seek(0)
+            box.append(tmp.read(1 << 16).decode("utf-8", "replace"))
+
+
+@contextlib.contextmanager
+def library_call(path, what: str):
+    """Run the block calling a format library on ``path``.
+
+    Args:
+        path: the file named in the error.
+        what: the start of the message, e.g. ``"not a readable LAS/LAZ file"``
+            or ``"cannot write E57"``.
+    Raises:
+        InputError: ``{path}: {what}: {the library's message}
+        [(library output: ...)]`` for any exception but our own errors and
+        KeyboardInterrupt / SystemExit, which pass unchanged.
+    """
+    with _captured_fd2() as out:
+        try:
+            yield
+        except (SplatEditError, KeyboardInterrupt, SystemExit, GeneratorExit):
+            raise
+        except MemoryError:
+            failure = "not enough memory"
+        except Exception as exc:   # noqa: BLE001 - libraries raise their own types
+            failure = _one_line(str(exc)) or type(exc).__name__
+            if isinstance(exc, OSError) and exc.strerror:
+                failure = exc.strerror
+        else:
+            return
+    said = _one_line(out[0]) if out else ""
+    extra = f" (library output: {said})" if said and said not in failure else ""
+    raise InputError(f"{what}: {failure}{extra}", path=str(path)) from None
