@@ -234,7 +234,7 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
             elif ext == ".pts":
                 write_pts(fh, cloud)
             elif ext == ".e57":
-                write_e57(fh, cloud, path.parent)
+                write_e57(fh, cloud, path)
             else:
                 write_off(fh, cloud)
     except OSError as exc:

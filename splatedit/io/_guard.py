@@ -33,6 +33,18 @@ def _one_line(text: str) -> str:
     return line if len(line) <= _MAX_LIBRARY_TEXT else line[:_MAX_LIBRARY_TEXT - 3] + "..."
 
 
+def _os_error_in(exc: BaseException):
+    """The first OSError with a ``strerror`` in ``exc``'s cause/context chain
+    (lazrs wraps the OSError of a full disk as 'Failed to call write')."""
+    seen = 0
+    while exc is not None and seen < 8:
+        if isinstance(exc, OSError) and exc.strerror:
+            return exc
+        exc = exc.__cause__ or exc.__context__
+        seen += 1
+    return None
+
+
 @contextlib.contextmanager
 def _captured_fd2():
     """Redirect file descriptor 2 to a temporary file for the block; yields
@@ -58,14 +70,37 @@ def _captured_fd2():
             box.append(tmp.read(1 << 16).decode("utf-8", "replace"))
 
 
+class RecordingStream:
+    """A binary file object passed to a library in place of ``fh``: the
+    OSError of a failed write (disk full) is kept in ``error``, since some
+    libraries replace it by their own message (lazrs: 'Failed to call
+    write')."""
+
+    def __init__(self, fh):
+        self._fh = fh
+        self.error: OSError | None = None
+
+    def write(self, data):
+        try:
+            return self._fh.write(data)
+        except OSError as exc:
+            self.error = exc
+            raise
+
+    def __getattr__(self, name):
+        return getattr(self._fh, name)
+
+
 @contextlib.contextmanager
-def library_call(path, what: str):
+def library_call(path, what: str, stream: RecordingStream | None = None):
     """Run the block calling a format library on ``path``.
 
     Args:
         path: the file named in the error.
         what: the start of the message, e.g. ``"not a readable LAS/LAZ file"``
             or ``"cannot write E57"``.
+        stream: the :class:`RecordingStream` the library writes to, if any:
+            its OSError's reason is added to the message.
     Raises:
         InputError: ``{path}: {what}: {the library's message}
         [(library output: ...)]`` for any exception but our own errors and
@@ -79,11 +114,14 @@ def library_call(path, what: str):
         except MemoryError:
             failure = "not enough memory"
         except Exception as exc:   # noqa: BLE001 - libraries raise their own types
-            failure = _one_line(str(exc)) or type(exc).__name__
-            if isinstance(exc, OSError) and exc.strerror:
-                failure = exc.strerror
+            text = str(exc).strip()
+            failure = text.splitlines()[0].strip() if text else type(exc).__name__
+            cause = _os_error_in(exc) or (stream.error if stream is not None else None)
+            if cause is not None:       # disk full in our own file object, under the library's wrapper
+                failure = cause.strerror if cause is exc else f"{failure}: {cause.strerror}"
         else:
             return
-    said = _one_line(out[0]) if out else ""
-    extra = f" (library output: {said})" if said and said not in failure else ""
+    said = _one_line("\n".join(ln for ln in (out[0] if out else "").splitlines()
+                               if failure not in ln))
+    extra = f" (library output: {said})" if said else ""
     raise InputError(f"{what}: {failure}{extra}", path=str(path)) from None

@@ -116,18 +116,26 @@ def _read_scans(e57, src: str, count: int, scan):
     return xyz, colors, intensity, stored
 
 
-def write_e57(fh, cloud: SplatCloud, directory) -> None:
+def write_e57(fh, cloud: SplatCloud, path) -> None:
     """Write ``cloud`` as a one-scan E57 file to the open binary file ``fh``
-    (pye57 writes only by path: a scratch file in ``directory``, copied)."""
+    (pye57 writes only by path: a scratch file in the folder of ``path``,
+    the target named in errors, copied)."""
     import shutil
     import tempfile
     from pathlib import Path
+    directory = Path(path).parent
     with tempfile.TemporaryDirectory(dir=directory, prefix=".splatedit-e57-") as tmp:
         scratch = Path(tmp) / "scan.e57"
-        with library_call(getattr(fh, "name", directory), "cannot write E57"):
+        with library_call(path, "cannot write E57"):
             _write_e57_path(str(scratch), cloud)
         with open(scratch, "rb") as src:
             shutil.copyfileobj(src, fh, 1 << 22)
+
+
+#: libE57 image files of failed writes, cancelled and kept alive: freeing
+#: one while its writer objects (held by the exception's traceback) still
+#: refer to it crashed the process (SIGSEGV) after the error line
+_FAILED_WRITES: list = []
 
 
 def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
@@ -151,5 +159,12 @@ def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
     e57 = pye57.E57(tmp_path, mode="w")
     try:
         e57.write_scan_raw(data, scan_header=header)
-    finally:
         e57.close()
+    except BaseException:
+        # a failed write (disk full) leaves libE57's file open: cancel it here,
+        # else pye57's __del__ closes it again at some later garbage
+        # collection and prints a second exception and libE57's debug lines
+        image_file = e57.__dict__.pop("image_file", None)
+        if image_file is not None:
+            _FAILED_WRITES.append(image_file)
+        raise

@@ -37,7 +37,7 @@ import warnings
 
 from splatedit.errors import InputError, InputWarning
 from splatedit.io._build import build_cloud, fits_origin, local_origin
-from splatedit.io._guard import library_call
+from splatedit.io._guard import RecordingStream, library_call
 from splatedit.model.cloud import Quantization, SplatCloud, column_bounds
 from splatedit.progress import report
 from splatedit.tolerances import (LAS_DEFAULT_SCALE, LAS_MIN_SCALE, LAZ_MAX_POINTS_PER_BYTE,
@@ -299,6 +299,7 @@ def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
     if own_rgb:
         c = cloud.colors.astype(np.uint16) * 257
         las.red, las.green, las.blue = c[:, 0], c[:, 1], c[:, 2]
-    with library_call(path, f"cannot write {'LAZ' if compress else 'LAS'}"):
-        las.write(fh, do_compress=compress,
+    stream = RecordingStream(fh)
+    with library_call(path, f"cannot write {'LAZ' if compress else 'LAS'}", stream):
+        las.write(stream, do_compress=compress,
                   laz_backend=laspy.LazBackend.Lazrs if compress else None)
