@@ -49,6 +49,9 @@ def cmd_render(args) -> int:
     for target, ext in ((args.output, ".png"), (args.buffers, ".npz")):
         if target is not None:
             check_output_path(target, overwrite=args.force, protect=args.input, extensions=(ext,))
+    from splatedit.io import is_gaussian_file
+    if args.edit is not None and not is_gaussian_file(args.input):
+        check_gpu_columns(args.edit)        # before the read and the fit (seconds, gigabytes)
     cloud = _read_model(args.input, args.progress)
     from splatedit.model.gaussians import GaussianCloud
     if isinstance(cloud, GaussianCloud):
@@ -63,6 +66,34 @@ def cmd_render(args) -> int:
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
     return 0
+
+
+def gpu_columns(edit) -> int:
+    """Basis columns the renderer needs for ``edit`` (a script Edit): 4 per
+    handle, one per point of each control curve of 2 points or more."""
+    return 4 * len(edit.handles) + sum(len(c.points) for c in edit.curves if len(c.points) >= 2)
+
+
+def check_gpu_columns(script_path) -> None:
+    """Refuse, before any fitting, an edit script whose last edit (the one
+    ``render --edit`` deforms on the GPU) needs more basis columns than the
+    renderer holds (``RENDER_MAX_BASIS_COLUMNS``).
+
+    Raises:
+        EditScriptError: naming the script file and the edit's JSON path.
+    """
+    from splatedit.errors import EditScriptError
+    from splatedit.script import load_script
+    from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
+    edit = load_script(script_path).edits[-1]
+    k = gpu_columns(edit)
+    if k > RENDER_MAX_BASIS_COLUMNS:
+        n_pts = sum(len(c.points) for c in edit.curves)
+        raise EditScriptError(
+            f"{len(edit.handles)} handle(s) and {n_pts} curve point(s) need {k} deformation columns on "
+            f"the GPU (4 per handle, 1 per curve point), at most {RENDER_MAX_BASIS_COLUMNS}: split the "
+            f"edit, or apply it with 'splatedit deform' and render the result",
+            json_path=edit.json_path, path=str(script_path))
 
 
 def _read_model(path, progress):
@@ -92,8 +123,11 @@ def _render_gaussians(args, cloud) -> int:
         if len(load_script(args.edit).edits) != 1:
             raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
                                            "(chained edits need the Gaussian CPU deformation)")
+        from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
+
         def gpu_can_draw(rows, d_c):
-            return isinstance(d_c, np.ndarray) and len(rows) == 5
+            return (isinstance(d_c, np.ndarray) and len(rows) == 5
+                    and rows[1].shape[1] <= RENDER_MAX_BASIS_COLUMNS)
 
         _, basis_rows, d_c = _gpu_edit(args, proxy, on_gpu=gpu_can_draw)
         if not gpu_can_draw(basis_rows, d_c):
