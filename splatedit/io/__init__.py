@@ -29,6 +29,7 @@ file intact.  An existing file is replaced only with ``overwrite=True``.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 from pathlib import Path
@@ -90,11 +91,24 @@ def read(path, *, progress=None) -> SplatCloud:
     ext = _ext(path, READ_EXTENSIONS, "reading")
     reader = _READERS[ext]
     check_readable_file(path)
-    if scan is not None:
-        return read_e57(path, scan=scan, progress=progress)
-    if ext == ".ply" and is_gaussian_ply(path):
-        return read_gaussian_ply(path, progress=progress).proxy_splats()
-    return reader(path, progress=progress)
+    with _memory_named(path):
+        if scan is not None:
+            return read_e57(path, scan=scan, progress=progress)
+        if ext == ".ply" and is_gaussian_ply(path):
+            return read_gaussian_ply(path, progress=progress).proxy_splats()
+        return reader(path, progress=progress)
+
+
+@contextlib.contextmanager
+def _memory_named(path):
+    """A MemoryError while reading ``path`` (a header whose count fits a
+    sparse file of that size: the size checks pass, the memory does not)
+    becomes an InputError naming the file."""
+    try:
+        yield
+    except MemoryError:
+        raise InputError(f"not enough memory to read it ({os.stat(path).st_size:,} bytes on disk)",
+                         path=str(path)) from None
 
 
 def read_summary(path, *, progress=None, lean_above: int = 0) -> CloudSummary:
@@ -143,7 +157,8 @@ def read_gaussians(path, *, progress=None) -> GaussianCloud:
     if not is_gaussian_ply(path):
         raise InputError("is not a Gaussian splatting PLY (its vertex element has no f_dc_0, "
                          "scale_0 or rot_0 property)", path=str(path))
-    return read_gaussian_ply(path, progress=progress)
+    with _memory_named(path):
+        return read_gaussian_ply(path, progress=progress)
 
 
 def write_gaussians(path, scene: GaussianCloud, *, overwrite: bool = False, progress=None) -> Path:

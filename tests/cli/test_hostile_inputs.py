@@ -130,6 +130,21 @@ PATH_ERRORS = [
     ("deform script is a FIFO", ["deform", "BUNNY", "--edit", "TMP/fifo.json", "-o", "TMP/out.ply"],
      ["fifo.json", "not a regular file"]),
     ("convert output is a FIFO", ["convert", "BUNNY", "TMP/fifo.ply", "-f"], ["fifo.ply", "not a regular file"]),
+    # issue 21 class 3: what is written must be what the name says
+    ("render -o a .ply", ["render", "TMP/fifo.ply", "-o", "TMP/out.ply"],
+     ["out.ply", "unsupported file extension '.ply'", ".png"]),
+    ("render -o the input --force", ["render", "TMP/fifo.ply", "-o", "TMP/fifo.ply", "-f"],
+     ["fifo.ply", "unsupported file extension '.ply'"]),
+    ("render --buffers not .npz", ["render", "TMP/fifo.ply", "-o", "TMP/x.png", "--buffers", "TMP/b.png"],
+     ["b.png", "supported: .npz"]),
+    # issue 21 class 7: the editor makes the same checks before any window
+    ("edit a FIFO", ["edit", "TMP/fifo.ply"], ["fifo.ply", "not a regular file"]),
+    ("edit --save-as in a missing folder", ["edit", "BUNNY", "--save-as", "TMP/nonexistent/x.ply"],
+     ["'--save-as'", "nonexistent", "directory does not exist"]),
+    ("edit --save-as a .png", ["edit", "BUNNY", "--save-as", "TMP/x.png"],
+     ["'--save-as'", "unsupported file extension '.png'"]),
+    ("edit --save-as a FIFO", ["edit", "BUNNY", "--save-as", "TMP/fifo.ply"], ["'--save-as'", "not a regular file"]),
+    ("edit an unknown format", ["edit", "TMP/afile"], ["afile", "unsupported file extension"]),
 ]
 
 
@@ -281,3 +296,134 @@ def test_demo_into_a_read_only_folder_is_one_line(tmp_path, capsys, sub):
         assert str(ro) in line
     finally:
         ro.chmod(0o755)
+
+
+# ------------------------------------------------- issue 21: limits before the work
+def test_render_edit_beyond_the_gpu_columns_is_refused_before_reading(tmp_path, capsys):
+    """Five rotating handles need 20 basis columns (16 on the GPU): refused
+    naming the script and the edit's JSON path, before the model is read
+    (a FIFO without writer here: reading it would hang) or anything fitted."""
+    import json
+    import os
+    fifo = tmp_path / "in.ply"
+    os.mkfifo(fifo)
+    sphere = {"sphere": {"center": [0, 0, 0], "radius": 0.1}}
+    script = tmp_path / "five.json"
+    script.write_text(json.dumps({"version": 1, "edits": [
+        {"support": sphere, "handle": sphere, "transform": {"translate": [0, 0, 0.01]}},
+        {"support": sphere, "handles": [sphere] * 5,
+         "transforms": [{"rotate": {"axis": [0, 0, 1], "degrees": 5}}] * 5}]}))
+    assert main(["-q", "render", str(fifo), "-o", str(tmp_path / "x.png"), "--edit", str(script)]) == 2
+    line = one_error_line(capsys)
+    assert str(script) in line and "$.edits[1]" in line and "20 deformation columns" in line
+    assert "RENDER_MAX_BASIS_COLUMNS" not in line and "'B'" not in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["five.json", "in.ply"]
+
+
+def test_gaussian_scene_beyond_the_limits_gets_the_same_line_from_info_and_render(tmp_path, capsys):
+    """Class 8: one validation per format (info accepted a scene at 1e20 that
+    render refused, naming 'positions')."""
+    import plyfile
+    from splatedit.data import gaussian_scene_path
+    v = plyfile.PlyData.read(str(gaussian_scene_path()))["vertex"].data.copy()
+    v["y"] += 1e20
+    src = tmp_path / "far.ply"
+    plyfile.PlyData([plyfile.PlyElement.describe(v, "vertex")]).write(str(src))
+    lines = []
+    for argv in (["info", str(src)], ["render", str(src), "-o", str(tmp_path / "x.png")],
+                 ["convert", str(src), str(tmp_path / "o.ply")]):
+        assert main(["-q", *argv]) == 2
+        lines.append(one_error_line(capsys))
+    assert len(set(lines)) == 1, lines
+    assert "property 'y'" in lines[0] and "row 0" in lines[0] and "positions" not in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["far.ply"]
+
+
+# ------------------------------------------- issue 21 class 1: full disks, library errors
+@pytest.mark.parametrize("ext", ["laz", "e57"])
+def test_full_disk_while_writing_a_scanner_format_is_one_line(tmp_path, ext):
+    """A file-size limit (RLIMIT_FSIZE, as a full disk: the write fails)
+    while lazrs / laspy / libE57 write: one error line with the reason, exit
+    2, no temporary left (libE57's debug lines and pye57's exception at
+    collection used to follow, and a crash)."""
+    import os
+    import resource
+    import signal
+    import subprocess
+    import sys
+    from splatedit.data import default_model_path
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (30000, 30000))
+
+    out = tmp_path / f"out.{ext}"
+    res = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "convert", str(default_model_path()),
+                          str(out)], preexec_fn=limit, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"splatedit: error: {out}: cannot write"), res.stderr
+    assert "File too large" in lines[0] or "ErrorWriteFailed" in lines[0]
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_count_that_fits_a_sparse_file_but_not_the_memory_is_one_line(tmp_path):
+    """A PLY declaring 500 million vertices over a sparse file of that size
+    passes every size check; the read must end in one line, not a MemoryError
+    traceback (the process's address space is capped at 1.5 GiB here)."""
+    import resource
+    import subprocess
+    import sys
+    n = 500_000_000
+    head = (f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n").encode()
+    src = tmp_path / "sparse.ply"
+    with open(src, "wb") as fh:
+        fh.write(head)
+        fh.truncate(len(head) + 12 * n)
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 * 2**29, 3 * 2**29))
+
+    for cmd in (["info", str(src)], ["convert", str(src), str(tmp_path / "o.xyz")]):
+        res = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", *cmd], preexec_fn=limit,
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode == 2, res.stderr
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and "not enough memory" in lines[0] and str(src) in lines[0], res.stderr
+
+
+# ------------------------------------------------------ issue 21 class 7: signals
+@pytest.mark.parametrize("first,second", [("SIGTERM", "SIGTERM"), ("SIGINT", "SIGINT"), ("SIGHUP", "SIGTERM")])
+def test_a_second_signal_during_the_clean_up_is_ignored(tmp_path, monkeypatch, capsys, first, second):
+    """The first SIGTERM / Ctrl+C / SIGHUP (terminal closed) interrupts the
+    write: the temporary is removed, the old file kept, exit 130; a second
+    one arriving while that is handled (sent here from inside the clean-up)
+    printed a traceback from the handler."""
+    import os
+    import signal
+    import splatedit.cli as cli
+    import splatedit.io as io_mod
+    from splatedit.data import default_model_path
+    out = tmp_path / "out.ply"
+    out.write_bytes(b"old contents")
+
+    def write_then_signal(fh, cloud, **kw):
+        fh.write(b"ply\npartial")
+        os.kill(os.getpid(), getattr(signal, first))
+
+    real_close = cli._Progress.close
+
+    def close_with_second_signal(self):
+        os.kill(os.getpid(), getattr(signal, second))
+        real_close(self)
+
+    monkeypatch.setattr(io_mod, "write_ply", write_then_signal)
+    monkeypatch.setattr(cli._Progress, "close", close_with_second_signal)
+    previous = {s: signal.getsignal(getattr(signal, s)) for s in ("SIGINT", "SIGTERM", "SIGHUP")}
+    assert main(["-q", "convert", str(default_model_path()), str(out), "-f"]) == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "splatedit: interrupted" and "Traceback" not in err
+    assert out.read_bytes() == b"old contents"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
+    assert {s: signal.getsignal(getattr(signal, s)) for s in previous} == previous
