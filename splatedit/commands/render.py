@@ -32,10 +32,28 @@ def _camera_from_args(args, cloud):
             camera = Camera(eye, target, up=up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
         raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+    _clip_to_main_body(camera, view.extent)
     if args.target is None and view.extent.note():
         args.progress.close()
         print(f"splatedit: note: {view.extent.note()}; the view frames the main body", file=sys.stderr)
     return camera
+
+
+def _clip_to_main_body(camera, extent) -> None:
+    """Near/far for a model with far outliers: chosen from the whole box, the
+    near plane (at least ``RENDER_NEAR_FAR_RATIO`` of the far one, for depth
+    precision) lay beyond the main body when one point sat 1e9 away, and the
+    image came out blank with exit 0.  Then the main body's depth range is
+    used, the far plane pushed out as far as that ratio allows: outliers
+    beyond it are clipped, the body is drawn."""
+    from splatedit.tolerances import RENDER_NEAR_FAR_RATIO
+    if not extent.robust:
+        return
+    body_near, body_far = camera.clip_range(extent.lo, extent.hi)
+    full_near, full_far = camera.clip_range(extent.full_lo, extent.full_hi)
+    if full_near > body_near:
+        camera.near = body_near
+        camera.far = max(body_far, min(full_far, body_near / RENDER_NEAR_FAR_RATIO))
 
 
 def cmd_render(args) -> int:

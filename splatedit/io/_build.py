@@ -203,6 +203,22 @@ def check_extent(lo, hi, path) -> None:
                          f"{MIN_EXTENT_ABS:g} (rescale the model)", path=str(path))
 
 
+def body_bounds(positions, bounds):
+    """The box the local origin is chosen for: ``bounds`` (the full box of
+    ``positions``, (lo, hi)) when it lies within ``REBASE_MIN_ABS`` of 0,
+    else the main body's box (:func:`splatedit.model.extent.framing_extent`).
+    One glitch point 1e9 away moved the origin of a scan near 0 to 5e8: the
+    main body's splats then sat at 5e8 in local coordinates, too coarse for
+    float32 and refused as degenerate; a UTM scan with a glitch at (0, 0, 0)
+    is rebased onto the scan, not between the two."""
+    lo, hi = bounds
+    if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
+        return bounds
+    from splatedit.model.extent import framing_extent
+    ext = framing_extent(positions)
+    return (ext.lo, ext.hi) if ext.robust else bounds
+
+
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
                 faces=None, progress=None, origin=None, already_local=False, intensity=None,
                 classification=None, quantization=None, point_fields=None,
@@ -229,7 +245,7 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     bounds = column_bounds(positions)
     check_extent(*bounds, path)
     if origin is None:
-        origin = local_origin(positions, bounds=bounds, stored=stored_origin)
+        origin = local_origin(positions, bounds=body_bounds(positions, bounds), stored=stored_origin)
     if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,

@@ -155,8 +155,13 @@ pcd_field = st.tuples(st.sampled_from(_PCD_NAMES), st.sampled_from(["1", "2", "4
                       st.one_of(st.sampled_from(["1", "3", "0", "-1"]), st.integers(0, 10**12).map(str)))
 
 
+xyz_field = st.tuples(st.sampled_from(["x", "y", "z"]), st.sampled_from(["4", "8", "2"]),
+                     st.sampled_from(["F", "I"]), st.sampled_from(["1", "1", "1", "3", "0"]))
+
+
 @FUZZ
-@given(fields=st.lists(pcd_field, min_size=0, max_size=6),
+@given(fields=st.tuples(st.lists(xyz_field, min_size=2, max_size=4), st.lists(pcd_field, max_size=4))
+       .map(lambda parts: parts[0] + parts[1]),
        points=st.one_of(st.integers(-5, 50), st.integers(0, 10**18)).map(str),
        data=st.sampled_from(["ascii", "binary", "binary_compressed", "other", ""]),
        drop=st.sets(st.sampled_from(["FIELDS", "SIZE", "TYPE", "COUNT", "POINTS"]), max_size=2),
