@@ -31,7 +31,13 @@ def _camera_from_args(args, cloud):
             up = args.up if args.up is not None else screen_up(view.camera.up, eye, target)
             camera = Camera(eye, target, up=up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
-        raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+        reason = str(exc).split(": ", 1)[1]
+        if getattr(args, exc.name, None) is not None:        # the user's own flag
+            raise ParameterError(f"--{exc.name}", reason) from None
+        # a default the command chose (no such flag given): name the model, not a flag
+        from splatedit.errors import InputError
+        raise InputError(f"cannot frame a default view (its {exc.name} would be {reason}); "
+                         f"give --eye and --target", path=str(args.input)) from None
     _clip_to_main_body(camera, view.extent)
     if args.target is None and view.extent.note():
         args.progress.close()

@@ -140,7 +140,9 @@ def origin_grid(lo, hi) -> float:
 def local_origin(positions, bounds=None, stored=None) -> np.ndarray:
     """(3,) float64 origin for the positions (``bounds``: their (min, max), if known).
 
-    Zeros when the bounding box lies within ``REBASE_MIN_ABS`` of 0.  Else
+    The box is the main body's when a few points lie far outside it
+    (:func:`body_bounds`; with ``positions`` given).
+    Zeros when the box lies within ``REBASE_MIN_ABS`` of 0.  Else
     ``stored`` (the origin a file we wrote carries) when it suits the box
     (:func:`fits_origin`), so a model read, edited, written and read again
     keeps its origin; else the box centre rounded to a multiple of
@@ -155,6 +157,10 @@ def local_origin(positions, bounds=None, stored=None) -> np.ndarray:
     lo, hi = column_bounds(positions) if bounds is None else bounds
     if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
         return np.zeros(3)
+    if positions is not None:
+        lo, hi = body_bounds(positions, (lo, hi))
+        if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
+            return np.zeros(3)
     if stored is not None and fits_origin(stored, lo, hi):
         return np.array(stored, dtype=np.float64)
     step = origin_grid(lo, hi)
@@ -245,7 +251,7 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     bounds = column_bounds(positions)
     check_extent(*bounds, path)
     if origin is None:
-        origin = local_origin(positions, bounds=body_bounds(positions, bounds), stored=stored_origin)
+        origin = local_origin(positions, bounds=bounds, stored=stored_origin)
     if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,

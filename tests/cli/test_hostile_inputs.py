@@ -427,3 +427,49 @@ def test_a_second_signal_during_the_clean_up_is_ignored(tmp_path, monkeypatch, c
     assert out.read_bytes() == b"old contents"
     assert sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
     assert {s: signal.getsignal(getattr(signal, s)) for s in previous} == previous
+
+
+# ------------------------------------------- issue 21 class 5: valid input, far values
+def _sphere(n=1500, radius=1.0, seed=0):
+    import numpy as np
+    p = np.random.default_rng(seed).normal(size=(n, 3))
+    return radius * p / np.linalg.norm(p, axis=1)[:, None]
+
+
+@pytest.mark.parametrize("argv", [["info", "FILE", "--json"], ["convert", "FILE", "OUT"],
+                                  ["convert", "FILE", "OUT", "--remove-outliers"]],
+                         ids=["info", "convert", "convert --remove-outliers"])
+def test_a_scan_with_one_glitch_point_1e9_away_is_accepted(tmp_path, capsys, argv):
+    """The point is valid (below 1e15); the main body's splats were refused as
+    'row 0: property 'u': degenerate splat axis' (the file has no u)."""
+    import json
+    import numpy as np
+    src = tmp_path / "glitch.xyz"
+    np.savetxt(src, np.vstack([_sphere(), [[1e9, 0, 0]]]))
+    out = tmp_path / "out.ply"
+    argv = [str(src) if a == "FILE" else str(out) if a == "OUT" else a for a in argv]
+    assert main(["-q", *argv]) == 0, capsys.readouterr().err
+    printed = capsys.readouterr().out
+    if argv[0] == "info":
+        info = json.loads(printed)
+        assert info["far_from_main_body"] == 1 and info["origin"] == [0.0, 0.0, 0.0]
+        assert 2.5 < info["main_body_diagonal"] < 3.5 and info["splat_radius_median"] < 0.3
+    else:
+        from splatedit.io import read
+        back = read(out)
+        assert back.n == (1500 if "--remove-outliers" in argv else 1501)
+        assert float(np.median(np.linalg.norm(back.u, axis=1))) < 0.3
+
+
+def test_a_sphere_at_the_magnitude_limit_renders_with_the_default_view(tmp_path, capsys):
+    """info accepts a sphere of radius 0.99e15; render refused it naming
+    '--eye', a flag nobody gave (the default eye stands 3e15 away)."""
+    import numpy as np
+    from PIL import Image
+    src = tmp_path / "big.xyz"
+    np.savetxt(src, _sphere(800, 0.99e15))
+    out = tmp_path / "big.png"
+    assert main(["-q", "render", str(src), "-o", str(out), "--size", "64x48"]) == 0, capsys.readouterr().err
+    img = np.asarray(Image.open(out))
+    covered = np.any(img != img[0, 0], axis=2).mean()
+    assert 0.1 < covered < 0.9
