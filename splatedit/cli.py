@@ -107,23 +107,18 @@ def cmd_edit(args) -> int:
 def check_edit_paths(model, save_as) -> None:
     """The checks ``splatedit edit`` makes before any window, the same the
     other commands make: the model must be a readable regular file of a known
-    format (a FIFO is refused by stat, never opened: opening it blocks until
-    a writer comes), and ``--save-as`` a writable target of a format the
-    editor writes (its folder exists; it may replace an older save).
+    format (:func:`splatedit.app.files.check_model_file`: a FIFO is refused
+    by stat, never opened, as opening it blocks until a writer comes), and
+    ``--save-as`` a writable target of a format the editor writes (its
+    folder exists; it may replace an older save).
 
     Raises:
         InputError / ParameterError: one line, exit 2.
     """
-    from splatedit.io import READ_EXTENSIONS, WRITE_EXTENSIONS, check_output_path, check_readable_file
-    from splatedit.io import split_scan_index
+    from splatedit.io import WRITE_EXTENSIONS, check_output_path
     if model is not None:
-        src = split_scan_index(model)[0]
-        check_readable_file(src)
-        ext = Path(src).suffix.lower()
-        if ext not in READ_EXTENSIONS:
-            from splatedit.errors import InputError
-            raise InputError(f"unsupported file extension {ext or '(none)'!r} for reading; "
-                             f"supported: {', '.join(READ_EXTENSIONS)}", path=str(model))
+        from splatedit.app.files import check_model_file
+        check_model_file(model)
     if save_as:
         try:
             check_output_path(save_as, overwrite=True, extensions=WRITE_EXTENSIONS)
