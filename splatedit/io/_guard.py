@@ -103,8 +103,9 @@ def library_call(path, what: str, stream: RecordingStream | None = None):
             its OSError's reason is added to the message.
     Raises:
         InputError: ``{path}: {what}: {the library's message}
-        [(library output: ...)]`` for any exception but our own errors and
-        KeyboardInterrupt / SystemExit, which pass unchanged.
+        [(library output: ...)]`` for any exception (a Rust library's panic
+        too, a BaseException) but our own errors and KeyboardInterrupt /
+        SystemExit, which pass unchanged.
     """
     with _captured_fd2() as out:
         try:
@@ -113,7 +114,7 @@ def library_call(path, what: str, stream: RecordingStream | None = None):
             raise
         except MemoryError:
             failure = "not enough memory"
-        except Exception as exc:   # noqa: BLE001 - libraries raise their own types
+        except BaseException as exc:   # noqa: BLE001 - pyo3's PanicException is a BaseException
             text = str(exc).strip()
             failure = text.splitlines()[0].strip() if text else type(exc).__name__
             cause = _os_error_in(exc) or (stream.error if stream is not None else None)

@@ -161,6 +161,8 @@ def check_las_header(path) -> int:
         if count > max(body, 1) * LAZ_MAX_POINTS_PER_BYTE:
             raise InputError(f"header: {count} points cannot be compressed into {body} bytes "
                              f"(the count is wrong or the file is truncated)", path=src)
+        _check_laszip_vlr(path, header_size, n_vlr, data_offset, count, src)
+        _check_chunk_table(path, data_offset, size, src)
         return count
     records = body // rec_len
     if count > records:
@@ -170,6 +172,66 @@ def check_las_header(path) -> int:
         warnings.warn(InputWarning(f"{src}: {records - count} point record(s) after the {count} the "
                                    f"header declares were ignored"), stacklevel=3)
     return count
+
+
+#: the chunk size of a LAZ file whose chunks vary in size
+_VARIABLE_CHUNKS = 0xFFFFFFFF
+
+
+def _check_laszip_vlr(path, header_size: int, n_vlr: int, data_offset: int, count: int, src: str) -> None:
+    """The 'laszip encoded' record of a LAZ file: its points per chunk, for
+    which lazrs allocates a buffer, may not exceed the file's points (or
+    laszip's default 50,000): a damaged chunk size of 5.3e8 aborted the
+    process (a failed allocation)."""
+    pos = header_size
+    try:
+        with open(path, "rb") as fh:
+            for _ in range(n_vlr):
+                fh.seek(pos)
+                head = fh.read(54)
+                if len(head) < 54:
+                    break
+                _, user, rec_id, length = struct.unpack_from("<H16sHH", head)
+                if user.rstrip(b"\0") == b"laszip encoded" and rec_id == 22204 and length >= 20:
+                    (chunk,) = struct.unpack("<I", fh.read(20)[12:16])
+                    if chunk != _VARIABLE_CHUNKS and chunk > max(count, 50_000):
+                        raise InputError(f"LAZ record: {chunk} points per chunk for {count} points: "
+                                         f"the file is damaged", path=src)
+                    return
+                pos += 54 + length
+                if pos > data_offset:
+                    break
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    raise InputError("a LAZ file without its 'laszip encoded' record (damaged, or not LAZ)", path=src)
+
+
+def _check_chunk_table(path, data_offset: int, size: int, src: str) -> None:
+    """A LAZ file's point data start with the offset of its chunk table (or
+    -1 for none); the table starts with a version and the number of chunks,
+    for which lazrs allocates 16 bytes each: a damaged count (1.4e9 chunks
+    in an 891-byte file) aborted the process (a failed 21 GB allocation).
+    Every chunk takes at least one byte of the data before the table."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(data_offset)
+            raw = fh.read(8)
+            if len(raw) < 8:
+                raise InputError("truncated LAZ data: no chunk table offset", path=src)
+            (table,) = struct.unpack("<q", raw)
+            if table == -1:
+                return
+            if not data_offset + 8 <= table <= size - 8:
+                raise InputError(f"LAZ chunk table offset {table} lies outside the point data "
+                                 f"({data_offset + 8}..{size - 8}): the file is truncated or damaged",
+                                 path=src)
+            fh.seek(table)
+            _, chunks = struct.unpack("<II", fh.read(8))
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    if chunks > table - data_offset - 8 + 1:
+        raise InputError(f"LAZ chunk table declares {chunks} chunks in {table - data_offset - 8} bytes "
+                         f"of point data: the file is truncated or damaged", path=src)
 
 
 def read_las(path, *, progress=None) -> SplatCloud:

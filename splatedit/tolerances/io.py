@@ -122,10 +122,10 @@ REBASE_STORED_REACH = 2.0
 #: a LAZ file may declare at most this many points per byte of compressed
 #: point data (more is refused before the library allocates for them).
 #: Measured with laspy/lazrs 0.8: 200,000 identical points (the best case of
-#: the arithmetic coder) take 0.0135 bytes each, 74 points per byte; 16x that
-#: margin.  'LASF' and random bytes made laspy allocate without end (2.7 GB
-#: at 120 s) before this bound
-LAZ_MAX_POINTS_PER_BYTE = 1200
+#: the arithmetic coder) take 0.0135 bytes each, 74 points per byte; about 5x
+#: that margin.  'LASF' and random bytes made laspy allocate without end
+#: (2.7 GB at 120 s) before this bound
+LAZ_MAX_POINTS_PER_BYTE = 400
 #: smallest |scale| of a LAS file accepted: a scale of 0 collapsed every
 #: point onto the offset; below 1e-12 model units (a picometre in metres)
 #: 32-bit integers span less than 4.3 mm, no scanner's grid

@@ -247,6 +247,22 @@ def _las(tmp_path, name, *, edits=(), append=b"", cut=None, n=40):
     return path
 
 
+def _laz_chunks(tmp_path, chunks, table=None):
+    """A LAZ file whose chunk table (its offset: the first 8 bytes of the
+    point data) declares ``chunks`` chunks, or whose offset is ``table``."""
+    import struct
+    path = _las(tmp_path, "c.laz")
+    data = bytearray(path.read_bytes())
+    start = struct.unpack_from("<I", data, 96)[0]
+    if table is not None:
+        struct.pack_into("<q", data, start, table)
+    else:
+        at = struct.unpack_from("<q", data, start)[0]
+        struct.pack_into("<I", data, at + 4, chunks)
+    path.write_bytes(bytes(data))
+    return path
+
+
 def _put(tmp_path, name, data):
     """Write ``data`` (bytes or str) to ``tmp_path / name``; returns the path."""
     path = tmp_path / name
@@ -296,6 +312,10 @@ SCANNER_CASES = [
     ("las 4e9 points", lambda t: _las(t, "b.las", edits=[(107, "I", 2**32 - 1)]), ["early end-of-file"]),
     ("laz 4e9 points", lambda t: _las(t, "b.laz", edits=[(107, "I", 2**32 - 1)]),
      ["cannot be compressed into"]),
+    ("laz chunk table count damaged", lambda t: _laz_chunks(t, 10**9), ["chunk table declares 1000000000"]),
+    ("laz chunk table offset damaged", lambda t: _laz_chunks(t, None, table=10**9), ["chunk table offset"]),
+    ("laz chunk size damaged", lambda t: _las(t, "k.laz", edits=[(227 + 54 + 12, "I", 534070706)]),
+     ["534070706 points per chunk"]),
     ("las 1e9 variable-length records", lambda t: _las(t, "v.las", edits=[(100, "I", 10**9)]),
      ["variable-length records do not fit"]),
     ("las point data offset past the end", lambda t: _las(t, "p.las", edits=[(96, "I", 10**8)]),

@@ -130,6 +130,23 @@ def test_las_with_lying_header_fields_is_read_or_refused_in_bounds(workdir, ext,
     read_bounded(path)
 
 
+@pytest.mark.parametrize("ext", [".las", ".laz"])
+@FUZZ
+@given(patches=st.lists(st.tuples(st.integers(227, 2000), st.binary(min_size=1, max_size=8)),
+                        min_size=1, max_size=4), cut=st.one_of(st.none(), st.integers(227, 2000)))
+def test_las_with_damaged_records_or_chunks_is_read_or_refused_in_bounds(workdir, ext, patches, cut):
+    """Damaged VLRs, point records, LAZ chunks and chunk tables: a damaged
+    chunk count made lazrs abort the process (a failed 21 GB allocation), a
+    damaged chunk a Rust panic (a BaseException)."""
+    data = bytearray(_las_cache(ext == ".laz"))
+    for pos, raw in patches:
+        pos %= len(data)
+        data[pos:pos + len(raw)] = raw
+    path = workdir / f"damaged{ext}"
+    path.write_bytes(bytes(data[:cut] if cut is not None else data))
+    read_bounded(path)
+
+
 @FUZZ
 @given(body=st.binary(min_size=0, max_size=600))
 def test_lasf_followed_by_random_bytes_is_refused_in_bounds(workdir, body):
