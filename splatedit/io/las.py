@@ -154,7 +154,8 @@ def check_las_header(path) -> int:
     if minor >= 4 and len(head) >= 255:
         first_evlr, n_evlr, count14 = struct.unpack_from("<Q I Q", head, 235)
         count = count14 or legacy_count
-        if n_evlr and data_offset <= first_evlr <= size:
+        if n_evlr:
+            _check_evlrs(path, first_evlr, n_evlr, data_offset, size, src)
             end = first_evlr
     body = end - data_offset
     if compressed:
@@ -172,6 +173,28 @@ def check_las_header(path) -> int:
         warnings.warn(InputWarning(f"{src}: {records - count} point record(s) after the {count} the "
                                    f"header declares were ignored"), stacklevel=3)
     return count
+
+
+def _check_evlrs(path, first: int, count: int, data_offset: int, size: int, src: str) -> None:
+    """LAS 1.4 extended variable-length records: they must start after the
+    point data offset and each (60-byte header plus its 64-bit length) end
+    within the file; laspy reads each length in one piece."""
+    if not data_offset <= first <= size or count * 60 > size - first:
+        raise InputError(f"header: {count} extended variable-length records from byte {first} do not "
+                         f"fit a file of {size} bytes", path=src)
+    pos = first
+    try:
+        with open(path, "rb") as fh:
+            for i in range(count):
+                fh.seek(pos + 20)
+                (length,) = struct.unpack("<Q", fh.read(8))
+                pos += 60 + length
+                if pos > size:
+                    raise InputError(f"extended variable-length record {i}: {length} bytes do not fit "
+                                     f"a file of {size} bytes", path=src)
+    except (OSError, struct.error):
+        raise InputError("cannot read the extended variable-length records (truncated?)",
+                         path=src) from None
 
 
 #: the chunk size of a LAZ file whose chunks vary in size

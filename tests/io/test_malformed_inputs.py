@@ -263,6 +263,25 @@ def _laz_chunks(tmp_path, chunks, table=None):
     return path
 
 
+def _las14_evlr(tmp_path, length):
+    """A LAS 1.4 file with one extended variable-length record declaring ``length`` bytes."""
+    import struct
+    import laspy
+    h = laspy.LasHeader(point_format=6, version="1.4")
+    h.scales, h.offsets = [0.01] * 3, [0.0] * 3
+    las = laspy.LasData(h)
+    for d in "XYZ":
+        las[d] = np.arange(40) * (3 if d == "X" else 1)
+    path = tmp_path / "e.las"
+    las.write(str(path))
+    data = bytearray(path.read_bytes())
+    size = len(data)
+    data += struct.pack("<H16sHQ32s", 0, b"user", 1, length, b"hostile")
+    struct.pack_into("<QI", data, 235, size, 1)
+    path.write_bytes(bytes(data))
+    return path
+
+
 def _put(tmp_path, name, data):
     """Write ``data`` (bytes or str) to ``tmp_path / name``; returns the path."""
     path = tmp_path / name
@@ -316,6 +335,8 @@ SCANNER_CASES = [
     ("laz chunk table offset damaged", lambda t: _laz_chunks(t, None, table=10**9), ["chunk table offset"]),
     ("laz chunk size damaged", lambda t: _las(t, "k.laz", edits=[(227 + 54 + 12, "I", 534070706)]),
      ["534070706 points per chunk"]),
+    ("las 1.4 extended record of 2**40 bytes", lambda t: _las14_evlr(t, 2**40),
+     ["extended variable-length record 0", "1099511627776 bytes"]),
     ("las 1e9 variable-length records", lambda t: _las(t, "v.las", edits=[(100, "I", 10**9)]),
      ["variable-length records do not fit"]),
     ("las point data offset past the end", lambda t: _las(t, "p.las", edits=[(96, "I", 10**8)]),

@@ -85,10 +85,10 @@ def read_bounded(path: Path) -> None:
 
 
 # ------------------------------------------------------------------- LAS / LAZ
-def _las_bytes(compress: bool) -> bytes:
+def _las_bytes(compress: bool, version: str = "1.2") -> bytes:
     import io
     import laspy
-    h = laspy.LasHeader(point_format=3, version="1.2")
+    h = laspy.LasHeader(point_format=3 if version == "1.2" else 6, version=version)
     h.scales, h.offsets = [0.01] * 3, [0.0] * 3
     las = laspy.LasData(h)
     rng = np.random.default_rng(0)
@@ -101,7 +101,9 @@ def _las_bytes(compress: bool) -> bytes:
 
 #: (offset, struct format) of the LAS header fields a hostile file lies in
 _LAS_FIELDS = [(24, "B"), (25, "B"), (94, "H"), (96, "I"), (100, "I"), (104, "B"), (105, "H"),
-               (107, "I"), (131, "d"), (139, "d"), (147, "d"), (155, "d"), (163, "d"), (171, "d")]
+               (107, "I"), (131, "d"), (139, "d"), (147, "d"), (155, "d"), (163, "d"), (171, "d"),
+               # LAS 1.4: first extended record, their number, the 64-bit point count
+               (235, "Q"), (243, "I"), (247, "Q")]
 
 
 def _field_value(fmt):
@@ -116,11 +118,11 @@ las_edits = st.lists(st.sampled_from(range(len(_LAS_FIELDS))).flatmap(
     lambda i: st.tuples(st.just(i), _field_value(_LAS_FIELDS[i][1]))), min_size=1, max_size=4)
 
 
-@pytest.mark.parametrize("ext", [".las", ".laz"])
+@pytest.mark.parametrize("ext,version", [(".las", "1.2"), (".laz", "1.2"), (".las", "1.4")])
 @FUZZ
 @given(edits=las_edits, cut=st.one_of(st.none(), st.integers(0, 2000)), tail=st.binary(max_size=64))
-def test_las_with_lying_header_fields_is_read_or_refused_in_bounds(workdir, ext, edits, cut, tail):
-    data = bytearray(_las_cache(ext == ".laz"))
+def test_las_with_lying_header_fields_is_read_or_refused_in_bounds(workdir, ext, version, edits, cut, tail):
+    data = bytearray(_las_cache(ext == ".laz", version))
     for i, value in edits:
         off, fmt = _LAS_FIELDS[i]
         struct.pack_into("<" + fmt, data, off, value)
@@ -159,10 +161,10 @@ def test_lasf_followed_by_random_bytes_is_refused_in_bounds(workdir, body):
 _LAS_CACHE: dict = {}
 
 
-def _las_cache(compress: bool) -> bytes:
-    if compress not in _LAS_CACHE:
-        _LAS_CACHE[compress] = _las_bytes(compress)
-    return _LAS_CACHE[compress]
+def _las_cache(compress: bool, version: str = "1.2") -> bytes:
+    if (compress, version) not in _LAS_CACHE:
+        _LAS_CACHE[compress, version] = _las_bytes(compress, version)
+    return _LAS_CACHE[compress, version]
 
 
 # ------------------------------------------------------------------------- PCD
