@@ -311,11 +311,18 @@ _RECEIVED: list[int] = []
 def _ignore_signals() -> None:
     """Ignore further interrupts (main thread only): the first one is being
     handled (temporary files removed, one line printed); a second one 10 ms
-    later must not raise inside that clean-up."""
+    later must not raise inside that clean-up.  A Python handler that does
+    nothing, not SIG_IGN: a signal already pending when the handler changes
+    to SIG_IGN makes Python print "OSError: Signal 2 ignored due to race
+    condition" with a traceback."""
     if threading.current_thread() is threading.main_thread():
         for sig in _INTERRUPTS:
             with contextlib.suppress(OSError, ValueError):
-                signal.signal(sig, signal.SIG_IGN)
+                signal.signal(sig, _note_signal)
+
+
+def _note_signal(signum, frame):
+    _RECEIVED.append(signum)
 
 
 def _raise_interrupt(signum, frame):
@@ -332,8 +339,9 @@ def _signals_as_interrupt(final: bool = False):
     ``EXIT_INTERRUPTED``), then further ones are ignored.  Returns a
     function that puts the previous handlers back (a no-op outside the main
     thread, where signal handlers cannot be set); with ``final`` (the real
-    command line, the process ends right after) handlers stay ignoring once
-    a signal came, so one arriving during the interpreter's exit is harmless."""
+    command line, the process ends right after) further interrupts are
+    ignored once one came, so one arriving during the interpreter's exit is
+    harmless."""
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
     _RECEIVED.clear()
@@ -343,6 +351,15 @@ def _signals_as_interrupt(final: bool = False):
 
     def restore():
         if final and _RECEIVED:
+            # the process ends now: ignore further interrupts, since Python's
+            # finalisation puts SIG_DFL back for every Python handler and one
+            # arriving then would kill the process (-2 / -15 instead of 130).
+            # Outside a handler, a signal pending while its handler becomes
+            # SIG_IGN raises its "ignored due to race condition" OSError from
+            # this very call (signal.signal checks pending signals)
+            for sig in _INTERRUPTS:
+                with contextlib.suppress(OSError, ValueError):
+                    signal.signal(sig, signal.SIG_IGN)
             return
         for sig, handler in previous.items():
             signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
