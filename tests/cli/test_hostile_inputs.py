@@ -473,3 +473,36 @@ def test_a_sphere_at_the_magnitude_limit_renders_with_the_default_view(tmp_path,
     img = np.asarray(Image.open(out))
     covered = np.any(img != img[0, 0], axis=2).mean()
     assert 0.1 < covered < 0.9
+
+
+def test_signals_during_the_clean_up_of_a_real_process_leave_one_line_and_exit_130(tmp_path):
+    """The command line's own process (handlers left ignoring at its end,
+    while Python's finalisation runs): SIGTERM mid-write, then SIGINT and
+    SIGHUP during the clean-up and one more after main() returned."""
+    import subprocess
+    import sys
+    from splatedit.data import default_model_path
+    out = tmp_path / "out.ply"
+    out.write_bytes(b"old contents")
+    code = f"""
+import os, signal, sys
+import splatedit.cli as cli
+import splatedit.io as io_mod
+def write(fh, cloud, **kw):
+    fh.write(b"ply partial")
+    os.kill(os.getpid(), signal.SIGTERM)
+real_close = cli._Progress.close
+def close(self):
+    os.kill(os.getpid(), signal.SIGINT)
+    os.kill(os.getpid(), signal.SIGHUP)
+    real_close(self)
+io_mod.write_ply = write
+cli._Progress.close = close
+sys.argv = ["splatedit", "-q", "convert", {str(default_model_path())!r}, {str(out)!r}, "-f"]
+code = cli.main()
+os.kill(os.getpid(), signal.SIGINT)
+sys.exit(code)
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 130 and res.stderr == "splatedit: interrupted\n", (res.returncode, res.stderr)
+    assert out.read_bytes() == b"old contents" and sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
