@@ -354,9 +354,8 @@ def _signals_as_interrupt(final: bool = False):
             # the process ends now: ignore further interrupts, since Python's
             # finalisation puts SIG_DFL back for every Python handler and one
             # arriving then would kill the process (-2 / -15 instead of 130).
-            # Outside a handler, a signal pending while its handler becomes
-            # SIG_IGN raises its "ignored due to race condition" OSError from
-            # this very call (signal.signal checks pending signals)
+            # signal.signal runs pending Python handlers (_note_signal) before
+            # it changes one; after the change the OS drops new ones
             for sig in _INTERRUPTS:
                 with contextlib.suppress(OSError, ValueError):
                     signal.signal(sig, signal.SIG_IGN)

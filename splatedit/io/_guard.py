@@ -9,6 +9,10 @@ standard error (libE57Format prints debug lines; a C library bypasses
 on success it is dropped.  Used by every reader and writer that calls such a
 library; the readers validate what they can (counts against the file size,
 finite scales) *before* the call, this is the net behind those checks.
+
+The capture redirects the process's file descriptor 2 for the call: what
+another thread prints on stderr meanwhile (the editor reads files in the
+background) lands in the capture too and is dropped on success.
 """
 
 from __future__ import annotations
