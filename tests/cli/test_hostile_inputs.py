@@ -506,3 +506,19 @@ sys.exit(code)
     res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert res.returncode == 130 and res.stderr == "splatedit: interrupted\n", (res.returncode, res.stderr)
     assert out.read_bytes() == b"old contents" and sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
+
+
+@pytest.mark.parametrize("case", ["las scale nan", "las scale 0", "las count above the records", "laz 4e9 points",
+                                  "pcd COUNT 3 for x", "pcd duplicate FIELDS", "gaussian huge log-scale"])
+@pytest.mark.parametrize("command", ["info", "convert", "render"])
+def test_hostile_scanner_files_are_one_line_for_every_command(tmp_path, capsys, case, command):
+    """Issue 21 classes 1, 3, 4, 8: the readers' checks are the same for every
+    command (rows of tests/io/test_malformed_inputs.py)."""
+    from tests.io.test_malformed_inputs import SCANNER_CASES
+    build, expected = next((c[1], c[2]) for c in SCANNER_CASES if c[0] == case)
+    src = build(tmp_path)
+    out = {"info": [], "convert": [str(tmp_path / "o.ply")], "render": ["-o", str(tmp_path / "o.png")]}[command]
+    assert main(["-q", command, str(src), *out]) == 2
+    line = one_error_line(capsys)
+    assert str(src) in line and all(sub in line for sub in expected), line
+    assert not (tmp_path / "o.ply").exists() and not (tmp_path / "o.png").exists()
