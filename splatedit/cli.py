@@ -33,6 +33,8 @@ from splatedit.errors import InputWarning, ParameterError, SplatEditError
 BENCH_NAMES = tuple(BENCHES)
 
 EXIT_BAD_INPUT = 2
+#: 128 + SIGINT, for Ctrl+C, SIGTERM and SIGHUP alike
+EXIT_INTERRUPTED = 130
 #: options taking x,y,z: a value with a leading minus works (``--eye -0.4,1,2``)
 VECTOR_OPTIONS = ("--eye", "--target", "--up")
 #: 128 + SIGPIPE, what a shell reports for a program killed by a closed pipe
@@ -96,9 +98,32 @@ def cmd_demo(args) -> int:
 
 
 def cmd_edit(args) -> int:
+    check_edit_paths(args.file, args.save_as)       # before the editor opens a window
     from splatedit.app.editor import run_editor
     from splatedit.app.options import options_from_args
     return run_editor(args.file, **options_from_args(args))
+
+
+def check_edit_paths(model, save_as) -> None:
+    """The checks ``splatedit edit`` makes before any window, the same the
+    other commands make: the model must be a readable regular file of a known
+    format (:func:`splatedit.app.files.check_model_file`: a FIFO is refused
+    by stat, never opened, as opening it blocks until a writer comes), and
+    ``--save-as`` a writable target of a format the editor writes (its
+    folder exists; it may replace an older save).
+
+    Raises:
+        InputError / ParameterError: one line, exit 2.
+    """
+    from splatedit.io import WRITE_EXTENSIONS, check_output_path
+    if model is not None:
+        from splatedit.app.files import check_model_file
+        check_model_file(model)
+    if save_as:
+        try:
+            check_output_path(save_as, overwrite=True, extensions=WRITE_EXTENSIONS)
+        except SplatEditError as exc:
+            raise ParameterError("--save-as", str(exc)) from None
 
 
 def cmd_main(args) -> int:
@@ -269,7 +294,7 @@ def main(argv: list[str] | None = None) -> int:
     args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv), VECTOR_OPTIONS))
     args.progress = _Progress(enabled=not args.quiet)
     func = getattr(args, "func", cmd_main)
-    restore = _sigterm_as_interrupt()
+    restore = _signals_as_interrupt(final=argv is None)
     try:
         with warnings.catch_warnings():
             _route_warnings(args.progress)
@@ -281,9 +306,17 @@ def main(argv: list[str] | None = None) -> int:
         print(f"splatedit: error: {exc}", file=sys.stderr)
         return EXIT_BAD_INPUT
     except KeyboardInterrupt:
+        _ignore_signals()       # a second Ctrl+C / SIGTERM during the clean-up: no traceback
         args.progress.close()
         print("splatedit: interrupted", file=sys.stderr)
-        return 130
+        return EXIT_INTERRUPTED
+    except MemoryError:
+        # a reader or library asked for more than there is (the readers bound
+        # what headers declare by the file size; this is the net behind them)
+        args.progress.close()
+        print("splatedit: error: not enough memory for this input "
+              "(a smaller model or image, or more memory)", file=sys.stderr)
+        return EXIT_BAD_INPUT
     except BrokenPipeError:
         # the reader of stdout went away (``splatedit info x.ply | head -1``):
         # stop quietly, and keep Python's exit flush from failing again
@@ -296,19 +329,68 @@ def main(argv: list[str] | None = None) -> int:
         restore()
 
 
+#: the signals handled like Ctrl+C: the terminal closed (SIGHUP), ``kill``
+#: (SIGTERM) and Ctrl+C itself
+_INTERRUPTS = tuple(getattr(signal, n) for n in ("SIGINT", "SIGTERM", "SIGHUP") if hasattr(signal, n))
+#: the signal numbers received during this run
+_RECEIVED: list[int] = []
+
+
+def _ignore_signals() -> None:
+    """Ignore further interrupts (main thread only): the first one is being
+    handled (temporary files removed, one line printed); a second one 10 ms
+    later must not raise inside that clean-up.  A Python handler that does
+    nothing, not SIG_IGN: a signal already pending when the handler changes
+    to SIG_IGN makes Python print "OSError: Signal 2 ignored due to race
+    condition" with a traceback."""
+    if threading.current_thread() is threading.main_thread():
+        for sig in _INTERRUPTS:
+            with contextlib.suppress(OSError, ValueError):
+                signal.signal(sig, _note_signal)
+
+
+def _note_signal(signum, frame):
+    _RECEIVED.append(signum)
+
+
 def _raise_interrupt(signum, frame):
+    _RECEIVED.append(signum)
+    if len(_RECEIVED) > 1:      # a second signal before the first's KeyboardInterrupt was handled
+        return
+    _ignore_signals()
     raise KeyboardInterrupt
 
 
-def _sigterm_as_interrupt():
-    """Handle SIGTERM like Ctrl+C (KeyboardInterrupt: temporary files are
-    removed, the target is untouched, exit code 130).  Returns a function
-    that puts the previous handler back (a no-op outside the main thread,
-    where signal handlers cannot be set)."""
+def _signals_as_interrupt(final: bool = False):
+    """Handle SIGINT, SIGTERM and SIGHUP alike: KeyboardInterrupt once
+    (temporary files are removed, the target is untouched, exit code
+    ``EXIT_INTERRUPTED``), then further ones are ignored.  Returns a
+    function that puts the previous handlers back (a no-op outside the main
+    thread, where signal handlers cannot be set); with ``final`` (the real
+    command line, the process ends right after) further interrupts are
+    ignored once one came, so one arriving during the interpreter's exit is
+    harmless."""
     if threading.current_thread() is not threading.main_thread():
         return lambda: None
-    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
-    return lambda: signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
+    _RECEIVED.clear()
+    previous = {}
+    for sig in _INTERRUPTS:
+        previous[sig] = signal.signal(sig, _raise_interrupt)
+
+    def restore():
+        if final and _RECEIVED:
+            # the process ends now: ignore further interrupts, since Python's
+            # finalisation puts SIG_DFL back for every Python handler and one
+            # arriving then would kill the process (-2 / -15 instead of 130).
+            # signal.signal runs pending Python handlers (_note_signal) before
+            # it changes one; after the change the OS drops new ones
+            for sig in _INTERRUPTS:
+                with contextlib.suppress(OSError, ValueError):
+                    signal.signal(sig, signal.SIG_IGN)
+            return
+        for sig, handler in previous.items():
+            signal.signal(sig, handler if handler is not None else signal.SIG_DFL)
+    return restore
 
 
 if __name__ == "__main__":

@@ -80,6 +80,8 @@ def check_model_file(path) -> None:
     if ext not in READ_EXTENSIONS:
         raise InputError(f"unsupported file extension {ext or '(none)'!r} for reading; "
                          f"supported: {', '.join(READ_EXTENSIONS)}", path=str(path))
+    from splatedit.io import check_readable_file
+    check_readable_file(p)          # by stat: opening a FIFO would block before any window
     try:
         with open(p, "rb") as f:
             f.read(1)
@@ -206,13 +208,17 @@ def save(ed, path: Path) -> None:
         ed.say(f"not saved: {path}: a Gaussian splatting scene is saved as a .ply")
         return
 
+    # the up axis the user sees (detected or chosen with U) goes into a PLY's
+    # header, so the saved file opens standing the same way
+    up = ed.camera.up.label if getattr(ed, "camera", None) is not None else None
+
     def work(progress):
         from splatedit.io import write, write_gaussians
         progress("saving", 0.0)
         if scene is not None:       # the committed edits' Gaussians (covariances, SH rotated), extras kept
-            write_gaussians(str(path), scene, overwrite=True, progress=progress)
+            write_gaussians(str(path), scene, overwrite=True, progress=progress, up_axis=up)
         else:
-            write(str(path), cloud, overwrite=True)
+            write(str(path), cloud, overwrite=True, up_axis=up)
         script.save(spath)
         return path, spath, pos, s
 

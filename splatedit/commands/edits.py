@@ -25,15 +25,24 @@ def cmd_convert(args) -> int:
         if args.remove_outliers:
             raise ParameterError("--remove-outliers", "works on point clouds, not on Gaussian scenes")
         g = read_gaussians(args.input, progress=args.progress)
-        write_gaussians(args.output, g, overwrite=args.force)
+        write_gaussians(args.output, g, overwrite=args.force, up_axis=_kept_up(args.input))
         print(f"wrote {args.output}: {len(g)} Gaussians ({g.kind.value}, SH degree {g.sh_degree})")
         return 0
     cloud = read(args.input, progress=args.progress)
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
-    write(args.output, cloud, overwrite=args.force)
+    write(args.output, cloud, overwrite=args.force, up_axis=_kept_up(args.input))
     print(f"wrote {args.output}: {cloud.n} splats" + _faces_note(cloud, args.output))
     return 0
+
+
+def _kept_up(input_path) -> str | None:
+    """The up axis a PLY input's header names ("+Z", ...; the editor writes it
+    on save), so that a converted or deformed copy opens standing the same
+    way; None when the input says nothing."""
+    from splatedit.model.orientation import header_up_hint
+    hint = header_up_hint(input_path)
+    return None if hint is None else hint.label
 
 
 def _faces_note(cloud, output) -> str:
@@ -97,7 +106,7 @@ def cmd_deform(args) -> int:
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)
-    write(args.output, out, overwrite=args.force)
+    write(args.output, out, overwrite=args.force, up_axis=_kept_up(args.input))
     print(f"wrote {args.output}: {out.n} splats, {len(reports)} edit(s) in {time.perf_counter() - t0:.2f} s")
     return 0
 
@@ -116,7 +125,7 @@ def _deform_gaussians(args) -> int:
     out, reports = run_script_gaussians(g, script, method=args.method, tol=args.tol,
                                         source=str(args.edit), progress=args.progress,
                                         on_edit=lambda rep: _print_edit(args, rep))
-    write_gaussians(args.output, out, overwrite=args.force)
+    write_gaussians(args.output, out, overwrite=args.force, up_axis=_kept_up(args.input))
     print(f"wrote {args.output}: {len(out)} Gaussians, {len(reports)} edit(s) in "
           f"{time.perf_counter() - t0:.2f} s")
     return 0

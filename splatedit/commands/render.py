@@ -31,22 +31,51 @@ def _camera_from_args(args, cloud):
             up = args.up if args.up is not None else screen_up(view.camera.up, eye, target)
             camera = Camera(eye, target, up=up, fov_deg=view.camera.fov_deg)
     except ParameterError as exc:
-        raise ParameterError(f"--{exc.name}", str(exc).split(": ", 1)[1]) from None
+        reason = str(exc).split(": ", 1)[1]
+        if getattr(args, exc.name, None) is not None:        # the user's own flag
+            raise ParameterError(f"--{exc.name}", reason) from None
+        # a default the command chose (no such flag given): name the model, not a flag
+        from splatedit.errors import InputError
+        raise InputError(f"cannot frame a default view (its {exc.name} would be {reason}); "
+                         f"give --eye and --target", path=str(args.input)) from None
+    _clip_to_main_body(camera, view.extent)
     if args.target is None and view.extent.note():
         args.progress.close()
         print(f"splatedit: note: {view.extent.note()}; the view frames the main body", file=sys.stderr)
     return camera
 
 
+def _clip_to_main_body(camera, extent) -> None:
+    """Near/far for a model with far outliers: chosen from the whole box, the
+    near plane (at least ``RENDER_NEAR_FAR_RATIO`` of the far one, for depth
+    precision) lay beyond the main body when one point sat 1e9 away, and the
+    image came out blank with exit 0.  Then the main body's depth range is
+    used, the far plane pushed out as far as that ratio allows: outliers
+    beyond it are clipped, the body is drawn."""
+    from splatedit.tolerances import RENDER_NEAR_FAR_RATIO
+    if not extent.robust:
+        return
+    body_near, body_far = camera.clip_range(extent.lo, extent.hi)
+    full_near, full_far = camera.clip_range(extent.full_lo, extent.full_hi)
+    if full_near > body_near:
+        camera.near = body_near
+        camera.far = max(body_far, min(full_far, body_near / RENDER_NEAR_FAR_RATIO))
+
+
 def cmd_render(args) -> int:
-    from splatedit.io.atomic import check_writable_target
+    from splatedit.io import check_output_path
     from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
         raise ParameterError("--buffers", "must differ from the PNG path (-o)")
     check_render_memory(args.size, args.buffers is not None)    # before reading anything
-    for target in (args.output, args.buffers):
+    # what is written must be what the name says: a PNG, and numpy's .npz
+    # (`render m.ply -o m.ply --force` wrote a PNG over the model)
+    for target, ext in ((args.output, ".png"), (args.buffers, ".npz")):
         if target is not None:
-            check_writable_target(target, overwrite=args.force, protect=args.input)
+            check_output_path(target, overwrite=args.force, protect=args.input, extensions=(ext,))
+    from splatedit.io import is_gaussian_file
+    if args.edit is not None and not is_gaussian_file(args.input):
+        check_gpu_columns(args.edit)        # before the read and the fit (seconds, gigabytes)
     cloud = _read_model(args.input, args.progress)
     from splatedit.model.gaussians import GaussianCloud
     if isinstance(cloud, GaussianCloud):
@@ -61,6 +90,34 @@ def cmd_render(args) -> int:
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
     return 0
+
+
+def gpu_columns(edit) -> int:
+    """Basis columns the renderer needs for ``edit`` (a script Edit): 4 per
+    handle, one per point of each control curve of 2 points or more."""
+    return 4 * len(edit.handles) + sum(len(c.points) for c in edit.curves if len(c.points) >= 2)
+
+
+def check_gpu_columns(script_path) -> None:
+    """Refuse, before any fitting, an edit script whose last edit (the one
+    ``render --edit`` deforms on the GPU) needs more basis columns than the
+    renderer holds (``RENDER_MAX_BASIS_COLUMNS``).
+
+    Raises:
+        EditScriptError: naming the script file and the edit's JSON path.
+    """
+    from splatedit.errors import EditScriptError
+    from splatedit.script import load_script
+    from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
+    edit = load_script(script_path).edits[-1]
+    k = gpu_columns(edit)
+    if k > RENDER_MAX_BASIS_COLUMNS:
+        n_pts = sum(len(c.points) for c in edit.curves)
+        raise EditScriptError(
+            f"{len(edit.handles)} handle(s) and {n_pts} curve point(s) need {k} deformation columns on "
+            f"the GPU (4 per handle, 1 per curve point), at most {RENDER_MAX_BASIS_COLUMNS}: split the "
+            f"edit, or apply it with 'splatedit deform' and render the result",
+            json_path=edit.json_path, path=str(script_path))
 
 
 def _read_model(path, progress):
@@ -90,8 +147,11 @@ def _render_gaussians(args, cloud) -> int:
         if len(load_script(args.edit).edits) != 1:
             raise ParameterError("--edit", f"{args.edit}: a Gaussian scene takes one edit per render "
                                            "(chained edits need the Gaussian CPU deformation)")
+        from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
+
         def gpu_can_draw(rows, d_c):
-            return isinstance(d_c, np.ndarray) and len(rows) == 5
+            return (isinstance(d_c, np.ndarray) and len(rows) == 5
+                    and rows[1].shape[1] <= RENDER_MAX_BASIS_COLUMNS)
 
         _, basis_rows, d_c = _gpu_edit(args, proxy, on_gpu=gpu_can_draw)
         if not gpu_can_draw(basis_rows, d_c):

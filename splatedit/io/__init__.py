@@ -31,6 +31,7 @@ file intact.  An existing file is replaced only with ``overwrite=True``.
 
 from __future__ import annotations
 
+import contextlib
 import os
 import stat
 from pathlib import Path
@@ -95,11 +96,24 @@ def read(path, *, progress=None) -> SplatCloud:
     ext = _ext(path, READ_EXTENSIONS, "reading")
     reader = _READERS[ext]
     check_readable_file(path)
-    if scan is not None:
-        return read_e57(path, scan=scan, progress=progress)
-    if ext == ".ply" and is_gaussian_ply(path):
-        return read_gaussian_ply(path, progress=progress).proxy_splats()
-    return reader(path, progress=progress)
+    with _memory_named(path):
+        if scan is not None:
+            return read_e57(path, scan=scan, progress=progress)
+        if ext == ".ply" and is_gaussian_ply(path):
+            return read_gaussian_ply(path, progress=progress).proxy_splats()
+        return reader(path, progress=progress)
+
+
+@contextlib.contextmanager
+def _memory_named(path):
+    """A MemoryError while reading ``path`` (a header whose count fits a
+    sparse file of that size: the size checks pass, the memory does not)
+    becomes an InputError naming the file."""
+    try:
+        yield
+    except MemoryError:
+        raise InputError(f"not enough memory to read it ({os.stat(path).st_size:,} bytes on disk)",
+                         path=str(path)) from None
 
 
 def read_columns(path, *, progress=None) -> PointColumns:
@@ -162,12 +176,16 @@ def read_gaussians(path, *, progress=None) -> GaussianCloud:
     if not is_gaussian_ply(path):
         raise InputError("is not a Gaussian splatting PLY (its vertex element has no f_dc_0, "
                          "scale_0 or rot_0 property)", path=str(path))
-    return read_gaussian_ply(path, progress=progress)
+    with _memory_named(path):
+        return read_gaussian_ply(path, progress=progress)
 
 
-def write_gaussians(path, scene: GaussianCloud, *, overwrite: bool = False, progress=None) -> Path:
+def write_gaussians(path, scene: GaussianCloud, *, overwrite: bool = False, progress=None,
+                    up_axis: str | None = None) -> Path:
     """Save a Gaussian scene atomically as a binary little-endian 3DGS/2DGS PLY
-    (the scene's own property order and types; unknown properties kept).
+    (the scene's own property order and types; unknown properties kept);
+    ``up_axis`` ("+Z", "-Y", ...) is recorded as a header comment
+    (``comment up_axis +Z``) that the editor and ``render`` read back.
 
     Raises:
         InputError: not a .ply target, an existing file without ``overwrite``,
@@ -181,7 +199,8 @@ def write_gaussians(path, scene: GaussianCloud, *, overwrite: bool = False, prog
     report(progress, "writing", 0.0)
     try:
         with atomic_open(path, "wb") as fh:
-            write_gaussian_ply(fh, scene, comment=f"written by splatedit from {scene.name or 'a Gaussian scene'}")
+            write_gaussian_ply(fh, scene, comment=f"written by splatedit from {scene.name or 'a Gaussian scene'}"
+                               + _up_comment(up_axis))
     except OSError as exc:
         raise InputError(f"cannot write: {exc.strerror or exc}", path=str(path)) from None
     report(progress, "writing", 1.0)
@@ -212,8 +231,17 @@ def check_output_path(path, *, overwrite: bool, protect=None, extensions=WRITE_E
     return check_writable_target(path, overwrite=overwrite, protect=protect)
 
 
+def _up_comment(up_axis: str | None) -> str:
+    """The PLY header line recording the model's up axis ("" for None)."""
+    if up_axis is None:
+        return ""
+    if up_axis not in ("+X", "+Y", "+Z", "-X", "-Y", "-Z"):
+        raise ValueError(f"up_axis must be one of +X +Y +Z -X -Y -Z, got {up_axis!r}")
+    return f"\nup_axis {up_axis}"
+
+
 def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = True,
-          axes: bool = True, progress=None) -> Path:
+          axes: bool = True, progress=None, up_axis: str | None = None) -> Path:
     """Save ``cloud`` atomically (:func:`splatedit.io.atomic.atomic_open`).
 
     Args:
@@ -224,6 +252,10 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
         binary: PLY only: binary little endian (default) or ascii.
         axes: PLY only: store normals and splat axes (default); False
             stores positions, colours and faces only.
+        up_axis: PLY only: the model's up axis ("+Z", "-Y", ...) as a header
+            comment (``comment up_axis +Z``), which the editor and ``render``
+            read back (:func:`splatedit.model.orientation.header_up_hint`);
+            other formats have no place for it (LAS/LAZ/E57 are Z-up anyway).
     Returns:
         the path written.
     Raises:
@@ -243,7 +275,7 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
         with atomic_open(path, "wb") as fh:
             if ext == ".ply":
                 write_ply(fh, cloud, binary=binary, axes=axes,
-                          comment=f"written by splatedit from {cloud.name or 'a splat cloud'}")
+                          comment=f"written by splatedit from {cloud.name or 'a splat cloud'}" + _up_comment(up_axis))
             elif ext == ".xyz":
                 write_xyz(fh, cloud)
             elif ext in (".las", ".laz"):
@@ -253,7 +285,7 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
             elif ext == ".pts":
                 write_pts(fh, cloud)
             elif ext == ".e57":
-                write_e57(fh, cloud, path.parent)
+                write_e57(fh, cloud, path)
             else:
                 write_off(fh, cloud)
     except OSError as exc:

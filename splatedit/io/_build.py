@@ -14,7 +14,7 @@ import numpy as np
 from splatedit.errors import InputError
 from splatedit.model.cloud import SplatCloud, column_bounds
 from splatedit.model.tangents import splats_from_normals, usable_normals
-from splatedit.tolerances import (MAX_COORDINATE_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
+from splatedit.tolerances import (MAX_COORDINATE_ABS, MIN_EXTENT_ABS, REBASE_GRID_MIN, REBASE_MIN_ABS,
                                   REBASE_STORED_REACH)
 
 
@@ -144,7 +144,9 @@ def origin_grid(lo, hi) -> float:
 def local_origin(positions, bounds=None, stored=None) -> np.ndarray:
     """(3,) float64 origin for the positions (``bounds``: their (min, max), if known).
 
-    Zeros when the bounding box lies within ``REBASE_MIN_ABS`` of 0.  Else
+    The box is the main body's when a few points lie far outside it
+    (:func:`body_bounds`; with ``positions`` given).
+    Zeros when the box lies within ``REBASE_MIN_ABS`` of 0.  Else
     ``stored`` (the origin a file we wrote carries) when it suits the box
     (:func:`fits_origin`), so a model read, edited, written and read again
     keeps its origin; else the box centre rounded to a multiple of
@@ -159,6 +161,10 @@ def local_origin(positions, bounds=None, stored=None) -> np.ndarray:
     lo, hi = column_bounds(positions) if bounds is None else bounds
     if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
         return np.zeros(3)
+    if positions is not None:
+        lo, hi = body_bounds(positions, (lo, hi))
+        if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
+            return np.zeros(3)
     if stored is not None and fits_origin(stored, lo, hi):
         return np.array(stored, dtype=np.float64)
     step = origin_grid(lo, hi)
@@ -277,6 +283,34 @@ def cloud_from_columns(cols: PointColumns, *, progress=None) -> SplatCloud:
                        quantization=cols.quantization, point_fields=cols.point_fields)
 
 
+def check_extent(lo, hi, path) -> None:
+    """Refuse a model whose bounding box ``lo``..``hi`` ((3,) each) is
+    positive but below ``MIN_EXTENT_ABS`` across: its squared distances
+    underflow float64, so sizes, normals and framing come out as nonsense
+    (a sphere 1e-300 across rendered as rings with exit 0).  All points in
+    one place (extent 0) stay valid: a single splat."""
+    side = float(np.max(np.asarray(hi, dtype=np.float64) - np.asarray(lo, dtype=np.float64)))
+    if 0.0 < side < MIN_EXTENT_ABS:
+        raise InputError(f"the model is {side:.3g} across, below the smallest supported extent "
+                         f"{MIN_EXTENT_ABS:g} (rescale the model)", path=str(path))
+
+
+def body_bounds(positions, bounds):
+    """The box the local origin is chosen for: ``bounds`` (the full box of
+    ``positions``, (lo, hi)) when it lies within ``REBASE_MIN_ABS`` of 0,
+    else the main body's box (:func:`splatedit.model.extent.framing_extent`).
+    One glitch point 1e9 away moved the origin of a scan near 0 to 5e8: the
+    main body's splats then sat at 5e8 in local coordinates, too coarse for
+    float32 and refused as degenerate; a UTM scan with a glitch at (0, 0, 0)
+    is rebased onto the scan, not between the two."""
+    lo, hi = bounds
+    if max(np.abs(lo).max(), np.abs(hi).max()) <= REBASE_MIN_ABS:
+        return bounds
+    from splatedit.model.extent import framing_extent
+    ext = framing_extent(positions)
+    return (ext.lo, ext.hi) if ext.robust else bounds
+
+
 def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, colors=None,
                 faces=None, progress=None, origin=None, already_local=False, intensity=None,
                 classification=None, quantization=None, point_fields=None,
@@ -300,8 +334,10 @@ def build_cloud(path, positions, *, normals=None, radius=None, u=None, v=None, c
     name, source = Path(path).name, str(path)
     if len(positions) == 0:
         raise InputError("zero vertices: the file holds no points", path=source, element="vertex")
+    bounds = column_bounds(positions)
+    check_extent(*bounds, path)
     if origin is None:
-        origin = local_origin(positions, stored=stored_origin)
+        origin = local_origin(positions, bounds=bounds, stored=stored_origin)
     if not already_local:
         positions = rebase(positions, origin)
     scan = dict(origin=origin, intensity=intensity, classification=classification,

@@ -9,7 +9,7 @@ from __future__ import annotations
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.io._build import colors_from_columns, local_origin, rebase
+from splatedit.io._build import check_extent, colors_from_columns, local_origin, rebase
 from splatedit.io._plybinary import (_AXES, _columns_view, _grow_bounds, body_chunks, in_range,
                                      vertex_columns)
 from splatedit.model.summary import CloudSummary
@@ -99,6 +99,7 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
     diag = float(np.linalg.norm(hi_b - lo_b))
     if not np.sqrt(shortest) > MIN_AXIS_LENGTH_REL * max(diag, 1e-300):
         return None
+    check_extent(lo_b, hi_b, path)
     origin = local_origin(positions, bounds=(lo_b, hi_b), stored=stored_origin)
     positions = rebase(positions, origin)
 

@@ -24,8 +24,10 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite
+from splatedit.io._guard import library_call
 from splatedit.io.las import grey_from_intensity
 from splatedit.model.cloud import SplatCloud
+from splatedit.tolerances import E57_MAX_POINTS_PER_BYTE
 
 
 def split_scan_index(path: str):
@@ -39,14 +41,26 @@ def split_scan_index(path: str):
 
 def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
     """Read an E57 file, all scans merged or the scan of index ``scan``."""
-    import pye57
     src = str(path)
-    try:
+    with library_call(src, "not a readable E57 file"):
+        import pye57
         e57 = pye57.E57(src)
         count = e57.scan_count
-    except Exception as exc:            # libE57Format raises its own exception types
-        raise InputError(f"not a readable E57 file: {str(exc).splitlines()[0] if str(exc) else exc}",
-                         path=src) from None
+    with library_call(src, "not a readable E57 file"):
+        xyz, colors, intensity, stored = _read_scans(e57, src, count, scan)
+    return build_cloud(src if scan is None else f"{src}#{scan}", xyz, colors=colors,
+                       progress=progress, intensity=intensity, stored_origin=stored)
+
+
+def _read_scans(e57, src: str, count: int, scan):
+    """The scans of the open ``e57`` (all ``count`` merged, or ``scan``);
+    each scan's point count is checked against the file size first.
+
+    Returns:
+        (xyz (n, 3) float64, colours (n, 4) uint8 or None, intensity (n,)
+        uint16 or None, the first scan's pose translation (3,))."""
+    import os
+    size = os.stat(src).st_size
     if count == 0:
         raise InputError("the file holds no scans", path=src)
     if scan is not None and not 0 <= scan < count:
@@ -56,16 +70,18 @@ def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
     for i in ([scan] if scan is not None else range(count)):
         header = e57.get_header(i)
         names = set(header.point_fields)
+        declared = int(header.point_count)
+        if not 0 <= declared <= size * E57_MAX_POINTS_PER_BYTE:
+            raise InputError(f"scan {i}: {declared} points cannot be stored in a file of {size} bytes "
+                             f"(the count is wrong)", path=src)
         if stored is None:
             try:
                 stored = np.asarray(header.translation, dtype=np.float64).reshape(3)
             except Exception:       # a pose node of another shape: no stored origin
                 stored = np.zeros(3)
-        try:
+        with library_call(src, f"scan {i}: cannot read"):
             d = e57.read_scan(i, colors="colorRed" in names, intensity="intensity" in names,
                               transform=True, ignore_missing_fields=True)
-        except Exception as exc:
-            raise InputError(f"scan {i}: cannot read: {exc}", path=src) from None
         if "cartesianX" not in d:
             raise InputError(f"scan {i}: no cartesian coordinates (spherical-only scans are "
                              f"not supported)", path=src)
@@ -97,21 +113,29 @@ def read_e57(path, *, scan: int | None = None, progress=None) -> SplatCloud:
         colors[:, :3] = np.rint(rgb)
     elif intensity is not None:
         colors = grey_from_intensity(intensity)
-    return build_cloud(src if scan is None else f"{src}#{scan}", xyz, colors=colors,
-                       progress=progress, intensity=intensity, stored_origin=stored)
+    return xyz, colors, intensity, stored
 
 
-def write_e57(fh, cloud: SplatCloud, directory) -> None:
+def write_e57(fh, cloud: SplatCloud, path) -> None:
     """Write ``cloud`` as a one-scan E57 file to the open binary file ``fh``
-    (pye57 writes only by path: a scratch file in ``directory``, copied)."""
+    (pye57 writes only by path: a scratch file in the folder of ``path``,
+    the target named in errors, copied)."""
     import shutil
     import tempfile
     from pathlib import Path
+    directory = Path(path).parent
     with tempfile.TemporaryDirectory(dir=directory, prefix=".splatedit-e57-") as tmp:
         scratch = Path(tmp) / "scan.e57"
-        _write_e57_path(str(scratch), cloud)
+        with library_call(path, "cannot write E57"):
+            _write_e57_path(str(scratch), cloud)
         with open(scratch, "rb") as src:
             shutil.copyfileobj(src, fh, 1 << 22)
+
+
+#: libE57 image files of failed writes, cancelled and kept alive: freeing
+#: one while its writer objects (held by the exception's traceback) still
+#: refer to it crashed the process (SIGSEGV) after the error line
+_FAILED_WRITES: list = []
 
 
 def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
@@ -135,5 +159,12 @@ def _write_e57_path(tmp_path: str, cloud: SplatCloud) -> None:
     e57 = pye57.E57(tmp_path, mode="w")
     try:
         e57.write_scan_raw(data, scan_header=header)
-    finally:
         e57.close()
+    except BaseException:
+        # a failed write (disk full) leaves libE57's file open: cancel it here,
+        # else pye57's __del__ closes it again at some later garbage
+        # collection and prints a second exception and libE57's debug lines
+        image_file = e57.__dict__.pop("image_file", None)
+        if image_file is not None:
+            _FAILED_WRITES.append(image_file)
+        raise

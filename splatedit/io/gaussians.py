@@ -149,12 +149,43 @@ def read_gaussian_ply(path, *, progress=None) -> GaussianCloud:
     extra = {nm: np.array(data[nm]) for nm in names if nm not in known}
     layout = tuple((nm, data.dtype[nm].newbyteorder("<").str) for nm in names)
     report(progress, "reading", 1.0)
-    return GaussianCloud(
+    scene = GaussianCloud(
         positions=pos, log_scales=_stack(data, [f"scale_{i}" for i in range(n_scales)], path),
         rotations=rot, opacity_logits=_stack(data, ("opacity",), path)[:, 0], sh=sh,
         normals=normals, extra=extra,
         kind=GaussianKind.GS3D if n_scales == 3 else GaussianKind.GS2D,
         name=Path(path).name, source=str(path), layout=layout)
+    check_gaussian_values(scene, str(path))
+    return scene
+
+
+def check_gaussian_values(g: GaussianCloud, path) -> None:
+    """The one validation of a Gaussian scene's values, shared by every
+    command (``info`` accepted a scene at 1e20 that ``render`` refused):
+    centres within ``MAX_COORDINATE_ABS`` (property ``x``/``y``/``z``), the
+    proxy disc's semi-axes (``GAUSSIAN_PROXY_SIGMAS`` standard deviations)
+    too (property ``scale_j``, the file's own name, not the proxy's ``u``),
+    and an extent of at least ``MIN_EXTENT_ABS`` unless all centres
+    coincide.
+
+    Raises:
+        InputError: naming the file, row and property.
+    """
+    import math
+    from splatedit.io._build import check_extent, check_finite
+    from splatedit.model.cloud import column_bounds
+    from splatedit.tolerances import GAUSSIAN_PROXY_SIGMAS, MAX_COORDINATE_ABS
+    check_finite({p: g.positions[:, j] for j, p in enumerate("xyz")}, path)
+    limit = math.log(MAX_COORDINATE_ABS / GAUSSIAN_PROXY_SIGMAS)
+    big = g.log_scales > limit
+    if big.any():
+        row, j = (int(v[0]) for v in np.nonzero(big))
+        v = float(g.log_scales[row, j])
+        raise _fail(path, f"scale_{j}", f"log-scale {v:.6g} is a standard deviation of "
+                    f"{math.exp(min(v, 709.0)):.3g}, beyond the supported magnitude "
+                    f"{MAX_COORDINATE_ABS:g} at {GAUSSIAN_PROXY_SIGMAS:g} sigma (rescale the scene)",
+                    row=row)
+    check_extent(*column_bounds(g.positions), path)
 
 
 def standard_layout(g: GaussianCloud) -> tuple[tuple[str, str], ...]:
@@ -213,6 +244,7 @@ def check_gaussians(g: GaussianCloud) -> None:
     if zero.any():
         raise InputError("zero quaternion", path=src, element="vertex",
                          row=int(np.flatnonzero(zero)[0]), prop="rot_0")
+    check_gaussian_values(g, src)
 
 
 def gaussian_vertex_array(g: GaussianCloud) -> np.ndarray:

@@ -31,11 +31,17 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.errors import InputError
+import os
+import struct
+import warnings
+
+from splatedit.errors import InputError, InputWarning
 from splatedit.io._build import build_cloud, fits_origin, local_origin
+from splatedit.io._guard import RecordingStream, library_call
 from splatedit.model.cloud import Quantization, SplatCloud, column_bounds
 from splatedit.progress import report
-from splatedit.tolerances import LAS_DEFAULT_SCALE, REBASE_MIN_ABS
+from splatedit.tolerances import (LAS_DEFAULT_SCALE, LAS_MIN_SCALE, LAZ_MAX_POINTS_PER_BYTE,
+                                  MAX_COORDINATE_ABS, REBASE_MIN_ABS)
 
 _RGB_FORMATS = (2, 3, 5, 7, 8, 10)
 
@@ -68,19 +74,204 @@ def _origin_step(world_lo, world_hi, scale, offset) -> np.ndarray:
     return np.round((grid - offset) / scale).astype(np.int64)
 
 
+#: bytes of a point record of each LAS point format (0..10), the least a
+#: record length may be (extra bytes come on top)
+_RECORD_BYTES = (20, 28, 26, 34, 57, 63, 30, 36, 38, 59, 67)
+#: LAS public header fields up to the offsets (the part every version has)
+_HEADER = struct.Struct("<4s H H 16s B B 32s 32s H H H I I B H I 5I 3d 3d 6d")
+
+
+def check_las_header(path) -> int:
+    """Validate the public header of a LAS/LAZ file against the file itself,
+    before laspy reads it (laspy trusts the header: 'LASF' and random bytes
+    made it allocate without end).
+
+    Checks: the signature and a complete header; header size, point-data
+    offset and the variable-length-record count within the file; a known
+    point format whose record length holds its fields; finite offsets and
+    finite scales of at least ``LAS_MIN_SCALE`` in magnitude (a scale of 0
+    collapses the cloud onto one point); the point count against the bytes
+    there are: an uncompressed file must hold exactly that many records
+    (fewer: an error, as a truncated PLY; more: an :class:`InputWarning`,
+    as PLY's rows after the declared count), a LAZ file at most
+    ``LAZ_MAX_POINTS_PER_BYTE`` points per byte of point data.
+
+    Returns:
+        the number of points the header declares.
+    Raises:
+        InputError: naming the file and the header field at fault.
+    """
+    src = str(path)
+    try:
+        size = os.stat(path).st_size
+        with open(path, "rb") as fh:
+            head = fh.read(375)
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    if head[:4] != b"LASF":
+        raise InputError("not a LAS/LAZ file (no 'LASF' signature)", path=src)
+    if len(head) < _HEADER.size:
+        raise InputError(f"truncated LAS header: {len(head)} bytes, a header has at least "
+                         f"{_HEADER.size}", path=src)
+    f = _HEADER.unpack_from(head)
+    major, minor = f[4], f[5]
+    header_size, data_offset, n_vlr, fmt_byte, rec_len, legacy_count = f[10:16]
+    scale, offset = np.array(f[21:24]), np.array(f[24:27])
+    if major != 1 or minor > 4:
+        raise InputError(f"header: unsupported LAS version {major}.{minor}", path=src)
+    if not _HEADER.size <= header_size <= data_offset <= size:
+        raise InputError(f"header: header size {header_size} and point data offset {data_offset} "
+                         f"do not fit a file of {size} bytes", path=src)
+    if n_vlr * 54 > data_offset - header_size:
+        raise InputError(f"header: {n_vlr} variable-length records do not fit in the "
+                         f"{data_offset - header_size} bytes before the points", path=src)
+    compressed = bool(fmt_byte & 0xC0)
+    fmt = fmt_byte & 0x3F
+    if fmt >= len(_RECORD_BYTES):
+        raise InputError(f"header: unknown point format {fmt}", path=src)
+    if rec_len < _RECORD_BYTES[fmt]:
+        raise InputError(f"header: point record length {rec_len} is below the {_RECORD_BYTES[fmt]} "
+                         f"bytes of point format {fmt}", path=src)
+    for name, vals in (("scale", scale), ("offset", offset)):
+        bad = ~np.isfinite(vals)
+        if bad.any():
+            j = int(np.flatnonzero(bad)[0])
+            raise InputError(f"header: {'xyz'[j]} {name} is {vals[j]} (must be finite)", path=src)
+    if (np.abs(scale) < LAS_MIN_SCALE).any():
+        j = int(np.flatnonzero(np.abs(scale) < LAS_MIN_SCALE)[0])
+        raise InputError(f"header: {'xyz'[j]} scale {scale[j]:g} is degenerate (it must be at least "
+                         f"{LAS_MIN_SCALE:g} in magnitude; 0 puts every point in one place)", path=src)
+    if (np.abs(scale) > MAX_COORDINATE_ABS).any():
+        j = int(np.argmax(np.abs(scale)))
+        raise InputError(f"header: {'xyz'[j]} scale {scale[j]:g} is beyond the supported magnitude "
+                         f"{MAX_COORDINATE_ABS:g}", path=src)
+    if (np.abs(offset) > MAX_COORDINATE_ABS).any():
+        j = int(np.argmax(np.abs(offset)))
+        raise InputError(f"header: {'xyz'[j]} offset {offset[j]:g} is beyond the supported magnitude "
+                         f"{MAX_COORDINATE_ABS:g}", path=src)
+    count = legacy_count
+    end = size
+    if minor >= 4 and len(head) >= 255:
+        first_evlr, n_evlr, count14 = struct.unpack_from("<Q I Q", head, 235)
+        count = count14 or legacy_count
+        if n_evlr:
+            _check_evlrs(path, first_evlr, n_evlr, data_offset, size, src)
+            end = first_evlr
+    body = end - data_offset
+    if compressed:
+        if count > max(body, 1) * LAZ_MAX_POINTS_PER_BYTE:
+            raise InputError(f"header: {count} points cannot be compressed into {body} bytes "
+                             f"(the count is wrong or the file is truncated)", path=src)
+        _check_laszip_vlr(path, header_size, n_vlr, data_offset, count, src)
+        _check_chunk_table(path, data_offset, size, src)
+        return count
+    records = body // rec_len
+    if count > records:
+        raise InputError(f"early end-of-file: the header says {count} points but the file holds "
+                         f"{records} point records (truncated, or the count is wrong)", path=src)
+    if records > count:
+        warnings.warn(InputWarning(f"{src}: {records - count} point record(s) after the {count} the "
+                                   f"header declares were ignored"), stacklevel=3)
+    return count
+
+
+def _check_evlrs(path, first: int, count: int, data_offset: int, size: int, src: str) -> None:
+    """LAS 1.4 extended variable-length records: they must start after the
+    point data offset and each (60-byte header plus its 64-bit length) end
+    within the file; laspy reads each length in one piece."""
+    if not data_offset <= first <= size or count * 60 > size - first:
+        raise InputError(f"header: {count} extended variable-length records from byte {first} do not "
+                         f"fit a file of {size} bytes", path=src)
+    pos = first
+    try:
+        with open(path, "rb") as fh:
+            for i in range(count):
+                fh.seek(pos + 20)
+                (length,) = struct.unpack("<Q", fh.read(8))
+                pos += 60 + length
+                if pos > size:
+                    raise InputError(f"extended variable-length record {i}: {length} bytes do not fit "
+                                     f"a file of {size} bytes", path=src)
+    except (OSError, struct.error):
+        raise InputError("cannot read the extended variable-length records (truncated?)",
+                         path=src) from None
+
+
+#: the chunk size of a LAZ file whose chunks vary in size
+_VARIABLE_CHUNKS = 0xFFFFFFFF
+
+
+def _check_laszip_vlr(path, header_size: int, n_vlr: int, data_offset: int, count: int, src: str) -> None:
+    """The 'laszip encoded' record of a LAZ file: its points per chunk, for
+    which lazrs allocates a buffer, may not exceed the file's points (or
+    laszip's default 50,000): a damaged chunk size of 5.3e8 aborted the
+    process (a failed allocation)."""
+    pos = header_size
+    try:
+        with open(path, "rb") as fh:
+            for _ in range(n_vlr):
+                fh.seek(pos)
+                head = fh.read(54)
+                if len(head) < 54:
+                    break
+                _, user, rec_id, length = struct.unpack_from("<H16sHH", head)
+                if user.rstrip(b"\0") == b"laszip encoded" and rec_id == 22204 and length >= 20:
+                    (chunk,) = struct.unpack("<I", fh.read(20)[12:16])
+                    if chunk != _VARIABLE_CHUNKS and chunk > max(count, 50_000):
+                        raise InputError(f"LAZ record: {chunk} points per chunk for {count} points: "
+                                         f"the file is damaged", path=src)
+                    return
+                pos += 54 + length
+                if pos > data_offset:
+                    break
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    raise InputError("a LAZ file without its 'laszip encoded' record (damaged, or not LAZ)", path=src)
+
+
+def _check_chunk_table(path, data_offset: int, size: int, src: str) -> None:
+    """A LAZ file's point data start with the offset of its chunk table (or
+    -1 for none); the table starts with a version and the number of chunks,
+    for which lazrs allocates 16 bytes each: a damaged count (1.4e9 chunks
+    in an 891-byte file) aborted the process (a failed 21 GB allocation).
+    Every chunk takes at least one byte of the data before the table."""
+    try:
+        with open(path, "rb") as fh:
+            fh.seek(data_offset)
+            raw = fh.read(8)
+            if len(raw) < 8:
+                raise InputError("truncated LAZ data: no chunk table offset", path=src)
+            (table,) = struct.unpack("<q", raw)
+            if table == -1:
+                return
+            if not data_offset + 8 <= table <= size - 8:
+                raise InputError(f"LAZ chunk table offset {table} lies outside the point data "
+                                 f"({data_offset + 8}..{size - 8}): the file is truncated or damaged",
+                                 path=src)
+            fh.seek(table)
+            _, chunks = struct.unpack("<II", fh.read(8))
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+    if chunks > table - data_offset - 8 + 1:
+        raise InputError(f"LAZ chunk table declares {chunks} chunks in {table - data_offset - 8} bytes "
+                         f"of point data: the file is truncated or damaged", path=src)
+
+
 def read_las(path, *, progress=None) -> SplatCloud:
-    """Read a ``.las`` or ``.laz`` file (see the module docstring)."""
-    import laspy
+    """Read a ``.las`` or ``.laz`` file (see the module docstring; the header is
+    checked first by :func:`check_las_header`)."""
     src = str(path)
     report(progress, "reading", 0.0)
-    try:
-        las = laspy.read(src)
-    except Exception as exc:        # laspy raises many kinds on corrupt data
-        msg = str(exc).splitlines()[0] if str(exc) else type(exc).__name__
-        raise InputError(f"not a readable LAS/LAZ file: {msg}", path=src) from None
-    n = len(las.points)
-    if n == 0:
+    declared = check_las_header(path)
+    if declared == 0:
         raise InputError("zero points: the file holds no points", path=src)
+    with library_call(src, "not a readable LAS/LAZ file"):
+        import laspy
+        las = laspy.read(src)
+    n = len(las.points)
+    if n != declared:
+        raise InputError(f"the header says {declared} points but {n} were decoded "
+                         f"(truncated, or the count is wrong)", path=src)
     scale = np.asarray(las.header.scales, dtype=np.float64)
     offset = np.asarray(las.header.offsets, dtype=np.float64)
     ints = np.empty((n, 3), dtype=np.int64)
@@ -88,6 +279,11 @@ def read_las(path, *, progress=None) -> SplatCloud:
         ints[:, j] = las[d]
     lo_i, hi_i = column_bounds(ints)
     world_lo, world_hi = lo_i * scale + offset, hi_i * scale + offset
+    for world in (world_lo, world_hi):
+        if (np.abs(world) > MAX_COORDINATE_ABS).any():
+            j = int(np.argmax(np.abs(world)))
+            raise InputError(f"{'xyz'[j]} coordinate {world[j]:g} (integers times scale plus offset) "
+                             f"is beyond the supported magnitude {MAX_COORDINATE_ABS:g}", path=src)
     if max(np.abs(world_lo).max(), np.abs(world_hi).max()) > REBASE_MIN_ABS:
         ref = _origin_step(world_lo, world_hi, scale, offset)
         origin = offset + ref * scale
@@ -188,5 +384,7 @@ def write_las(fh, cloud: SplatCloud, path, *, compress: bool) -> None:
     if own_rgb:
         c = cloud.colors.astype(np.uint16) * 257
         las.red, las.green, las.blue = c[:, 0], c[:, 1], c[:, 2]
-    las.write(fh, do_compress=compress,
-              laz_backend=laspy.LazBackend.Lazrs if compress else None)
+    stream = RecordingStream(fh)
+    with library_call(path, f"cannot write {'LAZ' if compress else 'LAS'}", stream):
+        las.write(stream, do_compress=compress,
+                  laz_backend=laspy.LazBackend.Lazrs if compress else None)

@@ -28,7 +28,18 @@ from splatedit.model.cloud import SplatCloud
 _KEYS = ("VERSION", "FIELDS", "SIZE", "TYPE", "COUNT", "WIDTH", "HEIGHT", "VIEWPOINT", "POINTS", "DATA")
 
 
+#: fields read as one value per point (a COUNT above 1 is refused for them)
+_SCALAR_FIELDS = ("x", "y", "z", "normal_x", "normal_y", "normal_z", "rgb", "rgba", "intensity")
+
+
 def _header(data: bytes, src: str):
+    """Parse and validate a PCD header (every field list of one length, names
+    unique, POINTS, SIZE and COUNT non-negative integers, one value per point
+    for the fields read, a row no larger than the file).
+
+    Returns:
+        (field names, row dtype, POINTS, DATA kind, body offset, header lines)
+    """
     fields = {}
     pos = 0
     line_no = 0
@@ -44,26 +55,48 @@ def _header(data: bytes, src: str):
         w = line.split()
         if w[0] not in _KEYS:
             raise InputError(f"header line {line_no}: unknown keyword {w[0]!r}", path=src)
+        if w[0] in fields:
+            raise InputError(f"header line {line_no}: {w[0]} given twice", path=src)
         fields[w[0]] = w[1:]
     for k in ("FIELDS", "SIZE", "TYPE", "POINTS"):
         if k not in fields:
             raise InputError(f"header: no {k} line", path=src)
     names = fields["FIELDS"]
+    if not names:
+        raise InputError("header: FIELDS lists no field", path=src)
     count = fields.get("COUNT", ["1"] * len(names))
     if not (len(fields["SIZE"]) == len(fields["TYPE"]) == len(count) == len(names)):
         raise InputError("header: FIELDS, SIZE, TYPE and COUNT differ in length", path=src)
+    seen = set()
+    for nm in names:
+        if nm != "_" and nm in seen:
+            raise InputError(f"header: field {nm!r} is listed twice in FIELDS", path=src)
+        seen.add(nm)
     try:
+        if len(fields["POINTS"]) != 1:
+            raise ValueError
         npts = int(fields["POINTS"][0])
         sizes = [int(s) for s in fields["SIZE"]]
         counts = [int(c) for c in count]
-    except (ValueError, IndexError):
+    except ValueError:
         raise InputError("header: POINTS, SIZE and COUNT must be integers", path=src) from None
+    if npts < 0:
+        raise InputError(f"header: POINTS {npts} is negative", path=src)
+    row_bytes = 0
+    for nm, c, sz in zip(names, counts, sizes):
+        if c < 1 or (nm in _SCALAR_FIELDS and c != 1):
+            raise InputError(f"header: field {nm!r} has COUNT {c} (must be "
+                             f"{'1' if nm in _SCALAR_FIELDS else 'at least 1'})", path=src)
+        row_bytes += c * max(sz, 1)
+    if row_bytes > len(data):
+        raise InputError(f"header: a row of {row_bytes} bytes (SIZE times COUNT) cannot fit in a file "
+                         f"of {len(data)} bytes", path=src)
     dt = []
-    for nm, t, s, c in zip(names, fields["TYPE"], sizes, counts):
+    for nm, t, sz, c in zip(names, fields["TYPE"], sizes, counts):
         code = {"F": "f", "I": "i", "U": "u"}.get(t)
-        if code is None or s not in (1, 2, 4, 8) or (code == "f" and s < 4):
-            raise InputError(f"header: field {nm!r} has unsupported TYPE {t} SIZE {s}", path=src)
-        dt.append((nm if nm != "_" else f"_pad{len(dt)}", f"<{code}{s}", (c,) if c > 1 else ()))
+        if code is None or sz not in (1, 2, 4, 8) or (code == "f" and sz < 4):
+            raise InputError(f"header: field {nm!r} has unsupported TYPE {t} SIZE {sz}", path=src)
+        dt.append((nm if nm != "_" else f"_pad{len(dt)}", f"<{code}{sz}", (c,) if c > 1 else ()))
     kind = fields["DATA"][0] if fields["DATA"] else ""
     return names, np.dtype(dt), npts, kind, pos, line_no
 
@@ -89,6 +122,8 @@ def read_pcd(path, *, progress=None) -> SplatCloud:
     except OSError as exc:
         raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
     names, dtype, n, kind, body, nhead = _header(data, src)
+    if n == 0:
+        raise InputError("zero points: POINTS is 0", path=src)
     if "x" not in names or "y" not in names or "z" not in names:
         raise InputError("missing field x, y or z", path=src)
     if kind == "binary_compressed":
@@ -98,14 +133,22 @@ def read_pcd(path, *, progress=None) -> SplatCloud:
         need = n * dtype.itemsize
         if len(data) - body < need:
             row = (len(data) - body) // dtype.itemsize
-            raise InputError("early end-of-file (the file is truncated or POINTS is wrong)",
-                             path=src, row=row)
+            raise InputError(f"early end-of-file: POINTS says {n} but the data hold {row} rows "
+                             f"(the file is truncated or POINTS is wrong)", path=src, row=row)
+        if len(data) - body > need:
+            warnings.warn(InputWarning(f"{src}: {len(data) - body - need} byte(s) after the {n} points "
+                                       f"POINTS declares were ignored"), stacklevel=3)
         rec = np.frombuffer(data, dtype=dtype, count=n, offset=body)
     elif kind == "ascii":
         tab = scan_numbers(data[body:], src, first_line=nhead + 1, progress=progress)
         width = sum(int(np.prod(dtype[i].shape)) or 1 for i in range(len(dtype)))
         if len(tab) < n:
-            raise InputError(f"{len(tab)} data lines but POINTS says {n} (truncated?)", path=src)
+            raise InputError(f"early end-of-file: {len(tab)} data lines but POINTS says {n} "
+                             f"(truncated, or POINTS is wrong)", path=src)
+        if len(tab) > n:
+            warnings.warn(InputWarning(f"{src}: {len(tab) - n} data line(s) from line {tab.line[n]} "
+                                       f"after the {n} points POINTS declares were ignored"),
+                          stacklevel=3)
         bad = tab.count[:n] != width
         if bad.any():
             row = int(np.flatnonzero(bad)[0])
@@ -120,7 +163,17 @@ def read_pcd(path, *, progress=None) -> SplatCloud:
                 v = vals[:, col]
                 rec[nm] = (v.astype(np.float32) if dtype[nm].kind == "f" else v.astype(np.uint32))
             else:
-                rec[nm] = vals[:, col:col + w].reshape(rec[nm].shape)
+                v = vals[:, col:col + w]
+                kind_nm = dtype[nm].base
+                if kind_nm.kind in "iu":
+                    info = np.iinfo(kind_nm)
+                    bad = ~((v >= info.min) & (v <= info.max))
+                    if bad.any():
+                        row = int(np.flatnonzero(bad.any(axis=1))[0])
+                        raise InputError(f"value {v[row][bad[row]][0]:g} does not fit the declared "
+                                         f"type {kind_nm} (line {tab.line[row]})", path=src, row=row,
+                                         prop=nm)
+                rec[nm] = v.reshape(rec[nm].shape)
             col += w
     else:
         raise InputError(f"header: DATA {kind!r} (expected ascii or binary)", path=src)

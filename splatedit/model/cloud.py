@@ -23,8 +23,24 @@ from typing import Optional
 import numpy as np
 
 from splatedit.errors import InputError
-from splatedit.tolerances import (MAX_COORDINATE_ABS, MIN_AXIS_LENGTH_REL,
-                                  MIN_AXIS_SINE, VALIDATE_CHUNK_ROWS)
+from splatedit.tolerances import (MAX_COORDINATE_ABS, MIN_AXIS_LENGTH_REL, MIN_AXIS_POSITION_FACTOR,
+                                  MIN_AXIS_SINE, MIN_EXTENT_ABS, VALIDATE_CHUNK_ROWS)
+
+
+def min_axis_lengths(positions: np.ndarray, diag: float) -> np.ndarray:
+    """(m,) float64: the length a splat axis must exceed at each of the (m, 3)
+    local ``positions`` of a cloud whose bounding-box diagonal is ``diag``:
+    ``MIN_AXIS_LENGTH_REL`` of the diagonal or, where smaller, of
+    ``MIN_AXIS_POSITION_FACTOR`` times the splat's distance from the origin
+    (at least ``MIN_EXTENT_ABS``).  One glitch point 1e9 away (diagonal 1e9)
+    made the main body's 0.15-unit splats near the origin "degenerate"
+    (refused as "row 0: property 'u'"); splats farther than diag / factor
+    from the origin keep the diagonal rule."""
+    if not len(positions):
+        return np.zeros(0)
+    here = np.sqrt(np.einsum("ij,ij->i", positions, positions))
+    return MIN_AXIS_LENGTH_REL * np.minimum(max(diag, 1e-300),
+                                            MIN_AXIS_POSITION_FACTOR * np.maximum(here, MIN_EXTENT_ABS))
 
 
 def _as_array(name, value, shape_tail, dtype, source):
@@ -131,7 +147,9 @@ class SplatCloud:
         Invariants: at least one splat; finite positions and axes, at most
         ``MAX_COORDINATE_ABS`` in magnitude (positions are local, after the
         ``origin`` is taken off); axes longer than ``MIN_AXIS_LENGTH_REL`` of
-        the bounding-box diagonal and not parallel; faces index existing
+        the bounding-box diagonal or, where smaller, of a multiple of the
+        splat's distance from the origin (:func:`min_axis_lengths`), and not
+        parallel; faces index existing
         splats.  Runs over ``VALIDATE_CHUNK_ROWS`` rows at a time, so its
         temporaries stay small for 10M splats.  ``values_checked``: skip
         the NaN / magnitude scan (a reader did it column by column).
@@ -167,9 +185,9 @@ class SplatCloud:
                              element="vertex", row=first_big, prop=nm)
         lo_c, hi_c = column_bounds(self.positions)
         diag = float(np.linalg.norm(hi_c - lo_c))
-        min_len = MIN_AXIS_LENGTH_REL * max(diag, 1e-300)
         for lo in range(0, n, step):
             bu, bv = self.u[lo:lo + step], self.v[lo:lo + step]
+            min_len = min_axis_lengths(self.positions[lo:lo + step], diag)
             uu = np.einsum("ij,ij->i", bu, bu)
             vv = np.einsum("ij,ij->i", bv, bv)
             lu, lv = np.sqrt(uu), np.sqrt(vv)
@@ -177,7 +195,8 @@ class SplatCloud:
                 bad = ~(ln > min_len)
                 if bad.any():
                     row = int(np.flatnonzero(bad)[0])
-                    raise InputError(f"degenerate splat axis (length {ln[row]:.3g})", path=src,
+                    raise InputError(f"degenerate splat axis (length {ln[row]:.3g}, the least "
+                                     f"there is {min_len[row]:.3g})", path=src,
                                      element="vertex", row=lo + row, prop=nm)
             # |u x v|^2 = |u|^2 |v|^2 - (u.v)^2 (Lagrange): no (n, 3) cross
             # product; at the 1e-6 threshold sine^2 = 1e-12 is far above the

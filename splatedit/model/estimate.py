@@ -25,7 +25,7 @@ import numpy as np
 from scipy.spatial import cKDTree
 
 from splatedit.errors import ParameterError
-from splatedit.model.cloud import SplatCloud
+from splatedit.model.cloud import SplatCloud, column_bounds, min_axis_lengths
 from splatedit.model.orient import orient_normals
 from splatedit.model.outliers import detect_outliers
 from splatedit.model.pca import morton_codes, neighbourhood_covariances, smallest_eigenvectors
@@ -294,6 +294,13 @@ def estimate_splats(points, normals=None, colors=None, progress=None, *, radius=
         part /= np.linalg.norm(part, axis=1, keepdims=True)
     if radius is None:
         r = robust_splat_radii(sp, nrm, distances=dist, neighbours=nb)
+        # a far stray point's radius is capped by its neighbours' (the main
+        # body's): at least twice what the cloud's validation requires there
+        lo_b, hi_b = column_bounds(sp)
+        diag = float(np.linalg.norm(hi_b - lo_b))
+        for lo_i in range(0, n, ESTIMATE_CHUNK_POINTS):
+            part = r[lo_i:lo_i + ESTIMATE_CHUNK_POINTS]
+            np.maximum(part, 2.0 * min_axis_lengths(sp[lo_i:lo_i + ESTIMATE_CHUNK_POINTS], diag), out=part)
     elif np.ndim(radius) == 1:
         r = np.asarray(radius, dtype=np.float64)[order]
     else:

@@ -13,7 +13,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.tolerances import (RENDER_CAMERA_MIN_UP_SINE, RENDER_CLIP_MARGIN_REL, RENDER_CLIP_MIN_RADIUS_REL,
                                   RENDER_FOV_DEG, RENDER_FRAME_MARGIN, RENDER_FRAME_MIN_RADIUS_REL,
-                                  RENDER_NEAR_FAR_RATIO, MAX_COORDINATE_ABS)
+                                  RENDER_NEAR_FAR_RATIO, RENDER_CAMERA_MAX_ABS)
 
 
 def _vec3(name, value) -> np.ndarray:
@@ -54,9 +54,9 @@ class Camera:
             raise ParameterError("fov_deg", f"must be in (0, 179), got {fov_deg}")
         self.fov_deg = float(fov_deg)
         for name, vec in (("eye", self.eye), ("target", self.target)):
-            if np.abs(vec).max() > MAX_COORDINATE_ABS:
+            if np.abs(vec).max() > RENDER_CAMERA_MAX_ABS:
                 raise ParameterError(name, f"{vec.tolist()} is beyond the supported magnitude "
-                                           f"{MAX_COORDINATE_ABS:g}")
+                                           f"{RENDER_CAMERA_MAX_ABS:g}")
         fwd = self.target - self.eye
         if not np.any(fwd):
             raise ParameterError("target", "must differ from eye")

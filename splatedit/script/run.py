@@ -309,12 +309,18 @@ def _degenerate_message(cloud, basis, d_c, exc: InputError) -> str:
     the model as a whole became too large for it (splat axes must be longer
     than MIN_AXIS_LENGTH_REL of the diagonal) or beyond MAX_COORDINATE_ABS:
     say how far the edit moves things instead of blaming that splat."""
+    from splatedit.tolerances import MIN_AXIS_LENGTH_REL, MIN_AXIS_POSITION_FACTOR
     row = exc.row
-    if row is not None and row in set(np.asarray(basis.indices).tolist()):
-        return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
-                "use a milder transform")
     d_c = getattr(d_c, "dC", d_c)    # a RotationDisplacement: its residual dC
     move = float(np.linalg.norm(d_c, axis=1).max()) if len(d_c) else 0.0
+    # a splat moved so far that its (unchanged) axes fall below the minimum
+    # length there (MIN_AXIS_LENGTH_REL of MIN_AXIS_POSITION_FACTOR times its
+    # distance from the origin): the move is the cause, not a squashed splat
+    too_far = (row is not None and 0 <= row < cloud.n and move * MIN_AXIS_LENGTH_REL * MIN_AXIS_POSITION_FACTOR
+               >= min(float(np.linalg.norm(cloud.u[row])), float(np.linalg.norm(cloud.v[row]))))
+    if row is not None and not too_far and row in set(np.asarray(basis.indices).tolist()):
+        return (f"the edit makes splats degenerate ({exc.reason}, splat {row}); "
+                "use a milder transform")
     return (f"the edit moves its controls up to {move:.3g} model units, {move / max(cloud.diagonal, 1e-300):.3g} "
             f"times the model's size ({cloud.diagonal:.3g}): the result cannot be stored "
             f"({exc.reason}); use a milder transform")

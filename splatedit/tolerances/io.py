@@ -116,3 +116,31 @@ REBASE_GRID_MIN = 1.0
 #: twice the grid origin's reach (one float32 bit), and far enough that an
 #: edit moving the model by a fraction of its size keeps the stored origin
 REBASE_STORED_REACH = 2.0
+
+
+# --- scanner readers against hostile headers (issue 21) -----------------------
+#: a LAZ file may declare at most this many points per byte of compressed
+#: point data (more is refused before the library allocates for them).
+#: Measured with laspy/lazrs 0.8: 200,000 identical points (the best case of
+#: the arithmetic coder) take 0.0135 bytes each, 74 points per byte; about 5x
+#: that margin.  'LASF' and random bytes made laspy allocate without end
+#: (2.7 GB at 120 s) before this bound
+LAZ_MAX_POINTS_PER_BYTE = 400
+#: smallest |scale| of a LAS file accepted: a scale of 0 collapsed every
+#: point onto the offset; below 1e-12 model units (a picometre in metres)
+#: 32-bit integers span less than 4.3 mm, no scanner's grid
+LAS_MIN_SCALE = 1e-12
+#: an E57 scan may declare at most this many points per byte of the whole
+#: file before pye57 allocates for them: libE57Format packs each field in at
+#: least one bit unless it is constant (then 0 bits: a scan of one repeated
+#: point, which no scanner writes); 8 bits per byte
+E57_MAX_POINTS_PER_BYTE = 8
+#: smallest positive extent (longest bounding-box side, model units) of a
+#: model.  Measured on a 400-point unit sphere scaled by 10^-e: at 1e-60 the
+#: spacing, splat sizes and boundary count of `info` equal the unit sphere's
+#: (scaled); at 1e-80 the boundary count is wrong (72 of 400 instead of 2:
+#: squared distances near 1e-160 lose their bits), at 1e-120 the splats
+#: come out degenerate, at 1e-300 the render showed rings with exit 0.  1e-50
+#: keeps a factor 1e10 from the first failure; all points in one place
+#: (extent 0) stay valid
+MIN_EXTENT_ABS = 1e-50

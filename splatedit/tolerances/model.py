@@ -8,6 +8,15 @@ carries the measurement behind it.
 # --- splat model validation ---------------------------------------------
 #: smallest allowed tangent-axis length, relative to the bounding-box diagonal
 MIN_AXIS_LENGTH_REL = 1e-9
+#: ... or, where smaller, relative to this many times the splat's distance
+#: from the local origin (issue 21): a scan of unit size with one glitch
+#: point 1e9 away has a diagonal of 1e9, and its 0.15-unit splats were
+#: refused as degenerate.  Splats farther than diagonal / 8 from the origin
+#: keep the diagonal rule (the editor's commit check relies on it: an edit
+#: that grows the diagonal still makes far-too-small splats there
+#: degenerate); float64 resolves an axis 1e-9 of its centre's magnitude
+#: with 7 digits to spare
+MIN_AXIS_POSITION_FACTOR = 8.0
 #: |u x v| / (|u| |v|) below this means u and v are (nearly) parallel
 MIN_AXIS_SINE = 1e-6
 

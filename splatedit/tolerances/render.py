@@ -178,3 +178,10 @@ PROGRESSIVE_SHADE_PAD_PX = 2.0
 #: path never).  The limits leave 2x headroom on the mean
 GS_TILE_MEAN_TOL = {"rgba16f": 0.35, "rgba32f": 0.01}
 GS_TILE_MAX_TOL = {"rgba16f": 4, "rgba32f": 1}
+#: largest |coordinate| of a camera's eye and target (model units): the
+#: default view of a model at the MAX_COORDINATE_ABS limit (a sphere of
+#: radius 1e15 at 40 degrees) puts the eye 3.1e15 away, and a user's eye
+#: may stand farther still.  1000x the model limit: float64 keeps 1e15-unit
+#: model detail at 1e18 to 1/8 unit (ulp 128 over a 1e15 body), the GPU sees
+#: the camera divided by the model's scale
+RENDER_CAMERA_MAX_ABS = 1e18

@@ -158,3 +158,23 @@ def test_convert_of_a_mesh_says_whether_its_faces_are_kept_or_dropped(tmp_path, 
     said = capsys.readouterr().out
     assert (": 4 splats, 4 faces" in said) is kept and ("faces were dropped" in said) is (not kept), said
     assert (read(out).faces is not None) is kept
+
+
+def test_deform_and_convert_keep_the_up_axis_the_input_header_names(tmp_path):
+    """A model saved by the editor with ``comment up_axis +Z`` stays Z-up
+    through ``convert`` and ``deform`` (PLY outputs)."""
+    import json
+
+    from splatedit.cli import main
+    from splatedit.data import default_model_path
+    from splatedit.io import read, write
+    from splatedit.model.orientation import header_up_hint
+    src = write(tmp_path / "zup.ply", read(default_model_path()), up_axis="+Z")
+    assert main(["-q", "convert", str(src), str(tmp_path / "conv.ply")]) == 0
+    assert header_up_hint(tmp_path / "conv.ply").label == "+Z"
+    script = tmp_path / "e.json"
+    script.write_text(json.dumps({"version": 1, "edits": [{"support": {"sphere": {"center": [0, 0.4, 0], "radius": 0.2}},
+                                                             "handle": {"sphere": {"center": [0, 0.47, -0.1], "radius": 0.06}},
+                                                             "transform": {"translate": [0.02, 0, 0]}}]}))
+    assert main(["-q", "deform", str(src), "--edit", str(script), "-o", str(tmp_path / "def.ply")]) == 0
+    assert header_up_hint(tmp_path / "def.ply").label == "+Z"

@@ -130,6 +130,21 @@ PATH_ERRORS = [
     ("deform script is a FIFO", ["deform", "BUNNY", "--edit", "TMP/fifo.json", "-o", "TMP/out.ply"],
      ["fifo.json", "not a regular file"]),
     ("convert output is a FIFO", ["convert", "BUNNY", "TMP/fifo.ply", "-f"], ["fifo.ply", "not a regular file"]),
+    # issue 21 class 3: what is written must be what the name says
+    ("render -o a .ply", ["render", "TMP/fifo.ply", "-o", "TMP/out.ply"],
+     ["out.ply", "unsupported file extension '.ply'", ".png"]),
+    ("render -o the input --force", ["render", "TMP/fifo.ply", "-o", "TMP/fifo.ply", "-f"],
+     ["fifo.ply", "unsupported file extension '.ply'"]),
+    ("render --buffers not .npz", ["render", "TMP/fifo.ply", "-o", "TMP/x.png", "--buffers", "TMP/b.png"],
+     ["b.png", "supported: .npz"]),
+    # issue 21 class 7: the editor makes the same checks before any window
+    ("edit a FIFO", ["edit", "TMP/fifo.ply"], ["fifo.ply", "not a regular file"]),
+    ("edit --save-as in a missing folder", ["edit", "BUNNY", "--save-as", "TMP/nonexistent/x.ply"],
+     ["'--save-as'", "nonexistent", "directory does not exist"]),
+    ("edit --save-as a .png", ["edit", "BUNNY", "--save-as", "TMP/x.png"],
+     ["'--save-as'", "unsupported file extension '.png'"]),
+    ("edit --save-as a FIFO", ["edit", "BUNNY", "--save-as", "TMP/fifo.ply"], ["'--save-as'", "not a regular file"]),
+    ("edit an unknown format", ["edit", "TMP/afile"], ["afile", "unsupported file extension"]),
 ]
 
 
@@ -281,3 +296,229 @@ def test_demo_into_a_read_only_folder_is_one_line(tmp_path, capsys, sub):
         assert str(ro) in line
     finally:
         ro.chmod(0o755)
+
+
+# ------------------------------------------------- issue 21: limits before the work
+def test_render_edit_beyond_the_gpu_columns_is_refused_before_reading(tmp_path, capsys):
+    """Five rotating handles need 20 basis columns (16 on the GPU): refused
+    naming the script and the edit's JSON path, before the model is read
+    (a FIFO without writer here: reading it would hang) or anything fitted."""
+    import json
+    import os
+    fifo = tmp_path / "in.ply"
+    os.mkfifo(fifo)
+    sphere = {"sphere": {"center": [0, 0, 0], "radius": 0.1}}
+    script = tmp_path / "five.json"
+    script.write_text(json.dumps({"version": 1, "edits": [
+        {"support": sphere, "handle": sphere, "transform": {"translate": [0, 0, 0.01]}},
+        {"support": sphere, "handles": [sphere] * 5,
+         "transforms": [{"rotate": {"axis": [0, 0, 1], "degrees": 5}}] * 5}]}))
+    assert main(["-q", "render", str(fifo), "-o", str(tmp_path / "x.png"), "--edit", str(script)]) == 2
+    line = one_error_line(capsys)
+    assert str(script) in line and "$.edits[1]" in line and "20 deformation columns" in line
+    assert "RENDER_MAX_BASIS_COLUMNS" not in line and "'B'" not in line
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["five.json", "in.ply"]
+
+
+def test_gaussian_scene_beyond_the_limits_gets_the_same_line_from_info_and_render(tmp_path, capsys):
+    """Class 8: one validation per format (info accepted a scene at 1e20 that
+    render refused, naming 'positions')."""
+    import plyfile
+    from splatedit.data import gaussian_scene_path
+    v = plyfile.PlyData.read(str(gaussian_scene_path()))["vertex"].data.copy()
+    v["y"] += 1e20
+    src = tmp_path / "far.ply"
+    plyfile.PlyData([plyfile.PlyElement.describe(v, "vertex")]).write(str(src))
+    lines = []
+    for argv in (["info", str(src)], ["render", str(src), "-o", str(tmp_path / "x.png")],
+                 ["convert", str(src), str(tmp_path / "o.ply")]):
+        assert main(["-q", *argv]) == 2
+        lines.append(one_error_line(capsys))
+    assert len(set(lines)) == 1, lines
+    assert "property 'y'" in lines[0] and "row 0" in lines[0] and "positions" not in lines[0]
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["far.ply"]
+
+
+# ------------------------------------------- issue 21 class 1: full disks, library errors
+@pytest.mark.parametrize("ext", ["laz", "e57"])
+def test_full_disk_while_writing_a_scanner_format_is_one_line(tmp_path, ext):
+    """A file-size limit (RLIMIT_FSIZE, as a full disk: the write fails)
+    while lazrs / laspy / libE57 write: one error line with the reason, exit
+    2, no temporary left (libE57's debug lines and pye57's exception at
+    collection used to follow, and a crash)."""
+    import os
+    import resource
+    import signal
+    import subprocess
+    import sys
+    from splatedit.data import default_model_path
+
+    def limit():
+        signal.signal(signal.SIGXFSZ, signal.SIG_IGN)
+        resource.setrlimit(resource.RLIMIT_FSIZE, (30000, 30000))
+
+    out = tmp_path / f"out.{ext}"
+    res = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", "convert", str(default_model_path()),
+                          str(out)], preexec_fn=limit, capture_output=True, text=True, timeout=120)
+    assert res.returncode == 2, res.stderr
+    lines = res.stderr.strip().splitlines()
+    assert len(lines) == 1 and lines[0].startswith(f"splatedit: error: {out}: cannot write"), res.stderr
+    assert "File too large" in lines[0] or "ErrorWriteFailed" in lines[0]
+    assert os.listdir(tmp_path) == []
+
+
+def test_a_count_that_fits_a_sparse_file_but_not_the_memory_is_one_line(tmp_path):
+    """A PLY declaring 500 million vertices over a sparse file of that size
+    passes every size check; the read must end in one line, not a MemoryError
+    traceback (the process's address space is capped at 1.5 GiB here)."""
+    import resource
+    import subprocess
+    import sys
+    n = 500_000_000
+    head = (f"ply\nformat binary_little_endian 1.0\nelement vertex {n}\nproperty float x\n"
+            "property float y\nproperty float z\nend_header\n").encode()
+    src = tmp_path / "sparse.ply"
+    with open(src, "wb") as fh:
+        fh.write(head)
+        fh.truncate(len(head) + 12 * n)
+
+    def limit():
+        resource.setrlimit(resource.RLIMIT_AS, (3 * 2**29, 3 * 2**29))
+
+    for cmd in (["info", str(src)], ["convert", str(src), str(tmp_path / "o.xyz")]):
+        res = subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", *cmd], preexec_fn=limit,
+                             capture_output=True, text=True, timeout=120)
+        assert res.returncode == 2, res.stderr
+        lines = res.stderr.strip().splitlines()
+        assert len(lines) == 1 and "not enough memory" in lines[0] and str(src) in lines[0], res.stderr
+
+
+# ------------------------------------------------------ issue 21 class 7: signals
+@pytest.mark.parametrize("first,second", [("SIGTERM", "SIGTERM"), ("SIGINT", "SIGINT"), ("SIGHUP", "SIGTERM")])
+def test_a_second_signal_during_the_clean_up_is_ignored(tmp_path, monkeypatch, capsys, first, second):
+    """The first SIGTERM / Ctrl+C / SIGHUP (terminal closed) interrupts the
+    write: the temporary is removed, the old file kept, exit 130; a second
+    one arriving while that is handled (sent here from inside the clean-up)
+    printed a traceback from the handler."""
+    import os
+    import signal
+    import splatedit.cli as cli
+    import splatedit.io as io_mod
+    from splatedit.data import default_model_path
+    out = tmp_path / "out.ply"
+    out.write_bytes(b"old contents")
+
+    def write_then_signal(fh, cloud, **kw):
+        fh.write(b"ply\npartial")
+        os.kill(os.getpid(), getattr(signal, first))
+
+    real_close = cli._Progress.close
+
+    def close_with_second_signal(self):
+        os.kill(os.getpid(), getattr(signal, second))
+        real_close(self)
+
+    monkeypatch.setattr(io_mod, "write_ply", write_then_signal)
+    monkeypatch.setattr(cli._Progress, "close", close_with_second_signal)
+    previous = {s: signal.getsignal(getattr(signal, s)) for s in ("SIGINT", "SIGTERM", "SIGHUP")}
+    assert main(["-q", "convert", str(default_model_path()), str(out), "-f"]) == 130
+    err = capsys.readouterr().err
+    assert err.strip() == "splatedit: interrupted" and "Traceback" not in err
+    assert out.read_bytes() == b"old contents"
+    assert sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
+    assert {s: signal.getsignal(getattr(signal, s)) for s in previous} == previous
+
+
+# ------------------------------------------- issue 21 class 5: valid input, far values
+def _sphere(n=1500, radius=1.0, seed=0):
+    import numpy as np
+    p = np.random.default_rng(seed).normal(size=(n, 3))
+    return radius * p / np.linalg.norm(p, axis=1)[:, None]
+
+
+@pytest.mark.parametrize("argv", [["info", "FILE", "--json"], ["convert", "FILE", "OUT"],
+                                  ["convert", "FILE", "OUT", "--remove-outliers"]],
+                         ids=["info", "convert", "convert --remove-outliers"])
+def test_a_scan_with_one_glitch_point_1e9_away_is_accepted(tmp_path, capsys, argv):
+    """The point is valid (below 1e15); the main body's splats were refused as
+    'row 0: property 'u': degenerate splat axis' (the file has no u)."""
+    import json
+    import numpy as np
+    src = tmp_path / "glitch.xyz"
+    np.savetxt(src, np.vstack([_sphere(), [[1e9, 0, 0]]]))
+    out = tmp_path / "out.ply"
+    argv = [str(src) if a == "FILE" else str(out) if a == "OUT" else a for a in argv]
+    assert main(["-q", *argv]) == 0, capsys.readouterr().err
+    printed = capsys.readouterr().out
+    if argv[0] == "info":
+        info = json.loads(printed)
+        assert info["far_from_main_body"] == 1 and info["origin"] == [0.0, 0.0, 0.0]
+        assert 2.5 < info["main_body_diagonal"] < 3.5 and info["splat_radius_median"] < 0.3
+    else:
+        from splatedit.io import read
+        back = read(out)
+        assert back.n == (1500 if "--remove-outliers" in argv else 1501)
+        assert float(np.median(np.linalg.norm(back.u, axis=1))) < 0.3
+
+
+def test_a_sphere_at_the_magnitude_limit_renders_with_the_default_view(tmp_path, capsys):
+    """info accepts a sphere of radius 0.99e15; render refused it naming
+    '--eye', a flag nobody gave (the default eye stands 3e15 away)."""
+    import numpy as np
+    from PIL import Image
+    src = tmp_path / "big.xyz"
+    np.savetxt(src, _sphere(800, 0.99e15))
+    out = tmp_path / "big.png"
+    assert main(["-q", "render", str(src), "-o", str(out), "--size", "64x48"]) == 0, capsys.readouterr().err
+    img = np.asarray(Image.open(out))
+    covered = np.any(img != img[0, 0], axis=2).mean()
+    assert 0.1 < covered < 0.9
+
+
+def test_signals_during_the_clean_up_of_a_real_process_leave_one_line_and_exit_130(tmp_path):
+    """The command line's own process (handlers left ignoring at its end,
+    while Python's finalisation runs): SIGTERM mid-write, then SIGINT and
+    SIGHUP during the clean-up and one more after main() returned."""
+    import subprocess
+    import sys
+    from splatedit.data import default_model_path
+    out = tmp_path / "out.ply"
+    out.write_bytes(b"old contents")
+    code = f"""
+import os, signal, sys
+import splatedit.cli as cli
+import splatedit.io as io_mod
+def write(fh, cloud, **kw):
+    fh.write(b"ply partial")
+    os.kill(os.getpid(), signal.SIGTERM)
+real_close = cli._Progress.close
+def close(self):
+    os.kill(os.getpid(), signal.SIGINT)
+    os.kill(os.getpid(), signal.SIGHUP)
+    real_close(self)
+io_mod.write_ply = write
+cli._Progress.close = close
+sys.argv = ["splatedit", "-q", "convert", {str(default_model_path())!r}, {str(out)!r}, "-f"]
+code = cli.main()
+os.kill(os.getpid(), signal.SIGINT)
+sys.exit(code)
+"""
+    res = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
+    assert res.returncode == 130 and res.stderr == "splatedit: interrupted\n", (res.returncode, res.stderr)
+    assert out.read_bytes() == b"old contents" and sorted(p.name for p in tmp_path.iterdir()) == ["out.ply"]
+
+
+@pytest.mark.parametrize("case", ["las scale nan", "las scale 0", "las count above the records", "laz 4e9 points",
+                                  "pcd COUNT 3 for x", "pcd duplicate FIELDS", "gaussian huge log-scale"])
+@pytest.mark.parametrize("command", ["info", "convert", "render"])
+def test_hostile_scanner_files_are_one_line_for_every_command(tmp_path, capsys, case, command):
+    """Issue 21 classes 1, 3, 4, 8: the readers' checks are the same for every
+    command (rows of tests/io/test_malformed_inputs.py)."""
+    from tests.io.test_malformed_inputs import SCANNER_CASES
+    build, expected = next((c[1], c[2]) for c in SCANNER_CASES if c[0] == case)
+    src = build(tmp_path)
+    out = {"info": [], "convert": [str(tmp_path / "o.ply")], "render": ["-o", str(tmp_path / "o.png")]}[command]
+    assert main(["-q", command, str(src), *out]) == 2
+    line = one_error_line(capsys)
+    assert str(src) in line and all(sub in line for sub in expected), line
+    assert not (tmp_path / "o.ply").exists() and not (tmp_path / "o.png").exists()

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.errors import InputError
+from splatedit.errors import InputError, InputWarning
 from splatedit.io import read
 from tests.io._plyutil import make_ply
 
@@ -224,3 +224,194 @@ def test_exact_files_do_not_warn(tmp_path):
         warnings.simplefilter("error")
         read(path)
         read(q)
+
+
+# ------------------------------------------ issue 21: scanner formats and Gaussians
+def _las(tmp_path, name, *, edits=(), append=b"", cut=None, n=40):
+    """A small LAS file (format 3, scale 0.01) with header fields overwritten:
+    ``edits`` = (offset, struct format, value)."""
+    import struct
+    import laspy
+    h = laspy.LasHeader(point_format=3, version="1.2")
+    h.scales, h.offsets = [0.01] * 3, [0.0] * 3
+    las = laspy.LasData(h)
+    rng = np.random.default_rng(1)
+    for d in "XYZ":
+        las[d] = rng.integers(0, 1000, n)
+    path = tmp_path / name
+    las.write(str(path))
+    data = bytearray(path.read_bytes())
+    for off, fmt, value in edits:
+        struct.pack_into("<" + fmt, data, off, value)
+    path.write_bytes(bytes(data[:cut] if cut is not None else data) + append)
+    return path
+
+
+def _laz_chunks(tmp_path, chunks, table=None):
+    """A LAZ file whose chunk table (its offset: the first 8 bytes of the
+    point data) declares ``chunks`` chunks, or whose offset is ``table``."""
+    import struct
+    path = _las(tmp_path, "c.laz")
+    data = bytearray(path.read_bytes())
+    start = struct.unpack_from("<I", data, 96)[0]
+    if table is not None:
+        struct.pack_into("<q", data, start, table)
+    else:
+        at = struct.unpack_from("<q", data, start)[0]
+        struct.pack_into("<I", data, at + 4, chunks)
+    path.write_bytes(bytes(data))
+    return path
+
+
+def _las14_evlr(tmp_path, length):
+    """A LAS 1.4 file with one extended variable-length record declaring ``length`` bytes."""
+    import struct
+    import laspy
+    h = laspy.LasHeader(point_format=6, version="1.4")
+    h.scales, h.offsets = [0.01] * 3, [0.0] * 3
+    las = laspy.LasData(h)
+    for d in "XYZ":
+        las[d] = np.arange(40) * (3 if d == "X" else 1)
+    path = tmp_path / "e.las"
+    las.write(str(path))
+    data = bytearray(path.read_bytes())
+    size = len(data)
+    data += struct.pack("<H16sHQ32s", 0, b"user", 1, length, b"hostile")
+    struct.pack_into("<QI", data, 235, size, 1)
+    path.write_bytes(bytes(data))
+    return path
+
+
+def _put(tmp_path, name, data):
+    """Write ``data`` (bytes or str) to ``tmp_path / name``; returns the path."""
+    path = tmp_path / name
+    (path.write_bytes if isinstance(data, bytes) else path.write_text)(data)
+    return path
+
+
+def _pcd(head_fields="x y z", size="4 4 4", typ="F F F", count="1 1 1", points="3",
+         data="ascii", body="0 0 0\n1 0 0\n0 1 0\n"):
+    return (f"VERSION 0.7\nFIELDS {head_fields}\nSIZE {size}\nTYPE {typ}\nCOUNT {count}\nWIDTH 3\n"
+            f"HEIGHT 1\nPOINTS {points}\nDATA {data}\n{body}").encode()
+
+
+def _gaussians(tmp_path, name, column, row, value):
+    import plyfile
+    from splatedit.data import gaussian_scene_path
+    v = plyfile.PlyData.read(str(gaussian_scene_path()))["vertex"].data.copy()
+    if row is None:
+        v[column] += value
+    else:
+        v[column][row] = value
+    path = tmp_path / name
+    plyfile.PlyData([plyfile.PlyElement.describe(v, "vertex")]).write(str(path))
+    return path
+
+
+NAN, INF = float("nan"), float("inf")
+SCANNER_CASES = [
+    # (id, builder(tmp_path) -> path, expected substrings); class 1 of issue 21
+    ("las scale nan", lambda t: _las(t, "s.las", edits=[(131, "d", NAN)]), ["header: x scale is nan"]),
+    ("las scale inf", lambda t: _las(t, "s.las", edits=[(147, "d", INF)]), ["z scale is inf"]),
+    ("las scale 1e300", lambda t: _las(t, "s.las", edits=[(139, "d", 1e300)]),
+     ["y scale 1e+300", "supported magnitude"]),
+    ("las offset nan", lambda t: _las(t, "o.las", edits=[(155, "d", NAN)]), ["x offset is nan"]),
+    ("las offset 1e300", lambda t: _las(t, "o.las", edits=[(171, "d", -1e300)]),
+     ["z offset -1e+300", "supported magnitude"]),
+    ("las coordinates beyond 1e15", lambda t: _las(t, "c.las", edits=[(131, "d", 1e13)]),
+     ["x coordinate", "supported magnitude"]),
+    # class 3: degenerate scale
+    ("las scale 0", lambda t: _las(t, "z.las", edits=[(139, "d", 0.0)]), ["y scale 0 is degenerate"]),
+    # class 4: lying counts
+    ("las count above the records", lambda t: _las(t, "n.las", edits=[(107, "I", 5000)]),
+     ["early end-of-file", "5000 points", "40 point records"]),
+    ("laz count above the records", lambda t: _las(t, "n.laz", edits=[(107, "I", 5000)]),
+     ["not a readable LAS/LAZ file"]),
+    # class 2: header-driven allocations bounded by the file size
+    ("las 4e9 points", lambda t: _las(t, "b.las", edits=[(107, "I", 2**32 - 1)]), ["early end-of-file"]),
+    ("laz 4e9 points", lambda t: _las(t, "b.laz", edits=[(107, "I", 2**32 - 1)]),
+     ["cannot be compressed into"]),
+    ("laz chunk table count damaged", lambda t: _laz_chunks(t, 10**9), ["chunk table declares 1000000000"]),
+    ("laz chunk table offset damaged", lambda t: _laz_chunks(t, None, table=10**9), ["chunk table offset"]),
+    ("laz chunk size damaged", lambda t: _las(t, "k.laz", edits=[(227 + 54 + 12, "I", 534070706)]),
+     ["534070706 points per chunk"]),
+    ("las 1.4 extended record of 2**40 bytes", lambda t: _las14_evlr(t, 2**40),
+     ["extended variable-length record 0", "1099511627776 bytes"]),
+    ("las 1e9 variable-length records", lambda t: _las(t, "v.las", edits=[(100, "I", 10**9)]),
+     ["variable-length records do not fit"]),
+    ("las point data offset past the end", lambda t: _las(t, "p.las", edits=[(96, "I", 10**8)]),
+     ["point data offset 100000000"]),
+    ("las record length below the format", lambda t: _las(t, "r.las", edits=[(105, "H", 4)]),
+     ["record length 4"]),
+    ("las truncated header", lambda t: _las(t, "h.las", cut=100), ["truncated LAS header"]),
+    ("lasf and random bytes", lambda t: _put(t, "x.las", b"LASF" + bytes(range(256)) * 2), ["header"]),
+    ("pcd COUNT 3 for x", lambda t: _put(t, "c.pcd", _pcd(count="3 1 1")),
+     ["field 'x' has COUNT 3 (must be 1)"]),
+    ("pcd huge COUNT", lambda t: _put(t, "h.pcd",
+        _pcd("x y z label", "4 4 4 4", "F F F U", "1 1 1 99999999999")),
+     ["a row of", "cannot fit"]),
+    ("pcd duplicate FIELDS", lambda t: _put(t, "d.pcd",
+        _pcd("x y z x", "4 4 4 4", "F F F F", "1 1 1 1", body="0 0 0 0\n1 0 0 0\n0 1 0 0\n")),
+     ["field 'x' is listed twice"]),
+    ("pcd negative POINTS", lambda t: _put(t, "n.pcd", _pcd(points="-3")),
+     ["POINTS -3 is negative"]),
+    ("pcd POINTS 0", lambda t: _put(t, "z.pcd", _pcd(points="0", body="")),
+     ["zero points"]),
+    ("pcd int field overflow", lambda t: _put(t, "i.pcd",
+        _pcd(typ="F F I", size="4 4 2", body="0 0 0\n1 0 1e30\n0 1 0\n")),
+     ["row 1", "property 'z'", "does not fit the declared type int16"]),
+    ("pcd binary POINTS above the data", lambda t: _put(t, "b.pcd",
+        _pcd(points="9", data="binary", body="") + np.zeros((3, 3), "<f4").tobytes()),
+     ["early end-of-file", "POINTS says 9", "3 rows"]),
+    # class 6 / 8: Gaussian scenes name their own properties, one validation for every command
+    ("gaussian scene at 1e20", lambda t: _gaussians(t, "far.ply", "x", None, 1e20),
+     ["row 0", "property 'x'", "supported magnitude"]),
+    ("gaussian huge log-scale", lambda t: _gaussians(t, "s.ply", "scale_1", 7, 60.0),
+     ["row 7", "property 'scale_1'", "log-scale 60"]),
+    # class 3: a model 1e-300 across
+    ("xyz 1e-300 across", lambda t: _put(t, "t.xyz",
+        "".join(f"{x}e-300 {y}e-300 {(x + y) % 3}e-300\n" for x in range(5) for y in range(5))),
+     ["across", "smallest supported extent"]),
+]
+
+
+@pytest.mark.parametrize("build,expected", [c[1:] for c in SCANNER_CASES], ids=[c[0] for c in SCANNER_CASES])
+def test_hostile_scanner_files_raise_one_input_error_naming_the_cause(tmp_path, build, expected):
+    """Issue 21 classes 1-4, 6, 8: every reader validates what it reads (finite,
+    non-degenerate scales, counts against the file size, field lists) before
+    the library or numpy sees it."""
+    import warnings
+    path = build(tmp_path)
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", InputWarning)
+        with pytest.raises(InputError) as info:
+            read(path)
+    msg = str(info.value)
+    assert path.name in msg and "\n" not in msg
+    for sub in expected:
+        assert sub in msg, f"{sub!r} not in {msg!r}"
+
+
+SCANNER_WARNINGS = [
+    # (id, builder, expected substrings of the one warning, points read); class 4
+    ("las records after the count", lambda t: _las(t, "m.las", edits=[(107, "I", 25)]),
+     ["15 point record(s) after the 25"], 25),
+    ("pcd ascii rows after POINTS", lambda t: _put(t, "a.pcd", _pcd(points="2")),
+     ["1 data line(s) from line 12", "after the 2 points"], 2),
+    ("pcd binary bytes after POINTS", lambda t: _put(t, "b.pcd",
+        _pcd(points="2", data="binary", body="") + np.eye(3, dtype="<f4").tobytes()),
+     ["12 byte(s) after the 2 points"], 2),
+]
+
+
+@pytest.mark.parametrize("build,expected,n", [c[1:] for c in SCANNER_WARNINGS],
+                         ids=[c[0] for c in SCANNER_WARNINGS])
+def test_scanner_data_beyond_the_declared_count_warns_like_ply(tmp_path, build, expected, n):
+    path = build(tmp_path)
+    with pytest.warns(InputWarning) as record:
+        cloud = read(path)
+    assert cloud.n == n
+    msg = str(record[0].message)
+    assert str(path) in msg, msg
+    for sub in expected:
+        assert sub in msg, f"{sub!r} not in {msg!r}"

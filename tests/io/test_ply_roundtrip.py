@@ -140,3 +140,23 @@ def test_vectorised_ascii_reader_equals_plyfile_reader(tmp_path, monkeypatch, co
     fast = read(src)
     monkeypatch.setattr(ply, "_read_ascii_fast", lambda *a: None)
     assert_same(fast, read(src))
+
+
+def test_the_up_axis_written_into_a_ply_header_is_what_the_reader_detects(tmp_path):
+    """The editor saves the up axis it shows (U, or detected) as
+    ``comment up_axis ...``: the saved file opens standing the same way."""
+    from splatedit.data import default_model_path
+    from splatedit.io import read, write
+    from splatedit.model.orientation import UpSource, detect_cloud_up_axis, header_up_hint
+    cloud = read(default_model_path())
+    for label in ("+Z", "-X"):
+        out = write(tmp_path / f"up{label[1]}.ply", cloud, up_axis=label)
+        hint = header_up_hint(out)
+        assert hint.label == label and hint.source is UpSource.FILE_HEADER
+        up = detect_cloud_up_axis(read(out), out)
+        assert up.label == label
+    plain = write(tmp_path / "plain.ply", cloud)
+    assert header_up_hint(plain) is None
+    import pytest
+    with pytest.raises(ValueError):
+        write(tmp_path / "bad.ply", cloud, up_axis="Z-up")
