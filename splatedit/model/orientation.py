@@ -13,7 +13,9 @@ from, in order:
    the bottom of the model along that axis (a one-sided scan taken from
    one side has many normals facing the scanner too, but spread over the
    whole depth: that is no floor), and the model is not tallest along it;
-3. otherwise +Y (the graphics convention of PLY / OFF / OBJ meshes: the
+3. a standing shape: a model ``UP_AXIS_TALL_Z_RATIO`` times taller along Z
+   than along X and Y (a figure exported from a Z-up tool) -> +Z;
+4. otherwise +Y (the graphics convention of PLY / OFF / OBJ meshes: the
    Stanford models, the bundled bunny).
 """
 
@@ -27,7 +29,8 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.tolerances import (FRONT_VIEW_Z_UP_COS, UP_AXIS_ALIGNED_COS, UP_AXIS_FLOOR_BAND,
-                                  UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION, UP_AXIS_SAMPLE)
+                                  UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION, UP_AXIS_SAMPLE,
+                                  UP_AXIS_TALL_Z_RATIO)
 
 #: the formats whose coordinates are Z-up by definition
 Z_UP_SUFFIXES = (".las", ".laz", ".e57")
@@ -37,6 +40,7 @@ class UpSource(enum.Enum):
     FILE_HEADER = "file header"
     FILE_FORMAT = "file format"
     GROUND = "ground normals"
+    SHAPE = "tall along Z"
     DEFAULT = "default"
     USER = "set by the user"
 
@@ -134,6 +138,8 @@ def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpA
                     best = (count, k, sign)
         if best is not None:
             return UpAxis(best[1], best[2], UpSource.GROUND)
+        if extent[2] > 0 and extent[2] >= UP_AXIS_TALL_Z_RATIO * max(extent[0], extent[1]):
+            return UpAxis(2, 1, UpSource.SHAPE)
     return UpAxis(1, 1, UpSource.DEFAULT)
 
 

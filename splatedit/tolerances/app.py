@@ -115,6 +115,12 @@ UP_AXIS_GROUND_MIN_FRACTION = 0.25
 #: flat underside).  hippo1's +Z-facing points: 3% within the bottom tenth of
 #: z (they cover its whole depth); a floor: all of them
 UP_AXIS_FLOOR_BAND = 0.1
+#: with no word from the file and no floor, a model at least this many times
+#: taller along Z than along X and Y stands Z-up (a figure from a Z-up tool:
+#: a standing person is 3.5-6x taller than wide or deep with the arms down);
+#: 3x keeps Y-up models that are long along Z lying as authored (a car about
+#: 2.5x as long as wide, the bunny 1.0x)
+UP_AXIS_TALL_Z_RATIO = 3.0
 UP_AXIS_FLOOR_MIN_IN_BAND = 0.5
 #: the floor rule runs on every n // this-th splat of a large model: its two tests
 #: are shares of points (binomial error of a share near the 0.25 / 0.5 limits with

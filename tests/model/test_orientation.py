@@ -139,3 +139,38 @@ def test_cloud_up_axis_on_a_sample_agrees_with_all_splats(monkeypatch):
     sampled = orientation.detect_cloud_up_axis(cloud)
     assert (sampled.axis, sampled.sign, sampled.source) == (whole.axis, whole.sign, whole.source)
     assert (whole.axis, whole.sign) == (2, 1)
+
+
+def _figure(height_axis: int, height=1.8, width=0.5, depth=0.3, n=4000, seed=4):
+    """Points on an ellipsoid `height` long along `height_axis` (a standing
+    figure with the arms down, as a Z-up tool exports it when axis 2)."""
+    rng = np.random.default_rng(seed)
+    s = rng.normal(size=(n, 3))
+    s /= np.linalg.norm(s, axis=1, keepdims=True)
+    radii = np.array([width, depth, depth]) / 2
+    radii[height_axis] = height / 2
+    if height_axis != 0:
+        radii[0] = width / 2
+    p = s * radii
+    nrm = s / radii
+    return p, nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
+
+
+def test_a_figure_standing_along_z_is_z_up_from_its_shape():
+    """man.off (a CGAL sample) opened lying down: a model 3x taller along Z
+    than wide and deep, with no word from the file and no floor, is +Z."""
+    p, n = _figure(2)
+    up = detect_up_axis(n, p)
+    assert (up.label, up.source) == ("+Z", UpSource.SHAPE)
+
+
+def test_models_long_along_z_but_not_standing_keep_y_up():
+    """A Y-up car about 2.5x as long (Z) as wide, and a figure standing
+    along Y, stay +Y: only a clearly tall Z extent counts."""
+    rng = np.random.default_rng(5)
+    car = rng.uniform(-1, 1, size=(3000, 3)) * [0.9, 0.75, 2.25]
+    nrm = rng.normal(size=(3000, 3))
+    up = detect_up_axis(nrm / np.linalg.norm(nrm, axis=1, keepdims=True), car)
+    assert up.label == "+Y"
+    p, n = _figure(1)
+    assert detect_up_axis(n, p).label == "+Y"
