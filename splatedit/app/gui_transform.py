@@ -15,10 +15,26 @@ from __future__ import annotations
 import numpy as np
 from imgui_bundle import imgui
 
+from splatedit.app import revision
+
 from splatedit.app.transform_fields import (TargetKind, TransformInput, apply_position, apply_transform,
                                             field_target)
 
 RED = imgui.ImVec4(1.0, 0.47, 0.47, 1.0)
+
+
+#: the fields show positions and moves to this fraction of the model's
+#: diagonal (1e-4: a 0.16 mm step on a 1.6 m model): "-0.0006" rather than
+#: "-0.00060034", which the three fields of a 1280x720 panel cut off
+FIELD_PRECISION_REL = 1e-4
+
+
+def length_format(diagonal: float) -> str:
+    """printf format of a length field for a model ``diagonal`` units across:
+    as many decimals as FIELD_PRECISION_REL of the diagonal needs, at most 6."""
+    step = max(float(diagonal), 1e-300) * FIELD_PRECISION_REL
+    decimals = int(min(6, max(0, -np.floor(np.log10(step)))))
+    return f"%.{decimals}f"
 
 
 def _entered() -> bool:
@@ -36,6 +52,16 @@ class TransformSection:
         self.fields = TransformInput()
         self.position: list = [0.0, 0.0, 0.0]
         self._typing = False
+        self._fmt = None            # (cloud revision, length format)
+
+    def _length_format(self, session) -> str:
+        """:func:`length_format` of the open model, computed once per cloud revision."""
+        if session is None:
+            return "%.4g"
+        key = revision.of(session.cloud)
+        if self._fmt is None or self._fmt[0] != key:
+            self._fmt = (key, length_format(session.cloud.diagonal))
+        return self._fmt[1]
 
     def draw(self, rect) -> None:
         """Lay out the section; ``rect(name)`` records the last item's rectangle."""
@@ -60,14 +86,15 @@ class TransformSection:
         imgui.begin_disabled(t.problem is not None)
         if not self._typing:
             self.position = [float(x) for x in t.position] if t.position is not None else [0.0, 0.0, 0.0]
+        fmt = self._length_format(s)
         imgui.set_next_item_width(220)
-        _, v = imgui.input_float3("position", self.position, "%.5g")
+        _, v = imgui.input_float3("position", self.position, fmt)
         self.position = list(v)
         moved = _entered()
         self._typing = imgui.is_item_active()
         rect("field_position")
         imgui.set_next_item_width(220)
-        _, v = imgui.input_float3("move", f.translate, "%.4g")
+        _, v = imgui.input_float3("move", f.translate, fmt)
         f.translate = list(v)
         go = _entered()
         rect("field_translate")
