@@ -312,10 +312,12 @@ class EditorGui(MenuBar):
             self._deformation()
         if imgui.collapsing_header("Transform", open_):
             self.transform.draw(self._rect)
-        if imgui.collapsing_header("Display", open_):
-            self._display()
+        # History before Display: at 1280x720 the History section was always
+        # below the fold (issue 19 item 8); the display options are set once
         if imgui.collapsing_header("History", open_):
             self._history()
+        if imgui.collapsing_header("Display", open_):
+            self._display()
 
     def _tool_button(self, label: str, name: str, action: Action, on: bool) -> None:
         if on:
