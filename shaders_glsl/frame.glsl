@@ -15,7 +15,7 @@ layout(std140, set = 0, binding = 0) uniform Frame {
     vec4 light;         // ambient, diffuse, specular, shininess
     vec4 misc;          // gaussian sharpness, 1/gamma, min weight, point-size threshold (pixels)
     uvec4 options;      // backface culling, apply gamma, display (0 shaded, 1 stretch heat map), -
-    vec4 display;       // splat size scale, grey albedo (sRGB; < 0: the file's colours), -, -
+    vec4 display;       // splat size scale, grey albedo (sRGB; < 0: the file's colours), EDL strength, EDL radius (pixels; resolve_edl.frag)
 } F;
 
 // Per-splat flag bits (renderer.py FLAG_*).

@@ -12,6 +12,9 @@ accumulator images and the same resolve pass:
 * compute: ``Prepass -> ComputeVisibility -> ComputeAttributes ->
   AccumulatorCopy -> Resolve``
 
+With eye-dome lighting (``edl``) the last pass is :class:`EyeDomeResolve`
+instead of :class:`Resolve`.
+
 (:func:`splat_frame`), and the pick frame is ``Prepass -> RasterSplats(pick)``.
 :mod:`splatedit.render.progressive` records its chunks with the same
 :class:`RasterSplats` and :class:`Resolve` objects (a chunk of splats, loading
@@ -27,7 +30,7 @@ from splatedit.render.frame import RESOURCES, Frame, FrameContext, Pass, Resolve
 from splatedit.render.splat_layout import RP_DEPTH, RP_PICK, rp_attr
 
 __all__ = ["RESOURCES", "Frame", "FrameContext", "Pass", "Resolve", "Prepass", "RasterSplats",
-           "ComputeVisibility", "ComputeAttributes", "AccumulatorCopy", "splat_frame", "pick_frame"]
+           "ComputeVisibility", "ComputeAttributes", "AccumulatorCopy", "EyeDomeResolve", "splat_frame", "pick_frame"]
 
 _RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 _RP_PICK_LOAD = V.RenderPassDesc(colors=(V.Attachment("r32ui", "load", initial="transfer_src", final="transfer_src"),),
@@ -146,10 +149,26 @@ class AccumulatorCopy(Pass):
         ctx.r.compute_rasterizer(ctx.t).record_copy(cb, ctx.r, self.final)
 
 
-def splat_frame(path: str, attr_final: str = "shader_read", resolve: bool = True) -> Frame:
+class EyeDomeResolve(Resolve):
+    """The shading pass with eye-dome lighting (Boucheny 2009): the resolve
+    shading, then every covered pixel darkened by the log-depth steps down
+    to its 8 neighbours at ``F.display.w`` pixels, ``exp(-300 *
+    F.display.z * mean step)`` (shaders_glsl/resolve_edl.frag); it reads
+    the linear view depth the accumulators hold (w*depth / w), so a scan
+    without normals still shows its edges and creases."""
+
+    name, timing, reads, writes = "resolve_edl", "shading", ("accum",), ("output",)
+    shader = "resolve_edl.frag"
+
+    def record(self, cb, ctx):
+        ctx.t.record_resolve(cb, ctx.target, self.shader, ctx.r.resolve_set_layout)
+
+
+def splat_frame(path: str, attr_final: str = "shader_read", resolve: bool = True, edl: bool = False) -> Frame:
     """The splat renderer's frame on ``path`` (``"raster"`` / ``"compute"``):
     pre-pass, visibility, attributes (accumulator images in layout
-    ``attr_final``), and (``resolve``) the shading pass."""
+    ``attr_final``), and (``resolve``) the shading pass, with eye-dome
+    lighting (:class:`EyeDomeResolve`) when ``edl``."""
     if path == "compute":
         passes = [Prepass(), ComputeVisibility(), ComputeAttributes(), AccumulatorCopy(attr_final)]
     elif path == "raster":
@@ -157,7 +176,7 @@ def splat_frame(path: str, attr_final: str = "shader_read", resolve: bool = True
     else:
         raise ValueError(f"unknown path {path!r}")
     if resolve:
-        passes.append(Resolve())
+        passes.append(EyeDomeResolve() if edl else Resolve())
     return Frame(passes)
 
 

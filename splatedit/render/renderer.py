@@ -50,7 +50,8 @@ from splatedit.render.splat_layout import (GEOM_STRIDE, RESOLVE_SET, RP_POINTS, 
 from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.uploads import SceneUploadsMixin
-from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
+from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_EDL_RADIUS_PX,
+                                  RENDER_EDL_STRENGTH, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MIN_WEIGHT,
                                   RENDER_POINT_SPLAT_MAX_PX, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT,
                                   RENDER_VISIBILITY_EPS_RADII)
@@ -129,6 +130,12 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self.splat_scale = 1.0
         #: shade a uniform grey instead of the file's colours (RENDER_GREY_ALBEDO)
         self.grey_shading = False
+        #: eye-dome lighting (frame_passes.EyeDomeResolve): darken each pixel
+        #: by the log-depth steps to its neighbours at ``edl_radius_px``
+        #: pixels, ``exp(-300 * edl_strength * mean step)``; off by default
+        self.edl = False
+        self.edl_strength = float(RENDER_EDL_STRENGTH)
+        self.edl_radius_px = float(RENDER_EDL_RADIUS_PX)
         self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         #: alpha of background pixels in the output (0: uncovered pixels are
@@ -297,7 +304,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         u["misc"] = (RENDER_GAUSS_SHARPNESS, 1.0 / RENDER_GAMMA, RENDER_MIN_WEIGHT,
                      min(float(self.point_max_px), 0.5 * self._max_point_size - 0.25) if self.point_splats else -1.0)
         u["options"] = (1 if self.backface_culling else 0, 1 if apply_gamma else 0, 1 if self.distortion_map else 0, 0)
-        u["display"] = (self.splat_scale, RENDER_GREY_ALBEDO if self.grey_shading else -1.0, 0.0, 0.0)
+        u["display"] = (self.splat_scale, RENDER_GREY_ALBEDO if self.grey_shading else -1.0,
+                        *((self.edl_strength, self.edl_radius_px) if self.edl else (0.0, 0.0)))
         self.ubo.write(u)
         if self._dC_dirty:
             self.dC_ubo.write(self._dC_block())
@@ -408,7 +416,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def splat_frame(self, width: int, height: int, attr_final: str = "shader_read", resolve: bool = True) -> Frame:
         """The pass list of a frame of this size on :meth:`frame_path`
         (:func:`splatedit.render.frame_passes.splat_frame`)."""
-        return splat_frame(self.frame_path(width, height), attr_final, resolve)
+        return splat_frame(self.frame_path(width, height), attr_final, resolve, self.edl)
 
     def record_frame(self, cb, camera: Camera, target: RenderTarget):
         """Record the frame (:meth:`splat_frame`) into ``cb`` writing ``target``

@@ -141,6 +141,15 @@ EDITOR_HELP_PAGE_OVERLAP = 2
 #: + 0.25 = 0.735), so highlights do not clip, and a grazing one (ambient
 #: only, 0.1 linear) still reads against the white background
 RENDER_GREY_ALBEDO = 0.72
+#: eye-dome lighting (`render --edl`, shaders_glsl/resolve_edl.frag): shade =
+#: exp(-300 * strength * mean over 8 neighbours at this radius of the log2
+#: depth step).  Strength 1 and radius 1.4 px are the defaults of Potree's EDL
+#: (its 8 neighbours at 1.4 px round to the adjacent pixels).  Measured on the
+#: grey step scene of tests/render/test_edl.py (depth 3.0 | 3.1, log2 step
+#: 0.047, 96x64, raster and compute alike): the far side's edge column goes
+#: from 221 to 24 (sRGB; 0.11x), every other column stays within 1/255
+RENDER_EDL_STRENGTH = 1.0
+RENDER_EDL_RADIUS_PX = 1.4
 
 
 # ---------------------------------------------------------------------------
