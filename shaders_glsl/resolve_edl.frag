@@ -4,9 +4,11 @@
 // shading of resolve.frag, then each covered pixel's colour multiplied by
 // exp(-300 * strength * S / 8), S = sum over the 8 neighbours at radius r
 // (pixels) of max(0, log2(depth) - log2(depth_neighbour)), depth the linear
-// view depth (the accumulated w*depth / w); an uncovered neighbour counts as
-// the far plane, so silhouettes get an outline (Boucheny 2009, "Interactive
-// scientific visualization of large datasets", ch. 4; the 300 is his scale).
+// view depth (the accumulated w*depth / w); an uncovered neighbour (or one
+// outside the image) counts as the far plane, so it never darkens a covered
+// pixel, and uncovered pixels stay background: no outline is drawn around
+// silhouettes (Boucheny 2009, "Interactive scientific visualization of large
+// datasets", ch. 4; the 300 is his scale).
 // F.display.z = strength, F.display.w = radius r (pixels).  Steps below
 // NOISE_LOG2 count as none: the rgba16f accumulators hold w*depth and w to
 // 2^-11 relative each, so a flat surface's log2(depth) jitters by up to

@@ -241,6 +241,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
     s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
+    s.add_argument("--edl", action="store_true",
+                   help="eye-dome lighting: darken depth edges (scans without good normals; point-splat models)")
     s.add_argument("--path", choices=("auto", "raster", "compute"), default=None,
                    help="draw path: raster passes or compute shaders (splats: default env var SPLATEDIT_RASTER, "
                         "else auto: the faster, measured; Gaussian scenes: quads or the compute tile "

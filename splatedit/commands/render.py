@@ -74,6 +74,8 @@ def cmd_render(args) -> int:
         if target is not None:
             check_output_path(target, overwrite=args.force, protect=args.input, extensions=(ext,))
     from splatedit.io import is_gaussian_file
+    if getattr(args, "edl", False) and is_gaussian_file(args.input):
+        raise ParameterError("--edl", "eye-dome lighting is for point-splat models, not Gaussian splat scenes")
     if args.edit is not None and not is_gaussian_file(args.input):
         check_gpu_columns(args.edit)        # before the read and the fit (seconds, gigabytes)
     cloud = _read_model(args.input, args.progress)
@@ -85,7 +87,8 @@ def cmd_render(args) -> int:
     if args.edit is not None:
         cloud, basis_rows, d_c = _gpu_edit(args, cloud, on_gpu=_splats_draw)
     render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
-                  buffers_path=args.buffers, raster_path=getattr(args, "path", None))
+                  buffers_path=args.buffers, raster_path=getattr(args, "path", None),
+                  edl=getattr(args, "edl", False))
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))

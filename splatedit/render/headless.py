@@ -47,7 +47,7 @@ def check_render_memory(size, buffers: bool = False) -> None:
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
                   basis=None, dC=None, selection=None, buffers_path=None,
-                  device_name: str | None = None, raster_path: str | None = None) -> Path:
+                  device_name: str | None = None, raster_path: str | None = None, edl: bool = False) -> Path:
     """Render ``cloud`` offscreen and save an RGBA PNG (atomically: temp file + rename).
 
     Args:
@@ -65,6 +65,7 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             colour; see :meth:`Renderer.render_buffers`) to this ``.npz``.
         raster_path: ``"auto"`` / ``"raster"`` / ``"compute"`` (the
             renderer's argument; default env var ``SPLATEDIT_RASTER`` or auto).
+        edl: eye-dome lighting (:attr:`Renderer.edl`, default strength and radius).
     Returns the PNG path.
 
     Raises:
@@ -84,6 +85,7 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         camera = default_view(cloud, (w, h), path=cloud.source).camera
     with Renderer(device_name=device_name, raster_path=raster_path) as r:
         r.set_cloud(cloud)
+        r.edl = bool(edl)
         if selection is not None:
             r.set_selection(*selection)
         if basis is not None:

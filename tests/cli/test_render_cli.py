@@ -86,3 +86,21 @@ def test_gpu_curve_edit_matches_rendering_the_cpu_deformed_file(tmp_path):
     diff = np.abs(np.asarray(Image.open(gpu_png)).astype(float)
                   - np.asarray(Image.open(cpu_png)).astype(float)).max(axis=2)
     assert diff.mean() < 0.5 and (diff > 24).mean() < 0.005, (diff.mean(), (diff > 24).mean())
+
+
+def test_render_edl_only_darkens_depth_edges_and_is_refused_for_gaussian_scenes(tmp_path, capsys):
+    from splatedit import cli
+    from splatedit.data import gaussian_scene_path
+    plain, edl = tmp_path / "plain.png", tmp_path / "edl.png"
+    assert cli.main(["-q", "render", str(default_model_path()), "-o", str(plain), *CAMERA]) == 0
+    assert cli.main(["-q", "render", str(default_model_path()), "-o", str(edl), "--edl", *CAMERA]) == 0
+    a = np.asarray(Image.open(plain)).astype(float)
+    b = np.asarray(Image.open(edl)).astype(float)
+    assert np.array_equal(a[..., 3], b[..., 3])                 # coverage and background unchanged
+    assert (b[..., :3] <= a[..., :3] + 1).all()                 # EDL only darkens
+    darker = (a[..., :3] - b[..., :3]).max(axis=2) > 24
+    assert 0.002 < darker.mean() < 0.2, darker.mean()           # the creases and overlaps, not everything
+    capsys.readouterr()
+    assert cli.main(["render", str(gaussian_scene_path()), "-o", str(tmp_path / "g.png"), "--edl"]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and err[0].startswith("splatedit: error: ") and "--edl" in err[0]
