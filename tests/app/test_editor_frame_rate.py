@@ -102,3 +102,27 @@ def test_a_100k_model_moves_as_a_level_whose_measured_frame_fits_the_moving_budg
         assert vp._predict(cfg, w * h) <= budget or cfg == vp._configs()[-1]
     finally:
         vp.close()
+
+
+@pytest.mark.window
+@pytest.mark.gpu
+def test_window_frame_bench_splits_moving_frames_into_stages(xvfb, monkeypatch, tmp_path):
+    """scripts/bench_editor_window_frames.py in a tiny form (the bundled
+    model, 3 moving frames): the stages add up to the whole frame, the
+    render and present stages are there and the render-only frame of the
+    same scene is measured in the same run."""
+    import importlib.util
+    from pathlib import Path
+    monkeypatch.setenv("DISPLAY", xvfb["display"])
+    path = Path(__file__).resolve().parents[2] / "scripts" / "bench_editor_window_frames.py"
+    spec = importlib.util.spec_from_file_location("bench_editor_window_frames", path)
+    mod = importlib.util.module_from_spec(spec)
+    spec.loader.exec_module(mod)
+    out = mod.measure("bunny", (320, 200), 3, tmp_path, profile=False)
+    mv = out["moving_ms"]
+    assert out["moving_frames"] == 3 and out["splats"] == 37706
+    assert mv["render"] > 0 and mv["present"] > 0 and mv["total"] >= mv["render"] + mv["present"]
+    one = out["moving_slowest_ms"]                             # one frame's record: exact split
+    stages = sum(v for k, v in one.items() if k != "total" and not k.startswith("gpu_"))
+    assert stages == pytest.approx(one["total"], abs=0.5) and one["other"] >= -0.1
+    assert out["render_only_moving_ms"] > 0 and out["render_only_still_ms"] > 0
