@@ -1,7 +1,7 @@
 """Where an editor frame goes: moving and still frames in the real window (issue 19 item 9).
 
     PYTHONPATH=$PWD python scripts/bench_editor_window_frames.py [bunny] [100000] [1000000]
-        [--size 1280x720] [--frames 30] [--profile] [--dir /tmp]
+        [--size 1280x720] [--frames 30] [--profile] [--no-panel] [--dir /tmp]
 
 For each model (``bunny``: the bundled model; a number: ``bench editor``'s
 bunny-surface cloud of that many splats, written as binary PLY) the editor is
@@ -89,7 +89,7 @@ def _median(xs):
     return round(xs[len(xs) // 2], 1) if xs else None
 
 
-def measure(spec: str, size, frames: int, folder: Path, profile: bool) -> dict:
+def measure(spec: str, size, frames: int, folder: Path, profile: bool, panel: bool = True) -> dict:
     from splatedit.app.editor import Editor
     from splatedit.tolerances import EDITOR_LOD_MIN_SPLATS
     path = _model(spec, folder)
@@ -142,6 +142,8 @@ def measure(spec: str, size, frames: int, folder: Path, profile: bool) -> dict:
             state["phase"] = "done"
         if ph == "load" and loaded():
             state["phase"], state["t_phase"] = "warm", now
+            if not panel and ed.panel_visible:
+                ed.toggle_panel()            # the side panel hidden (its share of the GUI pass)
             state["n"] = 0
         if state["phase"] == "warm":
             state["n"] += 1
@@ -228,6 +230,7 @@ def main() -> None:
     ap.add_argument("--frames", type=int, default=30)
     ap.add_argument("--profile", action="store_true")
     ap.add_argument("--dir", default="/tmp")
+    ap.add_argument("--no-panel", action="store_true", help="hide the side panel (Tab) while measuring")
     a = ap.parse_args()
     size = tuple(int(x) for x in a.size.split("x"))
     proc = None
@@ -236,7 +239,7 @@ def main() -> None:
         os.environ["DISPLAY"] = disp
     try:
         for spec in a.models:
-            out = measure(spec, size, a.frames, Path(a.dir), a.profile)
+            out = measure(spec, size, a.frames, Path(a.dir), a.profile, panel=not a.no_panel)
             prof = out.pop("profile", None)
             print(json.dumps(out), flush=True)
             if prof:

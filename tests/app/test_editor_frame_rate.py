@@ -124,5 +124,5 @@ def test_window_frame_bench_splits_moving_frames_into_stages(xvfb, monkeypatch, 
     assert mv["render"] > 0 and mv["present"] > 0 and mv["total"] >= mv["render"] + mv["present"]
     one = out["moving_slowest_ms"]                             # one frame's record: exact split
     stages = sum(v for k, v in one.items() if k != "total" and not k.startswith("gpu_"))
-    assert stages == pytest.approx(one["total"], abs=0.5) and one["other"] >= -0.1
+    assert stages == pytest.approx(one["total"], abs=1.0) and one["other"] >= -0.1
     assert out["render_only_moving_ms"] > 0 and out["render_only_still_ms"] > 0
