@@ -87,10 +87,10 @@ class Editor(EventRouting, FileActions, CrashGuard):
                 # GPU path: one device renders, draws the GUI and presents (no readback)
                 from splatedit.app.gui_panels import EditorGui
                 from splatedit.render.renderer import Renderer
-                self.viewport = Viewport(budget_ms=budget_ms, renderer=Renderer(device=pres.dev))
+                self.viewport = Viewport(budget_ms=self.frames.moving_budget_ms, renderer=Renderer(device=pres.dev))
                 self.gui = EditorGui(self, pres.dev)
             else:       # CPU fallback: frames read back, overlay blended on the CPU
-                self.viewport = Viewport(budget_ms=budget_ms)
+                self.viewport = Viewport(budget_ms=self.frames.moving_budget_ms)
         except BaseException:
             self.close()
             raise

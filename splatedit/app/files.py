@@ -15,7 +15,7 @@ import numpy as np
 from splatedit.app.gaussian_doc import gaussians_of, model_summary
 from splatedit.app.jobs import Cancelled, Job
 from splatedit.errors import InputError, SplatEditError
-from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_MIN_SPLATS
+from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS
 
 
 #: inputs saved in their own format (their scanner dimensions: intensity,
@@ -265,7 +265,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     if ed.use_lod and scene is None and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
             from splatedit.model.lod import LodPyramid
-            return LodPyramid(cloud, progress=progress, background=True)   # preview first
+            return LodPyramid(cloud, EDITOR_LOD_BUDGETS, progress=progress, background=True)   # preview first
         ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
     ed.viewport.set_gaussian_lod(None)
     if ed.use_lod and scene is not None:

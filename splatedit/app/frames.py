@@ -30,7 +30,7 @@ from splatedit.app.tools.base import DragMode
 from splatedit.app.progressive_refine import ProgressiveRefinement
 from splatedit.app.viewport import FrameInfo, ResidentFrame
 from splatedit.errors import ParameterError, SplatEditError
-from splatedit.tolerances import (EDITOR_ASYNC_REFINE_MS,
+from splatedit.tolerances import (EDITOR_ASYNC_REFINE_MS, EDITOR_MOVING_BUDGET_MS,
                                   EDITOR_PROGRESSIVE_MIN_CHUNK, EDITOR_PROGRESSIVE_STEPS_PER_FRAME,
                                   EDITOR_REFINE_DELAY_S)
 
@@ -49,6 +49,13 @@ def refine_above_ms() -> float:
     if not 0 < value < float("inf"):
         raise ParameterError("SPLATEDIT_REFINE_ABOVE_MS", f"must be a number of milliseconds > 0, got {text!r}")
     return value
+
+
+def moving_budget(budget_ms: float) -> float:
+    """The moving frame's budget (ms, the whole presented frame) for an
+    editor whose frame budget is ``budget_ms``: ``EDITOR_MOVING_BUDGET_MS``
+    (30 frames/s) or ``budget_ms`` when smaller."""
+    return min(float(budget_ms), EDITOR_MOVING_BUDGET_MS)
 
 
 @dataclass(frozen=True)
@@ -84,7 +91,10 @@ class FrameScheduler:
         self.frame_ms = 0.0
         self.moving_frame_ms: list[float] = []     # whole frames (render + overlay + present) while moving
         self._rendered_interactive = False
+        #: the frame interval while still (the progressive refinement's per-frame budget)
         self.budget_ms = float(budget_ms)
+        #: the whole moving frame's budget (30 frames/s unless ``budget_ms`` is smaller)
+        self.moving_budget_ms = moving_budget(budget_ms)
         #: full-quality frames predicted slower than this (ms) are refined progressively
         self.refine_above_ms = refine_above_ms()
         self.frame_overhead_ms = 10.0
@@ -193,7 +203,7 @@ class FrameScheduler:
             vp = ed.viewport
             extra = max(self.frame_ms - (vp.last_info.ms if vp.last_info else 0.0), 0.0)
             self.frame_overhead_ms = 0.8 * self.frame_overhead_ms + 0.2 * extra
-            vp.budget_ms = max(self.budget_ms - self.frame_overhead_ms, 0.3 * self.budget_ms)
+            vp.budget_ms = max(self.moving_budget_ms - self.frame_overhead_ms, 0.3 * self.moving_budget_ms)
         self._rendered_interactive = False
 
     def _draw_gpu(self, w: int, h: int) -> None:

@@ -1,6 +1,6 @@
 """The real editor window refining a large-enough model: one Vulkan device.
 
-A 150,000-splat model (the smallest that gets levels of detail,
+A 60,000-splat model (the smallest that gets levels of detail,
 ``EDITOR_LOD_MIN_SPLATS``) opened with a 5 ms motion budget (moving frames
 are levels of detail) and ``SPLATEDIT_REFINE_ABOVE_MS=1`` (every still view
 is refined): after a wheel step the view is refined progressively to full

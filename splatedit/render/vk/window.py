@@ -96,6 +96,12 @@ class Window:
         # *in event order*: glfwGetCursorPos on X11 queries the pointer's
         # current position, which is already ahead when events are queued.
         self._last_pos = self.cursor()
+        # the framebuffer size and the iconified state, kept from their callbacks:
+        # asking glfw is an X round trip (~1 ms each on the loaded machine, several
+        # per editor frame: issue 19 item 9); ``queries`` counts the real queries
+        self.queries = 0
+        self._fb_size = self._query_framebuffer_size()
+        self._iconified = bool(glfw.get_window_attrib(self.handle, glfw.ICONIFIED))
         glfw.set_key_callback(self.handle, self._on_key)
         glfw.set_char_callback(self.handle, self._on_char)
         glfw.set_mouse_button_callback(self.handle, self._on_button)
@@ -134,6 +140,7 @@ class Window:
         self.events.append(InputEvent("scroll", dx=dx, dy=dy, x=x, y=y, mods=self.mods()))
 
     def _on_resize(self, win, w, h):
+        self._fb_size = (int(w), int(h))
         self._update_scale()
         self.events.append(InputEvent("resize", w=w, h=h))
 
@@ -150,6 +157,7 @@ class Window:
         self.events.append(InputEvent("drop", paths=names, x=x, y=y))
 
     def _on_iconify(self, win, iconified):
+        self._iconified = bool(iconified)
         self.events.append(InputEvent("iconify", action=int(iconified)))
 
     # ----------------------------------------------------------------- API
@@ -180,11 +188,19 @@ class Window:
         out, self.events = self.events, []
         return out
 
+    def _query_framebuffer_size(self) -> tuple[int, int]:
+        self.queries += 1
+        w, h = self.glfw.get_framebuffer_size(self.handle)
+        return int(w), int(h)
+
     def framebuffer_size(self) -> tuple[int, int]:
-        return tuple(int(v) for v in self.glfw.get_framebuffer_size(self.handle))
+        """(w, h) pixels of the framebuffer as of the last :meth:`poll` (kept
+        from the resize callback; no window-system round trip)."""
+        return self._fb_size
 
     def iconified(self) -> bool:
-        return bool(self.glfw.get_window_attrib(self.handle, self.glfw.ICONIFIED))
+        """Minimized, as of the last :meth:`poll` (kept from the iconify callback)."""
+        return self._iconified
 
     def set_title(self, title: str) -> None:
         self.glfw.set_window_title(self.handle, title)
