@@ -17,8 +17,8 @@ from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
-from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, pack_basis_rows, pack_deform_block, selection_flags,
-                                        unit_scale)
+from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, pack_basis_rows, pack_deform_block,
+                                        selection_flags, unit_scale)
 from splatedit.render.splat_layout import FLAG_DEFORMED, GEOM_STRIDE
 from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
 from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
