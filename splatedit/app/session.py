@@ -44,9 +44,10 @@ rotation -> detail -> linear) picks the basis: rotation and linear share a
 key, so switching to or from detail refits); each committed edit records it.
 
 Parts kept in their own modules: the history (:mod:`splatedit.app.session_history`:
-snapshots, undo, redo), editing the rig (:mod:`splatedit.app.session_rig`:
+snapshots, undo, redo; an owned object, ``session.history_part``), editing the rig (:mod:`splatedit.app.session_rig`:
 handles, curve points), the pose and its manipulation
-(:mod:`splatedit.app.session_pose`: G/R/S, finish, commit), the rig's pose
+(:mod:`splatedit.app.session_pose`: G/R/S, finish, commit; these two are
+still mixed into :class:`Session`), the rig's pose
 and curve (:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
 a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
 figures (:mod:`splatedit.app.distortion_feed`), the selection masks
@@ -109,7 +110,7 @@ class SessionStats:
     commit: CommitProgress | None = None   # the running background commit
 
 
-class Session(SessionHistory, RigEditing, PoseEditing):
+class Session(RigEditing, PoseEditing):
     """The document (cloud, edits, history) with its selection, its rig
     (:class:`~splatedit.app.rig.Rig`: pose and curve), the fit scheduling
     (:class:`~splatedit.app.fitting.FitScheduler`) and the running
@@ -140,7 +141,9 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.rig = Rig()
         self.edits: tuple = ()
         self.history = History()
-        self.history.reset(self._snapshot("open"))
+        #: push / undo / redo of the document (:class:`~splatedit.app.session_history.SessionHistory`)
+        self.history_part = SessionHistory(self)
+        self.history.reset(self.history_part.snapshot("open"))
         self.manip: Manipulation | None = None
         self.manip_target = None      # ("handle", i) or ("curve", j)
         self.brush_target = SUPPORT
@@ -157,6 +160,31 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
         self.last_edit: LastEdit | None = None
         self._erasing = False       # the stroke being painted erases (its history name)
+
+    # ------------------------------------------------------------ history
+    # (the session's face of its history_part, SessionHistory)
+    def push(self, label: str) -> None:
+        """Record the current state (after a stroke, clear, pose change or commit)."""
+        self.history_part.push(label)
+
+    def undo(self) -> bool:
+        """Cancel a running move, else step back (False: nothing to undo, or a commit runs)."""
+        return self.history_part.undo()
+
+    def redo(self) -> bool:
+        """Step forward (False: nothing to redo, a move or a commit runs)."""
+        return self.history_part.redo()
+
+    def adopt_recovered(self, script, label: str) -> None:
+        """Make a recovery entry's edit script this document's committed edits
+        (:meth:`SessionHistory.adopt_recovered
+        <splatedit.app.session_history.SessionHistory.adopt_recovered>`)."""
+        self.history_part.adopt_recovered(script, label)
+
+    @property
+    def dirty(self) -> bool:
+        """Unsaved changes (a commit still running counts: quitting asks first)."""
+        return self.history_part.dirty
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)
