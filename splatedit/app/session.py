@@ -44,11 +44,11 @@ rotation -> detail -> linear) picks the basis: rotation and linear share a
 key, so switching to or from detail refits); each committed edit records it.
 
 Parts kept in their own modules: the history (:mod:`splatedit.app.session_history`:
-snapshots, undo, redo; an owned object, ``session.history_part``), editing the rig (:mod:`splatedit.app.session_rig`:
-handles, curve points), the pose and its manipulation
-(:mod:`splatedit.app.session_pose`: G/R/S, finish, commit; these two are
-still mixed into :class:`Session`), the rig's pose
-and curve (:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
+snapshots, undo, redo; an owned object, ``session.history_part``), editing the rig
+(:mod:`splatedit.app.session_rig`: handles, curve points; owned, ``session.rig_part``),
+the pose and its manipulation (:mod:`splatedit.app.session_pose`: G/R/S, finish,
+commit; still mixed into :class:`Session`), the rig's pose and curve
+(:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
 a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
 figures (:mod:`splatedit.app.distortion_feed`), the selection masks
 (:mod:`splatedit.select.selection`).
@@ -110,7 +110,7 @@ class SessionStats:
     commit: CommitProgress | None = None   # the running background commit
 
 
-class Session(RigEditing, PoseEditing):
+class Session(PoseEditing):
     """The document (cloud, edits, history) with its selection, its rig
     (:class:`~splatedit.app.rig.Rig`: pose and curve), the fit scheduling
     (:class:`~splatedit.app.fitting.FitScheduler`) and the running
@@ -139,6 +139,8 @@ class Session(RigEditing, PoseEditing):
         self.cloud = cloud
         self.selection = Selection(cloud.n)
         self.rig = Rig()
+        #: handle and curve-point editing (:class:`~splatedit.app.session_rig.RigEditing`)
+        self.rig_part = RigEditing(self)
         self.edits: tuple = ()
         self.history = History()
         #: push / undo / redo of the document (:class:`~splatedit.app.session_history.SessionHistory`)
@@ -185,6 +187,58 @@ class Session(RigEditing, PoseEditing):
     def dirty(self) -> bool:
         """Unsaved changes (a commit still running counts: quitting asks first)."""
         return self.history_part.dirty
+
+    # ---------------------------------------------------------------- rig
+    # (the session's face of its rig_part, RigEditing; each change is an undo step)
+    def add_handle(self) -> bool:
+        """Start a new handle (active; the brush then paints it).  An empty
+        active handle is reused.  Raises SplatEditError over 16 columns."""
+        return self.rig_part.add_handle()
+
+    def remove_handle(self) -> bool:
+        """Remove the active handle (and its pending transform)."""
+        return self.rig_part.remove_handle()
+
+    def select_handle(self, i: int) -> bool:
+        """Make handle ``i`` (modulo the count) the active one (not an undo step)."""
+        return self.rig_part.select_handle(i)
+
+    def cycle_handle(self, step: int = 1) -> bool:
+        """Make the handle ``step`` after the active one active (not an undo step)."""
+        return self.rig_part.cycle_handle(step)
+
+    def curve(self):
+        """The :class:`ControlCurve` through the picked points (None below 2)."""
+        return self.rig_part.curve()
+
+    def add_curve_point(self, point) -> bool:
+        """Append a picked point (2..16 per curve; consecutive ones distinct)."""
+        return self.rig_part.add_curve_point(point)
+
+    def remove_curve_point(self) -> bool:
+        """Remove the last picked point."""
+        return self.rig_part.remove_curve_point()
+
+    def clear_curve(self) -> bool:
+        """Remove every picked point."""
+        return self.rig_part.clear_curve()
+
+    def active_curve_point(self) -> int | None:
+        """Index of the picked point the transform fields edit, None without curve points."""
+        return self.rig_part.active_curve_point()
+
+    def select_curve_point(self, j: int) -> bool:
+        """Make picked point ``j`` (modulo the count) the active one (not an undo step)."""
+        return self.rig_part.select_curve_point(j)
+
+    def curve_point_positions(self, live: bool = True) -> np.ndarray:
+        """(k + 1, 3) current (moved) picked points."""
+        return self.rig_part.curve_point_positions(live)
+
+    def curve_polyline(self, count: int = 160, live: bool = True) -> np.ndarray | None:
+        """(>= count, 3) points of the moved curve for drawing (None below 2 points;
+        :meth:`RigEditing.curve_polyline <splatedit.app.session_rig.RigEditing.curve_polyline>`)."""
+        return self.rig_part.curve_polyline(count, live)
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)
