@@ -1,7 +1,7 @@
 """An edit's commit as background work (issue 10: long work shows progress,
 the window stays responsive).
 
-:meth:`~splatedit.app.session_pose.PoseEditing.commit` freezes the pose into
+:meth:`Session.commit <splatedit.app.session_pose.PoseEditing.commit>` freezes the pose into
 a :class:`CommitPlan` (the basis, the base cloud, the pose's dC and the
 script edit it records).  A commit estimated to take less than
 ``EDITOR_COMMIT_SYNC_MS`` (:func:`estimate_ms`) is applied at once on the

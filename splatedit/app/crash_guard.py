@@ -1,6 +1,6 @@
 """No internal error takes the editor's window down (issue 19 item 1).
 
-A part of :class:`~splatedit.app.editor.Editor` (mixed into it).  The loop
+An object the :class:`~splatedit.app.editor.Editor` owns (``editor.crash_guard``).  The loop
 dispatches work in a few places -- each window event
 (:meth:`~splatedit.app.routing.EventRouting.handle_events`), the landing of
 finished jobs (load, save, levels of detail, graph), the session's poll
@@ -38,18 +38,28 @@ from splatedit.errors import SplatEditError
 
 
 class CrashGuard:
-    """Central exception guard, recovery files and the restore question of the Editor."""
+    """Central exception guard, recovery files and the restore question of an editor.
 
-    #: the recovery entry the restore question is about (None: no question)
-    confirm_restore = None
-    #: the entry being restored (its load is running), then the restored one until it is saved
-    restoring = None
-    restored = None
-    _recovery_key = None
-    _recovery_entry = None      # the copy this run wrote last (a newer one replaces it)
-    _last_internal = None
-    #: the last internal error (the status file shows it; tests wait for it)
-    internal_errors = 0
+    Args:
+        ed: the editor it guards.  The guard reads its document (``session``,
+            ``path``, ``bundled``), reports through ``say`` and ``show_error``,
+            cancels its drag (``drag``, ``drag_tool``) and, restoring, opens
+            the recovered model (``open_path``) and sets ``cloud_name`` and
+            ``save_as``.
+    """
+
+    def __init__(self, ed):
+        self.ed = ed
+        #: the recovery entry the restore question is about (None: no question)
+        self.confirm_restore = None
+        #: the entry being restored (its load is running), then the restored one until it is saved
+        self.restoring = None
+        self.restored = None
+        self._recovery_key = None
+        self._recovery_entry = None      # the copy this run wrote last (a newer one replaces it)
+        self._last_internal = None
+        #: internal errors met so far (the status file shows it; tests wait for it)
+        self.internal_errors = 0
 
     # ------------------------------------------------------------- the guard
     @contextlib.contextmanager
@@ -59,7 +69,7 @@ class CrashGuard:
         try:
             yield
         except SplatEditError as exc:
-            self.say(str(exc))
+            self.ed.say(str(exc))
         except Exception as exc:  # noqa: BLE001 - the point: nothing takes the window down
             self.internal_error(what, exc)
 
@@ -76,29 +86,31 @@ class CrashGuard:
         with contextlib.suppress(Exception):
             self._reset_transient_state()
         saved = self.recovery_note(f"internal error while {what}: {type(exc).__name__}: {exc}")
-        self.show_error(f"internal error while {what}: {type(exc).__name__}: {exc}. "
+        self.ed.show_error(f"internal error while {what}: {type(exc).__name__}: {exc}. "
                         f"The document is kept{saved}; details on stderr")
 
     def _reset_transient_state(self) -> None:
         """A running move or drag may be half done: cancel it (the document
         itself only changes in whole history steps)."""
-        s = self.session
+        ed = self.ed
+        s = ed.session
         if s is not None and s.manip is not None:
             s.cancel()
-        self.drag, self.drag_tool = DragMode.NONE, None
+        ed.drag, ed.drag_tool = DragMode.NONE, None
 
     # -------------------------------------------------------------- recovery
     def write_recovery(self, reason: str):
         """Write the document as a recovery entry (once per history state);
         the entry, or None when nothing is unsaved or it was written already."""
-        s = self.session
+        ed = self.ed
+        s = ed.session
         if s is None or not s.edits or not s.dirty:
             return None
         key = (id(s), revision.of(s.cloud), s.history.position, len(s.edits))
         if key == self._recovery_key:
             return None
-        src = self.restored.source if self.restored is not None else (None if self.path is None else str(self.path))
-        entry = recovery.write_recovery(s, src, bundled=self.bundled, reason=reason)
+        src = self.restored.source if self.restored is not None else (None if ed.path is None else str(ed.path))
+        entry = recovery.write_recovery(s, src, bundled=ed.bundled, reason=reason)
         self._recovery_key = key
         if entry is not None:
             if self._recovery_entry is not None:    # this run's older copy: the new one supersedes it
@@ -135,7 +147,7 @@ class CrashGuard:
         self.confirm_restore = got[0]
         e = got[0]
         more = f" ({len(got) - 1} older in {e.manifest.parent})" if len(got) > 1 else ""
-        self.say(f"a recovery copy of {e.name} from {e.when()} ({e.edits} edit(s)): "
+        self.ed.say(f"a recovery copy of {e.name} from {e.when()} ({e.edits} edit(s)): "
                  f"Y restores it, N discards it, Esc asks again next time{more}")
         return True
 
@@ -145,37 +157,38 @@ class CrashGuard:
         if entry is None:
             return
         if answer is None:
-            self.say(f"the recovery copy stays in {entry.manifest.parent} (asked again at the next start)")
+            self.ed.say(f"the recovery copy stays in {entry.manifest.parent} (asked again at the next start)")
             return
         if not answer:
             recovery.discard(entry)
-            self.say(f"recovery copy of {entry.name} discarded")
+            self.ed.say(f"recovery copy of {entry.name} discarded")
             return
-        if self.open_path(entry.model, confirmed=True):
+        if self.ed.open_path(entry.model, confirmed=True):
             self.restoring = entry
 
     def on_restored(self) -> None:
         """The recovered model finished loading: adopt its edits and its source (for Ctrl+S)."""
         entry, self.restoring = self.restoring, None
-        s = self.session
+        ed = self.ed
+        s = ed.session
         try:
             from splatedit.script import load_script
             script = load_script(entry.script)
         except SplatEditError as exc:
-            self.show_error(f"the recovery copy's edit script cannot be read ({exc}); the model is "
+            ed.show_error(f"the recovery copy's edit script cannot be read ({exc}); the model is "
                             f"open without it: save it as a new file")
             return
         s.adopt_recovered(script, f"Recovered {len(script.edits)} edit(s)")
         if entry.source:            # saves go beside the source (never onto it), as before the crash
-            self.path, self.bundled = Path(entry.source), entry.bundled
-        self.cloud_name = entry.name
-        self.save_as = None
+            ed.path, ed.bundled = Path(entry.source), entry.bundled
+        ed.cloud_name = entry.name
+        ed.save_as = None
         self.restored = entry
-        self.say(f"restored {entry.name} from {entry.when()} with {len(script.edits)} edit(s): "
+        ed.say(f"restored {entry.name} from {entry.when()} with {len(script.edits)} edit(s): "
                  f"Ctrl+S saves it")
 
     def restored_saved(self, session) -> None:
         """A save of the restored document finished: its recovery entry is no longer needed."""
-        if self.restored is not None and session is self.session:
+        if self.restored is not None and session is self.ed.session:
             recovery.discard(self.restored)
             self.restored = None

@@ -59,7 +59,7 @@ from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN
                                   IQR_DEFAULT_TOL)
 
 
-class Editor(EventRouting, FileActions, CrashGuard):
+class Editor(EventRouting, FileActions):
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
                  budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
@@ -102,6 +102,9 @@ class Editor(EventRouting, FileActions, CrashGuard):
         #: the Dear ImGui interface (None: the CPU overlay fallback, or no window)
         self.gui = None
         self.session: Session | None = None
+        #: the central exception guard, recovery copies and the restore question
+        #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
+        self.crash_guard = CrashGuard(self)
         self.cloud_name = self.path.name if self.path else "model"
         self.jobs: dict[str, Job] = {}
         self.running = True
@@ -187,7 +190,7 @@ class Editor(EventRouting, FileActions, CrashGuard):
         """A question is open (save-as path, quit / open with unsaved changes, restore a
         recovery copy, the file browser)."""
         return (self.prompt is not None or self.confirm_quit or self.confirm_open is not None
-                or self.confirm_restore is not None or self.browser.shown)
+                or self.crash_guard.confirm_restore is not None or self.browser.shown)
 
     @property
     def frame_ms(self) -> float:
@@ -295,16 +298,17 @@ class Editor(EventRouting, FileActions, CrashGuard):
         if self.path is None:
             raise SplatEditError("no model to open")
         self.start_load()
-        if not self.offer_recovery() and self.offer_recent and self.recent_files():
+        guard = self.crash_guard
+        if not guard.offer_recovery() and self.offer_recent and self.recent_files():
             self.open_dialog(Path.cwd())
         restore_sigterm = _sigterm_as_interrupt()
         try:
             self._loop()
         except KeyboardInterrupt:
-            self.recover_on_exit("the editor was ended (SIGTERM or Ctrl+C)")
+            guard.recover_on_exit("the editor was ended (SIGTERM or Ctrl+C)")
             raise
         except BaseException as exc:
-            self.recover_on_exit(f"internal error: {exc!r}")
+            guard.recover_on_exit(f"internal error: {exc!r}")
             raise
         finally:
             restore_sigterm()
@@ -313,7 +317,7 @@ class Editor(EventRouting, FileActions, CrashGuard):
         return self.exit_code
 
     def _loop(self) -> None:
-        fr = self.frames
+        fr, guarded = self.frames, self.crash_guard.guarded
         try:
             while self.running:
                 s = self.session
@@ -326,17 +330,17 @@ class Editor(EventRouting, FileActions, CrashGuard):
                     pending = False          # minimized: nothing to draw, do not spin
                 events = self.window.poll(0.0 if pending else (0.05 if busy else 0.5))
                 self.handle_events(events)          # each event guarded on its own
-                with self.guarded("collecting a finished job"):
+                with guarded("collecting a finished job"):
                     self.poll_jobs()
                 if self.session is not None:
-                    with self.guarded("landing a fit or an edit"):
+                    with guarded("landing a fit or an edit"):
                         self.session.poll()
                         self.gizmo.report_commit()
                 if not self.running:
                     break
                 self._draw_guarded()
                 self.collect_validation()
-                with self.guarded("writing the status file"):
+                with guarded("writing the status file"):
                     self.write_status()
                 if self.max_seconds is not None and time.perf_counter() - self.start_time > self.max_seconds:
                     self.say("time limit reached")
@@ -349,18 +353,18 @@ class Editor(EventRouting, FileActions, CrashGuard):
     def _draw_guarded(self) -> None:
         """One frame; a failure (a Vulkan error, or a bug) is reported and the
         same scene is not retried at once (no error loop at the frame rate)."""
-        fr = self.frames
-        errors, failed = self.internal_errors, False
-        with self.guarded("drawing a frame"):
+        fr, guard = self.frames, self.crash_guard
+        errors, failed = guard.internal_errors, False
+        with guard.guarded("drawing a frame"):
             try:
                 fr.draw()
             except SplatEditError as exc:       # e.g. a Vulkan error: report, keep the document
                 self.say(f"drawing failed: {exc}")
                 failed = True
-        if not failed and self.internal_errors == errors:
+        if not failed and guard.internal_errors == errors:
             return
         if self.gui is not None:        # a frame left half laid out is closed (no-op after a whole one)
-            with self.guarded("closing the interrupted frame"):
+            with guard.guarded("closing the interrupted frame"):
                 self.gui.recover()
         fr.scene_key = fr.state() if self.session is not None else None
         time.sleep(0.2)

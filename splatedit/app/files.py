@@ -274,7 +274,8 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
             return build_gaussian_lod(scene, progress=progress)
         ed.jobs["lod"] = Job("Gaussian level of detail", rank, ed.wake)
     ed.brush.tools.prepare(cloud)
-    if getattr(ed, "restoring", None) is None:      # a recovery file is not a recent model
+    guard = getattr(ed, "crash_guard", None)
+    if guard is None or guard.restoring is None:      # a recovery file is not a recent model
         remember(ed, ed.path)
     what = model_summary(cloud)
     note = ed.camera.extent().note()
@@ -304,8 +305,8 @@ def poll_jobs(ed) -> None:
                 ed.exit_code = 2
                 ed.running = False
             elif name == "load":       # another model: the open one stays
-                if getattr(ed, "restoring", None) is not None:
-                    ed.restoring = None
+                if getattr(ed, "crash_guard", None) is not None:
+                    ed.crash_guard.restoring = None
                 text = str(err) if isinstance(err, SplatEditError) else f"{job.key}: cannot read the model: {err}"
                 ed.show_error(f"not opened: {text}")
             elif name in ("save", "export"):
@@ -315,9 +316,10 @@ def poll_jobs(ed) -> None:
             continue
         if name == "load":
             ed.on_loaded(job.result, job.key)
-            entry = getattr(ed, "restoring", None)
+            guard = getattr(ed, "crash_guard", None)
+            entry = None if guard is None else guard.restoring
             if entry is not None and Path(job.key) == Path(os.path.abspath(entry.model)):
-                ed.on_restored()         # a recovery entry: its edits and source come with it
+                guard.on_restored()         # a recovery entry: its edits and source come with it
         elif name == "lod" and hasattr(job.result, "rank"):      # a GaussianLod
             ed.viewport.set_gaussian_lod(job.result)
             ed.say(f"level of detail ready (moving: up to {job.result.m:,} of {job.result.n:,} Gaussians)")
@@ -332,8 +334,8 @@ def poll_jobs(ed) -> None:
                 ed.say(f"saved {ply} and {script.name} (the model opened since is not saved)")
                 continue
             ed.session.history.mark_saved(pos)
-            if hasattr(ed, "restored_saved"):
-                ed.restored_saved(saved_session)
+            if getattr(ed, "crash_guard", None) is not None:
+                ed.crash_guard.restored_saved(saved_session)
             ed.saved_path, ed.saved_script = ply, script
             ed.say(f"saved {ply} and {script.name}")
         elif name == "export":

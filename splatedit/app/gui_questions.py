@@ -24,8 +24,8 @@ def _buttons(ed) -> tuple | None:
     g = ed.g
     restore = restore_question(ed)
     if restore is not None:
-        return (restore, ("Restore (Y)", lambda: ed.answer_restore(True)),
-                ("Discard (N)", lambda: ed.answer_restore(False)))
+        return (restore, ("Restore (Y)", lambda: ed.crash_guard.answer_restore(True)),
+                ("Discard (N)", lambda: ed.crash_guard.answer_restore(False)))
     if ed.confirm_open is not None:
         name = ed.confirm_open.name
         return (open_question(ed), (f"Open {name} without saving (Y)", lambda: ed.answer_open(True)),

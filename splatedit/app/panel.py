@@ -220,7 +220,8 @@ def error_lines(message: str) -> list:
 
 def restore_question(ed) -> tuple | None:
     """The question at start when a recovery copy exists (rows), or None."""
-    e = getattr(ed, "confirm_restore", None)
+    guard = getattr(ed, "crash_guard", None)
+    e = None if guard is None else guard.confirm_restore
     if e is None:
         return None
     return (f"Recover unsaved work: {e.name} ({e.edits} edit(s), {e.when()})",

@@ -43,7 +43,7 @@ class EventRouting:
         shown in the error box, :mod:`splatedit.app.crash_guard`); the
         events after it are still handled."""
         for e in events:
-            with self.guarded(f"handling a {e.kind} event"):
+            with self.crash_guard.guarded(f"handling a {e.kind} event"):
                 if self.gui is not None and self.gui.takes(e):
                     continue
                 getattr(self, f"on_{e.kind}")(e)
@@ -160,9 +160,9 @@ class EventRouting:
         if self.prompt is not None:
             self.prompt_key(k, e.mods)
             return
-        if self.confirm_restore is not None:   # Y restores, N discards, Esc: next time
+        if self.crash_guard.confirm_restore is not None:   # Y restores, N discards, Esc: next time
             if k in (g.KEY_Y, g.KEY_N, g.KEY_ESCAPE):
-                self.answer_restore(None if k == g.KEY_ESCAPE else k == g.KEY_Y)
+                self.crash_guard.answer_restore(None if k == g.KEY_ESCAPE else k == g.KEY_Y)
             return
         if self.confirm_quit:              # N, Esc or anything else: stay
             self.answer_quit(k in (g.KEY_Y, g.KEY_Q))
@@ -209,7 +209,7 @@ class EventRouting:
         table = self.manip_actions if manip and action in self.manip_actions else self.actions
         # guarded here too: a GUI button runs its action while the frame is laid out, and
         # an error there must neither abandon the frame nor take the window down
-        with self.guarded(f"running '{action.value}'"):
+        with self.crash_guard.guarded(f"running '{action.value}'"):
             if not any(tool.intercept(action) for tool in self.tools):
                 table[action]()
         if s is not None:

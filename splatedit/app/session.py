@@ -44,10 +44,11 @@ rotation -> detail -> linear) picks the basis: rotation and linear share a
 key, so switching to or from detail refits); each committed edit records it.
 
 Parts kept in their own modules: the history (:mod:`splatedit.app.session_history`:
-snapshots, undo, redo), editing the rig (:mod:`splatedit.app.session_rig`:
-handles, curve points), the pose and its manipulation
-(:mod:`splatedit.app.session_pose`: G/R/S, finish, commit), the rig's pose
-and curve (:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
+snapshots, undo, redo; an owned object, ``session.history_part``), editing the rig
+(:mod:`splatedit.app.session_rig`: handles, curve points; owned, ``session.rig_part``),
+the pose and its manipulation (:mod:`splatedit.app.session_pose`: G/R/S, finish,
+commit; owned, ``session.pose_part``), the rig's pose and curve
+(:mod:`splatedit.app.rig`), the fit scheduling (:mod:`splatedit.app.fitting`),
 a G/R/S move (:mod:`splatedit.app.manipulation`), the live distortion
 figures (:mod:`splatedit.app.distortion_feed`), the selection masks
 (:mod:`splatedit.select.selection`).
@@ -109,7 +110,7 @@ class SessionStats:
     commit: CommitProgress | None = None   # the running background commit
 
 
-class Session(SessionHistory, RigEditing, PoseEditing):
+class Session:
     """The document (cloud, edits, history) with its selection, its rig
     (:class:`~splatedit.app.rig.Rig`: pose and curve), the fit scheduling
     (:class:`~splatedit.app.fitting.FitScheduler`) and the running
@@ -138,9 +139,15 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.cloud = cloud
         self.selection = Selection(cloud.n)
         self.rig = Rig()
+        #: handle and curve-point editing (:class:`~splatedit.app.session_rig.RigEditing`)
+        self.rig_part = RigEditing(self)
+        #: pose, G/R/S moves, finish and commit (:class:`~splatedit.app.session_pose.PoseEditing`)
+        self.pose_part = PoseEditing(self)
         self.edits: tuple = ()
         self.history = History()
-        self.history.reset(self._snapshot("open"))
+        #: push / undo / redo of the document (:class:`~splatedit.app.session_history.SessionHistory`)
+        self.history_part = SessionHistory(self)
+        self.history.reset(self.history_part.snapshot("open"))
         self.manip: Manipulation | None = None
         self.manip_target = None      # ("handle", i) or ("curve", j)
         self.brush_target = SUPPORT
@@ -153,10 +160,170 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         self.committer = CommitRunner(self.on_change)
         #: how the last background commit ended (the editor shows it and clears it)
         self.commit_outcome: CommitOutcome | None = None
-        self._rig_before_commit = None
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
         self.last_edit: LastEdit | None = None
         self._erasing = False       # the stroke being painted erases (its history name)
+
+    # ------------------------------------------------------------ history
+    # (the session's face of its history_part, SessionHistory)
+    def push(self, label: str) -> None:
+        """Record the current state (after a stroke, clear, pose change or commit)."""
+        self.history_part.push(label)
+
+    def undo(self) -> bool:
+        """Cancel a running move, else step back (False: nothing to undo, or a commit runs)."""
+        return self.history_part.undo()
+
+    def redo(self) -> bool:
+        """Step forward (False: nothing to redo, a move or a commit runs)."""
+        return self.history_part.redo()
+
+    def adopt_recovered(self, script, label: str) -> None:
+        """Make a recovery entry's edit script this document's committed edits
+        (:meth:`SessionHistory.adopt_recovered
+        <splatedit.app.session_history.SessionHistory.adopt_recovered>`)."""
+        self.history_part.adopt_recovered(script, label)
+
+    @property
+    def dirty(self) -> bool:
+        """Unsaved changes (a commit still running counts: quitting asks first)."""
+        return self.history_part.dirty
+
+    # ---------------------------------------------------------------- rig
+    # (the session's face of its rig_part, RigEditing; each change is an undo step)
+    def add_handle(self) -> bool:
+        """Start a new handle (active; the brush then paints it).  An empty
+        active handle is reused.  Raises SplatEditError over 16 columns."""
+        return self.rig_part.add_handle()
+
+    def remove_handle(self) -> bool:
+        """Remove the active handle (and its pending transform)."""
+        return self.rig_part.remove_handle()
+
+    def select_handle(self, i: int) -> bool:
+        """Make handle ``i`` (modulo the count) the active one (not an undo step)."""
+        return self.rig_part.select_handle(i)
+
+    def cycle_handle(self, step: int = 1) -> bool:
+        """Make the handle ``step`` after the active one active (not an undo step)."""
+        return self.rig_part.cycle_handle(step)
+
+    def curve(self):
+        """The :class:`ControlCurve` through the picked points (None below 2)."""
+        return self.rig_part.curve()
+
+    def add_curve_point(self, point) -> bool:
+        """Append a picked point (2..16 per curve; consecutive ones distinct)."""
+        return self.rig_part.add_curve_point(point)
+
+    def remove_curve_point(self) -> bool:
+        """Remove the last picked point."""
+        return self.rig_part.remove_curve_point()
+
+    def clear_curve(self) -> bool:
+        """Remove every picked point."""
+        return self.rig_part.clear_curve()
+
+    def active_curve_point(self) -> int | None:
+        """Index of the picked point the transform fields edit, None without curve points."""
+        return self.rig_part.active_curve_point()
+
+    def select_curve_point(self, j: int) -> bool:
+        """Make picked point ``j`` (modulo the count) the active one (not an undo step)."""
+        return self.rig_part.select_curve_point(j)
+
+    def curve_point_positions(self, live: bool = True) -> np.ndarray:
+        """(k + 1, 3) current (moved) picked points."""
+        return self.rig_part.curve_point_positions(live)
+
+    def curve_polyline(self, count: int = 160, live: bool = True) -> np.ndarray | None:
+        """(>= count, 3) points of the moved curve for drawing (None below 2 points;
+        :meth:`RigEditing.curve_polyline <splatedit.app.session_rig.RigEditing.curve_polyline>`)."""
+        return self.rig_part.curve_polyline(count, live)
+
+    # --------------------------------------------------- pose, moves, commit
+    # (the session's face of its pose_part, PoseEditing)
+    @property
+    def single_rig(self) -> bool:
+        """One handle and no curve: ending a manipulation commits at once."""
+        return self.pose_part.single_rig
+
+    @property
+    def pose_pending(self) -> bool:
+        """Some handle or curve point has a pending (uncommitted) move."""
+        return self.pose_part.pose_pending
+
+    @property
+    def committing(self) -> bool:
+        """A commit is running in the background (document changes are refused)."""
+        return self.pose_part.committing
+
+    def handle_matrix(self, k: int, live: bool = True) -> np.ndarray:
+        """Pending (4, 4) matrix of handle ``k`` (with the running manipulation when ``live``)."""
+        return self.pose_part.handle_matrix(k, live)
+
+    def live_curve_moves(self, live: bool = True) -> np.ndarray:
+        """(k + 1, 3) pending moves of the picked curve points (with the running drag when ``live``)."""
+        return self.pose_part.live_curve_moves(live)
+
+    def inputs(self, live: bool = True) -> list:
+        """Per-group inputs of ``basis.displacement`` (fitted handles, then the curve)."""
+        return self.pose_part.inputs(live)
+
+    def reset_pose(self) -> bool:
+        """Discard the pending transforms and curve moves (an undo step)."""
+        return self.pose_part.reset_pose()
+
+    def handle_centroid(self, k: int | None = None) -> np.ndarray:
+        """(3,) centroid of handle ``k`` (default: the active one) moved by its pending matrix."""
+        return self.pose_part.handle_centroid(k)
+
+    def active_fitted(self) -> bool:
+        """The active handle is part of the fitted basis."""
+        return self.pose_part.active_fitted()
+
+    def begin(self, mode: str, view: ViewInfo, mouse: tuple[float, float], pivot=None, frame=None,
+              frame_name: str = "") -> bool:
+        """Start G/R/S of the active handle about ``pivot`` with constraint axes
+        ``frame`` (:meth:`PoseEditing.begin <splatedit.app.session_pose.PoseEditing.begin>`)."""
+        return self.pose_part.begin(mode, view, mouse, pivot, frame, frame_name)
+
+    def begin_curve_point(self, j: int, view: ViewInfo, mouse: tuple[float, float]) -> bool:
+        """Start dragging picked curve point ``j`` (needs a basis with the curve)."""
+        return self.pose_part.begin_curve_point(j, view, mouse)
+
+    def current_matrix(self) -> np.ndarray:
+        """(4, 4) matrix of the running manipulation (identity without one)."""
+        return self.pose_part.current_matrix()
+
+    def current_dc(self):
+        """dC of the whole pose, live manipulation included (None without
+        basis), in the session's :attr:`deformation` mode."""
+        return self.pose_part.current_dc()
+
+    def cancel(self) -> None:
+        """Drop the running manipulation (the pose keeps its earlier moves)."""
+        self.pose_part.cancel()
+
+    def finish(self) -> str:
+        """End the running manipulation: ``"commit"``, ``"pose"`` or ``""``
+        (:meth:`PoseEditing.finish <splatedit.app.session_pose.PoseEditing.finish>`)."""
+        return self.pose_part.finish()
+
+    def commit(self) -> bool:
+        """Apply the pose (running manipulation included) as one edit, at once
+        or in the background (:meth:`PoseEditing.commit
+        <splatedit.app.session_pose.PoseEditing.commit>`)."""
+        return self.pose_part.commit()
+
+    def poll_commit(self) -> bool:
+        """Land a finished background commit (or restore the pose after its
+        error, :attr:`commit_outcome`); True when the state changed."""
+        return self.pose_part.poll_commit()
+
+    def wait_commit(self, timeout: float = 120.0) -> bool:
+        """Block until a background commit lands (tests, scripted use); True when none is left."""
+        return self.pose_part.wait_commit(timeout)
 
     # ------------------------------------------- the rig and the fit's state
     # (kept as attributes of the session: the editor, the tools and the tests use them)

@@ -1,8 +1,11 @@
 """The session's history: snapshots of the document, push / undo / redo.
 
-A part of :class:`~splatedit.app.session.Session` (mixed into it; it works
-on the session's ``cloud``, ``selection``, ``rig``, ``edits`` and
-``history``).  Every user action that changes the document pushes a
+An object a :class:`~splatedit.app.session.Session` owns
+(``session.history_part``; ``session.history`` is the snapshot stack,
+:class:`~splatedit.app.history.History`).  It works on the session's
+``cloud``, ``selection``, ``rig``, ``edits``, ``history`` and ``version``;
+the session's ``push``, ``undo``, ``redo``, ``adopt_recovered`` and
+``dirty`` delegate to it.  Every user action that changes the document pushes a
 :class:`~splatedit.app.history.Snapshot`; undo / redo restore one and
 restart the fit for the restored selection.
 """
@@ -14,55 +17,72 @@ from splatedit.select.selection import Selection
 
 
 class SessionHistory:
-    """Snapshots, push, undo, redo and the unsaved-changes flag of a Session."""
+    """Snapshots, push, undo, redo and the unsaved-changes flag of a Session.
+
+    Args:
+        session: the :class:`~splatedit.app.session.Session` whose document it
+            records and restores (a restore also cancels its manipulation and
+            restarts its fit).
+    """
+
+    def __init__(self, session):
+        self.s = session
 
     # ---------------------------------------------------------- snapshots
-    def _snapshot(self, label: str) -> Snapshot:
-        return Snapshot.make(self.cloud, self.selection.support, self.selection.handles, self.edits,
-                             label, active=self.selection.active, rig=self.rig.as_tuple(),
-                             memory=self.selection.memory())
+    def snapshot(self, label: str) -> Snapshot:
+        """The session's document now, as a history step named ``label``."""
+        s = self.s
+        return Snapshot.make(s.cloud, s.selection.support, s.selection.handles, s.edits,
+                             label, active=s.selection.active, rig=s.rig.as_tuple(),
+                             memory=s.selection.memory())
 
     def _restore(self, snap: Snapshot) -> None:
-        self.cloud = snap.cloud
+        ses = self.s
+        ses.cloud = snap.cloud
         s, _ = snap.masks()
-        self.selection = Selection(len(s), s, handles=snap.handle_masks(), active=snap.active)
-        self.selection.set_memory(snap.memory)
-        self.rig.restore(snap.rig)
+        ses.selection = Selection(len(s), s, handles=snap.handle_masks(), active=snap.active)
+        ses.selection.set_memory(snap.memory)
+        ses.rig.restore(snap.rig)
         self._sync_pose()
-        self.edits = snap.edits
-        self.manip = None
-        self.manip_target = None
-        self.version += 1
-        self.request_fit()
-        self.on_change()
+        ses.edits = snap.edits
+        ses.manip = None
+        ses.manip_target = None
+        ses.version += 1
+        ses.request_fit()
+        ses.on_change()
 
     def _sync_pose(self) -> None:
-        self.rig.sync_pose(len(self.selection.handles))
+        self.s.rig.sync_pose(len(self.s.selection.handles))
 
     def push(self, label: str) -> None:
         """Record the current state (after a stroke, clear, pose change or commit)."""
+        ses = self.s
         self._sync_pose()
-        self.history.push(self._snapshot(label))
-        self.version += 1
-        self.request_fit()
-        self.on_change()
+        ses.history.push(self.snapshot(label))
+        ses.version += 1
+        ses.request_fit()
+        ses.on_change()
 
     def undo(self) -> bool:
-        if self.committing:
+        """Cancel a running move, else step back (False: nothing to undo, or a commit runs)."""
+        ses = self.s
+        if ses.committing:
             return False
-        if self.manip is not None:
-            self.cancel()
+        if ses.manip is not None:
+            ses.cancel()
             return True
-        snap = self.history.undo()
+        snap = ses.history.undo()
         if snap is None:
             return False
         self._restore(snap)
         return True
 
     def redo(self) -> bool:
-        if self.manip is not None or self.committing:
+        """Step forward (False: nothing to redo, a move or a commit runs)."""
+        ses = self.s
+        if ses.manip is not None or ses.committing:
             return False
-        snap = self.history.redo()
+        snap = ses.history.redo()
         if snap is None:
             return False
         self._restore(snap)
@@ -74,14 +94,15 @@ class SessionHistory:
         its solver settings: the history restarts at one unsaved step
         ``label``, so a save writes the model and a script that replays from
         the original source."""
-        self.edits = tuple(script.edits)
-        self.method, self.tol, self.max_centers = script.solver.method, script.solver.tol, script.solver.max_centers
-        self.history.reset(self._snapshot(label))
-        self.history.saved_pos = -1
-        self.version += 1
-        self.on_change()
+        ses = self.s
+        ses.edits = tuple(script.edits)
+        ses.method, ses.tol, ses.max_centers = script.solver.method, script.solver.tol, script.solver.max_centers
+        ses.history.reset(self.snapshot(label))
+        ses.history.saved_pos = -1
+        ses.version += 1
+        ses.on_change()
 
     @property
     def dirty(self) -> bool:
         """Unsaved changes (a commit still running counts: quitting asks first)."""
-        return self.history.geometry_dirty or self.committing
+        return self.s.history.geometry_dirty or self.s.committing

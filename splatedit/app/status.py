@@ -33,6 +33,7 @@ def status_dict(ed) -> dict:
     cam = ed.cam
     vp = ed.viewport
     help_ = ed.help
+    guard = getattr(ed, "crash_guard", None)
     st = {"loaded": s is not None, "frames_presented": ed.presenter.frames_presented,
           "running": ed.running, "jobs": sorted(ed.jobs), "validation_messages": ed.validation_count,
           "confirm_quit": ed.confirm_quit, "prompt": ed.prompt, "help": help_.shown,
@@ -62,9 +63,9 @@ def status_dict(ed) -> dict:
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
           "browser": _browser(ed.browser), "message": ed.message,
           "script": str(ed.saved_script) if ed.saved_script else None,
-          "confirm_restore": str(ed.confirm_restore.model) if getattr(ed, "confirm_restore", None) else None,
-          "restored": str(ed.restored.model) if getattr(ed, "restored", None) else None,
-          "internal_errors": getattr(ed, "internal_errors", 0)}
+          "confirm_restore": str(guard.confirm_restore.model) if guard and guard.confirm_restore else None,
+          "restored": str(guard.restored.model) if guard and guard.restored else None,
+          "internal_errors": guard.internal_errors if guard else 0}
     gui = getattr(ed, "gui", None)
     st["gui"] = gui is not None
     if gui is not None:

@@ -81,9 +81,9 @@ def _frames(r: Renderer, cam, w, h, repeats):
 
 def _point_share(r: Renderer) -> float:
     """Share of the drawn splats of the last frame on the square-point path."""
-    if r._prep is None:
+    if r.prepass_part.current is None:
         return float("nan")
-    d = r._prep.draws.read().view(np.uint32)
+    d = r.prepass_part.current.draws.read().view(np.uint32)
     return float(d[5]) / max(int(d[1]) + int(d[5]), 1)
 
 

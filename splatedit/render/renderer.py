@@ -23,10 +23,11 @@ One vertex shader (``shaders_glsl/splat_vs.glsl``) serves both splat passes
 and the picking pass; it applies the deformation p' = p + B dC, u' = J u,
 v' = J v of splats that carry a basis row.
 
-:class:`Renderer` coordinates the frame; its parts live in
-:mod:`~splatedit.render.uploads` (cloud, selection, basis, detail and dC
-uploads), :mod:`~splatedit.render.prepass` (the compute pre-pass and its
-windows), :mod:`~splatedit.render.targets` (render targets and per-size
+:class:`Renderer` coordinates the frame and owns its parts: the scene's
+buffers (:class:`~splatedit.render.uploads.SceneUploads`, ``renderer.uploads``:
+cloud, selection, basis, detail and dC uploads), the compute pre-pass
+(:class:`~splatedit.render.prepass.Prepass`, ``renderer.prepass_part``: its
+buffers, windows and recording); it uses :mod:`~splatedit.render.targets` (render targets and per-size
 images, shared with the Gaussian renderer), :mod:`~splatedit.render.splat_layout`
 (descriptor sets, render passes, pipeline descriptions) and
 :mod:`~splatedit.render.gpu_units` (model units to GPU units).
@@ -43,13 +44,13 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.compute_raster import ComputeRaster, choose_path, probe_key, requested_path
 from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
-from splatedit.render.gpu_units import displacement_bound, gpu_camera
-from splatedit.render.prepass import PrepassMixin
-from splatedit.render.splat_layout import (GEOM_STRIDE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
-                                           UBO_BYTES, rp_attr, splat_desc)
+from splatedit.render.gpu_units import gpu_camera
+from splatedit.render.prepass import Prepass, PrepObjects
+from splatedit.render.splat_layout import (GEOM_STRIDE, PREP_MAX_SIZE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
+                                           UBO_BYTES, rp_attr, rp_window, splat_desc)
 from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
-from splatedit.render.uploads import SceneUploadsMixin
+from splatedit.render.uploads import SceneUploads
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_EDL_RADIUS_PX,
                                   RENDER_EDL_STRENGTH, RENDER_GAUSS_SHARPNESS, RENDER_GREY_ALBEDO,
                                   RENDER_LIGHT, RENDER_LOWPASS_RADIUS_PX, RENDER_MIN_WEIGHT,
@@ -57,7 +58,7 @@ from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_EDL_RA
                                   RENDER_VISIBILITY_EPS_RADII)
 
 
-class Renderer(SceneUploadsMixin, PrepassMixin):
+class Renderer:
     """Offscreen EWA splat renderer owning its Vulkan device.
 
     Use as a context manager or call :meth:`close`.  Typical use::
@@ -136,7 +137,6 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self.edl = False
         self.edl_strength = float(RENDER_EDL_STRENGTH)
         self.edl_radius_px = float(RENDER_EDL_RADIUS_PX)
-        self._prep = None             # _Prep of the compute pre-pass
         self.background = tuple(float(x) for x in background)
         #: alpha of background pixels in the output (0: uncovered pixels are
         #: told apart, as :mod:`splatedit.render.progressive` does)
@@ -149,21 +149,11 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._closed = False
         self.cache = self.sampler = self.ubo = self.splat_set = None
         self._targets = None
-        self._cloud_bufs = []
-        self._basis_buf = None
-        self._detail_buf = None       # (n_b, lambda / scale) per splat, see set_detail
-        self._detail_reach = 0.0
-        self._dummy_basis = {}
-        self.cloud = None
-        self.origin = np.zeros(3)
-        self.scale = 1.0
-        self.n = 0
-        self._basis_cols = 4
-        self._basis_rows = np.zeros(0, dtype=np.int64)
-        self._basis_reach = 0.0       # see _clip_bounds
-        self._dC = np.zeros((4, 3))
-        self._rot = None            # RotationDisplacement of the frame, or None
-        self._dC_dirty = True
+        #: the compute pre-pass (:class:`~splatedit.render.prepass.Prepass`; None
+        #: until the frame objects exist).  Not ``prepass``: that is the on/off switch.
+        self.prepass_part: Prepass | None = None
+        #: the scene's buffers (:class:`~splatedit.render.uploads.SceneUploads`)
+        self.uploads = SceneUploads(self.dev, self._free_prep)
         self.dC_ubo = None
         self.last_timings_ms: dict[str, float] = {}
         self._query = None
@@ -173,6 +163,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(SPLAT_SET))
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
             self._query = V.QueryPool(self.dev, 16)
+            self.prepass_part = Prepass(self.dev, self.cache, self.uploads, self.ubo, self.dC_ubo)
         except BaseException:
             try:
                 self.close()
@@ -201,7 +192,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if self.dev.device is not None:
             step(self.dev.wait_idle)
         step(lambda: self._free_compute_raster(wait=False))     # waited above
-        step(self._free_cloud)
+        step(self.uploads.free)
         if self._targets is not None:
             step(self._targets.destroy)
             self._targets = None
@@ -231,10 +222,87 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             raise ParameterError("renderer", "is closed")
 
     # -------------------------------------------------------------- scene
-    def _clip_bounds(self):
+    # The scene's buffers live in self.uploads (SceneUploads); these are the
+    # renderer's public face of them (and of the SceneRenderer protocol).
+    @property
+    def cloud(self):
+        """The uploaded :class:`~splatedit.model.cloud.SplatCloud` (None before :meth:`set_cloud`)."""
+        return self.uploads.cloud
+
+    @property
+    def n(self) -> int:
+        """Splats of the uploaded cloud (0 without one)."""
+        return self.uploads.n
+
+    @property
+    def origin(self) -> np.ndarray:
+        """(3,) model-space point that GPU coordinates are relative to (the cloud's box centre)."""
+        return self.uploads.origin
+
+    @property
+    def scale(self) -> float:
+        """Model units per GPU unit (an exact power of two, see :meth:`set_cloud`)."""
+        return self.uploads.scale
+
+    @property
+    def bounds(self):
+        """(lo, hi) undeformed bounds padded by the largest splat radius; near/far
+        come from these grown by the deformation's reach (:meth:`clip_bounds`)."""
+        return self.uploads.bounds
+
+    def set_cloud(self, cloud) -> None:
+        """Upload a cloud (float32 relative to its bounding-box centre, in units
+        of :attr:`scale`, a power of two near its size, so that a model of
+        any size from 1e-15 to 1e15 renders the same); clears selection and
+        basis (:meth:`SceneUploads.set_cloud <splatedit.render.uploads.SceneUploads.set_cloud>`)."""
+        self.check_open()
+        self.uploads.set_cloud(cloud)
+
+    def require_cloud(self):
+        """Raise ParameterError when no cloud is set."""
+        self.uploads.require_cloud()
+
+    def set_selection(self, support_mask=None, handle_mask=None, inactive_mask=None) -> None:
+        """Tint the support region (blue) and handle (green); boolean masks of
+        shape (n,) or index arrays; None clears.  ``inactive_mask``: splats
+        of inactive handles, tinted green and drawn darker."""
+        self.check_open()
+        self.uploads.set_selection(support_mask, handle_mask, inactive_mask)
+
+    def set_basis(self, indices, B, Bx, By, Bz) -> None:
+        """Deformation basis rows for the splats ``indices`` (N,); B, Bx, By, Bz
+        are (N, K) with any K in 1..``RENDER_MAX_BASIS_COLUMNS`` (16); other
+        splats are not deformed; a new K resets the displacement; drops a
+        :meth:`set_detail` (:meth:`SceneUploads.set_basis
+        <splatedit.render.uploads.SceneUploads.set_basis>` says more)."""
+        self.check_open()
+        self.uploads.set_basis(indices, B, Bx, By, Bz)
+
+    def set_detail(self, indices, detail) -> None:
+        """Detail-preserving mode: ``detail`` (N, 4) = (base normal n_b, offset
+        lambda in model units) of the splats ``indices`` (:meth:`SceneUploads.set_detail
+        <splatedit.render.uploads.SceneUploads.set_detail>`); drawn by the
+        compute pre-pass (images up to 4095 pixels)."""
+        self.check_open()
+        self.uploads.set_detail(indices, detail)
+
+    def clear_basis(self) -> None:
+        """Drop the deformation basis (every splat undeformed)."""
+        self.check_open()
+        self.uploads.clear_basis()
+
+    def set_displacement(self, dC) -> None:
+        """Control-frame displacement dC (K, 3), K = the basis' column count
+        (K = 4 before any :meth:`set_basis`); uploaded when the next frame is
+        recorded, whose near/far planes allow for the largest possible splat
+        displacement (:meth:`clip_bounds`)."""
+        self.check_open()
+        self.uploads.set_displacement(dC)
+
+    def clip_bounds(self):
         """The box that near/far are chosen from: the undeformed bounds grown
-        by a bound on any splat's displacement (see :meth:`_reach`), so that
-        geometry moved outside the model (a handle dragged towards the eye)
+        by a bound on any splat's displacement (:meth:`displacement_reach`), so
+        that geometry moved outside the model (a handle dragged towards the eye)
         is not clipped."""
         lo, hi = self.bounds
         grow = self.displacement_reach()
@@ -243,14 +311,71 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
     def displacement_reach(self) -> float:
         """A bound (model units) on how far any splat is moved from its uploaded
         position by the current basis and displacement (0 without a basis)."""
-        if not len(self._basis_rows):
-            return 0.0
-        move = displacement_bound(self._dC, self._rot)
-        return self._basis_reach * move + (self._detail_reach if move > 0 else 0.0)
+        return self.uploads.displacement_reach()
+
+    # ------------------------------------------------------------ pre-pass
+    def _free_prep(self):
+        if self.prepass_part is not None:
+            self.prepass_part.free()
+
+    def use_prepass(self) -> bool:
+        """Whether this frame's splat passes draw compute pre-pass records (see
+        the ``prepass`` argument; the detail mode always does)."""
+        t = self._targets
+        if self.uploads.detail_buf is not None:   # the detail mode has no vertex-path variant
+            if t is not None and max(t.width, t.height) > PREP_MAX_SIZE:
+                raise ParameterError("size", f"the detail mode renders images up to {PREP_MAX_SIZE} "
+                                             f"pixels wide and high, got {t.width}x{t.height}")
+            return True
+        if not self.prepass:
+            return False
+        # any size: clouds whose records (48 bytes per splat) or geometry do
+        # not fit one storage binding are drawn in splat windows
+        return not (t is not None and max(t.width, t.height) > PREP_MAX_SIZE)
+
+    @property
+    def prepass_windows(self) -> int:
+        """Splat windows the compute pre-pass prepares and draws the cloud in at
+        the current image size: 1 when the cloud fits one storage binding, 0 for
+        the vertex path (pre-pass off, images above 4095 pixels, no cloud)."""
+        if self.cloud is None or not self.use_prepass():
+            return 0
+        return len(self.prepass_part.spans())
+
+    def prep_objects(self) -> PrepObjects:
+        """The pre-pass buffers and sets (:meth:`Prepass.objects
+        <splatedit.render.prepass.Prepass.objects>`)."""
+        return self.prepass_part.objects()
+
+    def prep_range(self, first: int, count: int) -> tuple[int, list, list]:
+        """Sets that prepare only splats ``first`` .. ``first + count - 1``
+        (:meth:`Prepass.range_sets <splatedit.render.prepass.Prepass.range_sets>`)."""
+        return self.prepass_part.range_sets(first, count)
+
+    def record_prepass(self, cb, window: int = 0, sets: list | None = None):
+        """The compute pre-pass of splat window ``window`` (:meth:`Prepass.record
+        <splatedit.render.prepass.Prepass.record>`)."""
+        self.prepass_part.record(cb, window, sets)
+
+    def record_splat_pass(self, cb, kind: str, desc: V.RenderPassDesc, fb, clears, prepared: bool):
+        """One splat pass (``kind`` depth, attr or pick) into ``fb``. With several
+        pre-pass windows: per window, its pre-pass then its draws (in a render
+        pass that keeps the previous windows' results)."""
+        count = self.prepass_part.window_count(prepared)
+        if count == 1:
+            cb.begin_render_pass(self.cache.render_pass(desc), fb, clears)
+            self.record_splats(cb, kind, prepared)
+            cb.end_render_pass()
+            return
+        for k in range(count):
+            self.record_prepass(cb, k)
+            cb.begin_render_pass(self.cache.render_pass(rp_window(desc, k == 0, k == count - 1)), fb, clears)
+            self.record_splats(cb, kind, True, k)
+            cb.end_render_pass()
 
     # ---------------------------------------------------------- pipelines
     def _vertex_layout(self, basis_stride: int):
-        g = self._basis_groups
+        g = self.uploads.basis_groups
         bindings = (V.VertexBinding(0, GEOM_STRIDE), V.VertexBinding(1, 4), V.VertexBinding(2, 4),
                     V.VertexBinding(3, basis_stride))
         off = {f: SPLAT_GEOM.fields[f][1] for f in ("center", "u", "v")}    # splatedit/render/uniforms.py
@@ -261,9 +386,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         return bindings, tuple(attrs)
 
     def _splat_pipeline(self, kind: str, mode: int = 0):
-        g = self._basis_groups
-        deformed = self._basis_buf is not None and len(self._basis_rows) > 0
-        bindings, attrs = self._vertex_layout(64 * g if deformed else 0)
+        g = self.uploads.basis_groups
+        bindings, attrs = self._vertex_layout(64 * g if self.uploads.deformed else 0)
         layout = V.LayoutDesc(sets=(SPLAT_SET,))
         vert = "splat.vert" if g == 1 else f"splat_k{4 * g}.vert"
         return self.cache.pipeline(splat_desc(vert, kind, self.accum_format, layout, bindings=bindings,
@@ -286,7 +410,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         # by scale: so is the camera (a similarity: the image is the same)
         o, sc = self.origin, self.scale
         gpu_cam = gpu_camera(camera, o, sc)
-        lo, hi = self._clip_bounds()
+        lo, hi = self.clip_bounds()
         near, far = gpu_cam.clip_range((lo - o) / sc, (hi - o) / sc)
         view = gpu_cam.view_matrix()
         proj = gpu_cam.projection_matrix(width / height, near, far)
@@ -307,9 +431,10 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         u["display"] = (self.splat_scale, RENDER_GREY_ALBEDO if self.grey_shading else -1.0,
                         *((self.edl_strength, self.edl_radius_px) if self.edl else (0.0, 0.0)))
         self.ubo.write(u)
-        if self._dC_dirty:
-            self.dC_ubo.write(self._dC_block())
-            self._dC_dirty = False
+        up = self.uploads
+        if up.dC_dirty:
+            self.dC_ubo.write(up.deform_block())
+            up.dC_dirty = False
         self.near_far = (near * sc, far * sc)     # model units
 
     def record_splats(self, cb, kind: str, prepared: bool = False, window: int = 0):
@@ -320,7 +445,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             dset, draws = prep.dset, prep.draws
             n = np.array((prep.windows[window][1],), PREPARED_PUSH)
             for mode, offset in ((1, 0), (2, 16)):
-                pipeline = self._prepared_pipeline(kind, mode)
+                pipeline = self.prepass_part.draw_pipeline(kind, mode, self.accum_format)
                 cb.bind_pipeline(pipeline)
                 cb.bind_descriptor_set(pipeline, dset)
                 cb.push_constants(pipeline, n)
@@ -333,7 +458,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         instance each) as quads, or (point_splats) tiny ones as points + the
         others as quads (:mod:`splatedit.render.progressive` draws its chunks so)."""
         modes = ((1, 4), (2, 1)) if self.point_splats else ((0, 4),)
-        bufs = [self._geom, self._color, self._flags, self._basis_binding()]
+        up = self.uploads
+        bufs = [up.geom, up.color, up.flags, up.basis_binding()]
         for mode, verts in modes:
             pipeline = self._splat_pipeline(kind, mode)
             cb.bind_pipeline(pipeline)
@@ -407,7 +533,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         if frame.outputs & {"depth", "accum", "vis_buffer", "accum_buffers"}:
             self.frames_recorded += 1      # the shared targets a progressive frame draws into
         prepared = self.use_prepass()
-        ctx = FrameContext(self, t, target, prepared, self._prep_window_count(prepared))
+        ctx = FrameContext(self, t, target, prepared, self.prepass_part.window_count(prepared))
         cb.reset_queries(self._query)
         frame.record(cb, ctx, self._query)
         self._last_frame = frame
@@ -520,7 +646,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.begin_render_pass(self.cache.render_pass(RP_POINTS), t.fb_points, [(1.0, 1.0, 1.0, 1.0), 1.0])
             cb.bind_pipeline(pipe)
             cb.bind_descriptor_set(pipe, self.splat_set)
-            cb.bind_vertex_buffers(0, [self._geom])
+            cb.bind_vertex_buffers(0, [self.uploads.geom])
             cb.draw(self.n)
             cb.end_render_pass()
             cb.timestamp(self._query, 1)

@@ -54,7 +54,7 @@ def test_commit_progress_is_chunked_and_monotone(mode):
     several steps, never decreasing, ending at 1 (linear, rotation, detail)."""
     s = _posed(_bunny(), mode)
     try:
-        plan = s._commit_plan()
+        plan = s.pose_part.commit_plan()
         seen = []
         new = plan.work(lambda stage, f: seen.append((stage, f)))
         stages = list(dict.fromkeys(st for st, _ in seen))
@@ -81,7 +81,7 @@ def test_gaussian_commit_progress_is_chunked_and_bitwise_the_same():
     doc = gaussian_document(gaussians_from_splats(_bunny(20_000)))
     s = _posed(doc)
     try:
-        plan = s._commit_plan()
+        plan = s.pose_part.commit_plan()
         seen = []
         new = gaussians_of(plan.work(lambda stage, f: seen.append(f)))
         assert len(seen) >= 4 and seen[-1] == 1.0 and all(np.diff(seen) >= 0), seen

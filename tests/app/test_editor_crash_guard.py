@@ -153,7 +153,7 @@ def test_an_exception_in_a_key_handler_is_shown_the_document_kept_and_a_recovery
     # the same error again: no second recovery copy of the same state, the window stays
     ed.window.events = [key_event(glfw.KEY_M)]
     ed.loop_once()
-    assert len(recovery.entries()) == 1 and ed.internal_errors == 2
+    assert len(recovery.entries()) == 1 and ed.crash_guard.internal_errors == 2
 
 
 def test_an_exception_in_an_event_handler_outside_the_actions_is_caught(ed):
@@ -248,29 +248,29 @@ def test_nothing_unsaved_writes_no_recovery_copy(ed):
 def test_the_next_start_offers_the_copy_restore_adopts_its_edits_discard_removes_it(ed, tmp_path):
     s = ed.session
     edited(s)
-    e = ed.write_recovery("test")
+    e = ed.crash_guard.write_recovery("test")
     other = StubEditor(Session(plane_cloud(), fit_sync=True))
     try:
-        assert other.offer_recovery() and other.confirm_restore == e and other.modal()
+        assert other.crash_guard.offer_recovery() and other.crash_guard.confirm_restore == e and other.modal()
         # Esc: asked again next time (kept)
         other.on_key(key_event(glfw.KEY_ESCAPE))
-        assert other.confirm_restore is None and recovery.entries() == [e]
+        assert other.crash_guard.confirm_restore is None and recovery.entries() == [e]
         # Y: restore -- the recovered model opens (a load job), its edits become the document's
         opened = []
         other.open_path = lambda p, confirmed=False: opened.append(p) or True
-        assert other.offer_recovery()
+        assert other.crash_guard.offer_recovery()
         other.on_key(key_event(glfw.KEY_Y))
-        assert opened == [e.model] and other.restoring == e
+        assert opened == [e.model] and other.crash_guard.restoring == e
         other.session = Session(read(str(e.model)), fit_sync=True)       # what the load job lands
-        other.on_restored()
+        other.crash_guard.on_restored()
         r = other.session
-        assert len(r.edits) == 1 and r.dirty and other.path == ed.path and other.restored == e
+        assert len(r.edits) == 1 and r.dirty and other.path == ed.path and other.crash_guard.restored == e
         assert r.edit_script().edits == load_script(e.script).edits
-        other.restored_saved(r)                   # saving it removes the entry
+        other.crash_guard.restored_saved(r)       # saving it removes the entry
         assert recovery.entries() == []
         # N: discard
-        e2 = ed.write_recovery("again") or recovery.write_recovery(s, ed.path)
-        assert other.offer_recovery()
+        e2 = ed.crash_guard.write_recovery("again") or recovery.write_recovery(s, ed.path)
+        assert other.crash_guard.offer_recovery()
         other.on_key(key_event(glfw.KEY_N))
         assert recovery.entries() == [] and not e2.model.exists()
     finally:

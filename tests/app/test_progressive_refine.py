@@ -198,7 +198,7 @@ def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
                 break
         p = fr.last_progressive
         assert p is not None and p.done and len(p.step_ms) >= 4
-        assert vp.full.r._detail_buf is not None and p.frame.prepared
+        assert vp.full.r.uploads.detail_buf is not None and p.frame.prepared
         from splatedit.app.viewport import render_camera
         ref = vp.full.r.render(render_camera(ed.cam), W, H)
         diff = np.abs(ed.presenter.frames[-1][..., :3].astype(int) - ref[..., :3].astype(int))

@@ -143,7 +143,7 @@ def test_splat_geometry_and_detail_rows_bytes_equal_the_hand_packing(renderer, m
     cloud = read(default_model_path())
     monkeypatch.setattr(uploads, "RENDER_UPLOAD_CHUNK_SPLATS", 3000)    # several chunks, a partial last one
     renderer.set_cloud(cloud)
-    got = renderer._geom.read(cloud.n * SPLAT_GEOM.itemsize)
+    got = renderer.uploads.geom.read(cloud.n * SPLAT_GEOM.itemsize)
     inv = 1.0 / renderer.scale
     old = np.zeros((cloud.n, 9), np.float32)                             # the previous hand offsets
     np.multiply(cloud.positions - renderer.origin, inv, out=old[:, 0:3], casting="same_kind")
@@ -156,7 +156,7 @@ def test_splat_geometry_and_detail_rows_bytes_equal_the_hand_packing(renderer, m
     n_b = rng.normal(size=(500, 3))
     detail = np.column_stack([n_b / np.linalg.norm(n_b, axis=1, keepdims=True), rng.normal(size=500) * 1e-3])
     renderer.set_detail(idx, detail)
-    got = renderer._detail_buf.read(cloud.n * DETAIL_ROW.itemsize)
+    got = renderer.uploads.detail_buf.read(cloud.n * DETAIL_ROW.itemsize)
     old = np.zeros((cloud.n, 4), np.float32)
     old[idx, :3] = detail[:, :3]
     old[idx, 3] = detail[:, 3] / renderer.scale

@@ -108,13 +108,13 @@ def test_compute_path_matches_raster_in_prepass_windows(renderer, monkeypatch):
 
     cam = Camera(eye=(0.2, 0.3, 2.5), target=(0, 0, 0), fov_deg=50)
     monkeypatch.setattr(renderer.dev, "limits", Small())
-    renderer._free_prep()
+    renderer.prepass_part.free()
     try:
         got = _both(renderer, cam, 96, 72)
         assert renderer.prepass_windows == 3
     finally:
         monkeypatch.undo()
-        renderer._free_prep()
+        renderer.prepass_part.free()
     _assert_same_frame(*got)
 
 

@@ -86,7 +86,7 @@ def test_prepass_basis_windows(renderer, monkeypatch):
         monkeypatch.setattr(renderer.dev, "limits", Small())
     try:
         _compare(renderer, base, deformed, cam, setup)
-        assert len(renderer._prep.windows) == 1 and len(renderer._prep.windows[0][2]) == 3
+        assert len(renderer.prepass_part.current.windows) == 1 and len(renderer.prepass_part.current.windows[0][2]) == 3
     finally:
         monkeypatch.undo()
         renderer.set_cloud(base)

@@ -65,7 +65,7 @@ def test_detail_renders_through_the_prepass_even_when_it_is_off(renderer, plane)
         _compare(renderer, c, deformed, cam, _setup(renderer, det, dC))
         # a linear basis set afterwards drops the detail rows (vertex path again)
         renderer.set_basis(*det.rows_for_gpu())
-        assert renderer._detail_buf is None
+        assert renderer.uploads.detail_buf is None
     finally:
         renderer.prepass = saved
 
@@ -93,7 +93,7 @@ def test_detail_matches_cpu_in_prepass_windows(renderer, plane, monkeypatch):
         monkeypatch.setattr(renderer.dev, "limits", Small())
     try:
         _compare(renderer, c, deformed, cam, windowed)
-        assert [cnt for _, cnt, _ in renderer._prep.windows] == [1024, 1024, c.n - 2048]
+        assert [cnt for _, cnt, _ in renderer.prepass_part.current.windows] == [1024, 1024, c.n - 2048]
     finally:
         monkeypatch.undo()
         renderer.set_cloud(c)

@@ -117,7 +117,7 @@ def test_million_splat_sphere_hole_free_1280x720(renderer):
     cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))
     renderer.set_cloud(cloud)
     bufs = renderer.render_buffers(cam, w, h)
-    draws = renderer._prep.draws.read().view(np.uint32)
+    draws = renderer.prepass_part.current.draws.read().view(np.uint32)
     assert draws[5] > 0.9 * (draws[1] + draws[5]), draws          # the point path is exercised
     saved = renderer.point_splats
     try:

@@ -66,17 +66,17 @@ def test_windowed_prepass_matches_the_vertex_path(renderer, monkeypatch):
     ref = _frames(renderer, cam)[(False, False)]
     assert renderer.prepass_windows == 1
     monkeypatch.setattr(renderer.dev, "limits", Small())
-    renderer._free_prep()
+    renderer.prepass_part.free()
     try:
         saved = renderer.prepass
         renderer.prepass = True
         img, pick = renderer.render(cam, W, H), renderer.pick(cam, W, H)[0]
-        windows = renderer._prep.windows
+        windows = renderer.prepass_part.current.windows
         assert renderer.prepass_windows == 4
     finally:
         renderer.prepass = saved
         monkeypatch.undo()
-        renderer._free_prep()
+        renderer.prepass_part.free()
     assert [cnt for _, cnt, _ in windows] == [16384, 16384, 16384, 60000 - 3 * 16384]
     for w0, wn, chunks in windows:         # basis windows of 3,072 splats tile each splat window
         assert len(chunks) == -(-wn // 3072)

@@ -190,7 +190,7 @@ def test_progressive_frame_in_prepass_windows_of_a_deformed_cloud(renderer, monk
 
     cam = Camera(eye=(0.2, 0.3, 1.9), target=(0, 0, 0), fov_deg=60)
     monkeypatch.setattr(r.dev, "limits", Small())
-    r._free_prep()
+    r.prepass_part.free()
     try:
         full = r.render(cam, W, H)
         assert r.prepass_windows == 4
@@ -202,7 +202,7 @@ def test_progressive_frame_in_prepass_windows_of_a_deformed_cloud(renderer, monk
                 img = pf.step()
     finally:
         monkeypatch.undo()
-        r._free_prep()
+        r.prepass_part.free()
     assert starts == [0, 10048, 16384, 26432, 32768, 42816, 49152, 59200]
     _close_to(img, full)
 

@@ -24,8 +24,8 @@ def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monke
     for chunk in (cloud.n, 1000):
         monkeypatch.setattr(umod, "RENDER_UPLOAD_CHUNK_SPLATS", chunk)
         renderer.set_cloud(cloud)
-        geom = renderer._geom.read().view(np.float32).reshape(cloud.n, 9)
-        col = renderer._color.read().reshape(cloud.n, 4)
+        geom = renderer.uploads.geom.read().view(np.float32).reshape(cloud.n, 9)
+        col = renderer.uploads.color.read().reshape(cloud.n, 4)
         out.append((geom, col, renderer.render(cam, 96, 96)))
     assert cloud.n % 1000 != 0
     assert np.array_equal(out[0][0], out[1][0])
