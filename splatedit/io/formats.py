@@ -19,6 +19,7 @@ from splatedit.io.off import read_off, write_off
 from splatedit.io.pcd import read_pcd, write_pcd
 from splatedit.io.ply import read_ply, write_ply
 from splatedit.io.pts import read_pts, write_pts
+from splatedit.io.ptx import read_ptx
 from splatedit.io.xyz import read_xyz, write_xyz
 
 
@@ -110,6 +111,7 @@ FORMATS: tuple[Format, ...] = (
     Format("E57", (".e57",), read_e57, _write_e57, colours=True, intensity=True, origin=True,
            z_up=True, keep_on_save=True),
     Format("PCD", (".pcd",), read_pcd, _plain(write_pcd), colours=True, intensity=True, normals=True),
+    Format("Leica PTX", (".ptx",), read_ptx, colours=True, intensity=True),
 )
 
 _BY_EXT = {ext: f for f in FORMATS for ext in f.extensions}
