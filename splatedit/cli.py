@@ -197,9 +197,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--json", action="store_true", help="print one JSON object")
     s.set_defaults(func=cmd_info)
 
-    s = sub.add_parser("convert", help="convert between PLY, XYZ, OFF, LAS/LAZ, E57, PCD and PTS by extension "
-                                       "(estimates normals and sizes when missing); a Gaussian splatting PLY "
-                                       "stays one (see --to-splats)")
+    from splatedit.io import READ_EXTENSIONS, WRITE_EXTENSIONS    # the format registry's lists
+    s = sub.add_parser("convert", help=f"convert by extension: reads {' '.join(READ_EXTENSIONS)}, writes "
+                                       f"{' '.join(WRITE_EXTENSIONS)} (estimates normals and sizes when "
+                                       "missing); a Gaussian splatting PLY stays one (see --to-splats)")
     s.add_argument("input")
     s.add_argument("output")
     s.add_argument("--to-splats", action="store_true",

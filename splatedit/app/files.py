@@ -15,13 +15,15 @@ import numpy as np
 from splatedit.app.gaussian_doc import gaussians_of, model_summary
 from splatedit.app.jobs import Cancelled, Job
 from splatedit.errors import InputError, SplatEditError
+from splatedit.io.formats import extensions
 from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS
 
 
 #: inputs saved in their own format (their scanner dimensions: intensity,
 #: classification, the LAS scale/offset or E57 pose, survive); everything else
-#: is saved as splatedit's lossless splat PLY
-KEEP_FORMAT_SUFFIXES = (".las", ".laz", ".e57")
+#: is saved as splatedit's lossless splat PLY (the formats marked
+#: ``keep_on_save`` in :data:`splatedit.io.formats.FORMATS`)
+KEEP_FORMAT_SUFFIXES = extensions(keep_on_save=True)
 
 
 def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:

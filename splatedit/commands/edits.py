@@ -46,15 +46,17 @@ def _kept_up(input_path) -> str | None:
 
 
 def _faces_note(cloud, output) -> str:
-    """What became of a mesh's faces in ``output``: kept (PLY, OFF) or dropped
-    (the point formats: XYZ, LAS/LAZ, E57, PCD, PTS hold no faces)."""
+    """What became of a mesh's faces in ``output``: kept (the registry's
+    ``faces`` formats, :data:`splatedit.io.FACE_EXTENSIONS`: PLY, OFF) or
+    dropped (the point formats)."""
     from splatedit.io import FACE_EXTENSIONS
     if cloud.faces is None:
         return ""
     ext = Path(output).suffix.lower()
     if ext in FACE_EXTENSIONS:
         return f", {len(cloud.faces)} faces"
-    return f" (the {len(cloud.faces)} faces were dropped: {ext} holds points only; write .ply or .off to keep them)"
+    return (f" (the {len(cloud.faces)} faces were dropped: {ext} holds points only; "
+            f"write {' or '.join(FACE_EXTENSIONS)} to keep them)")
 
 
 def _print_edit(args, rep) -> None:

@@ -12,9 +12,11 @@ Public API::
     read_gaussians(path, *, progress=None) -> GaussianCloud
     write_gaussians(path, scene, *, overwrite=False, progress=None) -> Path
 
-The format follows the file extension (case-insensitive): ``.ply``;
-``.xyz``, ``.txt`` (XYZ text); ``.off``; ``.las``, ``.laz``; ``.e57`` (one
-scan by index: ``file.e57#2``); ``.pcd``; ``.pts`` (Leica).  Splats come from the file
+The format follows the file extension (case-insensitive), looked up in the
+registry :data:`splatedit.io.formats.FORMATS` (its readers, writers and
+capabilities): ``.ply``; ``.xyz``, ``.txt`` (XYZ text); ``.off``; ``.las``,
+``.laz``; ``.e57`` (one scan by index: ``file.e57#2``); ``.pcd``; ``.pts``
+(Leica); and the formats added there since.  Splats come from the file
 (our ``ux..vz`` PLY properties) or are derived: see
 :func:`splatedit.io._build.build_cloud`.  Every problem with an input file is
 an :class:`~splatedit.errors.InputError` naming the file.
@@ -39,14 +41,9 @@ from pathlib import Path
 from splatedit.errors import InputError
 from splatedit.io._build import PointColumns, cloud_from_columns, columns_only
 from splatedit.io.atomic import atomic_open, check_writable_target
-from splatedit.io.e57 import read_e57, split_scan_index, write_e57
-from splatedit.io.las import read_las, write_las
+from splatedit.io.e57 import split_scan_index
+from splatedit.io.formats import FORMATS, Format, by_extension, extensions, format_of
 from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply, write_gaussian_ply
-from splatedit.io.off import read_off, write_off
-from splatedit.io.pcd import read_pcd, write_pcd
-from splatedit.io.ply import read_ply, write_ply
-from splatedit.io.pts import read_pts, write_pts
-from splatedit.io.xyz import read_xyz, write_xyz
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.model.summary import CloudSummary
@@ -54,20 +51,18 @@ from splatedit.progress import report
 
 __all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "split_scan_index",
            "READ_EXTENSIONS", "WRITE_EXTENSIONS", "FACE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians",
-           "read_summary", "read_columns", "cloud_from_columns", "PointColumns"]
+           "read_summary", "read_columns", "cloud_from_columns", "PointColumns",
+           "FORMATS", "Format", "format_of"]
 
-_READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_pts,
-            ".off": read_off, ".las": read_las, ".laz": read_las, ".e57": read_e57,
-            ".pcd": read_pcd}
-#: extensions :func:`read` understands
-READ_EXTENSIONS = tuple(_READERS)
+#: extensions :func:`read` understands (from :data:`splatedit.io.formats.FORMATS`)
+READ_EXTENSIONS = extensions(readable=True)
 #: extensions :func:`write` understands (.ply is the lossless splat format;
 #: .xyz keeps positions and normals, .off positions and faces; the scanner
 #: formats keep positions, colours, intensity (and LAS classification), .pcd
 #: normals too)
-WRITE_EXTENSIONS = (".ply", ".xyz", ".off", ".las", ".laz", ".e57", ".pcd", ".pts")
+WRITE_EXTENSIONS = extensions(writable=True)
 #: the written formats that hold triangle faces (the others drop a mesh's faces)
-FACE_EXTENSIONS = (".ply", ".off")
+FACE_EXTENSIONS = extensions(writable=True, faces=True)
 
 
 def _ext(path, allowed, what) -> str:
@@ -94,13 +89,11 @@ def read(path, *, progress=None) -> SplatCloud:
     if os.path.isdir(path):
         check_readable_file(path)       # "is a directory", not "unsupported extension '(none)'"
     ext = _ext(path, READ_EXTENSIONS, "reading")
-    reader = _READERS[ext]
+    reader = by_extension(ext).reader
     check_readable_file(path)
     with _memory_named(path):
-        if scan is not None:
-            return read_e57(path, scan=scan, progress=progress)
-        if ext == ".ply" and is_gaussian_ply(path):
-            return read_gaussian_ply(path, progress=progress).proxy_splats()
+        if scan is not None:                # only an .e57 path splits off a scan index
+            return reader(path, scan=scan, progress=progress)
         return reader(path, progress=progress)
 
 
@@ -273,21 +266,8 @@ def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = Tr
     report(progress, "writing", 0.0)
     try:
         with atomic_open(path, "wb") as fh:
-            if ext == ".ply":
-                write_ply(fh, cloud, binary=binary, axes=axes,
-                          comment=f"written by splatedit from {cloud.name or 'a splat cloud'}" + _up_comment(up_axis))
-            elif ext == ".xyz":
-                write_xyz(fh, cloud)
-            elif ext in (".las", ".laz"):
-                write_las(fh, cloud, path, compress=ext == ".laz")
-            elif ext == ".pcd":
-                write_pcd(fh, cloud)
-            elif ext == ".pts":
-                write_pts(fh, cloud)
-            elif ext == ".e57":
-                write_e57(fh, cloud, path)
-            else:
-                write_off(fh, cloud)
+            comment = f"written by splatedit from {cloud.name or 'a splat cloud'}" + _up_comment(up_axis)
+            by_extension(ext).writer(fh, cloud, path, binary=binary, axes=axes, comment=comment)
     except OSError as exc:
         raise InputError(f"cannot write: {exc.strerror or exc}", path=str(path)) from None
     report(progress, "writing", 1.0)

@@ -32,10 +32,6 @@ from splatedit.tolerances import (FRONT_VIEW_Z_UP_COS, UP_AXIS_ALIGNED_COS, UP_A
                                   UP_AXIS_FLOOR_MIN_IN_BAND, UP_AXIS_GROUND_MIN_FRACTION, UP_AXIS_SAMPLE,
                                   UP_AXIS_TALL_Z_RATIO)
 
-#: the formats whose coordinates are Z-up by definition
-Z_UP_SUFFIXES = (".las", ".laz", ".e57")
-
-
 class UpSource(enum.Enum):
     FILE_HEADER = "file header"
     FILE_FORMAT = "file format"
@@ -104,20 +100,24 @@ def header_up_hint(path) -> UpAxis | None:
     return None
 
 
-def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpAxis:
+def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None, *,
+                   z_up_format: bool = False) -> UpAxis:
     """The up axis of a model.
 
     Args:
         normals: (n, 3) float64 unit normals (zero rows allowed).
         positions: (n, 3) float64, model units.
-        path: the file the model came from (its suffix is a hint), or None.
+        path: the file the model came from (its header may name the up
+            axis), or None.
+        z_up_format: the file's format is Z-up by definition (the callers
+            ask :func:`splatedit.io.formats.is_z_up`; model sits below io).
     """
     if path is not None:
         hint = header_up_hint(path)
         if hint is not None:
             return hint
-        if Path(path).suffix.lower() in Z_UP_SUFFIXES:
-            return UpAxis(2, 1, UpSource.FILE_FORMAT)
+    if z_up_format:
+        return UpAxis(2, 1, UpSource.FILE_FORMAT)
     n = np.asarray(normals, float)
     p = np.asarray(positions, float)
     if len(n) and len(p):
@@ -143,13 +143,13 @@ def detect_up_axis(normals: np.ndarray, positions: np.ndarray, path=None) -> UpA
     return UpAxis(1, 1, UpSource.DEFAULT)
 
 
-def detect_cloud_up_axis(cloud, path=None) -> UpAxis:
+def detect_cloud_up_axis(cloud, path=None, *, z_up_format: bool = False) -> UpAxis:
     """:func:`detect_up_axis` of a :class:`~splatedit.model.cloud.SplatCloud`:
     the file's word first (no normals needed), else the floor rule on every
     ``n // UP_AXIS_SAMPLE``-th splat (its tests are shares of points, which a
     sample of that size gives to well under a percent; the normals of all
     10M splats alone cost 2.8 s)."""
-    hint = detect_up_axis(np.zeros((0, 3)), np.zeros((0, 3)), path)
+    hint = detect_up_axis(np.zeros((0, 3)), np.zeros((0, 3)), path, z_up_format=z_up_format)
     if hint.source is not UpSource.DEFAULT:
         return hint
     step = max(1, -(-cloud.n // UP_AXIS_SAMPLE))

@@ -16,6 +16,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, front_direction
 from splatedit.render.camera import Camera
@@ -66,7 +67,7 @@ def default_view(cloud, size, *, path=None, up=None, fov_deg: float | None = Non
     extent = framing_extent(cloud.positions)
     axis = None
     if up is None:
-        axis = detect_cloud_up_axis(cloud, path)
+        axis = detect_cloud_up_axis(cloud, path, z_up_format=is_z_up(path))
     up_vec = axis.vector if up is None else np.asarray(up, dtype=np.float64)
     if not np.any(up_vec) or not np.all(np.isfinite(up_vec)):
         direction = np.array([0.0, 0.0, 1.0])       # a bad --up: Camera names it

@@ -403,7 +403,7 @@ def test_a_second_signal_during_the_clean_up_is_ignored(tmp_path, monkeypatch, c
     import os
     import signal
     import splatedit.cli as cli
-    import splatedit.io as io_mod
+    import splatedit.io.formats as io_mod   # the registry calls write_ply
     from splatedit.data import default_model_path
     out = tmp_path / "out.ply"
     out.write_bytes(b"old contents")
@@ -487,7 +487,7 @@ def test_signals_during_the_clean_up_of_a_real_process_leave_one_line_and_exit_1
     code = f"""
 import os, signal, sys
 import splatedit.cli as cli
-import splatedit.io as io_mod
+import splatedit.io.formats as io_mod   # the registry calls write_ply
 def write(fh, cloud, **kw):
     fh.write(b"ply partial")
     os.kill(os.getpid(), signal.SIGTERM)

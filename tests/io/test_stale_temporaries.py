@@ -17,7 +17,7 @@ from splatedit.io.atomic import remove_stale_temporaries
 
 def test_sigterm_during_a_write_removes_the_temporary_and_keeps_the_target(tmp_path, monkeypatch, capsys):
     """Handled like Ctrl+C: exit 130, the old file untouched, no hidden file left."""
-    import splatedit.io as io_mod
+    import splatedit.io.formats as io_mod   # the registry calls write_ply
     out = tmp_path / "out.ply"
     out.write_bytes(b"old contents")
     real = io_mod.write_ply

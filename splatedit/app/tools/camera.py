@@ -10,6 +10,7 @@ from splatedit.app import revision
 from splatedit.app.keymap import Action, Section
 from splatedit.app.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
+from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, next_up
 from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
@@ -64,7 +65,7 @@ class CameraTool(Tool):
     # ----------------------------------------------------------- up axis
     def detect_up(self, cloud, path) -> None:
         """Set the up axis from the model (and the file's format)."""
-        self.set_up(detect_cloud_up_axis(cloud, path))
+        self.set_up(detect_cloud_up_axis(cloud, path, z_up_format=is_z_up(path)))
 
     def fresh_view(self, cloud, path) -> None:
         """The view a newly opened model gets (as on the first open): its own
