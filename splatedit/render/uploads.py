@@ -21,9 +21,31 @@ from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, pack_bas
                                         selection_flags, unit_scale)
 from splatedit.render.splat_layout import FLAG_DEFORMED, GEOM_STRIDE
 from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
-from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
+from splatedit.tolerances import (RENDER_DEFAULT_COLOR, RENDER_GPU_BODY_RATIO, RENDER_GPU_BODY_SAMPLE, RENDER_MAX_BASIS_COLUMNS, RENDER_UPLOAD_CHUNK_SPLATS,
                                   RENDER_VISIBILITY_EPS_RADII)
 
+
+
+def gpu_body_box(positions: np.ndarray, lo: np.ndarray, hi: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    """The box the GPU's float32 units are centred and scaled on: the full box
+    (``lo``, ``hi``: (3,) model units) unless a few far points make it more
+    than ``RENDER_GPU_BODY_RATIO`` times the main body across; then the main
+    body's box (:func:`splatedit.model.extent.framing_extent`).  One glitch
+    point 1e9 away from a 1-unit scan centred the GPU coordinates 5e8 from
+    the body, where float32 steps are 32 units: the body rendered as a
+    vertical strip.  The test is a strided sample's 1-99% box (a few ms at
+    10M splats); the main body is computed only when it fires."""
+    n = len(positions)
+    full = float(np.linalg.norm(hi - lo))
+    if n < 2 or full == 0.0:
+        return lo, hi
+    sample = positions[::max(1, n // RENDER_GPU_BODY_SAMPLE)]
+    q_lo, q_hi = np.percentile(sample, [1.0, 99.0], axis=0)
+    if full <= RENDER_GPU_BODY_RATIO * float(np.linalg.norm(q_hi - q_lo)):
+        return lo, hi
+    from splatedit.model.extent import framing_extent
+    ext = framing_extent(positions)
+    return (ext.lo, ext.hi) if ext.robust else (lo, hi)
 
 class SceneUploads:
     """The scene a :class:`~splatedit.render.renderer.Renderer` draws: the
@@ -89,14 +111,16 @@ class SceneUploads:
     def set_cloud(self, cloud: SplatCloud) -> None:
         """Upload a cloud (float32 relative to its bounding-box centre, in units
         of :attr:`scale`, a power of two near its size, so that a model of
-        any size from 1e-15 to 1e15 renders the same); clears selection and
-        basis."""
+        any size from 1e-15 to 1e15 renders the same; a model whose box a few
+        glitch points blow up is centred and scaled on its main body,
+        :func:`gpu_body_box`); clears selection and basis."""
         if not isinstance(cloud, SplatCloud):
             raise ParameterError("cloud", f"must be a SplatCloud, got {type(cloud).__name__}")
         self.free()
         n = cloud.n
         lo, hi = cloud.bounds()
-        self.origin = 0.5 * (lo + hi)
+        body_lo, body_hi = gpu_body_box(cloud.positions, lo, hi)
+        self.origin = 0.5 * (body_lo + body_hi)
         # the largest semi-axis without the (n,) radii array (per-splat radii
         # are computed for the basis rows only, in _basis_radii)
         rmax = float(np.sqrt(max(np.einsum("ij,ij->i", cloud.u, cloud.u).max(),
@@ -106,7 +130,7 @@ class SceneUploads:
         self.bounds = (lo - rmax, hi + rmax)
         #: model units per GPU unit: eye space, positions, axes and dC are
         #: divided by it (an exact power of two), depths multiplied back
-        self.scale = unit_scale(float(np.linalg.norm(hi - lo)), rmax)
+        self.scale = unit_scale(float(np.linalg.norm(body_hi - body_lo)), rmax)
         self.geom = V.Buffer(self.dev, n * GEOM_STRIDE, ("vertex", "storage"))
         self._cloud_bufs.append(self.geom)
         self.color = V.Buffer(self.dev, 4 * n, ("vertex", "storage"))

@@ -185,3 +185,12 @@ GS_TILE_MAX_TOL = {"rgba16f": 4, "rgba32f": 1}
 #: model detail at 1e18 to 1/8 unit (ulp 128 over a 1e15 body), the GPU sees
 #: the camera divided by the model's scale
 RENDER_CAMERA_MAX_ABS = 1e18
+#: the GPU's float32 coordinates are centred and scaled on the main body
+#: instead of the full box when the full box is more than this many times the
+#: body across (a sample's 1-99% box): float32 keeps 1e-7 of the offset from
+#: the centre, so a body 1e-3 of the box across still has 1e-4 of itself in
+#: resolution; a scan with one glitch point 1e9 away (ratio 1e9) rendered as
+#: a vertical strip before
+RENDER_GPU_BODY_RATIO = 1e3
+#: points of the strided sample behind that test (a few ms at 10M splats)
+RENDER_GPU_BODY_SAMPLE = 65536

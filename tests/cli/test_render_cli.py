@@ -104,3 +104,24 @@ def test_render_edl_only_darkens_depth_edges_and_is_refused_for_gaussian_scenes(
     assert cli.main(["render", str(gaussian_scene_path()), "-o", str(tmp_path / "g.png"), "--edl"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("splatedit: error: ") and "--edl" in err[0]
+
+
+def test_a_scan_with_one_glitch_point_1e9_away_renders_its_body_not_a_strip(tmp_path):
+    """The GPU units are centred and scaled on the main body when one far
+    point blows the box up (render/uploads.gpu_body_box): a sphere with a
+    point 1e9 away renders as a round disc, as it does without the point
+    (before: a vertical strip, float32 steps of 32 units at 5e8)."""
+    import numpy as np
+    from PIL import Image
+
+    from splatedit.cli import main
+    from tests.render.scenes import sphere
+    pts = sphere(20000, overlap=1.2).positions
+    np.savetxt(tmp_path / "glitch.xyz", np.vstack([pts, [[1e9, 0.0, 0.0]]]), fmt="%.9g")
+    assert main(["-q", "render", str(tmp_path / "glitch.xyz"), "-o", str(tmp_path / "g.png"),
+                 "--size", "320x240"]) == 0
+    cover = np.asarray(Image.open(tmp_path / "g.png").convert("L")) < 200
+    rows, cols = np.flatnonzero(cover.any(axis=1)), np.flatnonzero(cover.any(axis=0))
+    assert cover.sum() > 5000
+    width, height = cols[-1] - cols[0] + 1, rows[-1] - rows[0] + 1
+    assert 0.8 < width / height < 1.25                           # round, not a strip
