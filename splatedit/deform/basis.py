@@ -36,9 +36,8 @@ from splatedit.deform.constraints import Constraints, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
 from splatedit.deform.rbf import TriharmonicRBF
-from splatedit.deform.rotation import (blend_jacobians, blend_terms, handle_blocks,
-                                       rotation_displacement, split_displacement)
-from splatedit.deform.rotation_centre import StretchProbe
+from splatedit.deform.rotation import blend_jacobians, blend_terms, handle_blocks, split_displacement
+from splatedit.deform.rotation_centre import StretchProbe, rotation_displacement
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.blas import single_blas_thread
 from splatedit.errors import ParameterError

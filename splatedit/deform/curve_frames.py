@@ -72,8 +72,8 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from splatedit.deform.curves import ControlCurve, catmull_rom_weights, segment_index
-from splatedit.deform.rotation import (RotationDisplacement, blend_terms, handle_blocks,
-                                       rotation_displacement)
+from splatedit.deform.rotation import RotationDisplacement, blend_terms, handle_blocks
+from splatedit.deform.rotation_centre import rotation_displacement
 from splatedit.tolerances import CURVE_FRAME_MIN_RAMP_SPACINGS
 
 #: frame table points per curve segment (the rotation between them is
@@ -461,7 +461,7 @@ def deform_points(basis, dC, points) -> np.ndarray:
 
 def curve_frame_displacement(basis, transforms: list):
     """``DeformationBasis.displacement(transforms, mode=ROTATION)`` with control
-    curves: the handles as :func:`~splatedit.deform.rotation.rotation_displacement`
+    curves: the handles as :func:`~splatedit.deform.rotation_centre.rotation_displacement`
     does; each curve whose points move gets its :class:`CurveFrame` and its
     columns of the residual are solved so that every moved curve's picked
     points land on their targets.  Returns what ``rotation_displacement``

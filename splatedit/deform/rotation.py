@@ -76,8 +76,6 @@ from scipy.linalg import polar
 from scipy.spatial.transform import Rotation
 
 from splatedit.deform.modes import DeformationMode
-from splatedit.deform.rotation_centre import choose_centre
-from splatedit.deform.transform import as_affine
 from splatedit.tolerances import ROTATION_FULL_DEGREES, ROTATION_MIN_ANGLE
 
 
@@ -90,7 +88,8 @@ class HandleRotation:
             angle in [0, pi]); zeros when the handle does not rotate.
         center: (3,) float64 model-space arc centre: the point of the
             rotation axis nearest the handle's centroid, or the centroid
-            (:func:`~splatedit.deform.rotation_centre.choose_centre`).
+            (:func:`~splatedit.deform.rotation_centre.choose_centre`, called by
+            :func:`~splatedit.deform.rotation_centre.rotation_displacement`).
         offsets: (4, 3) float64 the handle's control frame minus ``center``
             (model units), times the arc share phi (:func:`arc_share`):
             ``v_h = B_h offsets``.
@@ -218,30 +217,6 @@ class RotationDisplacement:
 def handle_blocks(basis) -> list[slice]:
     """Column slices of a DeformationBasis' handles (4 columns each, in order)."""
     return [basis.columns_for_group(g) for g, kind in enumerate(basis.group_kinds) if kind == "handle"]
-
-
-def rotation_displacement(basis, transforms: list):
-    """``DeformationBasis.displacement(transforms, mode=ROTATION)``: each
-    handle's (4, 4) map (None: identity) decomposed about the centre
-    :func:`~splatedit.deform.rotation_centre.choose_centre` picks, the
-    residual maps (and the curves' inputs) through the linear ``displacement``.  Returns a
-    RotationDisplacement, or the plain (K, 3) dC when no handle rotates (then
-    bitwise the linear mode's)."""
-    rotations, inputs = [], []
-    for i, (t, kind) in enumerate(zip(transforms, basis.group_kinds)):
-        if kind == "handle":
-            m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
-            ctl = basis.constraints.groups[i].controls
-            _, w, pivot = screw_axis(m, ctl)
-            centre = None if pivot is None else choose_centre(basis, i, w / np.linalg.norm(w), pivot)
-            rot, res = decompose(m, ctl, centre)
-            rotations.append(rot)
-            t = None if t is None else res
-        inputs.append(t)
-    dc = basis.displacement(inputs)
-    if any(r.w.any() for r in rotations):
-        return RotationDisplacement(dc, tuple(rotations))
-    return dc
 
 
 def apply_rotation(basis, cloud, dC: np.ndarray, rot: "RotationDisplacement"):

@@ -38,6 +38,9 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from splatedit.deform.rotation import (HandleRotation, RotationDisplacement, blend_terms, decompose, handle_blocks,
+                                       screw_axis)
+from splatedit.deform.transform import as_affine, rotate
 from splatedit.tolerances import (ROTATION_PROBE_BLEND, ROTATION_PROBE_DEGREES, ROTATION_PROBE_PERCENTILE,
                                   ROTATION_PROBE_SPLATS)
 
@@ -80,7 +83,6 @@ class StretchProbe:
         ``max(|u'|/|u|, |u|/|u'|, |v'|/|v|, |v|/|v'|)`` over the probe
         splats under ``rot`` (a RotationDisplacement: residual dC and blended
         rotations; ``blocks`` the handles' column slices)."""
-        from splatedit.deform.rotation import blend_terms
         dc = rot.dC
         _, (du, dv) = blend_terms(rot, self.pack, blocks, (self.u, self.v))
         rs = []
@@ -108,9 +110,6 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np
     differ); a rotation vector's axis flips where the angle passes 180
     degrees, where the blend itself flips to the short way round.  Without a
     probe (a basis not built by ``fit``): ``pivot``."""
-    from splatedit.deform.rotation import HandleRotation, RotationDisplacement, decompose, handle_blocks
-    from splatedit.deform.transform import rotate
-
     probe = getattr(basis, "stretch_probe", None)
     ctl = basis.constraints.groups[handle].controls
     g = ctl[0]
@@ -145,3 +144,26 @@ def choose_centre(basis, handle: int, axis: np.ndarray, pivot: np.ndarray) -> np
     cache[key] = best
     return best
 
+
+def rotation_displacement(basis, transforms: list):
+    """``DeformationBasis.displacement(transforms, mode=ROTATION)``: each
+    handle's (4, 4) map (None: identity) decomposed about the centre
+    :func:`choose_centre` picks, the
+    residual maps (and the curves' inputs) through the linear ``displacement``.  Returns a
+    RotationDisplacement, or the plain (K, 3) dC when no handle rotates (then
+    bitwise the linear mode's)."""
+    rotations, inputs = [], []
+    for i, (t, kind) in enumerate(zip(transforms, basis.group_kinds)):
+        if kind == "handle":
+            m = np.eye(4) if t is None else as_affine(t, name=f"transforms[{i}]")
+            ctl = basis.constraints.groups[i].controls
+            _, w, pivot = screw_axis(m, ctl)
+            centre = None if pivot is None else choose_centre(basis, i, w / np.linalg.norm(w), pivot)
+            rot, res = decompose(m, ctl, centre)
+            rotations.append(rot)
+            t = None if t is None else res
+        inputs.append(t)
+    dc = basis.displacement(inputs)
+    if any(r.w.any() for r in rotations):
+        return RotationDisplacement(dc, tuple(rotations))
+    return dc
