@@ -296,3 +296,32 @@ ROTSTRETCH_SLIDE_STEP_SHARE = 0.25
 #: On one thread the size is within the noise; 8,192 keeps three chunks of
 #: (K + 3) float64 rows in L2 like ROTATION_APPLY_CHUNK and DETAIL_APPLY_CHUNK
 LINEAR_APPLY_CHUNK = 8192
+
+
+# ---------------------------------------------------------------------------
+# Fewer needles in big grabs (issue 20.3): ARAP refinement of a committed edit
+# ---------------------------------------------------------------------------
+#: a rotation-mode edit is refined (splatedit.deform.refine) when more than
+#: this share of its moved support splats is stretched beyond
+#: DISTORTION_BROKEN_STRETCH (4x).  0: any needle.  Measured (bench/needles.py):
+#: the one-view arm-lift and head-bend edits have 0.5-5.3 % beyond 4x before
+#: and 0-0.03 % after three iterations; edits without a needle keep the RBF
+#: result bitwise
+NEEDLE_REFINE_MIN_SHARE = 0.0
+#: local/global ARAP iterations seeded by the RBF result.  Measured
+#: (bench/needles.py, loaded 2-core machine): splats beyond 4x on the bunny's
+#: ear lifted sideways / the hippo's leg / the bunny's head bent: 55 / 31 /
+#: 406 before, 2 / 0 / 4 after 3 iterations, 2 / 0 / 2 after 10 (p99 stretch
+#: 1.32 / 1.55 / 1.33 after 3); about 0.1 s per iteration per 10k support
+#: splats
+ARAP_ITERATIONS = 3
+#: weight of the pull of each free splat towards its RBF position, relative
+#: to one graph edge (keeps graph components without a constrained splat
+#: where the RBF put them, and the Laplacian system non-singular); 1e-4 edge
+#: weights move a connected component's solution by about 1e-4 of the move
+ARAP_ANCHOR = 1e-4
+#: a splat's tangent-plane edge fit (axes u' = J u) is degenerate when the
+#: smaller eigenvalue of its edges' 2x2 tangent Gram matrix is below this
+#: times the larger (its edges all along one line): its axes turn by its ARAP
+#: rotation instead
+ARAP_MIN_TANGENT_RANK_REL = 1e-3

@@ -1,0 +1,184 @@
+"""Fewer needles in big grabs (issue 20.3): as-rigid-as-possible steps on the
+support's neighbour graph, seeded by the RBF deformation.
+
+When a handle is translated far, the paper's linear RBF moves a splat at
+weight s by ``s t``; where the weight field falls steeply along the direction
+of ``t`` (the handle moves towards the fixed band, or the closed back of a
+part whose transition is narrower than its front) the Jacobian ``I + t grad
+s^T`` nearly collapses a tangent direction and the splats become needles
+(stretch ``max(s1, 1/s2)`` far beyond 4x).  Inferring a swing about the fixed
+rim (the rotation mode's machinery, with the handle kept at ``p + t``) barely
+changes that (measured: 0-20 % fewer splats beyond 4x, docs/PERFORMANCE.md):
+the collapse is local.
+
+This module refines the committed positions instead: a few local/global
+iterations of as-rigid-as-possible deformation (Sorkine & Alexa 2007, on a
+point graph: Sorkine 2007 "As-rigid-as-possible surface modeling"):
+
+* graph: the support's symmetric k-nearest-neighbour graph
+  (:class:`~splatedit.select.graph.NeighbourGraph`, uniform weights);
+* constraints: the fixed band and the handles keep their RBF positions
+  (exact: handle splats at ``T_h(p)``, the band where it was); splats outside
+  the support are not touched;
+* local step: per splat the rotation ``R_i`` closest to ``sum_j e'_ij e_ij^T``
+  (SVD, det +1); global step: the graph Laplacian system
+  ``L p' = sum_j (R_i + R_j) e_ij / 2`` for the free splats (factored once),
+  with a weak anchor ``ARAP_ANCHOR`` to the seed so that graph components
+  without a constrained splat stay where the RBF put them;
+* splat axes: per splat the least-squares linear map of its tangent plane
+  taking its edges' tangent coordinates to the deformed edges (``u' = J u``;
+  so the distortion figures measure what was done); where that fit is
+  degenerate (fewer than two independent edges) ``u' = R_i u``.
+
+Seeded by the RBF result, three iterations take the arm-lift and head-bend
+edits of the bench below 0.1 % of moved splats beyond 4x
+(``python -m splatedit.bench.needles``).
+"""
+
+from __future__ import annotations
+
+from dataclasses import dataclass
+
+import numpy as np
+from scipy import sparse
+from scipy.sparse.linalg import splu
+
+from splatedit.tolerances import ARAP_ANCHOR, ARAP_ITERATIONS, ARAP_MIN_TANGENT_RANK_REL
+
+
+@dataclass(frozen=True)
+class RefineResult:
+    """What :func:`arap_refine` did.
+
+    Attributes:
+        positions, u, v: (n, 3) float64 the refined arrays of the whole cloud.
+        iterations: local/global iterations run.
+        n_free: support splats that were free to move.
+        n_degenerate: free splats whose axes came from ``R_i`` (degenerate
+            tangent fit).
+    """
+    positions: np.ndarray
+    u: np.ndarray
+    v: np.ndarray
+    iterations: int
+    n_free: int
+    n_degenerate: int
+
+
+def _edges(index: np.ndarray, positions: np.ndarray, graph=None):
+    """(i, j) local edge arrays (both directions) of the support's subgraph."""
+    from splatedit.select.graph import NeighbourGraph
+    g = NeighbourGraph.build(positions) if graph is None else graph
+    sub = g.subgraph(index)
+    i = np.repeat(np.arange(sub.n), np.diff(sub.indptr))
+    return i, np.asarray(sub.indices, dtype=np.int64)
+
+
+def _rotations(agg: sparse.csr_matrix, e0: np.ndarray, e1: np.ndarray) -> np.ndarray:
+    """(n, 3, 3) rotations R_i closest to ``S_i = sum_j e0 e1^T`` (``R = V U^T``)."""
+    s = (agg @ (e0[:, :, None] * e1[:, None, :]).reshape(-1, 9)).reshape(-1, 3, 3)
+    u, _, vt = np.linalg.svd(s)
+    r = np.matmul(vt.transpose(0, 2, 1), u.transpose(0, 2, 1))
+    flip = np.linalg.det(r) < 0.0
+    if flip.any():
+        u2 = u[flip].copy()
+        u2[:, :, 2] *= -1.0
+        r[flip] = np.matmul(vt[flip].transpose(0, 2, 1), u2.transpose(0, 2, 1))
+    return r
+
+
+def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarray,
+                u: np.ndarray, v: np.ndarray, *, iterations: int = ARAP_ITERATIONS,
+                graph=None) -> RefineResult:
+    """As-rigid-as-possible refinement of a deformed support.
+
+    Args:
+        cloud: the base (undeformed) SplatCloud.
+        index: (N,) cloud indices of the support.
+        fixed: (N,) bool, support splats that keep their deformed position
+            (the fixed band and the handles).
+        positions, u, v: (n, 3) float64 the deformed cloud's arrays (the
+            seed; not modified).
+        iterations: local/global steps.
+        graph: optional NeighbourGraph of ``cloud.positions`` (built otherwise).
+    Returns:
+        RefineResult with new arrays: rows outside ``index`` and the fixed
+        rows are bitwise the inputs.
+    """
+    index = np.asarray(index, dtype=np.int64)
+    fixed = np.asarray(fixed, dtype=bool)
+    n = len(index)
+    out_p, out_u, out_v = positions.copy(), u.copy(), v.copy()
+    fi = np.flatnonzero(~fixed)
+    if n == 0 or len(fi) == 0 or iterations <= 0:
+        return RefineResult(out_p, out_u, out_v, 0, len(fi), 0)
+    i, j = _edges(index, cloud.positions, graph)
+    p0 = cloud.positions[index]
+    x = positions[index].copy()
+    seed = x[fi].copy()
+    ones = np.ones(len(i))
+    agg = sparse.csr_matrix((ones, (i, np.arange(len(i)))), shape=(n, len(i)))
+    adj = sparse.csr_matrix((ones, (i, j)), shape=(n, n))
+    lap = (sparse.diags(np.asarray(adj.sum(axis=1)).ravel()) - adj).tocsr()
+    ci = np.flatnonzero(fixed)
+    lff = (lap[fi][:, fi] + ARAP_ANCHOR * sparse.identity(len(fi))).tocsc()
+    lfc = lap[fi][:, ci]
+    lu = splu(lff)
+    e0 = p0[i] - p0[j]
+    const = ARAP_ANCHOR * seed - lfc @ x[ci]
+    r = None
+    for _ in range(iterations):
+        r = _rotations(agg, e0, x[i] - x[j])
+        rhs = agg @ (0.5 * np.einsum("nab,nb->na", r[i] + r[j], e0))
+        b = rhs[fi] + const
+        x[fi] = np.stack([lu.solve(np.ascontiguousarray(b[:, k])) for k in range(3)], axis=1)
+    r = _rotations(agg, e0, x[i] - x[j])
+    # splat axes: least-squares tangent-plane map of each free splat's edges
+    rows = index[fi]
+    uu, vv = cloud.u[index], cloud.v[index]
+    lu_, lv_ = np.linalg.norm(uu, axis=1), np.linalg.norm(vv, axis=1)
+    uh, vh = uu / lu_[:, None], vv / lv_[:, None]
+    d0, d1 = -e0, x[j] - x[i]
+    a = np.stack([(d0 * uh[i]).sum(1), (d0 * vh[i]).sum(1)], axis=1)          # (E, 2) tangent coords
+    gram = (agg @ (a[:, :, None] * a[:, None, :]).reshape(-1, 4)).reshape(-1, 2, 2)
+    mom = (agg @ (d1[:, :, None] * a[:, None, :]).reshape(-1, 6)).reshape(-1, 3, 2)
+    ev = np.linalg.eigvalsh(gram)
+    ok = ev[:, 0] > ARAP_MIN_TANGENT_RANK_REL * np.maximum(ev[:, 1], 1e-300)
+    jt = np.zeros((n, 3, 2))
+    jt[ok] = np.matmul(mom[ok], np.linalg.inv(gram[ok]))
+    nu = np.where(ok[:, None], jt[:, :, 0] * lu_[:, None], np.einsum("nab,nb->na", r, uu))
+    nv = np.where(ok[:, None], jt[:, :, 1] * lv_[:, None], np.einsum("nab,nb->na", r, vv))
+    out_p[rows] = x[fi]
+    out_u[rows] = nu[fi]
+    out_v[rows] = nv[fi]
+    return RefineResult(out_p, out_u, out_v, iterations, len(fi), int((~ok[fi]).sum()))
+
+
+def needs_refine(stats) -> bool:
+    """The rule: a rotation-mode edit is refined when more than
+    NEEDLE_REFINE_MIN_SHARE of its support splats (``stats``: their
+    :class:`~splatedit.deform.distortion.DistortionStats`) are stretched
+    beyond DISTORTION_BROKEN_STRETCH."""
+    from splatedit.tolerances import NEEDLE_REFINE_MIN_SHARE
+    return stats.n > 0 and stats.n_above_broken > NEEDLE_REFINE_MIN_SHARE * stats.n
+
+
+def refine_edit(basis, cloud, deformed, graph=None) -> tuple:
+    """:func:`arap_refine` of a committed edit: the fixed band and the
+    handles of ``basis`` (a fitted DeformationBasis of ``cloud``) keep their
+    positions in ``deformed`` (the RBF result), the other support splats are
+    refined.  Curve samples are not constrained beyond the RBF seed: an edit
+    with control curves is returned unchanged.
+
+    Returns:
+        (refined SplatCloud (validated), RefineResult), or (``deformed``, None)
+        when the edit has curves.
+    """
+    con = basis.constraints
+    if con.n_curves:
+        return deformed, None
+    idx = basis.indices
+    keep = np.concatenate([con.fixed_index] + [np.asarray(h) for h in con.handle_index])
+    fixed = np.isin(idx, keep)
+    res = arap_refine(cloud, idx, fixed, deformed.positions, deformed.u, deformed.v, graph=graph)
+    return deformed.replace(positions=res.positions, u=res.u, v=res.v), res
