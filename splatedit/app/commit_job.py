@@ -65,11 +65,13 @@ class CommitPlan:
     make_edit: object
     handles: int
     label: str = "Edit"
+    #: the edit's DeformationMode (None: the basis' result as it is)
+    mode: object = None
 
     def work(self, progress=None):
         """The deformed document (``commit_cloud``); ``progress(stage,
         fraction)`` after each chunk.  Raises InputError on a degenerate splat."""
-        return commit_cloud(self.basis, self.cloud, self.dc, progress=progress)
+        return commit_cloud(self.basis, self.cloud, self.dc, progress=progress, mode=self.mode)
 
     def run(self, progress=None):
         """``(deformed document, script Edit)``: what a commit job computes;

@@ -36,8 +36,10 @@ def gaussians_of(cloud) -> GaussianCloud | None:
     return getattr(cloud, _ATTR, None) if cloud is not None else None
 
 
-def commit_cloud(basis, cloud, dc, progress=None):
-    """The editor's commit of one edit: ``basis.commit`` for plain splats; for
+def commit_cloud(basis, cloud, dc, progress=None, mode=None):
+    """The editor's commit of one edit: ``basis.commit`` for plain splats
+    (with ``mode`` given, the deformation mode's refinement of needles, as
+    ``splatedit deform`` does: :func:`~splatedit.deform.refine.refine_committed`); for
     a Gaussian document the Gaussians deformed on the CPU by the basis and
     ``dc`` ((K, 3) or a RotationDisplacement) and re-wrapped as a new document.
     ``progress``: optional ``progress(stage, fraction)`` after each chunk
@@ -48,7 +50,11 @@ def commit_cloud(basis, cloud, dc, progress=None):
     """
     scene = gaussians_of(cloud)
     if scene is None:
-        return basis.commit(cloud, dc, progress=progress)
+        new = basis.commit(cloud, dc, progress=progress)
+        if mode is not None:
+            from splatedit.deform.refine import refine_committed
+            new = refine_committed(basis, cloud, new, mode)[0]
+        return new
     from splatedit.deform.gaussians import deform_with_evaluator
     return gaussian_document(deform_with_evaluator(scene, basis, dc, progress=progress))
 

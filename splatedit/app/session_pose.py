@@ -222,7 +222,7 @@ class PoseEditing:
             return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
                         fill_holes=False,  # the editor's closed selection, replayed as is
                         deformation=mode)
-        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles), label)
+        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles), label, self.deformation)
 
     def _land(self, plan, result) -> None:
         """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the

@@ -15,8 +15,8 @@ This module refines the committed positions instead: a few local/global
 iterations of as-rigid-as-possible deformation (Sorkine & Alexa 2007, on a
 point graph: Sorkine 2007 "As-rigid-as-possible surface modeling"):
 
-* graph: the support's symmetric k-nearest-neighbour graph
-  (:class:`~splatedit.select.graph.NeighbourGraph`, uniform weights);
+* graph: the support's symmetric ARAP_NEIGHBOURS-nearest-neighbour graph
+  (uniform weights; no edge is cut, so close splats stay coupled);
 * constraints: the fixed band and the handles keep their RBF positions
   (exact: handle splats at ``T_h(p)``, the band where it was); splats outside
   the support are not touched;
@@ -43,7 +43,7 @@ import numpy as np
 from scipy import sparse
 from scipy.sparse.linalg import splu
 
-from splatedit.tolerances import ARAP_ANCHOR, ARAP_ITERATIONS, ARAP_MIN_TANGENT_RANK_REL
+from splatedit.tolerances import ARAP_ANCHOR, ARAP_ITERATIONS, ARAP_MIN_TANGENT_RANK_REL, ARAP_NEIGHBOURS
 
 
 @dataclass(frozen=True)
@@ -65,13 +65,30 @@ class RefineResult:
     n_degenerate: int
 
 
-def _edges(index: np.ndarray, positions: np.ndarray, graph=None):
-    """(i, j) local edge arrays (both directions) of the support's subgraph."""
-    from splatedit.select.graph import NeighbourGraph
-    g = NeighbourGraph.build(positions) if graph is None else graph
-    sub = g.subgraph(index)
-    i = np.repeat(np.arange(sub.n), np.diff(sub.indptr))
-    return i, np.asarray(sub.indices, dtype=np.int64)
+def _graph(positions: np.ndarray, index: np.ndarray, k: int = ARAP_NEIGHBOURS):
+    """The refinement's nodes and edges: the support splats ``index`` and
+    every other splat among their ``k`` nearest neighbours (those stay
+    where they are), joined by the symmetrised k-nearest-neighbour edges
+    (both directions, no duplicates).  No edge is cut (unlike the selection
+    graph's): splats that are close are coupled, so the refinement cannot
+    pull a support splat away from a close splat of another part.
+
+    Returns:
+        (nodes (M,) cloud indices, support first; i, j (E,) node numbers)
+    """
+    from scipy.spatial import cKDTree
+    kk = min(k + 1, len(positions))
+    _, nb = cKDTree(positions).query(positions[index], k=kk)
+    extra = np.setdiff1d(nb[:, 1:].ravel(), index)
+    nodes = np.concatenate([index, extra])
+    local = np.full(len(positions), -1, dtype=np.int64)
+    local[nodes] = np.arange(len(nodes))
+    i = np.repeat(np.arange(len(index)), kk - 1)
+    j = local[nb[:, 1:].ravel()]
+    n = len(nodes)
+    a, b = np.concatenate([i, j]), np.concatenate([j, i])
+    key = np.unique(a * n + b)
+    return nodes, key // n, key % n
 
 
 def _rotations(agg: sparse.csr_matrix, e0: np.ndarray, e1: np.ndarray) -> np.ndarray:
@@ -88,8 +105,7 @@ def _rotations(agg: sparse.csr_matrix, e0: np.ndarray, e1: np.ndarray) -> np.nda
 
 
 def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarray,
-                u: np.ndarray, v: np.ndarray, *, iterations: int = ARAP_ITERATIONS,
-                graph=None) -> RefineResult:
+                u: np.ndarray, v: np.ndarray, *, iterations: int = ARAP_ITERATIONS) -> RefineResult:
     """As-rigid-as-possible refinement of a deformed support.
 
     Args:
@@ -100,19 +116,18 @@ def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarr
         positions, u, v: (n, 3) float64 the deformed cloud's arrays (the
             seed; not modified).
         iterations: local/global steps.
-        graph: optional NeighbourGraph of ``cloud.positions`` (built otherwise).
     Returns:
         RefineResult with new arrays: rows outside ``index`` and the fixed
         rows are bitwise the inputs.
     """
     index = np.asarray(index, dtype=np.int64)
-    fixed = np.asarray(fixed, dtype=bool)
-    n = len(index)
     out_p, out_u, out_v = positions.copy(), u.copy(), v.copy()
+    if len(index) == 0 or not (~np.asarray(fixed, dtype=bool)).any() or iterations <= 0:
+        return RefineResult(out_p, out_u, out_v, 0, 0, 0)
+    index, i, j = _graph(cloud.positions, index)
+    fixed = np.concatenate([np.asarray(fixed, dtype=bool), np.ones(len(index) - len(fixed), dtype=bool)])
+    n = len(index)
     fi = np.flatnonzero(~fixed)
-    if n == 0 or len(fi) == 0 or iterations <= 0:
-        return RefineResult(out_p, out_u, out_v, 0, len(fi), 0)
-    i, j = _edges(index, cloud.positions, graph)
     p0 = cloud.positions[index]
     x = positions[index].copy()
     seed = x[fi].copy()
@@ -163,7 +178,7 @@ def needs_refine(stats) -> bool:
     return stats.n > 0 and stats.n_above_broken > NEEDLE_REFINE_MIN_SHARE * stats.n
 
 
-def refine_edit(basis, cloud, deformed, graph=None) -> tuple:
+def refine_edit(basis, cloud, deformed) -> tuple:
     """:func:`arap_refine` of a committed edit: the fixed band and the
     handles of ``basis`` (a fitted DeformationBasis of ``cloud``) keep their
     positions in ``deformed`` (the RBF result), the other support splats are
@@ -180,5 +195,41 @@ def refine_edit(basis, cloud, deformed, graph=None) -> tuple:
     idx = basis.indices
     keep = np.concatenate([con.fixed_index] + [np.asarray(h) for h in con.handle_index])
     fixed = np.isin(idx, keep)
-    res = arap_refine(cloud, idx, fixed, deformed.positions, deformed.u, deformed.v, graph=graph)
+    res = arap_refine(cloud, idx, fixed, deformed.positions, deformed.u, deformed.v)
     return deformed.replace(positions=res.positions, u=res.u, v=res.v), res
+
+
+def refine_committed(basis, cloud, deformed, mode, stats=None):
+    """The rule of the rotation mode (issue 20.3): a committed ROTATION edit
+    with needles (:func:`needs_refine`) is refined by :func:`refine_edit`;
+    LINEAR (the paper's deformation) and DETAIL are kept as they are.
+
+    Args:
+        basis: the fitted DeformationBasis of ``cloud``; deformed: its
+            committed result; mode: the edit's DeformationMode; stats: the
+            support's DistortionStats of ``deformed`` (computed when None).
+    Returns:
+        (cloud, DistortionStats of the support, note or "")
+    """
+    from splatedit.deform.distortion import distortion_from_axes
+    from splatedit.deform.modes import DeformationMode
+    idx = basis.indices
+
+    def figures(c):
+        return distortion_from_axes(cloud.u[idx], cloud.v[idx], c.u[idx], c.v[idx])
+
+    if DeformationMode(mode) is not DeformationMode.ROTATION:
+        return deformed, (figures(deformed) if stats is None else stats), ""
+    stats = figures(deformed) if stats is None else stats
+    if not needs_refine(stats):
+        return deformed, stats, ""
+    from splatedit.errors import InputError
+    try:
+        new, res = refine_edit(basis, cloud, deformed)
+    except InputError:          # a refined splat failed the model's checks: keep the RBF result
+        return deformed, stats, ""
+    if res is None:
+        return deformed, stats, ""
+    after = figures(new)
+    return new, after, (f"needles refined: {stats.n_above_broken} -> {after.n_above_broken} splats beyond "
+                        f"{after.broken:g}x ({res.iterations} as-rigid-as-possible steps)")

@@ -12,7 +12,7 @@ import numpy as np
 
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
 from splatedit.deform.modes import DeformationMode
-from splatedit.deform.refine import needs_refine, refine_edit
+from splatedit.deform.refine import refine_committed
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.script.model import Edit, EditScript, SolverSettings
 from splatedit.script.parse import _Ctx
@@ -265,14 +265,7 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
                                   path=source) from None
         i_sup = basis.indices
         dist = distortion_from_axes(cloud.u[i_sup], cloud.v[i_sup], new.u[i_sup], new.v[i_sup])
-        refined = ""
-        if edit.deformation is DeformationMode.ROTATION and needs_refine(dist):
-            before = dist.n_above_broken
-            new, res = refine_edit(basis, cloud, new)
-            if res is not None:
-                dist = distortion_from_axes(cloud.u[i_sup], cloud.v[i_sup], new.u[i_sup], new.v[i_sup])
-                refined = (f"needles refined: {before} -> {dist.n_above_broken} splats beyond "
-                           f"{dist.broken:g}x ({res.iterations} as-rigid-as-possible steps)")
+        new, dist, refined = refine_committed(basis, cloud, new, edit.deformation, dist)
         disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
         con = basis.constraints
