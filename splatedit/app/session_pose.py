@@ -222,7 +222,8 @@ class PoseEditing:
             return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
                         fill_holes=False,  # the editor's closed selection, replayed as is
                         deformation=mode)
-        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles), label, self.deformation)
+        return CommitPlan(self.basis, self.cloud, dc, make_edit, len(sel.handles), label, self.deformation,
+                          tuple(mats) if curve is None or not moves.any() else ())
 
     def _land(self, plan, result) -> None:
         """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the
@@ -234,7 +235,12 @@ class PoseEditing:
         self.rig.reset_pose(plan.handles)
         self.rig.clear_curve()
         self.push(plan.label)
-        self.remember_edit(plan.cloud, plan.basis, plan.dc)
+        if plan.outcome.get("refined"):
+            # a refined translation (splatedit.deform.refine) is not what the basis
+            # and dC draw: its figures and heat map are not shown after the commit
+            self.last_edit = None
+        else:
+            self.remember_edit(plan.cloud, plan.basis, plan.dc)
 
     @property
     def committing(self) -> bool:

@@ -135,7 +135,7 @@ def measure(name: str, cloud, basis, m: np.ndarray, h: float, diag: float, mode:
     from splatedit.deform.refine import refine_committed
     t0 = time.perf_counter()
     new = basis.commit(cloud, basis.displacement([m], mode=mode))
-    new = refine_committed(basis, cloud, new, mode)[0]
+    new = refine_committed(basis, cloud, new, mode, [m])[0]
     seconds = time.perf_counter() - t0
     idx = basis.indices
     st = distortion_from_axes(cloud.u[idx], cloud.v[idx], new.u[idx], new.v[idx]).stretch

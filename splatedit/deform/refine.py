@@ -199,31 +199,45 @@ def refine_edit(basis, cloud, deformed) -> tuple:
     return deformed.replace(positions=res.positions, u=res.u, v=res.v), res
 
 
-def refine_committed(basis, cloud, deformed, mode, stats=None):
+def is_translation(matrices, n_curves: int = 0) -> bool:
+    """Whether an edit moves its handles by pure translations: every (4, 4)
+    map's linear part within NEEDLE_REFINE_LINEAR_TOL of the identity (largest
+    entry of ``A - I``) and no control curve."""
+    from splatedit.tolerances import NEEDLE_REFINE_LINEAR_TOL
+    return n_curves == 0 and len(matrices) > 0 and all(
+        float(np.abs(np.asarray(m, dtype=np.float64)[:3, :3] - np.eye(3)).max()) <= NEEDLE_REFINE_LINEAR_TOL
+        for m in matrices)
+
+
+def refine_committed(basis, cloud, deformed, mode, matrices, stats=None):
     """The rule of the rotation mode (issue 20.3): a committed ROTATION edit
-    with needles (:func:`needs_refine`) is refined by :func:`refine_edit`;
-    LINEAR (the paper's deformation) and DETAIL are kept as they are.
+    that translates its handles (:func:`is_translation`; rotations have the
+    arc blend already) and has needles (:func:`needs_refine`) is refined by
+    :func:`refine_edit`; LINEAR (the paper's deformation: the way to get its
+    plain translation) and DETAIL are kept as they are.
 
     Args:
         basis: the fitted DeformationBasis of ``cloud``; deformed: its
-            committed result; mode: the edit's DeformationMode; stats: the
-            support's DistortionStats of ``deformed`` (computed when None).
+            committed result; mode: the edit's DeformationMode; matrices:
+            the handles' (4, 4) maps; stats: the support's DistortionStats
+            of ``deformed`` (computed when None).
     Returns:
         (cloud, DistortionStats of the support, note or "")
     """
     from splatedit.deform.distortion import distortion_from_axes
     from splatedit.deform.modes import DeformationMode
+    from splatedit.errors import InputError
     idx = basis.indices
 
     def figures(c):
         return distortion_from_axes(cloud.u[idx], cloud.v[idx], c.u[idx], c.v[idx])
 
-    if DeformationMode(mode) is not DeformationMode.ROTATION:
+    if (DeformationMode(mode) is not DeformationMode.ROTATION
+            or not is_translation(matrices, basis.constraints.n_curves)):
         return deformed, (figures(deformed) if stats is None else stats), ""
     stats = figures(deformed) if stats is None else stats
     if not needs_refine(stats):
         return deformed, stats, ""
-    from splatedit.errors import InputError
     try:
         new, res = refine_edit(basis, cloud, deformed)
     except InputError:          # a refined splat failed the model's checks: keep the RBF result

@@ -330,3 +330,8 @@ ARAP_MIN_TANGENT_RANK_REL = 1e-3
 #: (which cuts long edges) left close splats uncoupled: the one-view hippo
 #: edit tore 52 neighbour pairs apart with it, 0 with this one
 ARAP_NEIGHBOURS = 10
+#: the refinement applies to edits whose handles are translated: every map's
+#: linear part within this of the identity (largest entry of A - I; as
+#: ROTATION_MIN_ANGLE, below which the rotation mode treats a map as a
+#: translation).  Rotations keep the arc blend, scales and shears the RBF
+NEEDLE_REFINE_LINEAR_TOL = 1e-6

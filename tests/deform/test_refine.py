@@ -52,7 +52,7 @@ def test_arm_lift_rotation_mode_has_under_a_thousandth_needles_and_exact_control
 def test_refined_commit_keeps_handle_fixed_band_and_outside_splats(bunny_ear):
     cloud, basis, m, h, diag = bunny_ear
     seed = basis.commit(cloud, basis.displacement([m], mode=DeformationMode.ROTATION))
-    new, stats, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION)
+    new, stats, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION, [m])
     assert "needles refined" in note
     assert stats.n_above_broken < GOAL_SHARE * stats.n
     _check_exact(cloud, basis, new, m, diag)
@@ -61,13 +61,26 @@ def test_refined_commit_keeps_handle_fixed_band_and_outside_splats(bunny_ear):
 def test_linear_mode_and_edits_without_needles_keep_the_rbf_result_bitwise(bunny_ear):
     cloud, basis, m, h, diag = bunny_ear
     seed = basis.commit(cloud, basis.displacement([m]))
-    new, _, note = refine_committed(basis, cloud, seed, DeformationMode.LINEAR)
+    new, _, note = refine_committed(basis, cloud, seed, DeformationMode.LINEAR, [m])
     assert new is seed and note == ""
     small = m.copy()
     small[:3, 3] *= 0.1                         # a gentle grab: no splat beyond 4x
     seed = basis.commit(cloud, basis.displacement([small], mode=DeformationMode.ROTATION))
-    new, stats, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION)
+    new, stats, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION, [small])
     assert stats.n_above_broken == 0 and new is seed and note == ""
+
+
+def test_rotations_scales_and_curves_are_not_refined(bunny_ear):
+    """The rule is for translations: a far grab that also turns or scales
+    the handle keeps the RBF (rotation-aware) result."""
+    from splatedit.deform.transform import compose, rotate, scale
+    cloud, basis, m, h, diag = bunny_ear
+    g = basis.constraints.groups[0].controls[0]
+    for extra in (rotate((1, 0, 0), 40.0, g), scale(2.0, g)):
+        mm = compose(extra, m)
+        seed = basis.commit(cloud, basis.displacement([mm], mode=DeformationMode.ROTATION))
+        new, _, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION, [mm])
+        assert new is seed and note == ""
 
 
 def test_arap_refine_with_no_free_splat_or_no_iteration_returns_copies(bunny_ear):
