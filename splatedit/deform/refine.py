@@ -79,16 +79,20 @@ def _graph(positions: np.ndarray, index: np.ndarray, k: int = ARAP_NEIGHBOURS):
     from scipy.spatial import cKDTree
     kk = min(k + 1, len(positions))
     _, nb = cKDTree(positions).query(positions[index], k=kk)
-    extra = np.setdiff1d(nb[:, 1:].ravel(), index)
+    nb = nb[:, 1:].ravel()
+    inside = np.zeros(len(positions), dtype=bool)
+    inside[index] = True
+    seen = np.zeros(len(positions), dtype=bool)
+    seen[nb] = True
+    extra = np.flatnonzero(seen & ~inside)
     nodes = np.concatenate([index, extra])
     local = np.full(len(positions), -1, dtype=np.int64)
     local[nodes] = np.arange(len(nodes))
-    i = np.repeat(np.arange(len(index)), kk - 1)
-    j = local[nb[:, 1:].ravel()]
     n = len(nodes)
-    a, b = np.concatenate([i, j]), np.concatenate([j, i])
-    key = np.unique(a * n + b)
-    return nodes, key // n, key % n
+    adj = sparse.csr_matrix((np.ones(len(nb)), (np.repeat(np.arange(len(index)), kk - 1), local[nb])),
+                            shape=(n, n))
+    adj = (adj + adj.T).tocoo()                 # symmetric, duplicates summed: one entry per edge
+    return nodes, adj.row.astype(np.int64), adj.col.astype(np.int64)
 
 
 def _rotations(agg: sparse.csr_matrix, e0: np.ndarray, e1: np.ndarray) -> np.ndarray:
@@ -178,24 +182,41 @@ def needs_refine(stats) -> bool:
     return stats.n > 0 and stats.n_above_broken > NEEDLE_REFINE_MIN_SHARE * stats.n
 
 
-def refine_edit(basis, cloud, deformed) -> tuple:
+def refine_edit(basis, cloud, deformed, stretch: np.ndarray | None = None) -> tuple:
     """:func:`arap_refine` of a committed edit: the fixed band and the
     handles of ``basis`` (a fitted DeformationBasis of ``cloud``) keep their
-    positions in ``deformed`` (the RBF result), the other support splats are
-    refined.  Curve samples are not constrained beyond the RBF seed: an edit
-    with control curves is returned unchanged.
+    positions in ``deformed`` (the RBF result).  With ``stretch`` ((N,) the
+    support splats' stretch under ``deformed``, in ``basis.indices`` order),
+    only the free splats within ARAP_REGION_SPACINGS point spacings of one
+    stretched beyond ARAP_REGION_STRETCH are refined (the needles are local:
+    the cost follows them, not the support); without it, every free splat.
+    An edit with control curves is returned unchanged (their samples are
+    not splats the refinement could hold).
 
     Returns:
         (refined SplatCloud (validated), RefineResult), or (``deformed``, None)
-        when the edit has curves.
+        when the edit has curves or nothing is to be refined.
     """
+    from scipy.spatial import cKDTree
+    from splatedit.tolerances import ARAP_REGION_SPACINGS, ARAP_REGION_STRETCH
     con = basis.constraints
     if con.n_curves:
         return deformed, None
     idx = basis.indices
     keep = np.concatenate([con.fixed_index] + [np.asarray(h) for h in con.handle_index])
-    fixed = np.isin(idx, keep)
-    res = arap_refine(cloud, idx, fixed, deformed.positions, deformed.u, deformed.v)
+    free = ~np.isin(idx, keep)
+    if stretch is not None:
+        seeds = free & (np.asarray(stretch) > ARAP_REGION_STRETCH)
+        if not seeds.any():
+            return deformed, None
+        p = cloud.positions[idx]
+        near = cKDTree(p[seeds]).query(p[free], distance_upper_bound=ARAP_REGION_SPACINGS * con.spacing)[0]
+        region = np.zeros(len(idx), dtype=bool)
+        region[np.flatnonzero(free)[np.isfinite(near)]] = True
+        free = region
+    nodes = idx[free]                           # the rest of the support: neighbours held at the RBF result
+    res = arap_refine(cloud, nodes, np.zeros(len(nodes), dtype=bool), deformed.positions, deformed.u,
+                      deformed.v)
     return deformed.replace(positions=res.positions, u=res.u, v=res.v), res
 
 
@@ -239,7 +260,7 @@ def refine_committed(basis, cloud, deformed, mode, matrices, stats=None):
     if not needs_refine(stats):
         return deformed, stats, ""
     try:
-        new, res = refine_edit(basis, cloud, deformed)
+        new, res = refine_edit(basis, cloud, deformed, stats.stretch)
     except InputError:          # a refined splat failed the model's checks: keep the RBF result
         return deformed, stats, ""
     if res is None:

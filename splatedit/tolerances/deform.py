@@ -335,3 +335,15 @@ ARAP_NEIGHBOURS = 10
 #: ROTATION_MIN_ANGLE, below which the rotation mode treats a map as a
 #: translation).  Rotations keep the arc blend, scales and shears the RBF
 NEEDLE_REFINE_LINEAR_TOL = 1e-6
+#: the refinement is local: only free splats within ARAP_REGION_SPACINGS
+#: point spacings of a splat stretched beyond ARAP_REGION_STRETCH move (the
+#: rest of the support holds them at the RBF result), so its cost follows
+#: the needles, not the support.  Sweep (bench/needles.py cases, splats
+#: beyond 4x / largest stretch / seconds; bunny ear 10.6k support, bunny head
+#: 16k, a 27.9k bunny support): the whole support 1 / 5.8x / 0.76 s, 5 / 7.5x
+#: / 0.61 s, 0 / 3.1x / 0.94 s; > 2x within 20 h 2 / 7.5x / 0.48 s, 5 / 7.5x
+#: / 0.52 s, 0 / 3.1x / 0.26 s; > 2x within 10 h 3 / 25x / 0.14 s (a splat on
+#: the region's rim), 4 / 7.5x / 0.52 s, 0 / 3.1x / 0.15 s; > 3x within 10 h
+#: 4 / 8.8x, 6 / 7.8x, 2 / 5.9x
+ARAP_REGION_STRETCH = 2.0
+ARAP_REGION_SPACINGS = 20.0
