@@ -8,28 +8,34 @@ part whose transition is narrower than its front) the Jacobian ``I + t grad
 s^T`` nearly collapses a tangent direction and the splats become needles
 (stretch ``max(s1, 1/s2)`` far beyond 4x).  Inferring a swing about the fixed
 rim (the rotation mode's machinery, with the handle kept at ``p + t``) barely
-changes that (measured: 0-20 % fewer splats beyond 4x, docs/PERFORMANCE.md):
+changes that (measured: -20 % to +20 % splats beyond 4x, docs/PERFORMANCE.md):
 the collapse is local.
 
 This module refines the committed positions instead: a few local/global
-iterations of as-rigid-as-possible deformation (Sorkine & Alexa 2007, on a
-point graph: Sorkine 2007 "As-rigid-as-possible surface modeling"):
+iterations of as-rigid-as-possible deformation (Sorkine & Alexa 2007,
+"As-rigid-as-possible surface modeling", here on a point graph):
 
-* graph: the support's symmetric ARAP_NEIGHBOURS-nearest-neighbour graph
-  (uniform weights; no edge is cut, so close splats stay coupled);
-* constraints: the fixed band and the handles keep their RBF positions
-  (exact: handle splats at ``T_h(p)``, the band where it was); splats outside
-  the support are not touched;
-* local step: per splat the rotation ``R_i`` closest to ``sum_j e'_ij e_ij^T``
+* region: the free support splats within ARAP_REGION_SPACINGS point spacings
+  of one stretched beyond ARAP_REGION_STRETCH (:func:`refine_edit`); the
+  fixed band, the handles, the rest of the support and every other splat
+  keep their RBF positions (exact control: handle splats at ``T_h(p)``, the
+  band where it was, splats outside the support untouched);
+* graph: the region's symmetrised ARAP_NEIGHBOURS-nearest-neighbour graph,
+  with the neighbours outside the region as held nodes (uniform weights; no
+  edge is cut, so close splats, of another part too, stay coupled);
+* local step: per splat the rotation ``R_i`` closest to ``sum_j e_ij e'_ij^T``
   (SVD, det +1); global step: the graph Laplacian system
   ``L p' = sum_j (R_i + R_j) e_ij / 2`` for the free splats (factored once),
   with a weak anchor ``ARAP_ANCHOR`` to the seed so that graph components
-  without a constrained splat stay where the RBF put them;
+  without a held splat stay where the RBF put them;
 * splat axes: per splat the least-squares linear map of its tangent plane
   taking its edges' tangent coordinates to the deformed edges (``u' = J u``;
   so the distortion figures measure what was done); where that fit is
-  degenerate (fewer than two independent edges) ``u' = R_i u``.
+  degenerate (edges along one line) ``u' = R_i u``.
 
+The rule (:func:`refine_committed`): rotation mode, every handle translated,
+no curve, a needle in the committed result.  ``splatedit deform`` and the
+editor's commit apply it; the live drag shows the RBF result.
 Seeded by the RBF result, three iterations take the arm-lift and head-bend
 edits of the bench below 0.1 % of moved splats beyond 4x
 (``python -m splatedit.bench.needles``).
