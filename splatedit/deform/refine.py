@@ -71,7 +71,7 @@ class RefineResult:
     n_degenerate: int
 
 
-def _graph(positions: np.ndarray, index: np.ndarray, k: int = ARAP_NEIGHBOURS):
+def _graph(positions: np.ndarray, index: np.ndarray, k: int = ARAP_NEIGHBOURS, margin: float | None = None):
     """The refinement's nodes and edges: the support splats ``index`` and
     every other splat among their ``k`` nearest neighbours (those stay
     where they are), joined by the symmetrised k-nearest-neighbour edges
@@ -79,13 +79,23 @@ def _graph(positions: np.ndarray, index: np.ndarray, k: int = ARAP_NEIGHBOURS):
     graph's): splats that are close are coupled, so the refinement cannot
     pull a support splat away from a close splat of another part.
 
+    ``margin`` (model units): neighbours are searched among the splats
+    within it of the bounding box of ``index`` only (None: all).
+
     Returns:
         (nodes (M,) cloud indices, support first; i, j (E,) node numbers)
     """
     from scipy.spatial import cKDTree
-    kk = min(k + 1, len(positions))
-    _, nb = cKDTree(positions).query(positions[index], k=kk)
+    pts = positions[index]
+    cand = None
+    if margin is not None:
+        lo, hi = pts.min(axis=0) - margin, pts.max(axis=0) + margin
+        cand = np.flatnonzero(np.all((positions >= lo) & (positions <= hi), axis=1))
+    kk = min(k + 1, len(positions) if cand is None else len(cand))
+    _, nb = cKDTree(positions if cand is None else positions[cand]).query(pts, k=kk)
     nb = nb[:, 1:].ravel()
+    if cand is not None:
+        nb = cand[nb]
     inside = np.zeros(len(positions), dtype=bool)
     inside[index] = True
     seen = np.zeros(len(positions), dtype=bool)
@@ -115,7 +125,8 @@ def _rotations(agg: sparse.csr_matrix, e0: np.ndarray, e1: np.ndarray) -> np.nda
 
 
 def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarray,
-                u: np.ndarray, v: np.ndarray, *, iterations: int = ARAP_ITERATIONS) -> RefineResult:
+                u: np.ndarray, v: np.ndarray, *, iterations: int = ARAP_ITERATIONS,
+                spacing: float | None = None) -> RefineResult:
     """As-rigid-as-possible refinement of a deformed support.
 
     Args:
@@ -126,6 +137,9 @@ def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarr
         positions, u, v: (n, 3) float64 the deformed cloud's arrays (the
             seed; not modified).
         iterations: local/global steps.
+        spacing: the point spacing (model units): neighbours are searched
+            within ARAP_GRAPH_MARGIN_SPACINGS of it around the support's
+            bounding box (None: in the whole cloud).
     Returns:
         RefineResult with new arrays: rows outside ``index`` and the fixed
         rows are bitwise the inputs.
@@ -134,7 +148,9 @@ def arap_refine(cloud, index: np.ndarray, fixed: np.ndarray, positions: np.ndarr
     out_p, out_u, out_v = positions.copy(), u.copy(), v.copy()
     if len(index) == 0 or not (~np.asarray(fixed, dtype=bool)).any() or iterations <= 0:
         return RefineResult(out_p, out_u, out_v, 0, 0, 0)
-    index, i, j = _graph(cloud.positions, index)
+    from splatedit.tolerances import ARAP_GRAPH_MARGIN_SPACINGS
+    margin = None if spacing is None else ARAP_GRAPH_MARGIN_SPACINGS * spacing
+    index, i, j = _graph(cloud.positions, index, margin=margin)
     fixed = np.concatenate([np.asarray(fixed, dtype=bool), np.ones(len(index) - len(fixed), dtype=bool)])
     n = len(index)
     fi = np.flatnonzero(~fixed)
@@ -222,7 +238,7 @@ def refine_edit(basis, cloud, deformed, stretch: np.ndarray | None = None) -> tu
         free = region
     nodes = idx[free]                           # the rest of the support: neighbours held at the RBF result
     res = arap_refine(cloud, nodes, np.zeros(len(nodes), dtype=bool), deformed.positions, deformed.u,
-                      deformed.v)
+                      deformed.v, spacing=con.spacing)
     return deformed.replace(positions=res.positions, u=res.u, v=res.v), res
 
 

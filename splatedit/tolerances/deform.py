@@ -347,3 +347,9 @@ NEEDLE_REFINE_LINEAR_TOL = 1e-6
 #: 4 / 8.8x, 6 / 7.8x, 2 / 5.9x
 ARAP_REGION_STRETCH = 2.0
 ARAP_REGION_SPACINGS = 20.0
+#: the refinement's neighbours are searched among the splats within this many
+#: point spacings of the region's bounding box only (a commit on a 1M-splat
+#: cloud builds no tree of the whole cloud).  The 10 nearest neighbours of a
+#: surface splat lie within about 2 spacings (sqrt(10 / pi) on a regular
+#: sampling); 8 leaves room for sparse patches
+ARAP_GRAPH_MARGIN_SPACINGS = 8.0
