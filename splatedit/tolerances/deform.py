@@ -353,3 +353,21 @@ ARAP_REGION_SPACINGS = 20.0
 #: surface splat lie within about 2 spacings (sqrt(10 / pi) on a regular
 #: sampling); 8 leaves room for sparse patches
 ARAP_GRAPH_MARGIN_SPACINGS = 8.0
+#: the refinement's global step: a sparse LU up to this many free splats,
+#: conjugate gradients (Jacobi preconditioner, warm start from the current
+#: positions, the three coordinates at once) above.  The LU's fill grows
+#: faster than the region: 50k free splats, 12M entries, 3.2 s to factor
+#: (loaded 2-core machine).  CG with 200 / 50 / 20 steps per global step,
+#: every free splat on CG: splats beyond 4x 2 / 2 / 1 (bunny ear), 5 / 5 / 4
+#: (bunny head), 0 / 0 / 0 (ear pushed down), the same as the LU's 2 / 5 / 0
+#: from 50 steps on (seconds 0.47 / 0.36 / 0.26 for the ear, load 12)
+ARAP_DIRECT_MAX_SPLATS = 20000
+ARAP_CG_RTOL = 1e-6
+ARAP_CG_MAXITER = 50
+#: a region of more free splats than this is not refined (the RBF result is
+#: kept and the edit's note says so): its cost grows with the region.  A
+#: synthetic smooth region on a 1M-splat bunny (splatedit.app.bench's
+#: surface), loaded 2-core machine (load 8-11): 0.9 s at 10k splats (LU),
+#: 6.6 s at 50k and 14.6 s at 100k (CG, 50 steps); 55x and 140x a copy of
+#: the 1M cloud in the same run
+ARAP_MAX_REGION_SPLATS = 100_000

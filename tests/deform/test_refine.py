@@ -84,6 +84,27 @@ def test_rotations_scales_and_curves_are_not_refined(bunny_ear):
         assert new is seed and note == ""
 
 
+def test_a_region_beyond_the_cap_keeps_the_rbf_result_and_says_so(bunny_ear, monkeypatch):
+    import splatedit.tolerances as tol
+    cloud, basis, m, h, diag = bunny_ear
+    seed = basis.commit(cloud, basis.displacement([m], mode=DeformationMode.ROTATION))
+    monkeypatch.setattr(tol, "ARAP_MAX_REGION_SPLATS", 10)
+    new, stats, note = refine_committed(basis, cloud, seed, DeformationMode.ROTATION, [m])
+    assert new is seed and note.startswith("needles not refined") and stats.n_above_broken == 55
+
+
+def test_conjugate_gradients_give_the_direct_solve_figures(bunny_ear, monkeypatch):
+    """Regions above ARAP_DIRECT_MAX_SPLATS take CG: forced here on the ear."""
+    import splatedit.tolerances as tol
+    cloud, basis, m, h, diag = bunny_ear
+    direct = measure("arm-bunny-ear", cloud, basis, m, h, diag, DeformationMode.ROTATION)
+    monkeypatch.setattr(tol, "ARAP_DIRECT_MAX_SPLATS", 0)
+    iterative = measure("arm-bunny-ear", cloud, basis, m, h, diag, DeformationMode.ROTATION)
+    assert iterative.broken <= direct.broken + 1 and iterative.share < GOAL_SHARE
+    assert iterative.p99_stretch == pytest.approx(direct.p99_stretch, rel=0.02)
+    assert iterative.handle_error <= EXACT_REL and iterative.fixed_error <= EXACT_REL
+
+
 def test_arap_refine_with_no_free_splat_or_no_iteration_returns_copies(bunny_ear):
     cloud, basis, m, h, diag = bunny_ear
     seed = basis.commit(cloud, basis.displacement([m]))
