@@ -304,9 +304,10 @@ def refine_committed(basis, cloud, deformed, mode, matrices, stats=None):
         basis: the fitted DeformationBasis of ``cloud``; deformed: its
             committed result; mode: the edit's DeformationMode; matrices:
             the handles' (4, 4) maps; stats: the support's DistortionStats
-            of ``deformed`` (computed when None).
+            of ``deformed`` (computed when None and the rule needs it).
     Returns:
-        (cloud, DistortionStats of the support, note or "")
+        (cloud, DistortionStats of the support (``stats`` as given when the
+        rule does not apply), note or "")
     """
     from splatedit.deform.distortion import distortion_from_axes
     from splatedit.deform.modes import DeformationMode
@@ -318,7 +319,7 @@ def refine_committed(basis, cloud, deformed, mode, matrices, stats=None):
 
     if (DeformationMode(mode) is not DeformationMode.ROTATION
             or not is_translation(matrices, basis.constraints.n_curves)):
-        return deformed, (figures(deformed) if stats is None else stats), ""
+        return deformed, stats, ""
     stats = figures(deformed) if stats is None else stats
     if not needs_refine(stats):
         return deformed, stats, ""
