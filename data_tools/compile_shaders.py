@@ -6,7 +6,9 @@ compiled with exactly::
 
     glslangValidator -V -Ishaders_glsl -o spirv/NAME.STAGE.spv shaders_glsl/NAME.STAGE
 
-(run from the repository root; ``*.glsl`` files are include-only), and the
+(run from the repository root; ``*.glsl`` files are include-only; a stage file
+whose text holds the line ``// spirv: vulkan1.1`` gets ``--target-env vulkan1.1``
+appended, for subgroup operations, which need SPIR-V 1.3), and the
 result is copied byte for byte to ``splatedit/spirv/`` (package data, what the
 renderer loads at run time).  Both copies are committed.
 
@@ -27,6 +29,8 @@ ROOT = Path(__file__).resolve().parent.parent
 SRC = "shaders_glsl"
 OUT_DIRS = (ROOT / "spirv", ROOT / "splatedit" / "spirv")
 STAGES = (".vert", ".frag", ".comp")
+#: a line of a stage file asking for SPIR-V 1.3 (Vulkan 1.1: subgroup operations)
+TARGET_VK11 = "// spirv: vulkan1.1"
 
 
 def shader_sources() -> list[str]:
@@ -38,6 +42,8 @@ def compile_one(src: str, out: Path) -> None:
     # glslang 12 wants the include path glued to -I ("-I shaders_glsl" is an
     # error there); includes resolve relative to the including file anyway.
     cmd = ["glslangValidator", "-V", "-I" + SRC, "-o", str(out), src]
+    if TARGET_VK11 in (ROOT / src).read_text().splitlines():
+        cmd += ["--target-env", "vulkan1.1"]
     try:
         res = subprocess.run(cmd, cwd=ROOT, capture_output=True, text=True)
     except FileNotFoundError:

@@ -10,7 +10,7 @@ from splatedit.render.gaussians import GaussianRenderer
 from splatedit.render.gs_headless import default_camera, render_gaussians_to_png
 
 scene = gaussians_from_splats(read(default_model_path()))    # synthetic Gaussians on the bunny's splats
-with GaussianRenderer() as r:                  # sort="gpu": the bitonic compute sort instead
+with GaussianRenderer() as r:                  # sort="gpu": the GPU radix sort; path="compute": the tile rasterizer
     r.set_gaussians(scene)                     # a splatedit.model.gaussians.GaussianCloud
     cam = default_camera(scene, 640, 480)
     img = r.render(cam, 640, 480)              # (480, 640, 4) uint8

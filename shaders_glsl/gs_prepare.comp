@@ -3,7 +3,9 @@
 // Gaussian splatting pre-pass, once per Gaussian per frame: deformation
 // (p + B dC, J Sigma J^T, polar rotation of J for the SH), EWA projection to a
 // screen conic, SH colour, culling, depth key.  Threads n .. sort length - 1
-// pad the sort with culled keys.
+// pad the sort with culled keys.  With P.compact the visible Gaussians append
+// (key, index) to keys / order instead (slots taken in groups of the
+// workgroup, draws[1] counts them), for the GPU radix sort of only those.
 #include "gs_common.glsl"
 #define DEFORM_BINDING 9
 #include "deform.glsl"
@@ -41,9 +43,16 @@ void deform_group(uint g, vec4 B, vec4 Bx, vec4 By, vec4 Bz, inout vec3 dp, inou
 }
 
 layout(local_size_x = 64) in;
-layout(push_constant) uniform Push { uint groups; uint polar_iterations; } P;
+layout(push_constant) uniform Push { uint groups; uint polar_iterations; uint compact; } P;
 shared uint s_count;
 shared uint s_base;
+
+// the view depth z > 0 as a key whose unsigned order is its float order
+// (sign bit set; gpu_sort.py sortable_float_keys for any sign)
+uint sortable_depth(float z) {
+    uint b = floatBitsToUint(z);
+    return (b & 0x80000000u) != 0u ? ~b : b | 0x80000000u;
+}
 
 const float C0 = 0.28209479177387814;
 const float C1 = 0.4886025119029199;
@@ -99,6 +108,7 @@ void main() {
     uint i = gl_GlobalInvocationID.x;
     uint n = F.counts.x;
     bool visible = false;
+    uint key = GS_NONE;
     if (i < n) {
         uint g = GEOM_STRIDE * i;
         uint c0 = g + GEOM_CENTER, s0 = g + GEOM_COV, d0 = g + GEOM_SH_DC;
@@ -174,17 +184,25 @@ void main() {
                     rec[REC_STRIDE * i + REC_CONIC] = vec4(yy / det, -xy / det, xx / det, sqrt(F.params.z / q));
                     rec[REC_STRIDE * i + REC_AXES] = vec4(a1, a2);
                     rec[REC_STRIDE * i + REC_COLOR] = vec4(col, uintBitsToFloat(i + 1u));
-                    keys[i] = floatBitsToUint(z);
+                    if (P.compact == 0u) keys[i] = sortable_depth(z);
+                    key = sortable_depth(z);
                 }
             }
         }
     }
     if (!visible && i < n) rec[REC_STRIDE * i + REC_CENTER] = vec4(0.0);       // the pick pass draws every record
-    if (!visible && i < F.counts.z) keys[i] = GS_NONE;
-    if (i < F.counts.z) order[i] = i;
+    if (P.compact == 0u) {
+        if (!visible && i < F.counts.z) keys[i] = GS_NONE;
+        if (i < F.counts.z) order[i] = i;
+    }
     if (gl_LocalInvocationIndex == 0u) s_count = 0u;
     barrier();
-    if (visible) atomicAdd(s_count, 1u);
+    uint local = visible ? atomicAdd(s_count, 1u) : 0u;
     barrier();
-    if (gl_LocalInvocationIndex == 0u && s_count > 0u) atomicAdd(draws[1], s_count);
+    if (gl_LocalInvocationIndex == 0u && s_count > 0u) s_base = atomicAdd(draws[1], s_count);
+    barrier();
+    if (P.compact != 0u && visible) {
+        keys[s_base + local] = key;
+        order[s_base + local] = i;
+    }
 }

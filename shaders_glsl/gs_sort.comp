@@ -1,20 +1,21 @@
 #version 450
-#extension GL_GOOGLE_include_directive : require
-// One compare-exchange step (k, j) of a bitonic sort of (keys, order) in
-// ascending key order; sort length F.counts.z is a power of two.
-#include "gs_common.glsl"
+// One compare-exchange step (k, j) of a bitonic sort of (keys, values) in
+// ascending key order, sort length n a power of two (the sort the radix sort
+// replaced; splatedit/render/gpu_sort.py keeps it for comparison).
 
 layout(local_size_x = 256) in;
-layout(push_constant) uniform Push { uint k; uint j; } P;
+layout(push_constant) uniform Push { uint k; uint j; uint n; } P;
+layout(std430, set = 0, binding = 0) buffer BKeys { uint keys[]; };
+layout(std430, set = 0, binding = 1) buffer BVals { uint vals[]; };
 
 void main() {
     uint i = gl_GlobalInvocationID.x;
     uint l = i ^ P.j;
-    if (i >= F.counts.z || l <= i) return;
+    if (i >= P.n || l <= i) return;
     uint a = keys[i], b = keys[l];
     bool up = (i & P.k) == 0u;
     if (up ? a > b : a < b) {
         keys[i] = b; keys[l] = a;
-        uint t = order[i]; order[i] = order[l]; order[l] = t;
+        uint t = vals[i]; vals[i] = vals[l]; vals[l] = t;
     }
 }

@@ -129,7 +129,16 @@ def cmd_bench(args) -> int:
         if what != "render":
             raise ParameterError("--gaussians", f"applies to 'bench render', not 'bench {what}'")
         what = "gaussian-render"
-    for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats, large=args.large):
+    from splatedit.bench.runner import SIZED
+    if args.size is not None and what not in SIZED + ("render",):
+        raise ParameterError("--size", f"applies to 'bench render / {' / '.join(SIZED)}', not 'bench {what}'")
+    if args.path is not None and what not in SIZED:
+        raise ParameterError("--path", f"applies to 'bench {' / '.join(SIZED)}', not 'bench {what}' "
+                                       "(bench render compares both paths in every case)")
+    if args.model and what != "render":
+        raise ParameterError("--model", f"applies to 'bench render', not 'bench {what}'")
+    for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats, large=args.large,
+                          size=args.size, path=args.path, models=args.model):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -198,6 +207,10 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--fov", type=float, default=None, help="vertical field of view in degrees")
     s.add_argument("--edit", type=Path, help="apply this edit script on the GPU before rendering")
     s.add_argument("--buffers", help="also save depth/normal/weight/color float arrays to this .npz")
+    s.add_argument("--path", choices=("auto", "raster", "compute"), default=None,
+                   help="draw path: raster passes or compute shaders (splats: default env var SPLATEDIT_RASTER, "
+                        "else auto: the faster, measured; Gaussian scenes: quads or the compute tile "
+                        "rasterizer, default the device's, see docs/PERFORMANCE.md)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 
@@ -218,6 +231,12 @@ def build_parser() -> argparse.ArgumentParser:
                         "(e.g. --splats 1000000 10000000)")
     s.add_argument("--large", action="store_true",
                    help="io: also the 10M-splat PLY read (writes an 840 MB file to the temp folder)")
+    s.add_argument("--size", type=parse_size, default=None,
+                   help="render, gaussian-render: image WxH (default 1280x720, 640x360 with --quick)")
+    s.add_argument("--path", choices=("raster", "compute"), default=None,
+                   help="gaussian-render: only this draw path (default: both, compared in the same run)")
+    s.add_argument("--model", action="append", default=[], metavar="FILE",
+                   help="render: also this model (e.g. a real scan); repeatable")
     s.set_defaults(func=cmd_bench)
     return p
 

@@ -258,7 +258,7 @@ def bench_editor_first_image(n: int, size=(1280, 720), frames: int = 4, budget_m
         cam.frame((lo + hi) / 2, cloud.diagonal / 2, w / h)
         vp.render(cam, w, h, interactive=True)
         first = time.perf_counter() - t0
-        first_splats = vp.last_info["splats"]
+        first_splats = vp.last_info.splats
         ms = []
         for _ in range(frames):
             cam.orbit(15, 0)
@@ -273,8 +273,8 @@ def bench_editor_first_image(n: int, size=(1280, 720), frames: int = 4, budget_m
                "lod_all_levels_s": round(levels_s, 2),
                "first_image_splats": int(first_splats),
                "moving_fps": round(1000.0 / float(np.median(ms)), 1),
-               "moving_splats": int(vp.last_info["splats"]),
-               "moving_resolution_divisor": int(vp.last_info["div"])}
+               "moving_splats": int(vp.last_info.splats),
+               "moving_resolution_divisor": int(vp.last_info.div)}
         if cloud.n <= full_frame_max:
             t1 = time.perf_counter()
             vp.render(cam, w, h)

@@ -43,7 +43,7 @@ class DistortionFeed:
             def work(progress):
                 if hasattr(basis, "detail_for_gpu"):   # a DetailBasis: its own exact figures
                     return key, basis.distortion(cloud, dc)
-                if rot is not None:     # exact Jacobians with the blended rotations
+                if rot is not None or getattr(dc, "curves", ()):   # exact Jacobians: rotations, curve frames
                     return key, basis_distortion(basis, cloud, dc)
                 if self._probe is None:
                     self._probe = DistortionProbe(basis, cloud)

@@ -25,11 +25,15 @@ Entry point: :func:`run_editor`.
 
 from __future__ import annotations
 
+import contextlib
 import os
+import signal
 import sys
+import threading
 import time
 from pathlib import Path
 
+from splatedit.app.crash_guard import CrashGuard
 from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
 from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
 from splatedit.app.file_actions import FileActions
@@ -54,7 +58,7 @@ from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN
                                   IQR_DEFAULT_TOL)
 
 
-class Editor(EventRouting, FileActions):
+class Editor(EventRouting, FileActions, CrashGuard):
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
                  budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
@@ -174,8 +178,10 @@ class Editor(EventRouting, FileActions):
         self.frames.motion()
 
     def modal(self) -> bool:
-        """A question is open (save-as path, quit / open with unsaved changes, the file browser)."""
-        return self.prompt is not None or self.confirm_quit or self.confirm_open is not None or self.browser.shown
+        """A question is open (save-as path, quit / open with unsaved changes, restore a
+        recovery copy, the file browser)."""
+        return (self.prompt is not None or self.confirm_quit or self.confirm_open is not None
+                or self.confirm_restore is not None or self.browser.shown)
 
     @property
     def frame_ms(self) -> float:
@@ -207,7 +213,7 @@ class Editor(EventRouting, FileActions):
         t.update({
             Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
-            Action.DEFORMATION_MODE: lambda: self.say(f"deformation: {s().cycle_deformation().value}"),
+            Action.DEFORMATION_MODE: self.cycle_deformation,
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
             Action.SPLATS_LARGER: lambda: self.scale_splats(EDITOR_SPLAT_SCALE_STEP),
             Action.PANEL: self.toggle_panel, Action.HELP: self.help.toggle,
@@ -218,6 +224,12 @@ class Editor(EventRouting, FileActions):
             Action.SAVE: self.save_edits, Action.SAVE_AS: self.ask_save_as,
             Action.EXPORT_SCRIPT: self.export_script, Action.QUIT: self.request_quit})
         return t
+
+    def cycle_deformation(self) -> None:
+        """B: the next deformation mode of new edits (a Gaussian scene has no detail mode: B says so)."""
+        s = self.session
+        mode = s.cycle_deformation()
+        self.say(f"deformation: {mode.value}" + ("" if s.detail_available else f"; {s.DETAIL_UNAVAILABLE}"))
 
     def toggle_distortion_map(self) -> None:
         """D: colour the support by stretch (renderer heat map) / back to shading."""
@@ -268,11 +280,33 @@ class Editor(EventRouting, FileActions):
 
     # ----------------------------------------------------------------- loop
     def run(self) -> int:
+        """The event loop until quit.  Every place it dispatches work (events,
+        finished jobs, the session's fits and commits, frames, the status file)
+        runs under :meth:`~splatedit.app.crash_guard.CrashGuard.guarded`: a bug
+        there is shown in the error box and the document is kept (with a
+        recovery copy of unsaved edits); SIGTERM ends it like Ctrl+C
+        (KeyboardInterrupt), after writing a recovery copy of unsaved edits."""
         if self.path is None:
             raise SplatEditError("no model to open")
         self.start_load()
-        if self.offer_recent and self.recent_files():
+        if not self.offer_recovery() and self.offer_recent and self.recent_files():
             self.open_dialog(Path.cwd())
+        restore_sigterm = _sigterm_as_interrupt()
+        try:
+            self._loop()
+        except KeyboardInterrupt:
+            self.recover_on_exit("the editor was ended (SIGTERM or Ctrl+C)")
+            raise
+        except BaseException as exc:
+            self.recover_on_exit(f"internal error: {exc!r}")
+            raise
+        finally:
+            restore_sigterm()
+        if self.load_error is not None:
+            raise self.load_error
+        return self.exit_code
+
+    def _loop(self) -> None:
         fr = self.frames
         try:
             while self.running:
@@ -285,30 +319,45 @@ class Editor(EventRouting, FileActions):
                 if w == 0 or h == 0 or self.window.iconified():
                     pending = False          # minimized: nothing to draw, do not spin
                 events = self.window.poll(0.0 if pending else (0.05 if busy else 0.5))
-                self.handle_events(events)
-                self.poll_jobs()
+                self.handle_events(events)          # each event guarded on its own
+                with self.guarded("collecting a finished job"):
+                    self.poll_jobs()
                 if self.session is not None:
-                    self.session.poll()
-                    self.gizmo.report_commit()
+                    with self.guarded("landing a fit or an edit"):
+                        self.session.poll()
+                        self.gizmo.report_commit()
                 if not self.running:
                     break
-                try:
-                    fr.draw()
-                except SplatEditError as exc:       # e.g. a Vulkan error: report, keep the document
-                    self.say(f"drawing failed: {exc}")
-                    fr.scene_key = fr.state() if self.session is not None else None
-                    time.sleep(0.2)
+                self._draw_guarded()
                 self.collect_validation()
-                self.write_status()
+                with self.guarded("writing the status file"):
+                    self.write_status()
                 if self.max_seconds is not None and time.perf_counter() - self.start_time > self.max_seconds:
                     self.say("time limit reached")
                     break
         finally:
             self.running = False
-            self.write_status()
-        if self.load_error is not None:
-            raise self.load_error
-        return self.exit_code
+            with contextlib.suppress(Exception):
+                self.write_status()
+
+    def _draw_guarded(self) -> None:
+        """One frame; a failure (a Vulkan error, or a bug) is reported and the
+        same scene is not retried at once (no error loop at the frame rate)."""
+        fr = self.frames
+        errors, failed = self.internal_errors, False
+        with self.guarded("drawing a frame"):
+            try:
+                fr.draw()
+            except SplatEditError as exc:       # e.g. a Vulkan error: report, keep the document
+                self.say(f"drawing failed: {exc}")
+                failed = True
+        if not failed and self.internal_errors == errors:
+            return
+        if self.gui is not None:        # a frame left half laid out is closed (no-op after a whole one)
+            with self.guarded("closing the interrupted frame"):
+                self.gui.recover()
+        fr.scene_key = fr.state() if self.session is not None else None
+        time.sleep(0.2)
 
     def close(self) -> None:
         if self.session is not None:
@@ -333,6 +382,21 @@ class Editor(EventRouting, FileActions):
             self.window.close()
             self.window = None
         self.collect_validation()
+
+
+def _raise_interrupt(signum, frame):
+    raise KeyboardInterrupt
+
+
+def _sigterm_as_interrupt():
+    """SIGTERM ends the editor like Ctrl+C (KeyboardInterrupt: a recovery
+    copy of unsaved edits is written, the window closed, exit code 130).
+    Returns a function that puts the previous handler back (a no-op off the
+    main thread, where handlers cannot be set)."""
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+    previous = signal.signal(signal.SIGTERM, _raise_interrupt)
+    return lambda: signal.signal(signal.SIGTERM, previous if previous is not None else signal.SIG_DFL)
 
 
 def run_editor(path=None, **options) -> int:
@@ -379,6 +443,9 @@ def main(argv=None) -> int:
     except SplatEditError as exc:
         print(f"splatedit: error: {exc}", file=sys.stderr)
         return 2
+    except KeyboardInterrupt:
+        print("splatedit: interrupted", file=sys.stderr)
+        return 130
 
 
 if __name__ == "__main__":

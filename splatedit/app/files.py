@@ -268,7 +268,8 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
             return build_gaussian_lod(scene, progress=progress)
         ed.jobs["lod"] = Job("Gaussian level of detail", rank, ed.wake)
     ed.brush.tools.prepare(cloud)
-    remember(ed, ed.path)
+    if getattr(ed, "restoring", None) is None:      # a recovery file is not a recent model
+        remember(ed, ed.path)
     what = model_summary(cloud)
     note = ed.camera.extent().note()
     ed.say(f"loaded {ed.cloud_name}: {what} (up axis {ed.camera.up.label}, "
@@ -297,6 +298,8 @@ def poll_jobs(ed) -> None:
                 ed.exit_code = 2
                 ed.running = False
             elif name == "load":       # another model: the open one stays
+                if getattr(ed, "restoring", None) is not None:
+                    ed.restoring = None
                 text = str(err) if isinstance(err, SplatEditError) else f"{job.key}: cannot read the model: {err}"
                 ed.show_error(f"not opened: {text}")
             elif name in ("save", "export"):
@@ -306,6 +309,9 @@ def poll_jobs(ed) -> None:
             continue
         if name == "load":
             ed.on_loaded(job.result, job.key)
+            entry = getattr(ed, "restoring", None)
+            if entry is not None and Path(job.key) == Path(os.path.abspath(entry.model)):
+                ed.on_restored()         # a recovery entry: its edits and source come with it
         elif name == "lod" and hasattr(job.result, "rank"):      # a GaussianLod
             ed.viewport.set_gaussian_lod(job.result)
             ed.say(f"level of detail ready (moving: up to {job.result.m:,} of {job.result.n:,} Gaussians)")
@@ -320,6 +326,8 @@ def poll_jobs(ed) -> None:
                 ed.say(f"saved {ply} and {script.name} (the model opened since is not saved)")
                 continue
             ed.session.history.mark_saved(pos)
+            if hasattr(ed, "restored_saved"):
+                ed.restored_saved(saved_session)
             ed.saved_path, ed.saved_script = ply, script
             ed.say(f"saved {ply} and {script.name}")
         elif name == "export":

@@ -41,6 +41,33 @@ class FitStats:
                    st.get("fit_seconds"), st.get("basis_seconds"), int(basis.n_columns))
 
 
+def basis_bytes(basis) -> int:
+    """The bytes of the arrays a fitted basis holds (its own attributes, one
+    level deep, and the arrays of its constraints and CPU cache)."""
+    import numpy as np
+    total, seen = 0, set()
+
+    def add(v) -> None:
+        nonlocal total
+        if isinstance(v, np.ndarray) and id(v) not in seen:
+            seen.add(id(v))
+            total += v.base.nbytes if isinstance(v.base, np.ndarray) and id(v.base) not in seen else v.nbytes
+            if isinstance(v.base, np.ndarray):
+                seen.add(id(v.base))
+        elif isinstance(v, dict):
+            for x in v.values():
+                add(x)
+        elif isinstance(v, (list, tuple)):
+            for x in v:
+                add(x)
+
+    for obj in (basis, getattr(basis, "constraints", None), getattr(basis, "rbf", None)):
+        if obj is not None and hasattr(obj, "__dict__"):
+            for v in vars(obj).values():
+                add(v)
+    return total
+
+
 @dataclass(frozen=True)
 class FitProgress:
     """A running fit: its stage, fraction done (0..1) and seconds so far."""
@@ -68,18 +95,51 @@ class FitScheduler:
         self.groups = None
         self.error: str | None = None
         self._graph = None    # (positions, NeighbourGraph) of the last detail fit's cloud
+        #: bases replaced since (key -> (basis, groups)), newest last: undo / redo back to
+        #: their selection takes them again instead of refitting (bounded, :meth:`_stash`)
+        self._kept: dict = {}
 
     def current(self, key) -> bool:
         """The basis (or the running fit) is for ``key``."""
         return (self.basis is not None and self.key == key) or (self.job is not None and self.job.key == key)
 
     def clear(self) -> None:
-        """Forget the basis and the error, cancel a running fit."""
+        """Forget the basis (kept for :meth:`recall`) and the error, cancel a running fit."""
         if self.job is not None:
             self.job.cancel.set()
             self.job = None
+        if self.basis is not None:
+            self._stash(self.key, self.basis, self.groups)
         self.basis = self.key = self.groups = None
         self.error = None
+
+    def _stash(self, key, basis, groups) -> None:
+        """Keep a replaced basis: at most EDITOR_FIT_KEEP_BASES of them and
+        EDITOR_FIT_KEEP_BYTES in all (the oldest go first; a larger one is not kept)."""
+        from splatedit.tolerances import EDITOR_FIT_KEEP_BASES, EDITOR_FIT_KEEP_BYTES
+        self._kept.pop(key, None)
+        if hasattr(basis, "release_cpu_cache"):
+            basis.release_cpu_cache()       # rebuilt by the next commit; only B is drawn
+        self._kept[key] = (basis, groups, basis_bytes(basis))
+        while self._kept and (len(self._kept) > EDITOR_FIT_KEEP_BASES
+                              or sum(v[2] for v in self._kept.values()) > EDITOR_FIT_KEEP_BYTES):
+            self._kept.pop(next(iter(self._kept)))
+
+    def drop_kept(self) -> None:
+        """Forget the kept bases (memory back; the next undo refits)."""
+        self._kept.clear()
+
+    def recall(self, key) -> bool:
+        """Take back the basis kept for ``key`` (its key includes the cloud's
+        revision, the masks, the curve and the kind: it is exactly what a new
+        fit would compute); True when there was one."""
+        got = self._kept.pop(key, None)
+        if got is None:
+            return False
+        self.basis, self.groups, _ = got
+        self.key = key
+        self.error = None
+        return True
 
     def neighbour_graph(self, cloud):
         """The :class:`~splatedit.select.graph.NeighbourGraph` of ``cloud`` for

@@ -23,6 +23,10 @@ from splatedit.model.gaussians import GaussianCloud
 
 _ATTR = "_splatedit_gaussians"
 
+#: why a Gaussian document has no detail mode (as ``splatedit deform`` refuses it): the
+#: Gaussians' transport needs the plain basis' displacements and Jacobians
+DETAIL_UNAVAILABLE = "the detail mode is not available for Gaussian scenes (rotation and linear are)"
+
 
 def gaussian_document(scene: GaussianCloud):
     """The proxy SplatCloud of ``scene`` with ``scene`` attached (n splats, same indices)."""
@@ -59,6 +63,9 @@ def commit_cloud(basis, cloud, dc, progress=None, mode=None, matrices=(), outcom
             if outcome is not None:
                 outcome["refined"] = note
         return new
+    if not (hasattr(basis, "displacements") and hasattr(basis, "jacobians")):     # a DetailBasis
+        from splatedit.errors import SplatEditError
+        raise SplatEditError(DETAIL_UNAVAILABLE)
     from splatedit.deform.gaussians import deform_with_evaluator
     return gaussian_document(deform_with_evaluator(scene, basis, dc, progress=progress))
 

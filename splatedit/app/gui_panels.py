@@ -196,6 +196,10 @@ class EditorGui(MenuBar):
     def discard(self) -> None:
         self.gui.discard_frame()
 
+    def recover(self) -> None:
+        """After an exception while a frame was laid out: close it (ImGui's error recovery)."""
+        self.gui.recover_frame()
+
     def close(self) -> None:
         self.gui.close()
 
@@ -387,22 +391,22 @@ class EditorGui(MenuBar):
 
     def _deformation(self) -> None:
         ed, s = self.ed, self.ed.session
-        detail_ok = bool(getattr(s, "detail_available", False))
+        detail_ok = s.detail_available
         for m in DeformationMode:
             if m is DeformationMode.DETAIL and not detail_ok:
                 imgui.begin_disabled()
             if imgui.radio_button(m.value, s.deformation is m) and s.deformation is not m:
-                if hasattr(s, "set_deformation"):
-                    s.set_deformation(m)
-                else:
-                    s.deformation = m
-                    s.on_change()
+                s.set_deformation(m)
                 ed.say(f"deformation: {m.value}")
             self._rect(f"mode_{m.value}")
             if m is DeformationMode.DETAIL and not detail_ok:
                 imgui.end_disabled()
             imgui.same_line()
         imgui.new_line()
+        if not detail_ok:       # a Gaussian scene: say why detail is greyed out
+            imgui.push_text_wrap_pos(0.0)
+            imgui.text_disabled("detail: not available for Gaussian scenes")
+            imgui.pop_text_wrap_pos()
         if s.pose_pending and s.manip is None and not s.committing:
             imgui.text_colored(YELLOW, "pending moves")
             if imgui.button("Apply (Enter)"):

@@ -1,5 +1,6 @@
-"""The editor's centred questions in the Dear ImGui interface: unsaved
-changes before opening another model or quitting, and the save-as path.
+"""The editor's centred questions in the Dear ImGui interface: restoring a
+recovery copy at start (:mod:`splatedit.app.crash_guard`), unsaved changes
+before opening another model or quitting, and the save-as path.
 
 Each has its keys (Y / N / Esc, Enter / Esc; :mod:`splatedit.app.routing`)
 and clickable buttons that call the same handlers
@@ -13,7 +14,7 @@ from __future__ import annotations
 
 from imgui_bundle import imgui
 
-from splatedit.app.panel import Box, open_question, save_prompt_lines
+from splatedit.app.panel import Box, open_question, restore_question, save_prompt_lines
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
 
@@ -21,6 +22,10 @@ YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
 def _buttons(ed) -> tuple | None:
     """(rows, (yes label, yes callback), (no label, no callback)) of the open question, or None."""
     g = ed.g
+    restore = restore_question(ed)
+    if restore is not None:
+        return (restore, ("Restore (Y)", lambda: ed.answer_restore(True)),
+                ("Discard (N)", lambda: ed.answer_restore(False)))
     if ed.confirm_open is not None:
         name = ed.confirm_open.name
         return (open_question(ed), (f"Open {name} without saving (Y)", lambda: ed.answer_open(True)),

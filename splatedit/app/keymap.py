@@ -247,7 +247,8 @@ KEYMAP: tuple[Binding, ...] = (
             mouse=True),
     Binding(S.DEFORMATION, "B", "deformation of new edits: ROTATION (default: the handles' rotations are blended,\n"
             "bends and twists keep their thickness) / DETAIL (as ROTATION on a smoothed base\n"
-            "surface, the relief re-attached along its normals; refits) / LINEAR (the paper's)",
+            "surface, the relief re-attached along its normals; refits) / LINEAR (the paper's);\n"
+            "a Gaussian scene: ROTATION / LINEAR (no DETAIL: B says so)",
             Action.DEFORMATION_MODE, ("b",)),
     Binding(S.DEFORMATION, "G / R / S", "grab / rotate / scale the active handle with the mouse\n"
             "(the overlay shows the distance / angle / factor while moving)", Action.GRAB, ("g",)),

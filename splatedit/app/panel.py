@@ -213,6 +213,16 @@ def error_lines(message: str) -> list:
     return lines
 
 
+def restore_question(ed) -> tuple | None:
+    """The question at start when a recovery copy exists (rows), or None."""
+    e = getattr(ed, "confirm_restore", None)
+    if e is None:
+        return None
+    return (f"Recover unsaved work: {e.name} ({e.edits} edit(s), {e.when()})",
+            "Y: restore it     N: discard it     Esc: ask again next time",
+            f"(kept in {e.manifest.parent})")
+
+
 def open_question(ed) -> tuple | None:
     """The unsaved-changes question before opening another model (rows), or None."""
     if ed.confirm_open is None:
@@ -281,7 +291,7 @@ def compose_overlay(ed, w: int, h: int) -> list:
         patches.append(help_patch)
     patches += ed.browser.overlay(w, h)
     patches += error_box(ed, w, h, y)
-    center_msg = open_question(ed)
+    center_msg = restore_question(ed) or open_question(ed)
     if center_msg is not None:
         pass
     elif ed.confirm_quit:

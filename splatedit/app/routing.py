@@ -18,7 +18,6 @@ from pathlib import Path
 from splatedit.app import files
 from splatedit.app.keymap import Action, Context, lookup
 from splatedit.app.tools.base import DragMode
-from splatedit.errors import SplatEditError
 
 #: wheel notch -> help lines scrolled
 HELP_WHEEL_LINES = 3
@@ -39,13 +38,15 @@ class EventRouting:
     """The Editor's ``on_<kind>`` event handlers and action dispatch."""
 
     def handle_events(self, events) -> None:
+        """Each event to its handler, under the editor's guard (a
+        SplatEditError is a message; any other exception an internal error
+        shown in the error box, :mod:`splatedit.app.crash_guard`); the
+        events after it are still handled."""
         for e in events:
-            try:
+            with self.guarded(f"handling a {e.kind} event"):
                 if self.gui is not None and self.gui.takes(e):
                     continue
                 getattr(self, f"on_{e.kind}")(e)
-            except SplatEditError as exc:
-                self.say(str(exc))
 
     def on_resize(self, e) -> None:
         self.frames.invalidate()
@@ -159,6 +160,10 @@ class EventRouting:
         if self.prompt is not None:
             self.prompt_key(k, e.mods)
             return
+        if self.confirm_restore is not None:   # Y restores, N discards, Esc: next time
+            if k in (g.KEY_Y, g.KEY_N, g.KEY_ESCAPE):
+                self.answer_restore(None if k == g.KEY_ESCAPE else k == g.KEY_Y)
+            return
         if self.confirm_quit:              # N, Esc or anything else: stay
             self.answer_quit(k in (g.KEY_Y, g.KEY_Q))
             return
@@ -202,6 +207,9 @@ class EventRouting:
             return
         manip = s is not None and s.manip is not None
         table = self.manip_actions if manip and action in self.manip_actions else self.actions
-        table[action]()
+        # guarded here too: a GUI button runs its action while the frame is laid out, and
+        # an error there must neither abandon the frame nor take the window down
+        with self.guarded(f"running '{action.value}'"):
+            table[action]()
         if s is not None:
             self.motion()

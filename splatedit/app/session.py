@@ -62,6 +62,7 @@ from splatedit.app import revision
 from splatedit.app.commit_job import CommitOutcome, CommitProgress, CommitRunner
 from splatedit.app.distortion_feed import DistortionFeed
 from splatedit.app.fitting import FitProgress, FitScheduler, FitStats, fitted_kind
+from splatedit.app.gaussian_doc import DETAIL_UNAVAILABLE, gaussians_of
 from splatedit.app.history import History
 from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.rig import Rig
@@ -216,6 +217,9 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         if self.fit.current(key) or self.committing:    # a landing commit refits
             return
         self.fit.clear()
+        if self.fit.recall(key):      # undo / redo back to a fitted selection: no refit
+            self.on_change()
+            return
         hidx = self.selection.nonempty()
         curve = self.curve()
         if not hidx and curve is None:
@@ -278,23 +282,47 @@ class Session(SessionHistory, RigEditing, PoseEditing):
     #: the B key's cycle of deformation modes
     DEFORMATION_CYCLE = (DeformationMode.ROTATION, DeformationMode.DETAIL, DeformationMode.LINEAR)
 
+    #: why the detail mode cannot be chosen for a Gaussian scene (as ``splatedit deform`` says)
+    DETAIL_UNAVAILABLE = DETAIL_UNAVAILABLE
+
+    @property
+    def detail_available(self) -> bool:
+        """The detail mode can be chosen: not for a Gaussian document (the
+        Gaussians' covariance and SH transport needs the plain basis'
+        Jacobians; ``splatedit deform`` and ``render --edit`` refuse it too)."""
+        return gaussians_of(self.cloud) is None
+
+    def deformation_cycle(self) -> tuple:
+        """The modes B cycles through for this document (detail left out where unavailable)."""
+        return tuple(m for m in self.DEFORMATION_CYCLE
+                     if m is not DeformationMode.DETAIL or self.detail_available)
+
     def cycle_deformation(self) -> DeformationMode:
-        """Switch the mode of new edits: rotation -> detail -> linear -> rotation.
+        """Switch the mode of new edits: rotation -> detail -> linear -> rotation
+        (rotation <-> linear for a Gaussian document, :attr:`detail_available`).
         Rotation and linear share the fitted basis (the live pose is shown in
         the new mode at once); switching to or from detail refits (a
         :class:`~splatedit.deform.detail.DetailBasis`: base surface plus normal
         offsets), the pose is kept and drawn again when the fit is done.  Not
         an undo step (a setting, like the brush mode); each committed edit
         records its mode."""
-        cyc = self.DEFORMATION_CYCLE
-        return self.set_deformation(cyc[(cyc.index(self.deformation) + 1) % len(cyc)])
+        cyc = self.deformation_cycle()
+        at = cyc.index(self.deformation) if self.deformation in cyc else -1
+        return self.set_deformation(cyc[(at + 1) % len(cyc)])
 
     def set_deformation(self, mode) -> DeformationMode:
         """Make ``mode`` (a DeformationMode or its name) the mode of new edits
-        (refits when the kind of basis changes, see :meth:`cycle_deformation`)."""
+        (refits when the kind of basis changes, see :meth:`cycle_deformation`).
+
+        Raises:
+            SplatEditError: DETAIL for a Gaussian document (nothing changes)."""
         if self.committing:
             return self.deformation
-        self.deformation = DeformationMode(mode)
+        mode = DeformationMode(mode)
+        if mode is DeformationMode.DETAIL and not self.detail_available:
+            from splatedit.errors import SplatEditError
+            raise SplatEditError(self.DETAIL_UNAVAILABLE)
+        self.deformation = mode
         self.request_fit()          # a no-op unless the basis kind changed
         self.on_change()
         return self.deformation
@@ -346,9 +374,27 @@ class Session(SessionHistory, RigEditing, PoseEditing):
         edit's cloud, basis and dC (:meth:`shown_edit`: the same deformed
         surface, its stretch coloured)."""
         last = self.shown_edit() if heat_map else None
-        if last is not None:
+        if last is not None and not getattr(last.dc, "curves", ()):
+            # (a curve-frame edit is not redrawn from its base on the GPU, which has
+            # no frames: the document itself is shown, without the heat colours)
             return last.cloud, last.basis, last.dc
-        return self.cloud, self.basis, self.current_dc() if self.basis is not None else None
+        dc = self.current_dc() if self.basis is not None else None
+        if getattr(dc, "curves", ()) and gaussians_of(self.cloud) is None:
+            # moved curves in the rotation mode carry frames, which the GPU pass
+            # cannot draw: the pose is shown as a CPU-deformed copy (as committed).
+            # A Gaussian scene keeps its GPU preview (the linear curve edit): its
+            # CPU deformation re-decomposes every Gaussian
+            return self._frame_preview(dc), None, None
+        return self.cloud, self.basis, dc
+
+    def _frame_preview(self, dc):
+        """The document deformed by ``dc`` (a CurveFrameDisplacement) on the
+        CPU, kept while the cloud, basis and pose stay the same."""
+        key = (self.cloud, self.basis, dc.tobytes())
+        cached = getattr(self, "_frame_preview_cache", None)
+        if cached is None or cached[0][0] is not key[0] or cached[0][1] is not key[1] or cached[0][2] != key[2]:
+            cached = self._frame_preview_cache = (key, self.basis.apply(self.cloud, dc))
+        return cached[1]
 
     # ---------------------------------------------------------------- export
     def edit_script(self):

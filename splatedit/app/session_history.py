@@ -68,6 +68,19 @@ class SessionHistory:
         self._restore(snap)
         return True
 
+    def adopt_recovered(self, script, label: str) -> None:
+        """Make ``script``'s edits (an EditScript from a recovery entry,
+        :mod:`splatedit.app.recovery`) this document's committed edits, with
+        its solver settings: the history restarts at one unsaved step
+        ``label``, so a save writes the model and a script that replays from
+        the original source."""
+        self.edits = tuple(script.edits)
+        self.method, self.tol, self.max_centers = script.solver.method, script.solver.tol, script.solver.max_centers
+        self.history.reset(self._snapshot(label))
+        self.history.saved_pos = -1
+        self.version += 1
+        self.on_change()
+
     @property
     def dirty(self) -> bool:
         """Unsaved changes (a commit still running counts: quitting asks first)."""

@@ -11,6 +11,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from splatedit.deform.modes import DeformationMode
 from splatedit.errors import SplatEditError
 from splatedit.select.selection import HANDLE
 from splatedit.tolerances import RENDER_MAX_BASIS_COLUMNS
@@ -143,12 +144,17 @@ class RigEditing:
         return np.array(self.curve_points) + self.live_curve_moves(live)
 
     def curve_polyline(self, count: int = 160, live: bool = True) -> np.ndarray | None:
-        """(>= count, 3) points of the moved curve ``c'(t) = c(t) + W(t) dq``
-        for drawing: exactly the targets the fitted deformation gives the
-        curve's samples (through every moved picked point; None below 2
-        points)."""
+        """(>= count, 3) points of the moved curve for drawing (through every
+        moved picked point; None below 2 points): in the linear mode
+        ``c'(t) = c(t) + W(t) dq``, exactly the targets the fitted deformation
+        gives the curve's samples; otherwise the curve whose frame the splats
+        follow, the Catmull-Rom spline through the moved points
+        (:mod:`splatedit.deform.curve_frames`)."""
         c = self.curve()
         if c is None:
             return None
         t = np.union1d(np.linspace(0.0, 1.0, count), c.params)
-        return c.evaluate(t, c.points + self.live_curve_moves(live))
+        moved = c.points + self.live_curve_moves(live)
+        if self.deformation is DeformationMode.LINEAR:
+            return c.evaluate(t, moved)
+        return c.shape_weights(t) @ moved

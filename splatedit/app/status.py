@@ -61,7 +61,10 @@ def status_dict(ed) -> dict:
           "path": str(ed.path) if ed.path else None, "cloud_name": ed.cloud_name,
           "error_box": ed.error_box, "error_rect": list(ed.error_rect) if ed.error_rect else None, "confirm_open": str(ed.confirm_open) if ed.confirm_open else None,
           "browser": _browser(ed.browser), "message": ed.message,
-          "script": str(ed.saved_script) if ed.saved_script else None}
+          "script": str(ed.saved_script) if ed.saved_script else None,
+          "confirm_restore": str(ed.confirm_restore.model) if getattr(ed, "confirm_restore", None) else None,
+          "restored": str(ed.restored.model) if getattr(ed, "restored", None) else None,
+          "internal_errors": getattr(ed, "internal_errors", 0)}
     gui = getattr(ed, "gui", None)
     st["gui"] = gui is not None
     if gui is not None:

@@ -179,8 +179,11 @@ def bench_las(n: int, tmp: Path) -> Iterator[dict]:
                "laspy_read_s": round(tl, 3), "mm_exact": same}
 
 
-def bench_io(*, quick: bool = False, large: bool = False) -> Iterator[dict]:
-    counts = (200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,))
+def bench_io(*, quick: bool = False, large: bool = False, counts=None, las_points: int | None = None
+             ) -> Iterator[dict]:
+    """The PLY reads (``counts`` splats, default by ``quick`` / ``large``) and
+    the LAS round trip (``las_points``)."""
+    counts = counts or ((200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,)))
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-io-") as tmp:
         yield from bench_ply_read(counts, Path(tmp))
-        yield from bench_las(20_000 if quick else 1_000_000, Path(tmp))
+        yield from bench_las(las_points or (20_000 if quick else 1_000_000), Path(tmp))

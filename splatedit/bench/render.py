@@ -13,6 +13,7 @@ lavapipe shares the CPU with everything else on the machine: compare
 from __future__ import annotations
 
 import time
+from pathlib import Path
 from typing import Iterator
 
 import numpy as np
@@ -86,16 +87,82 @@ def _point_share(r: Renderer) -> float:
     return float(d[5]) / max(int(d[1]) + int(d[5]), 1)
 
 
-def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: int) -> dict:
+def _paths(r: Renderer, cam, w: int, h: int, repeats: int) -> dict:
+    """Both rasterization paths of the plain frame in the same run, alternating
+    (raster, compute, raster, ...) so that machine load hits both alike: the
+    compute path's keys, its ratio to the raster path and how far apart their
+    images are (RGB, 8-bit levels; coverage = non-background pixels)."""
+    saved = r.raster_path
+    frames = {"raster": [], "compute": []}
+    images = {}
+    try:
+        for p in ("raster", "compute"):
+            r.raster_path = p
+            images[p] = r.render(cam, w, h)               # warm-up, and the compared image
+        for _ in range(repeats):
+            for p in ("raster", "compute"):
+                r.raster_path = p
+                r.render(cam, w, h)
+                frames[p].append(dict(r.last_timings_ms))
+        r.raster_path = "compute"
+        ran_compute = r.frame_path(w, h)
+    finally:
+        r.raster_path = saved
+    med = {p: float(np.median([x["total"] for x in v])) for p, v in frames.items()}
+    best = {p: float(min(x["total"] for x in v)) for p, v in frames.items()}
+    a, b = (images[p][..., :3].astype(np.int16) for p in ("raster", "compute"))
+    diff = np.abs(a - b)
+    bg = np.array([round(255 * c) for c in r.background[:3]], np.int16)
+    cov_a, cov_b = (np.any(x != bg, axis=2) for x in (a, b))
+    cmed = {k: float(np.median([x[k] for x in frames["compute"]])) for k in frames["compute"][0]}
+    return {
+        "path_compute_ran": ran_compute,
+        "ms_frame_raster": round(med["raster"], 2), "ms_frame_compute": round(med["compute"], 2),
+        "compute_over_raster": round(med["compute"] / med["raster"], 3),
+        "compute_over_raster_best": round(best["compute"] / best["raster"], 3),
+        "ms_compute_visibility": round(cmed.get("visibility", float("nan")), 2),
+        "ms_compute_attributes": round(cmed.get("attributes", float("nan")), 2),
+        "image_mean_diff": round(float(diff.mean()), 4), "image_max_diff": int(diff.max()),
+        "image_bad_share": round(float((diff.max(axis=2) > 24).mean()), 5),
+        "coverage_raster": int(cov_a.sum()), "coverage_compute": int(cov_b.sum()),
+        "coverage_mismatch": int((cov_a != cov_b).sum()),
+    }
+
+
+def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: int,
+          deform: bool = True) -> dict:
     t0 = time.perf_counter()
     n = cloud.n
     r.set_cloud(cloud)
     cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))
+    paths = _paths(r, cam, w, h, repeats)
     plain, plain_best = _frames(r, cam, w, h, repeats)
     share = _point_share(r)
     r.render_points_floor(cam, w, h)
     floors = [r.render_points_floor(cam, w, h) for _ in range(repeats)]
     pts, pts_best = float(np.median(floors)), float(min(floors))
+    out = {
+        "bench": "render", "model": model, "device": r.dev.name, "path": r.frame_path(w, h),
+        "splats": int(n), "width": w, "height": h, **paths,
+        "ms_prepass": round(plain["prepass"], 2), "ms_visibility": round(plain["visibility"], 2),
+        "ms_attributes": round(plain["attributes"], 2),
+        "ms_shading": round(plain["shading"], 2), "ms_frame": round(plain["total"], 2),
+        "splats_per_s": round(n / (plain["total"] * 1e-3)),
+        "ms_points_floor": round(pts, 2), "frame_over_floor": round(plain["total"] / pts, 3),
+        "ms_frame_best": round(plain_best["total"], 2), "ms_points_floor_best": round(pts_best, 2),
+        "frame_over_floor_best": round(plain_best["total"] / pts_best, 3),
+        "point_path_share": round(share, 4),
+    }
+    if deform:
+        out.update(_deformed(r, cloud, cam, w, h, repeats, plain, plain_best))
+    out["loadavg_1min"] = _loadavg()
+    out["wall_s"] = round(time.perf_counter() - t0, 1)
+    return out
+
+
+def _deformed(r: Renderer, cloud: SplatCloud, cam, w: int, h: int, repeats: int, plain, plain_best) -> dict:
+    """The deformation cases of :func:`bench_render` (default path)."""
+    n = cloud.n
     lo, hi = cloud.bounds()
     B = _basis((cloud.positions - 0.5 * (lo + hi)) / max(float(np.max(hi - lo)) / 2.0, 1e-12))
     dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]])
@@ -119,15 +186,6 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
     tenth, tenth_best = _frames(r, cam, w, h, repeats)
     r.clear_basis()
     return {
-        "bench": "render", "model": model, "device": r.dev.name, "splats": int(n), "width": w, "height": h,
-        "ms_prepass": round(plain["prepass"], 2), "ms_visibility": round(plain["visibility"], 2),
-        "ms_attributes": round(plain["attributes"], 2),
-        "ms_shading": round(plain["shading"], 2), "ms_frame": round(plain["total"], 2),
-        "splats_per_s": round(n / (plain["total"] * 1e-3)),
-        "ms_points_floor": round(pts, 2), "frame_over_floor": round(plain["total"] / pts, 3),
-        "ms_frame_best": round(plain_best["total"], 2), "ms_points_floor_best": round(pts_best, 2),
-        "frame_over_floor_best": round(plain_best["total"] / pts_best, 3),
-        "point_path_share": round(share, 4),
         "ms_frame_deformed_all": round(full["total"], 2),
         "deformed_all_over_plain": round(full["total"] / plain["total"], 3),
         "ms_frame_deformed_10pct": round(tenth["total"], 2),
@@ -142,8 +200,6 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
         "rotation_over_deformed_prepass": round(rot["prepass"] / full["prepass"], 3),
         "rotation_over_deformed_prepass_best": round(rot_best["prepass"] / full_best["prepass"], 3),
         "deformed_10pct_over_plain_best": round(tenth_best["total"] / plain_best["total"], 3),
-        "loadavg_1min": _loadavg(),
-        "wall_s": round(time.perf_counter() - t0, 1),
     }
 
 
@@ -156,18 +212,30 @@ def _loadavg() -> float:
 
 
 def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repeats: int = 3,
-                 device_name: str | None = None, bunny: bool = True) -> Iterator[dict]:
+                 device_name: str | None = None, bunny: bool = True, models=(),
+                 deform_max: int = 2_000_000) -> Iterator[dict]:
     """Yield one dict per case: a sphere per splat count in ``counts``, then
     (``bunny``) the bundled bunny model (``splatedit.data.default_model_path()``
-    read with :func:`splatedit.io.read`), all at ``size``.
+    read with :func:`splatedit.io.read`) and every file of ``models`` (e.g. a
+    real scan), all at ``size``.
 
-    Every case has the same keys (times in ms are GPU timestamps; "median"
+    Every case has these keys (times in ms are GPU timestamps; "median"
     and "best" are over ``repeats`` frames after a warm-up frame):
 
-    * ``bench`` = "render", ``model`` ("sphere" / "bunny"), ``device``,
-      ``splats``, ``width``, ``height``;
+    * ``bench`` = "render", ``model`` ("sphere" / "bunny" / the file name),
+      ``device``, ``path`` (the default path's, "raster" / "compute", which
+      the other per-pass keys measure), ``splats``, ``width``, ``height``;
+    * both paths of the plain frame in the same run (alternating frames):
+      ``ms_frame_raster``, ``ms_frame_compute`` (medians),
+      ``compute_over_raster`` (and ``_best``: the fastest frames),
+      ``path_compute_ran`` (what the compute request drew: "raster" where the
+      device cannot), ``ms_compute_visibility``, ``ms_compute_attributes``;
+      their images: ``image_mean_diff``, ``image_max_diff`` (RGB levels),
+      ``image_bad_share`` (share of pixels off by more than 24 levels),
+      ``coverage_raster``, ``coverage_compute``, ``coverage_mismatch``
+      (non-background pixels, and pixels covered by one path only);
     * ``ms_prepass``, ``ms_visibility``, ``ms_attributes``, ``ms_shading``,
-      ``ms_frame``: median per pass and whole frame (undeformed);
+      ``ms_frame``: median per pass and whole frame (undeformed, default path);
     * ``splats_per_s``: splats / median frame time;
     * ``ms_points_floor``: median one-pixel POINT_LIST floor
       (:meth:`Renderer.render_points_floor`); ``frame_over_floor`` = ms_frame
@@ -175,6 +243,12 @@ def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repea
     * ``ms_frame_best``, ``ms_points_floor_best``, ``frame_over_floor_best``:
       the same with the fastest frame of each (less sensitive to machine load);
     * ``point_path_share``: share of the drawn splats on the square-point path;
+    * ``loadavg_1min``: /proc/loadavg at the end of the case (NaN elsewhere);
+    * ``wall_s``: wall-clock seconds of the case.
+
+    Cases of at most ``deform_max`` splats (they hold a full basis) add, on
+    the default path:
+
     * ``ms_frame_deformed_all`` / ``deformed_all_over_plain``: median frame
       with every splat carrying a 4-column basis row (Gaussian bumps,
       displacement ~2% of the model size), and its ratio to ``ms_frame``;
@@ -189,15 +263,16 @@ def bench_render(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720), repea
       ``_best``) their ratio;
     * ``ms_prepass_rotation_all`` / ``rotation_over_deformed_prepass`` (and
       ``_best``): the pre-pass with the same basis as a rotation-aware handle
-      turned 120 degrees (``DeformationMode.ROTATION``), over the linear one;
-    * ``loadavg_1min``: /proc/loadavg at the end of the case (NaN elsewhere);
-    * ``wall_s``: wall-clock seconds of the case.
+      turned 120 degrees (``DeformationMode.ROTATION``), over the linear one.
     """
     w, h = size
     with Renderer(device_name=device_name, validation=False) as r:
         for n in counts:
-            yield _case(r, sphere_cloud(int(n)), "sphere", w, h, repeats)
+            yield _case(r, sphere_cloud(int(n)), "sphere", w, h, repeats, deform=int(n) <= deform_max)
+        from splatedit.io import read
         if bunny:
             from splatedit.data import default_model_path
-            from splatedit.io import read
             yield _case(r, read(default_model_path()), "bunny", w, h, repeats)
+        for path in models:
+            cloud = read(path)
+            yield _case(r, cloud, Path(path).name, w, h, repeats, deform=cloud.n <= deform_max)

@@ -26,8 +26,20 @@ def cmd_convert(args) -> int:
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
     write(args.output, cloud, overwrite=args.force)
-    print(f"wrote {args.output}: {cloud.n} splats" + ("" if cloud.faces is None else f", {len(cloud.faces)} faces"))
+    print(f"wrote {args.output}: {cloud.n} splats" + _faces_note(cloud, args.output))
     return 0
+
+
+def _faces_note(cloud, output) -> str:
+    """What became of a mesh's faces in ``output``: kept (PLY, OFF) or dropped
+    (the point formats: XYZ, LAS/LAZ, E57, PCD, PTS hold no faces)."""
+    from splatedit.io import FACE_EXTENSIONS
+    if cloud.faces is None:
+        return ""
+    ext = Path(output).suffix.lower()
+    if ext in FACE_EXTENSIONS:
+        return f", {len(cloud.faces)} faces"
+    return f" (the {len(cloud.faces)} faces were dropped: {ext} holds points only; write .ply or .off to keep them)"
 
 
 def _print_edit(args, rep) -> None:

@@ -54,9 +54,9 @@ def cmd_render(args) -> int:
     camera = _camera_from_args(args, cloud)
     basis_rows = d_c = None
     if args.edit is not None:
-        cloud, basis_rows, d_c = _gpu_edit(args, cloud)
+        cloud, basis_rows, d_c = _gpu_edit(args, cloud, on_gpu=_splats_draw)
     render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
-                  buffers_path=args.buffers)
+                  buffers_path=args.buffers, raster_path=getattr(args, "path", None))
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
@@ -102,11 +102,19 @@ def _render_gaussians(args, cloud) -> int:
                                             progress=args.progress)
             basis_rows = d_c = None
             on_cpu = True
-    render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c)
+    render_gaussians_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
+                            path=getattr(args, "path", None) or "auto")
     how = ", deformed on the CPU" if on_cpu else ", deformed on the GPU" if basis_rows is not None else ""
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {len(cloud)} Gaussians, SH degree "
           f"{cloud.sh_degree}{how})")
     return 0
+
+
+def _splats_draw(rows, d_c) -> bool:
+    """Whether the splat renderer draws this edit: not the frames of moved
+    curves in the rotation mode (:mod:`splatedit.deform.curve_frames`; its GPU
+    pass draws the paper's linear curve edit), which are applied on the CPU."""
+    return not getattr(d_c, "curves", ())
 
 
 def _gpu_edit(args, cloud, on_gpu=None):
@@ -133,8 +141,8 @@ def _gpu_edit(args, cloud, on_gpu=None):
     mode = script.edits[-1].deformation.value
     detail = getattr(basis, "detail_for_gpu", None)   # the detail mode (splatedit.deform.detail)
     rows = basis.rows_for_gpu() + ((detail(),) if detail else ())
-    where = ("uploaded to the GPU" if on_gpu is None or on_gpu(rows, d_c)
-             else f"fitted; the {mode} edit is applied on the CPU")
+    gpu = on_gpu is None or on_gpu(rows, d_c)
+    where = "uploaded to the GPU" if gpu else f"fitted; the {mode} edit is applied on the CPU"
     print(f"edit {len(script.edits) - 1}: {mode} deformation, support {len(basis.indices)} splats, "
           f"{st['method']} with {st['n_centers']} centers (residual {st['residual']:.2e}), "
           f"{basis.n_columns} basis columns {where}")
@@ -147,4 +155,6 @@ def _gpu_edit(args, cloud, on_gpu=None):
     if dist.exceeds_warn:
         print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
               f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
+    if not gpu and on_gpu is _splats_draw:
+        return basis.commit(cloud, d_c), None, None
     return cloud, rows, d_c

@@ -31,6 +31,7 @@ import time
 import numpy as np
 
 from splatedit.deform.apply_plan import APPLY_STAGE, CHECK_STAGE, apply_hot_path, build_hot_path
+from splatedit.deform.curve_frames import CurveFrameDisplacement, curve_frame_displacement, frames_terms
 from splatedit.deform.constraints import Constraints, build_constraints
 from splatedit.deform.frames import affine_coordinate_gradients, affine_coordinates
 from splatedit.deform.modes import DeformationMode
@@ -41,7 +42,7 @@ from splatedit.deform.rotation_centre import StretchProbe
 from splatedit.deform.transform import apply_affine, as_affine
 from splatedit.errors import ParameterError
 from splatedit.progress import report
-from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL
+from splatedit.tolerances import BAND_RINGS, IQR_DEFAULT_TOL, POLY_CHECK_PROBE_SPLATS
 
 #: progress stage name of the basis evaluation
 PROGRESS_STAGE = "precomputing deformation basis"
@@ -93,6 +94,9 @@ class DeformationBasis:
         self.stats = stats
         self._cpu = None  # lazily built hot-path arrays, see _cpu_arrays
         self.stretch_probe = None  # free splats where rotation centres are compared (fit() sets it)
+        self.support_positions = None  # (N, 3) positions of the support splats (fit() sets it; curve frames)
+        #: move-independent terms of curve frames at the support (splatedit.deform.curve_frames)
+        self.frame_cache: dict = {}
 
     # ------------------------------------------------------------ building
     @classmethod
@@ -127,8 +131,10 @@ class DeformationBasis:
         con = build_constraints(cloud, support, handles, curves=curves, rings=rings,
                                 spacing=spacing)
         t_con = time.perf_counter()
+        free = con.free_index
         rbf = TriharmonicRBF.fit(con.points, con.values, method=method, tol=tol,
-                                 max_centers=max_centers, progress=progress)
+                                 max_centers=max_centers, progress=progress,
+                                 probe=cloud.positions[free[::max(1, len(free) // POLY_CHECK_PROBE_SPLATS)]])
         t1 = time.perf_counter()
 
         pos = cloud.positions
@@ -169,6 +175,7 @@ class DeformationBasis:
             spacing=float(con.spacing), message=getattr(rbf, "message", ""),
         )
         out = cls(con, rbf, pack, stats)
+        out.support_positions = pos[idx].copy()
         if len(free_rows):
             out.stretch_probe = StretchProbe.sample(pack, free_rows, cloud.u[idx[free_rows]],
                                                     cloud.v[idx[free_rows]])
@@ -273,6 +280,8 @@ class DeformationBasis:
             transforms = [transforms]
         transforms = list(transforms)
         if mode is DeformationMode.ROTATION and len(transforms) == self.n_groups:
+            if "curve" in self.group_kinds:     # moved curves carry their frames
+                return curve_frame_displacement(self, transforms)
             return rotation_displacement(self, transforms)
         if len(transforms) != self.n_groups:
             raise ParameterError("transforms", f"need one matrix per handle and one (k + 1, 3) "
@@ -307,7 +316,11 @@ class DeformationBasis:
 
     def displacements(self, dC) -> np.ndarray:
         """(N, 3) displacements of the support splats: ``B dC`` (plus the
-        blended rotations of a RotationDisplacement)."""
+        blended rotations of a RotationDisplacement, the curves' frame terms
+        of a CurveFrameDisplacement)."""
+        if isinstance(dC, CurveFrameDisplacement):
+            pos = self._support_positions()
+            return self.displacements(dC.base()) + frames_terms(dC, self, pos)[0]
         d, rot = split_displacement(dC)
         out = self.B @ self._check_dc(d)
         if rot is not None:
@@ -317,6 +330,12 @@ class DeformationBasis:
     def jacobians(self, dC) -> np.ndarray:
         """(N, 3, 3) Jacobians ``J`` of the deformation at the support splats
         (dC: (K, 3) or a RotationDisplacement)."""
+        if isinstance(dC, CurveFrameDisplacement):
+            out = self.jacobians(dC.base())
+            pos = self._support_positions()
+            cols = frames_terms(dC, self, pos, list(np.eye(3)[:, None, :].repeat(len(pos), 1)))[1]
+            out += np.stack(cols, axis=2)
+            return out
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
         blocks = None if rot is None else handle_blocks(self)
@@ -330,6 +349,23 @@ class DeformationBasis:
             if rot is not None:
                 o += blend_jacobians(rot, self._pack[s:s + _BASIS_CHUNK], blocks)
         return out
+
+    def still_tree(self):
+        """KD-tree of the splats that do not follow a curve's frame: the fixed
+        band and the handles' splats (built once; curve frames), None if none."""
+        if not hasattr(self, "_still_tree"):
+            from scipy.spatial import cKDTree
+            con = self.constraints
+            pts = [con.points[:len(con.fixed_index)]]
+            pts += [self._support_positions()[np.searchsorted(self.indices, h)] for h in con.handle_index]
+            pts = np.concatenate(pts)
+            self._still_tree = cKDTree(pts) if len(pts) else None
+        return self._still_tree
+
+    def _support_positions(self) -> np.ndarray:
+        if self.support_positions is None:
+            raise ParameterError("dC", "curve frames need the support's positions (a basis made by fit())")
+        return self.support_positions
 
     def _check_cloud(self, cloud):
         n = self.constraints.n_points
@@ -358,6 +394,16 @@ class DeformationBasis:
         optional ``progress(APPLY_STAGE, fraction of the support's rows done)``
         after each chunk of the run plan (a commit in the editor's background)."""
         self._check_cloud(cloud)
+        if isinstance(dC, CurveFrameDisplacement):    # residual and handles, then the curves' frames
+            outs = self.apply_arrays(cloud, dC.base(), progress=progress)
+            idx = self.indices
+            pos = cloud.positions[idx]
+            if self.support_positions is not None and np.array_equal(pos, self.support_positions):
+                pos = self.support_positions        # the base cloud: its move-independent terms are kept
+            dp, (du, dv) = frames_terms(dC, self, pos, (cloud.u[idx], cloud.v[idx]))
+            for o, x in zip(outs, (dp, du, dv)):
+                o[idx] += x
+            return outs
         d, rot = split_displacement(dC)
         d = self._check_dc(d)
         srcs = (cloud.positions, cloud.u, cloud.v)

@@ -83,6 +83,12 @@ def _segments(tau: np.ndarray, t) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
     return tt, seg, np.clip(s, 0.0, 1.0)
 
 
+def segment_index(tau: np.ndarray, t) -> np.ndarray:
+    """(len(t),) the segment 0 .. k - 1 of each parameter ``t`` (clamped into
+    [0, 1]) over the knots ``tau`` (k + 1,)."""
+    return _segments(tau, t)[1]
+
+
 def smoothstep5(s) -> np.ndarray:
     """``6 s^5 - 15 s^4 + 10 s^3``: 0 -> 1 on [0, 1] with zero first and second
     derivatives at both ends (the displacement weights' blend)."""

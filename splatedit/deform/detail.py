@@ -52,7 +52,7 @@ from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.constraints import as_mask
 from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.modes import DeformationMode
-from splatedit.deform.rotation import split_displacement
+from splatedit.deform.rotation import RotationDisplacement, split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.estimate import estimate_normals
 from splatedit.model.tangents import tangent_frame
@@ -342,7 +342,10 @@ class DetailBasis:
         handle rotates, else dC (K, 3)) or linearly (``mode`` LINEAR: dC)."""
         mode = DeformationMode(mode)
         base_mode = DeformationMode.LINEAR if mode is DeformationMode.LINEAR else DeformationMode.ROTATION
-        return self.base_basis.displacement(transforms, mode=base_mode)
+        d = self.base_basis.displacement(transforms, mode=base_mode)
+        if getattr(d, "curves", ()):    # the base keeps the paper's curve edit (no curve frames here)
+            return RotationDisplacement(d.dC, d.rotations) if d.rotating else d.dC
+        return d
 
     def rows_for_gpu(self, handle: int | None = None):
         """``(indices, B, Bx, By, Bz)`` at the base points (all groups; the

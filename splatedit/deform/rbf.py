@@ -49,6 +49,8 @@ from splatedit.tolerances import (
     EVAL_CHUNK_ROWS,
     EVAL_THREADS,
     IQR_DEFAULT_TOL,
+    POLY_CHECK_FACTOR,
+    POLY_CHECK_RTOL,
     RESIDUAL_NOTE_FACTOR,
     RESIDUAL_NOTE_MIN,
 )
@@ -114,6 +116,14 @@ class TriharmonicRBF:
         self.tol = info.tol
         self.rcond = info.rcond
         self.fit_seconds = info.seconds
+        #: terms of the quadratic kept (0..10; fewer where the constraints lie
+        #: on a quadric up to their precision), the relative singular values
+        #: of its affine and quadratic blocks (None below 10 constraints) and
+        #: the smallest one kept
+        self.poly_rank = info.poly_rank
+        self.poly_singular = info.poly_singular
+        self.poly_weakest = info.poly_weakest
+        self.coordinate_precision = info.precision * self.scale
         k = self.weights.shape[1]
         c = self._centers_n
         # [W, c_x W, c_y W, c_z W]: one GEMM with the distance matrix gives
@@ -147,7 +157,7 @@ class TriharmonicRBF:
     @classmethod
     def fit(cls, points, values, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
             max_centers: Optional[int] = None,
-            progress: Optional[ProgressFn] = None) -> "TriharmonicRBF":
+            progress: Optional[ProgressFn] = None, probe=None) -> "TriharmonicRBF":
         """Fit ``f`` with ``f(points[i]) = values[i]`` (exactly or to ``tol``).
 
         Parameters
@@ -191,17 +201,52 @@ class TriharmonicRBF:
         values agree within DUPLICATE_VALUE_RTOL, and raise SolverError
         otherwise (the interpolation problem has no solution).
 
-        Polynomial: dropped (as in the paper, Sect. 4) when m < 10 or the
-        normalised 10-column monomial matrix P has
-        ``s_min / s_max < POLY_RANK_RTOL`` (all constraints on a quadric,
-        e.g. a sphere or a plane); ``polynomial`` is False and a note says why.
+        Polynomial: by its numerical rank on the constraint set.  The paper
+        (Sect. 4) drops it when all constraints lie on a quadric (system (3)
+        is singular then); a decision on exact singularity fails for points a
+        rounding away from a quadric (spheres, cylinders, cones, planes stored
+        in float32 or with a few decimals): the quadric's coefficient is then
+        fitted to the rounding, and the field's normal derivative explodes
+        (a 2,000-point sphere at 7 decimals: 3x3 Jacobian stretch 218x, PCA
+        splat axes 4.9x; docs/PERFORMANCE.md).  So the column-scaled monomial
+        matrix is factored by an SVD (:func:`~splatedit.deform.rbf_fit.polynomial_basis`)
+        and only the directions whose singular value stands above
+        POLY_NOISE_FACTOR times the first-order effect of the coordinates'
+        precision (:func:`~splatedit.deform.rbf_fit.coordinate_precision`:
+        half the decimal grid they lie on, else float32 rounding) and above
+        POLY_RANK_RTOL are kept: ``poly_rank`` of 10 terms (9 on a sphere,
+        cylinder or cone, 6 on a plane, 0 below 10 constraints), the side
+        conditions ``P_r^T w = 0`` on those only, in every method.  Then the
+        fit is checked rather than trusted: when a kept direction is weak
+        (s/s_max < POLY_CHECK_RTOL) the fit without the weak directions is
+        computed too, and taken when the polynomial one's largest Jacobian
+        (at the constraints and the ``probe`` points) is POLY_CHECK_FACTOR
+        times steeper and it meets its constraints as well; a note says
+        which.  ``polynomial`` is False when no term is kept.
+
+        probe : optional (p, 3) points (e.g. free support splats) where that
+            check also measures the Jacobian.
 
         Raises ParameterError for bad arguments and SolverError when the
         system cannot be solved (conflicting duplicates; a singular system,
         e.g. a single constraint point, whose kernel matrix is [0]).
         """
         t_start = time.perf_counter()
-        sol: FitSolution = solve_constraints(points, values, method, tol, max_centers, progress)
+        args = (points, values, method, tol, max_centers, progress)
+        sol: FitSolution = solve_constraints(*args)
+        f = cls._from_solution(sol)
+        info = sol.info
+        if info.poly_rank and info.poly_weakest < POLY_CHECK_RTOL:
+            # weak polynomial directions: check the fit against the one without
+            # them rather than trusting it (near-quadric constraints with more
+            # relief than their rounding, e.g. noisy float64 data)
+            g = cls._from_solution(solve_constraints(*args, poly_rtol=POLY_CHECK_RTOL))
+            f = _checked_choice(f, g, sol.points, probe)
+        f.fit_seconds = time.perf_counter() - t_start
+        return f
+
+    @classmethod
+    def _from_solution(cls, sol: FitSolution) -> "TriharmonicRBF":
         f = cls(centers_n=sol.centers_n, weights=sol.weights, poly_coeffs=sol.poly_coeffs,
                 shift=sol.shift, scale=sol.scale, center_indices=sol.center_indices,
                 info=sol.info)
@@ -209,8 +254,11 @@ class TriharmonicRBF:
         # constraint (the solver's own figure is blind to rounding, e.g. when
         # near-duplicate points with different values make the system singular)
         f._set_achieved(achieved_residuals(f, sol.points, sol.values), sol.info.residuals)
-        f.fit_seconds = time.perf_counter() - t_start
         return f
+
+    def _residual_limit(self) -> float:
+        """The achieved residual above which a note calls the fit ill-conditioned."""
+        return max(self.tol if self.method == "iqr" else 0.0, RESIDUAL_NOTE_MIN) * RESIDUAL_NOTE_FACTOR
 
     def _set_achieved(self, achieved: np.ndarray, solver: np.ndarray) -> None:
         self.residuals = achieved
@@ -218,8 +266,7 @@ class TriharmonicRBF:
         self.solver_residual = float(np.max(solver)) if solver.size else 0.0
         self.notes.append(f"residual {self.residual:.2g} (||f(x_i) - b_i|| / ||b|| over all "
                           f"{self.n_input_constraints} constraints)")
-        limit = max(self.tol if self.method == "iqr" else 0.0, RESIDUAL_NOTE_MIN) * RESIDUAL_NOTE_FACTOR
-        if self.residual > limit:
+        if self.residual > self._residual_limit():
             self.notes.append(
                 f"the fitted field misses its constraints by {self.residual:.2g} relative "
                 f"(the solver's own figure: {self.solver_residual:.2g}): the system is "
@@ -323,3 +370,36 @@ def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarr
         d = f(points[s:s + step]) - values[s:s + step]
         res_sq += np.einsum("ij,ij->j", d, d)
     return _relative_residuals(np.sqrt(res_sq), values)
+
+
+def field_roughness(f: "TriharmonicRBF", points: np.ndarray) -> float:
+    """The largest Frobenius norm of the fitted field's Jacobian (k, 3) over
+    ``points`` (N, 3), model units: how steep the field gets, the quantity a
+    wild polynomial term (a quadric's coefficient fitted to rounding) blows
+    up in the directions the constraints do not see (a surface's normal)."""
+    out = 0.0
+    step = max(1, f._chunk_rows())
+    for s in range(0, len(points), step):
+        g = f.gradient(points[s:s + step])
+        out = max(out, float(np.sqrt(np.max(np.einsum("nkd,nkd->n", g, g)))))
+    return out
+
+
+def _checked_choice(f: "TriharmonicRBF", g: "TriharmonicRBF", points: np.ndarray,
+                    probe) -> "TriharmonicRBF":
+    """``f`` (the polynomial with weak directions) or ``g`` (without them):
+    ``g`` when ``f`` is POLY_CHECK_FACTOR times steeper (:func:`field_roughness`
+    at the constraints and the ``probe`` points) and ``g`` meets its
+    constraints as well (achieved residual within its note limit or ``f``'s)."""
+    pts = points if probe is None else np.vstack([points, _as_float_array("probe", probe).reshape(-1, 3)])
+    rf, rg = field_roughness(f, pts), field_roughness(g, pts)
+    ok = g.residual <= max(f.residual, g._residual_limit())
+    weak = f.poly_rank - g.poly_rank
+    what = (f"checked against the fit without its {weak} weak polynomial direction(s) "
+            f"(s/s_max < {POLY_CHECK_RTOL:g}): largest Jacobian {rf:.3g} vs {rg:.3g}")
+    if ok and rf > POLY_CHECK_FACTOR * rg:
+        g.notes.append(what + f": the polynomial's weak directions make the field "
+                       f"{rf / rg:.3g}x steeper, dropped")
+        return g
+    f.notes.append(what + ": kept")
+    return f

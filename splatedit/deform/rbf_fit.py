@@ -2,8 +2,10 @@
 
 :func:`solve_constraints` validates the constraints, normalises them into
 [-1, 1]^3 (bounding-box centre and half its largest extent), merges
-(near-)duplicates, decides whether the quadratic polynomial can be kept and
-which solver runs, and solves for the weights either exactly (dense LU of
+(near-)duplicates, decides which part of the quadratic polynomial the
+constraints determine numerically (:func:`polynomial_basis`, with the
+coordinates' precision from :func:`coordinate_precision`) and which solver
+runs, and solves for the weights either exactly (dense LU of
 system (3), :func:`_fit_lu`) or by the incremental least-squares QR of
 Sect. 5 (:func:`_fit_iqr`, farthest-point centres, lazily built columns in a
 :class:`~splatedit.deform.qr.IncrementalQR`).  The result is the raw
@@ -21,6 +23,7 @@ from typing import Optional
 import numpy as np
 from scipy.linalg import lapack
 
+from splatedit.blas import single_blas_thread
 from splatedit.deform.centers import FarthestPointSampler
 from splatedit.deform.kernels import N_POLY, kernel_matrix, poly_matrix
 from splatedit.deform.qr import IncrementalQR
@@ -35,7 +38,10 @@ from splatedit.tolerances import (
     IQR_R_DIAG_RTOL,
     LU_MAX_CONSTRAINTS,
     LU_MIN_RCOND,
+    POLY_NOISE_FACTOR,
     POLY_RANK_RTOL,
+    COORD_FLOAT32_REL_PRECISION,
+    COORD_GRID_MAX_DECIMALS,
 )
 
 METHODS = ("auto", "iqr", "lu")
@@ -139,6 +145,10 @@ class _FitInfo:
     tol: float = IQR_DEFAULT_TOL
     rcond: Optional[float] = None
     seconds: float = 0.0
+    poly_rank: int = 0
+    poly_singular: Optional[np.ndarray] = None
+    poly_weakest: float = 1.0
+    precision: float = 0.0
 
 
 @dataclass
@@ -168,6 +178,156 @@ class FitSolution:
     info: _FitInfo
 
 
+def coordinate_precision(pts: np.ndarray) -> float:
+    """The precision (model units) to which the coordinates ``pts`` (m, 3) are
+    known.  Coordinates that all lie on a decimal grid of 10^-d (d <=
+    COORD_GRID_MAX_DECIMALS: text files written with d decimals, LAS-style
+    scaled integers) are known to half its step, at least to their storage's
+    own rounding (float32 when every value is a float32).  Otherwise they are
+    assumed to come from float32 storage (every 3DGS file and most scans,
+    possibly moved since): COORD_FLOAT32_REL_PRECISION of their largest
+    magnitude.
+    """
+    mag = float(np.max(np.abs(pts))) if pts.size else 0.0
+    if mag == 0.0:
+        return 0.0
+    eps32 = COORD_FLOAT32_REL_PRECISION * mag
+    eps64 = float(np.finfo(np.float64).eps) * mag
+    is32 = bool(np.array_equal(pts.astype(np.float32).astype(np.float64), pts))
+    own = eps32 if is32 else eps64
+    # a value of the grid, stored, is off it by its storage's rounding (plus
+    # the rounding of pts / step); grids not coarser than that are not seen
+    allowed = 2.0 * own + 8.0 * eps64
+    for d in range(COORD_GRID_MAX_DECIMALS + 1):
+        step = 10.0 ** -d
+        if step <= 4.0 * allowed:
+            break
+        k = pts / step
+        if float(np.max(np.abs(k - np.rint(k)))) * step <= allowed:
+            return max(0.5 * step, own)
+    return eps32
+
+
+@dataclass
+class PolyBasis:
+    """The part of the quadratic polynomial space Pi_2 that the constraint
+    points determine numerically (see :func:`polynomial_basis`).
+
+    Attributes:
+        matrix: (m, r) the retained polynomial columns at the constraints
+            (orthogonal, each of norm sqrt(m)).
+        coeffs: (10, r) their monomial coefficients (normalised coordinates):
+            ``matrix = poly_matrix(pts_n) @ coeffs``.
+        rank: r, 0..10 (the affine part first: ``n_affine`` of its 4 terms).
+        n_affine: how many of r span affine functions (4; 3 on a plane).
+        singular: (10,) the singular values of the affine block and of the
+            quadratic block beyond it, relative to the largest, each block
+            in descending order.
+        weakest: the smallest relative singular value kept (1.0 when r = 0).
+        cut: (2,) the relative cuts of the two blocks (values at or below
+            them were dropped).
+        note: what was dropped and why ("" when nothing was).
+    """
+
+    matrix: np.ndarray
+    coeffs: np.ndarray
+    rank: int
+    n_affine: int
+    singular: np.ndarray
+    weakest: float
+    cut: np.ndarray
+    note: str = ""
+
+
+def _monomial_gradient_norms(pts_n: np.ndarray) -> np.ndarray:
+    """(10,) ``||grad p_j||`` (2-norm over the points) of the monomials."""
+    m = pts_n.shape[0]
+    gx, gy, gz = np.sum(pts_n * pts_n, axis=0)
+    return np.sqrt(np.array([0.0, m, m, m, 4 * gx, gx + gy, gx + gz, 4 * gy, gy + gz, 4 * gz]))
+
+
+def _independent_block(cols: np.ndarray, noise: float, cut_rel: float):
+    """SVD of ``cols`` (m, c), unit-scaled columns: (u_kept (m, r), map (c, r)
+    with ``cols @ map = u_kept``, all singular values, the absolute cut)."""
+    if cols.shape[1] == 0:
+        return np.zeros((cols.shape[0], 0)), np.zeros((0, 0)), np.zeros(0), 0.0
+    u, s, vt = np.linalg.svd(cols, full_matrices=False)
+    cut = max(cut_rel, POLY_NOISE_FACTOR * noise)
+    r = int(np.count_nonzero(s > cut))
+    return u[:, :r], vt[:r].T / s[:r], s, cut
+
+
+def polynomial_basis(pts_n: np.ndarray, precision: float,
+                     rtol: Optional[float] = None) -> PolyBasis:
+    """The numerically independent part of Pi_2 at the points ``pts_n``
+    (m, 3), normalised coordinates known to ``precision`` (normalised units).
+
+    A rank-revealing factorisation in two blocks, so that affine functions
+    stay exactly reproduced wherever the points determine them: the affine
+    monomials (1, x, y, z), scaled to unit columns, by an SVD; then the 6
+    quadratic monomials, scaled, with their affine part projected out (the
+    quadratic directions the points see beyond the affine ones), by an SVD.
+    In each block a direction is dropped when its singular value is within
+    POLY_NOISE_FACTOR times the first-order bound of the coordinates'
+    rounding on the block (``||dP_j|| <= precision ||grad p_j||`` per
+    column), or below POLY_RANK_RTOL (or ``rtol``, the fit's check, see
+    :meth:`TriharmonicRBF.fit`) of the largest singular value.  Such a
+    direction is a quadric (a sphere, cylinder or cone: one quadratic
+    direction; a plane: its normal coordinate and 3 quadratic ones) the points
+    lie on up to their precision: its coefficient would be fitted to the
+    rounding, with wild derivatives off the surface, so it is left out.
+    """
+    # tall, 10 columns: OpenBLAS's threads only contend here (20,000 points on
+    # the loaded 2-core machine: 8 ms on one thread, 70-160 ms on two)
+    with single_blas_thread():
+        return _polynomial_basis(pts_n, precision, rtol)
+
+
+def _polynomial_basis(pts_n: np.ndarray, precision: float, rtol: Optional[float]) -> PolyBasis:
+    m = pts_n.shape[0]
+    p = poly_matrix(pts_n)
+    norms = np.linalg.norm(p, axis=0)
+    safe = np.where(norms > 0, norms, 1.0)
+    rel_noise = precision * _monomial_gradient_norms(pts_n) / safe
+    ps = p / safe
+    scale_s = float(np.linalg.norm(ps, 2))
+    cut_rel = max(POLY_RANK_RTOL, rtol or 0.0) * scale_s
+    # affine block
+    n1 = 4
+    u1, map1, s1, cut1 = _independent_block(ps[:, :n1], float(np.linalg.norm(rel_noise[:n1])), cut_rel)
+    r1 = u1.shape[1]
+    # quadratic block beyond the affine span
+    quad = ps[:, n1:]
+    proj = u1.T @ quad  # (r1, 6)
+    quad_rest = quad - u1 @ proj
+    u2, map2, s2, cut2 = _independent_block(quad_rest, float(np.linalg.norm(rel_noise[n1:])), cut_rel)
+    r2 = u2.shape[1]
+    # monomial coefficients of the kept columns (scaled columns -> monomials)
+    coef = np.zeros((N_POLY, r1 + r2))
+    coef[:n1, :r1] = map1
+    coef[n1:, r1:] = map2
+    # quad_rest @ map2 = quad @ map2 - u1 @ (proj @ map2), u1 = affine @ map1
+    coef[:n1, r1:] = -map1 @ (proj @ map2)
+    coeffs = coef / safe[:, None] * np.sqrt(m)
+    matrix = p @ coeffs
+    sv = np.concatenate([s1, s2]) / scale_s
+    kept = np.concatenate([s1[:r1], s2[:r2]]) / scale_s
+    weakest = float(kept.min()) if kept.size else 1.0
+    r = r1 + r2
+    note = ""
+    if r == 0:
+        note = "polynomial dropped: no direction of it is determined by the constraints"
+    elif r < N_POLY:
+        dropped = np.concatenate([s1[r1:], s2[r2:]]) / scale_s
+        note = (f"polynomial reduced to {r} of {N_POLY} terms ({r1} affine): the constraints lie "
+                f"on a quadric up to their precision (dropped s/s_max "
+                f"{', '.join(f'{v:.1e}' for v in dropped)}; cuts {cut1 / scale_s:.1e} affine, "
+                f"{cut2 / scale_s:.1e} quadratic; coordinate precision {precision:.1e} of the "
+                f"half extent)")
+    return PolyBasis(matrix=matrix, coeffs=coeffs, rank=r, n_affine=r1, singular=sv,
+                     weakest=weakest, cut=np.array([cut1, cut2]) / scale_s, note=note)
+
+
 class SingularSystemError(SolverError):
     """The exact LU system cannot be solved; ``reason`` says how it is singular
     (``method="auto"`` then falls back to the incremental QR)."""
@@ -179,11 +339,15 @@ class SingularSystemError(SolverError):
 
 def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
                       max_centers: Optional[int] = None,
-                      progress: Optional[ProgressFn] = None) -> FitSolution:
+                      progress: Optional[ProgressFn] = None,
+                      poly_rtol: Optional[float] = None) -> FitSolution:
     """Validate, normalise, merge duplicates and solve ``f(points) = values``.
 
     The arguments, the duplicate, polynomial and method rules are those of
-    :meth:`splatedit.deform.rbf.TriharmonicRBF.fit` (documented there).
+    :meth:`splatedit.deform.rbf.TriharmonicRBF.fit` (documented there);
+    ``poly_rtol`` additionally drops polynomial directions with singular value
+    below ``poly_rtol`` times the largest (the fit's check, see
+    :func:`polynomial_basis`).
     Raises ParameterError for bad arguments and SolverError when the system
     cannot be solved.
     """
@@ -208,18 +372,19 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
         notes.append(f"merged {n_merged} duplicate constraint point(s) with identical values")
     m = pts_n.shape[0]
 
-    # polynomial or not
-    use_poly = True
+    # polynomial: its numerically independent part on the constraint set
+    precision = coordinate_precision(pts) / scale
     if m < N_POLY:
-        use_poly = False
+        poly = None
         notes.append(f"polynomial dropped: {m} < {N_POLY} constraints cannot determine a quadratic")
     else:
-        s = np.linalg.svd(poly_matrix(pts_n), compute_uv=False)
-        ratio = s[-1] / s[0]
-        if not ratio > POLY_RANK_RTOL:
-            use_poly = False
-            notes.append(f"polynomial dropped: constraints lie on a quadric "
-                         f"(monomial matrix s_min/s_max = {ratio:.1e} < {POLY_RANK_RTOL:g})")
+        poly = polynomial_basis(pts_n, precision, rtol=poly_rtol)
+        poly_sv, poly_weakest = poly.singular, poly.weakest
+        if poly.note:
+            notes.append(poly.note)
+        if poly.rank == 0:
+            poly = None
+    use_poly = poly is not None
     if not use_poly and m == 1:
         raise SolverError(
             "a single (distinct) constraint point cannot be fitted: without the "
@@ -250,7 +415,7 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     report(progress, PROGRESS_STAGE, 0.0)
     if used == "lu":
         try:
-            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, use_poly)
+            w, q, idx, residuals, rcond = _fit_lu(pts_n, vals, poly)
         except SingularSystemError as exc:
             if method != "auto":
                 raise
@@ -266,14 +431,17 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     else:
         rcond = None
         w, q, idx, residuals, history, iqr_notes = _fit_iqr(
-            pts_n, vals, use_poly, tol, max_centers, progress)
+            pts_n, vals, poly, tol, max_centers, progress)
         head.extend(iqr_notes)
     notes = head + notes
     report(progress, PROGRESS_STAGE, 1.0)
 
     info = _FitInfo(method=used, polynomial=use_poly, residuals=residuals,
                     residual_history=history, notes=notes, n_constraints=m,
-                    n_input_constraints=m_in, tol=tol, rcond=rcond)
+                    n_input_constraints=m_in, tol=tol, rcond=rcond,
+                    poly_rank=poly.rank if use_poly else 0,
+                    poly_singular=None if m < N_POLY else poly_sv,
+                    poly_weakest=poly.weakest if use_poly else 1.0, precision=precision)
     return FitSolution(points=pts, values=vals_in, centers_n=pts_n[idx], weights=w,
                        poly_coeffs=q, shift=shift, scale=scale, center_indices=keep[idx],
                        info=info)
@@ -294,14 +462,15 @@ def _relative_residuals(res_norm: np.ndarray, b: np.ndarray) -> np.ndarray:
     return out
 
 
-def _fit_lu(pts_n, vals, use_poly):
+def _fit_lu(pts_n, vals, poly):
     m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
+    use_poly = poly is not None
+    npoly = poly.rank if use_poly else 0
     size = m + npoly
     a = np.zeros((size, size), order="F")
     kernel_matrix(pts_n, pts_n, out=a[:m, :m])
     if use_poly:
-        p = poly_matrix(pts_n)
+        p = poly.matrix
         a[:m, m:] = p
         a[m:, :m] = p.T
     rhs = np.zeros((size, k))
@@ -319,13 +488,14 @@ def _fit_lu(pts_n, vals, use_poly):
     res = np.linalg.norm(a @ x - rhs, axis=0)
     residuals = _relative_residuals(res, vals)
     w = x[:m]
-    q = x[m:] if use_poly else None
+    q = poly.coeffs @ x[m:] if use_poly else None
     return w, q, np.arange(m), residuals, float(rcond)
 
 
-def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
+def _fit_iqr(pts_n, vals, poly, tol, max_centers, progress):
     m, k = vals.shape
-    npoly = N_POLY if use_poly else 0
+    use_poly = poly is not None
+    npoly = poly.rank if use_poly else 0
     n_rows = m + npoly
     cap = m if max_centers is None else min(max_centers, m)
     max_cols = npoly + cap
@@ -333,7 +503,7 @@ def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
     rhs[:m] = vals
     qr = IncrementalQR(n_rows, max_cols, rhs)
     sampler = FarthestPointSampler(pts_n)
-    p_all = poly_matrix(pts_n) if use_poly else None
+    p_all = poly.matrix if use_poly else None
     order_parts = []
     hist_parts = []  # residuals for center counts 0, 1, ...
     bn = np.linalg.norm(vals, axis=0)
@@ -377,7 +547,7 @@ def _fit_iqr(pts_n, vals, use_poly, tol, max_centers, progress):
     x = qr.solve(stop_cols)
     order = np.concatenate(order_parts)[:n_centers] if order_parts else np.zeros(0, np.intp)
     w = x[npoly:]
-    q = x[:npoly] if use_poly else None
+    q = poly.coeffs @ x[:npoly] if use_poly else None
     summary = (f"iqr: {n_centers} of {m} constraints as centers, residual "
                f"{np.max(residuals):.2g}")
     if np.max(residuals) < tol:

@@ -49,7 +49,7 @@ from splatedit.model.summary import CloudSummary
 from splatedit.progress import report
 
 __all__ = ["read", "write", "convert", "check_output_path", "check_readable_file", "split_scan_index",
-           "READ_EXTENSIONS", "WRITE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians",
+           "READ_EXTENSIONS", "WRITE_EXTENSIONS", "FACE_EXTENSIONS", "is_gaussian_file", "read_gaussians", "write_gaussians",
            "read_summary"]
 
 _READERS = {".ply": read_ply, ".xyz": read_xyz, ".txt": read_xyz, ".pts": read_pts,
@@ -62,6 +62,8 @@ READ_EXTENSIONS = tuple(_READERS)
 #: formats keep positions, colours, intensity (and LAS classification), .pcd
 #: normals too)
 WRITE_EXTENSIONS = (".ply", ".xyz", ".off", ".las", ".laz", ".e57", ".pcd", ".pts")
+#: the written formats that hold triangle faces (the others drop a mesh's faces)
+FACE_EXTENSIONS = (".ply", ".off")
 
 
 def _ext(path, allowed, what) -> str:

@@ -72,7 +72,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
         k: neighbours per point in the Riemannian graph.
         tree: optional prebuilt ``cKDTree(points)``.
         neighbours: optional (n, >= k + 1) integer indices from
-            :func:`splatedit.model.estimate.knn` (the point itself included).
+            :func:`splatedit.model.neighbours.knn` (the point itself included).
         chunk: points per chunk of the forest and edge passes.
         inplace: flip the rows of ``normals`` itself (a C-contiguous float64
             array) instead of a copy.
@@ -99,7 +99,7 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
     report(progress, "orienting normals", 0.0)
     k = int(min(max(k, 1), n - 1))
     if neighbours is None or neighbours.shape[1] < k + 1:
-        from splatedit.model.estimate import knn
+        from splatedit.model.neighbours import knn
         _, neighbours = knn(pts, k + 1, tree=tree)
     nb = neighbour_indices(pts, k + 1, neighbours=neighbours)      # (n, k), self left out
     chunk = max(int(chunk), 1)

@@ -10,11 +10,13 @@ Per frame:
    projection + GS_LOWPASS_PX2), colour from the SH at the view direction
    (R^T times it for a deformed Gaussian: its SH live in its original frame),
    culling, and the view depth as the sort key;
-2. depth sort of the keys: ``sort="cpu"`` (default) reads the keys back and
-   sorts them with numpy; ``sort="gpu"`` runs a bitonic sort in a compute
-   shader (``gs_sort.comp``).  On lavapipe the CPU sort is the faster
-   (docs/PERFORMANCE.md, "Gaussian splatting");
-3. one screen-aligned quad per visible Gaussian in depth order, spanning the
+2. depth sort of the keys: ``sort="cpu"`` reads the keys back and sorts them
+   with numpy; ``sort="gpu"`` appends the visible Gaussians' keys in the
+   pre-pass and sorts only those with the GPU radix sort
+   (:mod:`splatedit.render.gpu_sort`, the count read on the GPU);
+   ``sort="bitonic"``: the bitonic sort it replaced (comparisons only);
+   ``sort="auto"``: :func:`choose_sort`;
+3. ``path="raster"``: one screen-aligned quad per visible Gaussian in depth order, spanning the
    ellipse where its alpha reaches GS_ALPHA_MIN, with the conic evaluated in
    the fragment shader and blended *front to back* ("under" operator on
    premultiplied colour into an RGBA16F target whose alpha is 1 - T).  Front
@@ -23,6 +25,9 @@ Per frame:
    (1 - alpha rounds to 1 in half float below T ~ 2.4e-4): the
    fixed-function blend cannot skip the fragment, but it stops changing the
    pixel, the equivalent of the reference's early stop;
+   ``path="compute"``: the compute tile rasterizer (:mod:`splatedit.render.gs_tiles`)
+   sums the same terms per 16x16 tile in a workgroup and stops at
+   GS_MIN_TRANSMITTANCE; ``path="auto"``: :func:`choose_path`;
 4. a full-screen resolve writes C + T * background to the target.
 
 The pick pass draws the Gaussians of opacity >= GS_PICK_MIN_OPACITY as
@@ -46,13 +51,40 @@ from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.gpu_units import (MAX_GROUPS, displacement_bound, gpu_camera,
                                         pack_basis_rows, pack_deform_block, selection_flags, unit_scale)
-from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _SORT_WG, _UBO_BYTES,
+from splatedit.render.gpu_sort import BitonicSort, RadixSort
+from splatedit.render.gs_resources import (_GS_SET, _NONE, _PREP_WG, _REC_BYTES, _RESOLVE_SET, _UBO_BYTES, PATHS,
                                            SORTS, _rp_accum, _Targets, gaussian_bounds, pack_geometry)
+from splatedit.render.gs_tiles import TileRasterizer
 from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
-from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH, GS_SORT_PUSH
+from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
-                                  GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, RENDER_BACKGROUND,
-                                  RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
+                                  GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, GS_TILE_PAIRS_PER_GAUSSIAN,
+                                  RENDER_BACKGROUND, RENDER_MAX_BASIS_COLUMNS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
+
+
+def choose_path(dev: V.Device) -> str:
+    """The draw path of ``path="auto"``, a documented rule: on a CPU device
+    (lavapipe) the path measured faster there (:data:`CPU_DEVICE_PATH`,
+    docs/PERFORMANCE.md, "Gaussian splatting: radix sort and tile
+    rasterizer"); "compute" on every GPU, by argument, not yet measured:
+    compute shaders use the whole chip (on an H100/H200 only 2 of 66 TPCs run
+    vertex and fragment shaders) and the tile rasterizer stops blending a
+    pixel once its transmittance is used up, where the quad path still
+    shades and blends every fragment behind it."""
+    return CPU_DEVICE_PATH if V.is_cpu_device(dev) else "compute"
+
+
+def choose_sort(dev: V.Device) -> str:
+    """The depth sort of ``sort="auto"``: on a CPU device the sort measured
+    faster there (:data:`CPU_DEVICE_SORT`), on a GPU the GPU radix sort (the
+    keys never leave the GPU and the CPU waits for no sort between the
+    pre-pass and the draw)."""
+    return CPU_DEVICE_SORT if V.is_cpu_device(dev) else "gpu"
+
+
+#: lavapipe's faster path and sort (bench gaussian-render, docs/PERFORMANCE.md)
+CPU_DEVICE_PATH = "raster"
+CPU_DEVICE_SORT = "cpu"
 
 
 class GaussianRenderer:
@@ -66,8 +98,12 @@ class GaussianRenderer:
 
     Args:
         sort: ``"cpu"`` (numpy argsort of the read-back depth keys, two
-            submissions per frame) or ``"gpu"`` (bitonic sort in a compute
-            shader, one submission).
+            submissions per frame), ``"gpu"`` (GPU radix sort of the visible
+            Gaussians' keys), ``"bitonic"`` (the former GPU sort, of every
+            key) or ``"auto"`` (:func:`choose_sort`).
+        path: ``"raster"`` (a quad per Gaussian), ``"compute"`` (the tile
+            rasterizer, :mod:`splatedit.render.gs_tiles`) or ``"auto"``
+            (:func:`choose_path`).
         background: display-referred RGB (3 floats in 0..1) behind the scene.
         accum_format: ``"rgba16f"`` or ``"rgba32f"`` blend target.
         device: share an existing :class:`splatedit.render.vk.Device` (the
@@ -75,17 +111,23 @@ class GaussianRenderer:
             as for :class:`~splatedit.render.renderer.Renderer`).
     """
 
-    def __init__(self, *, sort: str = "cpu", background=RENDER_BACKGROUND, accum_format: str = "rgba16f",
-                 device: V.Device | None = None, device_name: str | None = None, validation: bool | None = None):
+    def __init__(self, *, sort: str = "auto", path: str = "auto", background=RENDER_BACKGROUND,
+                 accum_format: str = "rgba16f", device: V.Device | None = None, device_name: str | None = None,
+                 validation: bool | None = None):
         if sort not in SORTS:
             raise ParameterError("sort", f"must be one of {SORTS}, got {sort!r}")
+        if path not in PATHS:
+            raise ParameterError("path", f"must be one of {PATHS}, got {path!r}")
         if accum_format not in ("rgba16f", "rgba32f"):
             raise ParameterError("accum_format", f"must be 'rgba16f' or 'rgba32f', got {accum_format!r}")
-        self.sort = sort
         self.accum_format = accum_format
         self.background = tuple(float(x) for x in background)[:3]
         self._own_device = device is None
         self.dev = device if device is not None else V.Device(device_name=device_name, validation=validation)
+        #: the draw path and depth sort in use (``"auto"`` resolved for this device)
+        self.path = choose_path(self.dev) if path == "auto" else path
+        self.sort = choose_sort(self.dev) if sort == "auto" else sort
+        self._radix = self._bitonic = self._tiles = None
         self._closed = False
         self.cache = self.sampler = self.ubo = self.dC_ubo = self._query = None
         self._targets = None
@@ -154,6 +196,11 @@ class GaussianRenderer:
 
     # --------------------------------------------------------------- scene
     def _free_scene(self):
+        for name in ("_tiles", "_radix", "_bitonic"):
+            obj = getattr(self, name)
+            if obj is not None:
+                obj.destroy()
+                setattr(self, name, None)
         for b in reversed(self._bufs):
             b.destroy()
         self._bufs = []
@@ -218,6 +265,14 @@ class GaussianRenderer:
         self._cols, self._dC, self._basis_idx, self._reach = 4, np.zeros((4, 3)), np.zeros(0, np.int64), 0.0
         self._rot = None
         self._write_dset()
+        if self.sort == "gpu":
+            self._radix = RadixSort(self.dev, self.cache, self._keys, self._order, self._draws, capacity=n,
+                                    count_index=1)
+        elif self.sort == "bitonic":
+            self._bitonic = BitonicSort(self.dev, self.cache, self._keys, self._order)
+        if self.path == "compute":
+            self._tiles = TileRasterizer(self.dev, self.cache, self._dset, _GS_SET, n,
+                                         int(GS_TILE_PAIRS_PER_GAUSSIAN * n) + 4096, self.accum_format)
 
     def _write_dset(self):
         if self._dset is None:
@@ -342,7 +397,7 @@ class GaussianRenderer:
                        GS_ALPHA_MIN)
         u["params"] = (GS_ALPHA_MAX, GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS ** 2, near * GS_NEAR_CULL_REL)
         u["background"] = (*self.background, 1.0)
-        u["counts"] = (self.count, self._rest_uints, self._sort_length() if self.sort == "gpu" else self.count,
+        u["counts"] = (self.count, self._rest_uints, self._sort_length() if self.sort == "bitonic" else self.count,
                        1 if srgb_target else 0)
         u["tint_support"] = RENDER_TINT_SUPPORT
         u["tint_handle"] = RENDER_TINT_HANDLE
@@ -361,25 +416,19 @@ class GaussianRenderer:
         cb.bind_descriptor_set(pipe, self._dset)
         return pipe
 
-    def _record_prepass(self, cb):
+    def _record_prepass(self, cb, compact: bool = False):
+        """The pre-pass; ``compact``: append the visible keys (the radix sort's input)."""
         pipe = self._bind_compute(cb, "gs_prepare.comp", GS_PREP_PUSH)
         groups = self._groups if len(self._basis_idx) else 1
-        cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS), GS_PREP_PUSH))
-        count = self._sort_length() if self.sort == "gpu" else self.count
+        cb.push_constants(pipe, np.array((groups, GS_POLAR_ITERATIONS, int(compact)), GS_PREP_PUSH))
+        count = self._sort_length() if self.sort == "bitonic" else self.count
         cb.dispatch((count + _PREP_WG - 1) // _PREP_WG)
 
     def _record_gpu_sort(self, cb):
-        pipe = self._bind_compute(cb, "gs_sort.comp", GS_SORT_PUSH)
-        n2 = self._sort_length()
-        k = 2
-        while k <= n2:
-            j = k // 2
-            while j >= 1:
-                cb.memory_barrier("compute", "shader_write", "compute", "shader_read|shader_write")
-                cb.push_constants(pipe, np.array((k, j), GS_SORT_PUSH))
-                cb.dispatch((n2 + _SORT_WG - 1) // _SORT_WG)
-                j //= 2
-            k *= 2
+        if self.sort == "gpu":
+            self._radix.record(cb, bits=32)
+        else:
+            self._bitonic.record(cb, self._sort_length())
 
     def _draw_pipeline(self):
         layout = V.LayoutDesc(sets=(_GS_SET,))
@@ -391,6 +440,9 @@ class GaussianRenderer:
         Then :meth:`record_draw` records the draw into any command buffer (the
         editor's frame); :meth:`render` does both."""
         self._check()
+        if self.path == "compute" and self._tiles.pairs_wanted() > self._tiles.capacity:
+            # the last frame (e.g. the editor's, drawn by record_draw) dropped pairs: room for this one
+            self._tiles.grow(self._tiles.pairs_wanted())
         self._targets_for(width, height)
         self._write_ubo(camera, width, height, srgb_target)
         self.epoch += 1
@@ -401,23 +453,24 @@ class GaussianRenderer:
         def rec(cb):
             cb.reset_queries(self._query)
             cb.timestamp(self._query, 0, bottom=False)
-            self._record_prepass(cb)
+            self._record_prepass(cb, compact=self.sort == "gpu")
             # the barrier first: lavapipe writes a timestamp without waiting for a
             # dispatch still running (the pass measured ~0 ms without it)
             cb.memory_barrier("compute", "shader_write", "compute|host", "shader_read|shader_write|host_read")
             cb.timestamp(self._query, 1)
-            if self.sort == "gpu":
+            if self.sort != "cpu":
                 self._record_gpu_sort(cb)
                 cb.memory_barrier("compute", "shader_write", "compute", "shader_read")
                 cb.timestamp(self._query, 2)
         self.dev.submit(rec)
-        ts = self._query.results_ns(3 if self.sort == "gpu" else 2)
+        gpu_sort = self.sort != "cpu"
+        ts = self._query.results_ns(3 if gpu_sort else 2)
         # lavapipe's timestamps around a lone dispatch read ~0 after the first
         # frame: the CPU-sort path reports the pre-pass submission's wall time
-        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6 if self.sort == "gpu"
+        timings = {"prepass": float(ts[1] - ts[0]) * 1e-6 if gpu_sort
                    else (time.perf_counter() - t0) * 1e3}
         nvis = int(dv[1])
-        if self.sort == "gpu":
+        if gpu_sort:
             timings["sort"] = float(ts[2] - ts[1]) * 1e-6
             timings["prepass"] = max((time.perf_counter() - t0) * 1e3 - timings["sort"], 0.0)
         else:
@@ -437,6 +490,12 @@ class GaussianRenderer:
         """Record the Gaussians' draw and the resolve into ``target`` (after
         :meth:`prepare_frame` for the same size)."""
         t = self._targets_for(target.width, target.height)
+        if self.path == "compute":
+            self._tiles.record(cb, t)
+            cb.timestamp(self._query, 3)
+            t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
+            cb.timestamp(self._query, 4)
+            return
         cb.memory_barrier("host", "host_write", "draw_indirect|vertex", "indirect_read|shader_read")
         pipe = self._draw_pipeline()
         cb.begin_render_pass(self.cache.render_pass(_rp_accum(self.accum_format)), t.fb_accum,
@@ -449,6 +508,15 @@ class GaussianRenderer:
         t.record_resolve(cb, target, "gs_resolve.frag", _RESOLVE_SET)
         cb.timestamp(self._query, 4)
 
+    def _check_tile_pairs(self) -> bool:
+        """After a compute-path frame: when it wanted more (tile, Gaussian)
+        pairs than the buffers hold, grow them; True when the frame should be
+        drawn again."""
+        if self.path != "compute":
+            return False
+        wanted = self._tiles.pairs_wanted()
+        return wanted > self._tiles.capacity and self._tiles.grow(wanted)
+
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
         """Render offscreen: (height, width, 4) uint8 RGBA, alpha 255."""
         self.prepare_frame(camera, width, height)
@@ -459,6 +527,8 @@ class GaussianRenderer:
             cb.timestamp(self._query, 2, bottom=False)
             self.record_draw(cb, t.offscreen)
         out = t.read_output(rec)
+        if self._check_tile_pairs():
+            out = t.read_output(rec)
         ts = self._query.results_ns(5)
         self.last_timings_ms["draw"] = float(ts[3] - ts[2]) * 1e-6
         self.last_timings_ms["resolve"] = float(ts[4] - ts[3]) * 1e-6

@@ -33,14 +33,16 @@ def default_camera(cloud: GaussianCloud, width: int, height: int) -> Camera:
 
 
 def render_gaussians_to_png(cloud: GaussianCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
-                            basis=None, dC=None, sort: str = "cpu", device_name: str | None = None) -> Path:
+                            basis=None, dC=None, sort: str = "auto", path: str = "auto",
+                            device_name: str | None = None) -> Path:
     """Render a GaussianCloud offscreen and save an RGBA PNG (atomically).
 
     Args:
         size: (width, height) pixels; camera: default :func:`default_camera`.
         basis: optional ``(indices, B, Bx, By, Bz)`` rows applied on the GPU
             with ``dC`` ((K, 3), default zeros), as :func:`render_to_png`.
-        sort: ``"cpu"`` or ``"gpu"`` depth sort (:class:`GaussianRenderer`).
+        sort: depth sort, path: draw path (``"raster"``, ``"compute"`` or
+            ``"auto"``), as for :class:`GaussianRenderer`.
     Returns the PNG path.
     """
     if not isinstance(cloud, GaussianCloud):
@@ -50,7 +52,7 @@ def render_gaussians_to_png(cloud: GaussianCloud, out_png, *, size=(512, 512), c
     out_png = Path(out_png)
     _prepare_output(out_png)
     camera = default_camera(cloud, w, h) if camera is None else camera
-    with GaussianRenderer(sort=sort, device_name=device_name) as r:
+    with GaussianRenderer(sort=sort, path=path, device_name=device_name) as r:
         r.set_gaussians(cloud)
         if basis is not None:
             idx, B, Bx, By, Bz = basis

@@ -28,7 +28,12 @@ _GS_SET = (V.Binding(0, "uniform", "vert|frag|comp"), V.Binding(1, "storage", "c
            V.Binding(7, "storage", "vert|comp"), V.Binding(8, "storage", "comp"), V.Binding(9, "uniform", "comp"),
            V.Binding(11, "storage", "comp"))
 _RESOLVE_SET = (V.Binding(0, "uniform", "frag"), V.Binding(10, "sampled", "frag"))
-SORTS = ("cpu", "gpu")
+#: depth sorts: "auto" (:func:`splatedit.render.gaussians.choose_sort`), "cpu"
+#: (numpy), "gpu" (the GPU radix sort), "bitonic" (the GPU sort it replaced)
+SORTS = ("auto", "cpu", "gpu", "bitonic")
+#: draw paths: "auto" (:func:`splatedit.render.gaussians.choose_path`), "raster"
+#: (a quad per Gaussian, fixed-function blending), "compute" (the tile rasterizer)
+PATHS = ("auto", "raster", "compute")
 
 
 def _rp_accum(fmt: str) -> V.RenderPassDesc:
@@ -48,7 +53,8 @@ class _Targets(SizedTargets):
 
     def _create(self, r):       # r: the GaussianRenderer
         dev = r.dev
-        self.accum = self._add(V.Image(dev, self.width, self.height, r.accum_format, ("color", "sampled")))
+        # storage: the compute tile rasterizer (gs_tiles.py) writes it instead of the quad draw
+        self.accum = self._add(V.Image(dev, self.width, self.height, r.accum_format, ("color", "sampled", "storage")))
         self.fb_accum = self._fb(r.cache.render_pass(_rp_accum(r.accum_format)), [self.accum])
         self.out = self._add(V.Image(dev, self.width, self.height, "rgba8", ("color", "transfer_src")))
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")

@@ -39,13 +39,12 @@ on the GPU into the image that is presented); ``framebuffer`` must be made with
 ``gui.painter.render_pass(fmt)`` (or any pass of the same format).  Each
 :class:`Gui` owns its ImGui context; every method makes it current first.
 
-``python -m splatedit.render.gui --demo`` opens a window with a small panel
+``python -m splatedit.render.gui_demo --demo`` opens a window with a small panel
 (:mod:`splatedit.render.gui_demo`).
 """
 
 from __future__ import annotations
 
-import sys
 from dataclasses import dataclass
 
 import numpy as np
@@ -135,6 +134,25 @@ class Gui:
         self._current()
         if self._in_frame:
             imgui.end_frame()
+            self._in_frame = False
+
+    def recover_frame(self) -> None:
+        """End a frame left unbalanced by an exception in the middle of its
+        layout (a window's ``begin`` without ``end``): ImGui's own error
+        recovery closes what was left open (logged, not asserted), so the
+        next :meth:`new_frame` starts clean."""
+        io = self._current()
+        if not self._in_frame:
+            return
+        assert_on = io.config_error_recovery_enable_assert
+        tooltip_on = io.config_error_recovery_enable_tooltip
+        io.config_error_recovery_enable_assert = False
+        io.config_error_recovery_enable_tooltip = False
+        try:
+            imgui.end_frame()
+        finally:
+            io.config_error_recovery_enable_assert = assert_on
+            io.config_error_recovery_enable_tooltip = tooltip_on
             self._in_frame = False
 
     def render(self, cmd, framebuffer, *, fmt: str, clear=None, final: str = "color") -> GuiFrameStats:
@@ -276,33 +294,3 @@ def _index_bytes(vec) -> int:
     except KeyError:
         raise TypeError(f"unknown ImDrawIdx vector type {name} (imgui-bundle built with another "
                         "index type?)") from None
-
-
-def main(argv=None) -> int:
-    import argparse
-    p = argparse.ArgumentParser(prog="python -m splatedit.render.gui",
-                                description="Dear ImGui on splatedit's Vulkan renderer")
-    p.add_argument("--demo", action="store_true", help="open a window with a demo panel")
-    p.add_argument("--size", default="800x500", help="window size WxH (default 800x500)")
-    p.add_argument("--status-file", help="write the demo's state as JSON after every frame (tests)")
-    p.add_argument("--frames", type=int, default=0, help="quit after this many frames (0: run until closed)")
-    args = p.parse_args(argv)
-    if not args.demo:
-        p.print_help()
-        return 0
-    from splatedit.errors import SplatEditError
-    from splatedit.render.gui_demo import run_demo
-    try:
-        w, h = (int(v) for v in args.size.lower().split("x"))
-    except ValueError:
-        print(f"splatedit: error: --size: expected WxH, got {args.size!r}", file=sys.stderr)
-        return 2
-    try:
-        return run_demo((w, h), status_file=args.status_file, frames=args.frames)
-    except SplatEditError as exc:
-        print(f"splatedit: error: {exc}", file=sys.stderr)
-        return 2
-
-
-if __name__ == "__main__":
-    sys.exit(main())

@@ -129,3 +129,32 @@ def run_demo(size=(800, 500), *, status_file: str | None = None, frames: int = 0
         win.close()
         _report_validation()
     return 0
+
+
+def main(argv=None) -> int:
+    import argparse
+    p = argparse.ArgumentParser(prog="python -m splatedit.render.gui_demo",
+                                description="Dear ImGui on splatedit's Vulkan renderer")
+    p.add_argument("--demo", action="store_true", help="open a window with a demo panel")
+    p.add_argument("--size", default="800x500", help="window size WxH (default 800x500)")
+    p.add_argument("--status-file", help="write the demo's state as JSON after every frame (tests)")
+    p.add_argument("--frames", type=int, default=0, help="quit after this many frames (0: run until closed)")
+    args = p.parse_args(argv)
+    if not args.demo:
+        p.print_help()
+        return 0
+    from splatedit.errors import SplatEditError
+    try:
+        w, h = (int(v) for v in args.size.lower().split("x"))
+    except ValueError:
+        print(f"splatedit: error: --size: expected WxH, got {args.size!r}", file=sys.stderr)
+        return 2
+    try:
+        return run_demo((w, h), status_file=args.status_file, frames=args.frames)
+    except SplatEditError as exc:
+        print(f"splatedit: error: {exc}", file=sys.stderr)
+        return 2
+
+
+if __name__ == "__main__":
+    sys.exit(main())

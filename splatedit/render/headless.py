@@ -47,7 +47,7 @@ def check_render_memory(size, buffers: bool = False) -> None:
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
                   basis=None, dC=None, selection=None, buffers_path=None,
-                  device_name: str | None = None) -> Path:
+                  device_name: str | None = None, raster_path: str | None = None) -> Path:
     """Render ``cloud`` offscreen and save an RGBA PNG (atomically: temp file + rename).
 
     Args:
@@ -63,6 +63,8 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
         selection: optional ``(support_mask, handle_mask)`` to tint.
         buffers_path: also save the float buffers (depth, normal, weight,
             colour; see :meth:`Renderer.render_buffers`) to this ``.npz``.
+        raster_path: ``"auto"`` / ``"raster"`` / ``"compute"`` (the
+            renderer's argument; default env var ``SPLATEDIT_RASTER`` or auto).
     Returns the PNG path.
 
     Raises:
@@ -80,7 +82,7 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
     if camera is None:
         from splatedit.render.framing import default_view
         camera = default_view(cloud, (w, h), path=cloud.source).camera
-    with Renderer(device_name=device_name) as r:
+    with Renderer(device_name=device_name, raster_path=raster_path) as r:
         r.set_cloud(cloud)
         if selection is not None:
             r.set_selection(*selection)

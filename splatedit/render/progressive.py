@@ -52,27 +52,18 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.renderer import Renderer
-from splatedit.render.splat_layout import _RP_DEPTH, _rp_attr
-from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP, RP_PICK
+from splatedit.render.frame_passes import FrameContext, RasterSplats, Resolve
+from splatedit.render.splat_layout import _RESOLVE_SET, _WORKGROUP
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
 
 #: splats per box of the shading rect (:meth:`ProgressiveFrame._chunk_rect`)
 _BOX_BLOCK = 4096
 
-_RP_DEPTH_LOAD = V.RenderPassDesc(depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
-_RP_PICK_LOAD = V.RenderPassDesc(colors=(V.Attachment("r32ui", "load", initial="transfer_src", final="transfer_src"),),
-                                 depth=V.Attachment("d32f", "load", initial="transfer_src", final="transfer_src"))
 #: the shading pass over the shown image: loads it, writes covered pixels ("over":
 #: the intermediate uniforms give uncovered pixels alpha 0, so they keep what is there)
 _RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
 _OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(_RESOLVE_SET,)),
                             topology="triangle_list", blend_alpha=True)
-
-
-def _rp_attr_load(fmt: str) -> V.RenderPassDesc:
-    col = V.Attachment(fmt, "load", initial="shader_read", final="shader_read")
-    return V.RenderPassDesc(colors=(col, col),
-                            depth=V.Attachment("d32f", "load", initial="depth", final="depth"))
 
 
 def _union(a, b):
@@ -170,35 +161,26 @@ class ProgressiveFrame:
         if prepared:
             window, sets, objs = r._prep_range(first, count)
 
-        def draw(cb, kind: str, desc: V.RenderPassDesc, fb, clears) -> None:
-            if prepared:
-                r._record_prepass(cb, window, sets)
-            cb.begin_render_pass(r.cache.render_pass(desc), fb, clears)
-            if prepared:
-                r._record_splats(cb, kind, True, window)
-            else:
-                r._record_vertex_splats(cb, kind, first, count)
-            cb.end_render_pass()
+        ctx = FrameContext(r, t, t.offscreen, prepared)
+
+        def draw(cb, kind: str) -> None:
+            RasterSplats(kind, chunk=(first, count, window, sets)).record(cb, ctx)
 
         try:
             if self.phase == "depth":
                 r._write_ubo(self.camera, self.width, self.height)
 
                 def rec(cb):
-                    draw(cb, "depth", _RP_DEPTH if first == 0 else _RP_DEPTH_LOAD, t.fb_depth,
-                         [1.0] if first == 0 else [None])
+                    draw(cb, "depth")
                 r.dev.submit(rec)
                 out = None
             else:
                 self._write_ubo(0.0)
-                fmt = r.accum_format
 
                 def rec(cb):
-                    clear = [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None] if first == 0 else [None] * 3
-                    draw(cb, "attr", _rp_attr(fmt, "shader_read") if first == 0 else _rp_attr_load(fmt),
-                         t.fb_attr, clear)
+                    draw(cb, "attr")
                     if readback:
-                        r._record_resolve(cb, t, t.offscreen)
+                        Resolve().record(cb, ctx)
                         cb.copy_image_to_buffer(t.out, self._rb)
                         cb.host_read_barrier()
                 r.dev.submit(rec)
@@ -240,15 +222,7 @@ class ProgressiveFrame:
             r._write_ubo(self.camera, self.width, self.height)
 
             def rec(cb):
-                if prepared:
-                    r._record_prepass(cb, window, sets)
-                cb.begin_render_pass(r.cache.render_pass(RP_PICK if first == 0 else _RP_PICK_LOAD), t.fb_pick,
-                                     [(0, 0, 0, 0), 1.0] if first == 0 else [None, None])
-                if prepared:
-                    r._record_splats(cb, "pick", True, window)
-                else:
-                    r._record_vertex_splats(cb, "pick", first, count)
-                cb.end_render_pass()
+                RasterSplats("pick", chunk=(first, count, window, sets)).record(cb, FrameContext(r, t, None, prepared))
             r.dev.submit(rec)
         finally:
             for o in reversed(objs):
@@ -308,7 +282,7 @@ class ProgressiveFrame:
                 self._write_ubo(r.background_alpha)
 
                 def rec(cb):
-                    r._record_resolve(cb, t, t.offscreen)
+                    Resolve().record(cb, FrameContext(r, t, t.offscreen))
                 r.dev.submit(rec)
                 self._unshown, self._final = False, True
             return self._read(t.out) if readback else t.out

@@ -10,6 +10,15 @@ Three passes per frame (Botsch, Hornung, Zwicker, Kobbelt 2005):
    background, gamma; it writes a :class:`RenderTarget` (an offscreen RGBA8
    image here; a swapchain image for the editor).
 
+The frame is a list of pass objects (:mod:`splatedit.render.frame_passes`).
+Passes 1 and 2 run on one of two paths over the same accumulators and the
+same shading pass: raster (the pre-pass records drawn as quads and points)
+or compute (:mod:`splatedit.render.compute_raster`: the records rasterized
+by compute shaders, visibility by 64-bit atomicMin); ``raster_path`` and
+:meth:`Renderer.frame_path` choose.  Picking is always drawn by the raster
+path; the distortion heat map and the selection tints are in the records
+(both paths).
+
 One vertex shader (``shaders_glsl/splat_vs.glsl``) serves both splat passes
 and the picking pass; it applies the deformation p' = p + B dC, u' = J u,
 v' = J v of splats that carry a basis row.
@@ -32,9 +41,11 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
+from splatedit.render.compute_raster import ComputeRaster, choose_path, probe_key, requested_path
+from splatedit.render.frame_passes import Frame, FrameContext, pick_frame, splat_frame
 from splatedit.render.gpu_units import displacement_bound, gpu_camera
 from splatedit.render.prepass import PrepassMixin
-from splatedit.render.splat_layout import (RP_PICK, _GEOM_STRIDE, _RESOLVE_SET, _RP_DEPTH, _RP_POINTS, _SPLAT_SET,
+from splatedit.render.splat_layout import (_GEOM_STRIDE, _RESOLVE_SET, _RP_POINTS, _SPLAT_SET,
                                            _UBO_BYTES, _rp_attr, _splat_desc)
 from splatedit.render.targets import RenderTarget, _Targets, create_frame_objects, resolve_desc, targets_for
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
@@ -80,15 +91,30 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             each pass runs the pre-pass of a window, then draws it.
         device: share an existing :class:`splatedit.render.vk.Device` (then
             the renderer does not close it).
+        raster_path: ``"auto"``, ``"raster"`` or ``"compute"``: how the splat
+            frame is rasterized (:mod:`splatedit.render.compute_raster`; the
+            attribute :attr:`raster_path`).  Default: env var
+            ``SPLATEDIT_RASTER`` (``compute`` / ``raster``), else ``"auto"``
+            (:func:`~splatedit.render.compute_raster.choose_path`: compute
+            wherever the device and frame allow it).  A frame the compute
+            path cannot draw (no 64-bit / float atomics, the vertex path, an
+            image over the storage-buffer range) is drawn by the raster path
+            even when ``"compute"`` is asked for; :meth:`frame_path` says which.
     """
 
     def __init__(self, *, device_name: str | None = None, validation: bool | None = None,
                  accum_format: str = "rgba16f", backface_culling: bool = True,
                  background=RENDER_BACKGROUND, point_splats: bool = True, prepass: bool = True,
-                 device: V.Device | None = None):
+                 device: V.Device | None = None, raster_path: str | None = None):
         if accum_format not in ("rgba16f", "rgba32f"):
             raise ParameterError("accum_format", f"must be 'rgba16f' or 'rgba32f', got {accum_format!r}")
         self.accum_format = accum_format
+        #: requested rasterization path, "auto" | "raster" | "compute" (see raster_path)
+        self.raster_path = requested_path(raster_path)
+        self._crast = None            # ComputeRaster of the current size and pre-pass
+        #: the "auto" path's measured choice per probe_key(width, height, splat
+        #: count): {"path", "ms_raster", "ms_compute"} (one probe frame of each path)
+        self.path_probes: dict = {}
         self.backface_culling = bool(backface_culling)
         self.point_splats = bool(point_splats)
         #: point path threshold (pixels), see ``point_splats``
@@ -139,7 +165,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             create_frame_objects(self, _UBO_BYTES)
             self.splat_set = V.DescriptorSet(self.dev, self.cache.set_layout(_SPLAT_SET))
             self.splat_set.write({0: self.ubo, 1: self.dC_ubo})
-            self._query = V.QueryPool(self.dev, 8)
+            self._query = V.QueryPool(self.dev, 16)
         except BaseException:
             try:
                 self.close()
@@ -167,6 +193,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
 
         if self.dev.device is not None:
             step(self.dev.wait_idle)
+        step(lambda: self._free_compute_raster(wait=False))     # waited above
         step(self._free_cloud)
         if self._targets is not None:
             step(self._targets.destroy)
@@ -309,44 +336,85 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.bind_vertex_buffers(0, bufs)
             cb.draw(verts, count, 0, first)
 
-    def _record_passes_12(self, cb, t: _Targets, attr_final: str):
-        """Visibility and attribute passes. Timings: with several pre-pass
-        windows the pre-pass runs inside each pass (once per window and pass),
-        so its time is part of the visibility and attribute times."""
-        self.frames_recorded += 1
-        cb.timestamp(self._query, 0, bottom=False)
-        prepared = self._use_prepass()
-        if prepared and self._prep_window_count(prepared) == 1:
-            self._record_prepass(cb)
-        cb.timestamp(self._query, 1)
-        self._record_splat_pass(cb, "depth", _RP_DEPTH, t.fb_depth, [1.0], prepared)
-        cb.timestamp(self._query, 2)
-        self._record_splat_pass(cb, "attr", _rp_attr(self.accum_format, attr_final),
-                                t.fb_attr if attr_final == "shader_read" else self._fb_attr_readback(t),
-                                [(0.0, 0.0, 0.0, 0.0), (0.0, 0.0, 0.0, 0.0), None], prepared)
-        cb.timestamp(self._query, 3)
-
     def _fb_attr_readback(self, t: _Targets):
         if getattr(t, "fb_attr_rb", None) is None:
             rp = self.cache.render_pass(_rp_attr(self.accum_format, "transfer_src"))
             t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
         return t.fb_attr_rb
 
+    # ------------------------------------------------- frames as pass lists
+    #: the resolve pass's descriptor-set layout (frame_passes.Resolve)
+    _resolve_set_layout = _RESOLVE_SET
+
+    def frame_path(self, width: int, height: int) -> str:
+        """``"compute"`` or ``"raster"``: the path a frame of this size takes
+        now (:attr:`raster_path` and what the device and frame allow,
+        :func:`~splatedit.render.compute_raster.choose_path`)."""
+        self._targets_for(width, height)
+        path = choose_path(self.raster_path, self.dev, width, height, self._use_prepass())
+        if path == "compute" and self.raster_path == "auto":
+            key = probe_key(width, height, self.n)
+            if key not in self.path_probes:
+                self.path_probes[key] = self._probe_paths(width, height)
+            path = self.path_probes[key]["path"]
+        return path
+
+    def _probe_paths(self, width: int, height: int) -> dict:
+        """The measured choice of ``"auto"``: one frame of each path (the
+        current frame uniforms, no shading pass), the faster by GPU time wins
+        (:attr:`path_probes`)."""
+        t = self._targets_for(width, height)
+        ms = {}
+        for path in ("raster", "compute"):
+            self.dev.submit(lambda cb, p=path: self._record(cb, splat_frame(p, resolve=False), t))
+            ms[path] = self._last_frame.read_timings(self._query)["total"]
+        return {"path": min(ms, key=ms.get), **{f"ms_{p}": round(v, 3) for p, v in ms.items()}}
+
+    def _compute_raster(self, t: _Targets) -> ComputeRaster:
+        """The compute rasterizer's buffers for targets ``t`` and the current pre-pass."""
+        prep = self._prep_objects()
+        c = self._crast
+        if c is None or c.t is not t or c.prep is not prep:
+            self._free_compute_raster()
+            self._crast = ComputeRaster(self, t, prep)
+        return self._crast
+
+    def _free_compute_raster(self, wait: bool = True) -> None:
+        if self._crast is not None:
+            c, self._crast = self._crast, None
+            if wait:
+                self.dev.wait_idle()
+            c.destroy()
+
+    def _record(self, cb, frame: Frame, t: _Targets, target=None) -> Frame:
+        """Record ``frame`` (timestamps in the query pool) against targets ``t``."""
+        if frame.outputs & {"depth", "accum", "vis_buffer", "accum_buffers"}:
+            self.frames_recorded += 1      # the shared targets a progressive frame draws into
+        prepared = self._use_prepass()
+        ctx = FrameContext(self, t, target, prepared, self._prep_window_count(prepared))
+        cb.reset_queries(self._query)
+        frame.record(cb, ctx, self._query)
+        self._last_frame = frame
+        return frame
+
+    def splat_frame(self, width: int, height: int, attr_final: str = "shader_read", resolve: bool = True) -> Frame:
+        """The pass list of a frame of this size on :meth:`frame_path`
+        (:func:`splatedit.render.frame_passes.splat_frame`)."""
+        return splat_frame(self.frame_path(width, height), attr_final, resolve)
+
     def record_frame(self, cb, camera: Camera, target: RenderTarget):
-        """Record the three passes into ``cb`` writing ``target`` (used by
-        :meth:`render`; the editor calls it with a swapchain target)."""
+        """Record the frame (:meth:`splat_frame`) into ``cb`` writing ``target``
+        (used by :meth:`render`; the editor calls it with a swapchain target)."""
         self._require_cloud()
         t = self._targets_for(target.width, target.height)
         self._write_ubo(camera, target.width, target.height, target.apply_gamma)
-        cb.reset_queries(self._query)
-        self._record_passes_12(cb, t, "shader_read")
-        self._record_resolve(cb, t, target)
-        cb.timestamp(self._query, 4)
+        self._record(cb, self.splat_frame(target.width, target.height), t, target)
 
-    def _read_timings(self, names):
-        ts = self._query.results_ns(len(names) + 1)
-        self.last_timings_ms = {n: float(ts[i + 1] - ts[i]) * 1e-6 for i, n in enumerate(names)}
-        self.last_timings_ms["total"] = float(ts[len(names)] - ts[0]) * 1e-6
+    def _read_timings(self):
+        """Per-pass GPU times of the last recorded frame into :attr:`last_timings_ms`
+        (``prepass``, ``visibility``, ``attributes``, ``shading``, ``total`` as
+        the frame has them; ms)."""
+        self.last_timings_ms = self._last_frame.read_timings(self._query)
 
     # ---------------------------------------------------------- public API
     def render(self, camera: Camera, width: int, height: int) -> np.ndarray:
@@ -355,7 +423,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._require_cloud()
         t = self._targets_for(width, height)
         out = t.read_output(lambda cb: self.record_frame(cb, camera, t.offscreen))
-        self._read_timings(("prepass", "visibility", "attributes", "shading"))
+        self._read_timings()
         return out
 
     def render_resident(self, camera: Camera, width: int, height: int):
@@ -368,7 +436,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         self._require_cloud()
         t = self._targets_for(width, height)
         self.dev.submit(lambda cb: self.record_frame(cb, camera, t.offscreen))
-        self._read_timings(("prepass", "visibility", "attributes", "shading"))
+        self._read_timings()
         return t.out
 
     def render_buffers(self, camera: Camera, width: int, height: int) -> dict[str, np.ndarray]:
@@ -392,8 +460,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
         try:
             def rec(cb):
                 self._write_ubo(camera, width, height)
-                cb.reset_queries(self._query)
-                self._record_passes_12(cb, t, "transfer_src")
+                self._record(cb, self.splat_frame(width, height, "transfer_src", resolve=False), t)
                 cb.copy_image_to_buffer(t.accum_color, rb)
                 cb.copy_image_to_buffer(t.accum_normal, rb, buf_offset=plane)
                 cb.host_read_barrier()
@@ -401,7 +468,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             raw = rb.read()
         finally:
             rb.destroy()
-        self._read_timings(("prepass", "visibility", "attributes"))
+        self._read_timings()
         a = V.readback_array(raw[:plane], self.accum_format, width, height).astype(np.float32)
         b = V.readback_array(raw[plane:], self.accum_format, width, height).astype(np.float32)
         w = a[..., 3]
@@ -442,7 +509,8 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
             cb.end_render_pass()
             cb.timestamp(self._query, 1)
         self.dev.submit(rec)
-        self._read_timings(("points",))
+        ts = self._query.results_ns(2)
+        self.last_timings_ms = {"points": float(ts[1] - ts[0]) * 1e-6, "total": float(ts[1] - ts[0]) * 1e-6}
         return self.last_timings_ms["points"]
 
     def pick(self, camera: Camera, width: int, height: int, rect=None):
@@ -455,13 +523,7 @@ class Renderer(SceneUploadsMixin, PrepassMixin):
 
         def rec(cb):
             self._write_ubo(camera, width, height)
-            cb.reset_queries(self._query)
-            cb.timestamp(self._query, 0, bottom=False)
-            prepared = self._use_prepass()
-            if prepared and self._prep_window_count(prepared) == 1:
-                self._record_prepass(cb)
-            self._record_splat_pass(cb, "pick", RP_PICK, t.fb_pick, [(0, 0, 0, 0), 1.0], prepared)
-            cb.timestamp(self._query, 1)
+            self._record(cb, pick_frame(), t)
         out = t.read_pick(rect, rec)
-        self._read_timings(("pick",))
+        self._read_timings()
         return out

@@ -182,8 +182,10 @@ class _Targets(SizedTargets):
             return self._add(V.Image(dev, width, height, fmt, usage))
 
         self.depth = img("d32f", ("depth", "transfer_src"))
-        self.accum_color = img(r.accum_format, ("color", "sampled", "transfer_src"))
-        self.accum_normal = img(r.accum_format, ("color", "sampled", "transfer_src"))
+        # storage: the compute rasterizer's copy pass writes them (splatedit.render.compute_raster)
+        accum_usage = ("color", "sampled", "transfer_src") + (("storage",) if r.dev.compute_raster else ())
+        self.accum_color = img(r.accum_format, accum_usage)
+        self.accum_normal = img(r.accum_format, accum_usage)
         self.out = img("rgba8", ("color", "transfer_src"))
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
         rp_depth = r.cache.render_pass(_RP_DEPTH)

@@ -146,15 +146,26 @@ BASIS_GROUP = np.dtype([
     ("Bz", "<f4", (4,)),
 ])
 
-#: push constants (std430) of gs_prepare.comp: basis groups per row, polar iterations
-GS_PREP_PUSH = np.dtype([("groups", "<u4"), ("polar_iterations", "<u4")])
-#: push constants of gs_sort.comp: bitonic stage k, step j
-GS_SORT_PUSH = np.dtype([("k", "<u4"), ("j", "<u4")])
+#: push constants (std430) of gs_prepare.comp: basis groups per row, polar
+#: iterations, compact (1: append the visible keys for the GPU radix sort)
+GS_PREP_PUSH = np.dtype([("groups", "<u4"), ("polar_iterations", "<u4"), ("compact", "<u4")])
+#: push constants of gs_sort.comp: bitonic stage k, step j, sort length n (a power of two)
+GS_SORT_PUSH = np.dtype([("k", "<u4"), ("j", "<u4"), ("n", "<u4")])
+#: push constants of the radix sort (gs_radix.glsl): digit shift, index of the
+#: count in the count buffer, capacity of the buffers
+RADIX_PUSH = np.dtype([("shift", "<u4"), ("count_index", "<u4"), ("capacity", "<u4"), ("pad", "<u4")])
+#: push constants of the tile rasterizer (gs_tile.glsl): pair capacity, tiles
+#: per row, tile rows, the transmittance where blending stops
+TILE_PUSH = np.dtype([("capacity", "<u4"), ("tiles_x", "<u4"), ("tiles_y", "<u4"), ("t_min", "<f4")])
 #: push constants of prepare_cs.glsl: basis window (base, count), record slots
 #: n, first splat wbase of the per-splat window
 PREP_PUSH = np.dtype([("base", "<u4"), ("count", "<u4"), ("n", "<u4"), ("wbase", "<u4")])
 #: push constants of prepared.vert: record slots
 PREPARED_PUSH = np.dtype([("n", "<u4")])
+#: push constants of the compute rasterizer (splat_cs_raster.glsl): record
+#: slots, mode (0 per splat, 1 the big-splat list), workgroups of mode 1,
+#: the pixel count above which a splat goes to the list
+CRAST_PUSH = np.dtype([("n", "<u4"), ("mode", "<u4"), ("groups", "<u4"), ("big_pixels", "<u4")])
 #: push constants of gui.vert: pixels -> NDC scale and translation
 GUI_PUSH = np.dtype([("scale", "<f4", (2,)), ("translate", "<f4", (2,))])
 #: one vertex of the GUI's vertex buffer: Dear ImGui's ImDrawVert, copied
@@ -238,7 +249,8 @@ def _int_expr(expr: str, consts: dict[str, int]) -> int:
 _ALIGN_SIZE = {"float": (4, 4), "int": (4, 4), "uint": (4, 4), "bool": (4, 4),
                "vec2": (8, 8), "uvec2": (8, 8), "ivec2": (8, 8),
                "vec3": (16, 12), "uvec3": (16, 12), "ivec3": (16, 12),
-               "vec4": (16, 16), "uvec4": (16, 16), "ivec4": (16, 16), "mat4": (16, 64)}
+               "vec4": (16, 16), "uvec4": (16, 16), "ivec4": (16, 16), "mat4": (16, 64),
+               "uint64_t": (8, 8)}
 
 
 def _round(x: int, a: int) -> int:

@@ -81,6 +81,17 @@ EDITOR_MIN_SCALE_FACTOR = 1e-3
 #: long enough to be seen after releasing the mouse (a reaction takes ~0.3 s),
 #: short enough not to hide the support colour while the next stroke starts
 EDITOR_CLOSURE_HIGHLIGHT_S = 1.2
+#: fitted bases kept after they are replaced (a commit, a selection change), so
+#: that undo / redo back to their document takes them again at once instead of
+#: refitting (the curve's dots and the pending pose are drawn on the surface at
+#: once, not floating over it until the fit ends).  Kept without their CPU
+#: apply cache (rebuilt by the next commit); sizes measured with
+#: fitting.basis_bytes, one handle: the bunny's ear (3,017 support splats)
+#: 1.0 MB, 99,000 support splats of a 300k bunny 15.5 MB (fitted in 6 s on
+#: the loaded 2-core machine, which undo now skips); so the last 4 bases, at
+#: most 256 MB in all (a larger one is not kept: it is refitted)
+EDITOR_FIT_KEEP_BASES = 4
+EDITOR_FIT_KEEP_BYTES = 256 << 20
 #: clouds up to this many splats get their neighbour graph built on the spot
 #: when a tool needs it before the background job has finished (measured
 #: NeighbourGraph.build on 2 shared cores: bunny 37.7k 0.28 s, 200k random

@@ -24,8 +24,48 @@ EVAL_CHUNK_ROWS = 8192
 #: threads that evaluate chunks of a fitted RBF in parallel (numpy releases the GIL)
 EVAL_THREADS = 2
 #: relative singular-value cutoff that declares the polynomial block rank
-#: deficient (constraints on a quadric)
+#: deficient (constraints on a quadric) whatever the coordinates' precision
 POLY_RANK_RTOL = 1e-9
+#: float32 storage rounds a coordinate to 2^-24 of its magnitude (half an ulp):
+#: the precision assumed for coordinates on no decimal grid, whatever their
+#: type (a float32 scan moved in float64 keeps its float32 noise)
+COORD_FLOAT32_REL_PRECISION = 2.0 ** -24
+#: coordinates that all lie on a grid of 10^-d (d <= this) are known to half
+#: that step (files written with d decimals); 12: the finest rounding the
+#: issue's tests use (a unit object's float64 coordinates carry 16 digits)
+COORD_GRID_MAX_DECIMALS = 12
+#: a polynomial direction whose singular value (column-scaled monomial
+#: matrix: the affine block, then the quadratic block beyond the affine span)
+#: is below this many times the first-order bound of the coordinates'
+#: rounding on its block is dropped (the constraints lie on a quadric up to
+#: their precision).  Measured (bench/quadric.py shapes, 2,000 points, 3-12
+#: decimals and float32): the dropped quadric directions are at most 0.25
+#: (sphere), 0.23 (cylinder), 0.29 (cone), 0.36 (plane) of that bound, so 10
+#: leaves a margin of 28x or more; the kept ones are at least 0.12 of the
+#: largest.  Kept, the quadric's coefficient made the lift's 3x3 Jacobian
+#: stretch 2.3x-160,000x (full precision 1.4x).  On the scans' one-view
+#: edits (bunny00, kitten, hippo1; diagonal 1.2-1.6) rounded to 3 decimals
+#: the cut keeps 6-9 of 10 terms and moves the max splat stretch by at most
+#: 0.9 %, the 3x3 one by at most 4.4 %; at 4 decimals and unrounded all 10
+POLY_NOISE_FACTOR = 10.0
+#: a fit whose polynomial keeps a direction with s/s_max below this is
+#: checked against the fit without those weak directions (a second fit).
+#: Measured: one-view edits of the bunny, kitten and hippo have smallest
+#: s/s_max 9e-3 .. 0.2 (never checked)
+POLY_CHECK_RTOL = 1e-3
+#: ... and falls back to it when its largest Jacobian (constraints and probe
+#: splats) is this many times that of the fit without the weak directions.
+#: Measured: the 2,000-point sphere with every coordinate moved by up to
+#: 3e-6 / 1e-5 / 3e-5 / 1e-4 / 3e-4 at random (float64 off any grid: the
+#: quadric is above the float32 cut, so kept): ratio 49 / 15 / 5.3 / 1.89 /
+#: 1.01; at 2.0 the fourth stayed (3x3 Jacobian stretch of the lift 1.57x
+#: against 1.42x exact, over the 10 % the issue allows), at 1.5 it falls back
+#: (1.41x); the fifth is a sphere no more (kept, 1.32x)
+POLY_CHECK_FACTOR = 1.5
+#: free support splats (evenly strided) where DeformationBasis.fit lets that
+#: check measure the Jacobian too, besides the constraints (one gradient
+#: evaluation of at most this many points per fit, only when checked)
+POLY_CHECK_PROBE_SPLATS = 2048
 #: cap on the bytes of one (chunk rows x n_centers) float64 work matrix when
 #: evaluating a fitted RBF; the chunk is min(EVAL_CHUNK_ROWS, this / (8 n))
 #: rows, so evaluation memory stays bounded even for thousands of centers.
@@ -59,6 +99,11 @@ AFFINE_MIN_SINGULAR_REL = 1e-9
 #: consecutive picked curve points closer than this (relative to the points'
 #: extent) coincide
 CURVE_MIN_CHORD_REL = 1e-9
+#: rotation mode, moved curves (splatedit.deform.curve_frames): the frame
+#: motion fades in over at least this many point spacings from the fixed band
+#: (the band itself is BAND_RINGS = 3 thick; 3 more keep the fade's gradient
+#: below 1/2 per spacing: the trunk bend of splatedit.bench.trunk)
+CURVE_FRAME_MIN_RAMP_SPACINGS = 3.0
 
 
 # --- constraints --------------------------------------------------------

@@ -226,3 +226,44 @@ def test_the_panel_names_gaussians_as_gaussians(scene):
     assert "splats" not in model_summary(doc)
     plain = scene.proxy_splats()
     assert model_summary(plain) == f"{plain.n:,} splats"
+
+
+def test_detail_mode_is_not_offered_for_a_gaussian_document_and_b_cycles_rotation_linear(scene):
+    """Issue 19 item 1: B on a Gaussian scene went to DETAIL, whose basis the
+    Gaussian transport cannot use (the commit raised AttributeError and the
+    window closed).  As ``splatedit deform`` refuses it, the editor does not
+    offer it: B cycles rotation <-> linear, choosing detail is refused with
+    a message, and the plain splats' cycle still has it."""
+    from splatedit.errors import SplatEditError
+    s = _ear_session(scene)
+    try:
+        assert not s.detail_available
+        assert s.deformation_cycle() == (DeformationMode.ROTATION, DeformationMode.LINEAR)
+        assert s.cycle_deformation() is DeformationMode.LINEAR
+        assert s.basis is not None and type(s.basis).__name__ == "DeformationBasis"
+        with pytest.raises(SplatEditError, match="not available for Gaussian scenes"):
+            s.set_deformation(DeformationMode.DETAIL)
+        assert s.deformation is DeformationMode.LINEAR
+        assert s.cycle_deformation() is DeformationMode.ROTATION
+        _turn(s, 45.0)
+        assert s.commit() and len(s.edits) == 1       # the commit works in the modes offered
+    finally:
+        s.close()
+    plain = Session(scene.proxy_splats(), fit_sync=True)
+    try:
+        assert plain.detail_available and DeformationMode.DETAIL in plain.deformation_cycle()
+    finally:
+        plain.close()
+
+
+def test_a_detail_basis_given_to_the_gaussian_commit_is_refused_with_a_message(scene):
+    """The transport behind the issue's AttributeError: a DetailBasis reaching
+    the Gaussian commit (any caller) is one clear SplatEditError, nothing changed."""
+    from splatedit.deform.detail import DetailBasis
+    from splatedit.errors import SplatEditError
+    doc = gaussian_document(scene)
+    y = doc.positions[:, 1]
+    sup, hnd = y > np.percentile(y, 85), y > np.percentile(y, 94)
+    basis = DetailBasis.fit(doc, sup, [hnd])
+    with pytest.raises(SplatEditError, match="not available for Gaussian scenes"):
+        commit_cloud(basis, doc, np.zeros((basis.n_columns, 3)))

@@ -37,3 +37,20 @@ def test_revisions_increase_and_none_is_zero():
     assert revision.of(None) == 0
     ra, rb = revision.of(a), revision.of(b)
     assert 0 < ra < rb < revision.next_revision()
+
+
+def test_a_shallow_copy_gets_its_own_revision_not_its_originals():
+    """``copy.copy`` carries the stored number along in ``__dict__`` (the
+    committed cloud of an edit is made that way): the copy must still be
+    another revision, else caches keyed by it (the fitted basis) hand the
+    copy's entry to the original (issue 19 item 2: undo then rotate)."""
+    import copy
+    a = plane_cloud()
+    ra = revision.of(a)
+    b = copy.copy(a)
+    rb = revision.of(b)
+    assert rb != ra and revision.of(a) == ra and revision.of(b) == rb
+    c = copy.copy(b)                  # a copy of a copy, also after the original is gone
+    del a
+    gc.collect()
+    assert revision.of(c) not in (ra, rb)

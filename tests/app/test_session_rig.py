@@ -6,6 +6,8 @@ import json
 import numpy as np
 import pytest
 
+from splatedit.deform.modes import DeformationMode
+
 from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.session import Session, ViewInfo, GRAB
 from splatedit.errors import SplatEditError
@@ -186,10 +188,12 @@ def test_column_budget(session):
 
 
 def test_drawn_curve_is_the_curve_the_fit_uses(session):
-    """The editor draws c'(t) = c(t) + W(t) dq: before and after dragging the
-    tip up, the drawn polyline passes through the (moved) picked points, and
-    the fitted field carries every kept curve sample onto it, upwards only."""
+    """Linear mode: the editor draws c'(t) = c(t) + W(t) dq: before and after
+    dragging the tip up, the drawn polyline passes through the (moved) picked
+    points, and the fitted field carries every kept curve sample onto it,
+    upwards only."""
     s = session
+    s.deformation = DeformationMode.LINEAR
     paint_support(s)
     p = s.cloud.positions
     picks = [int(np.argmin(np.linalg.norm(p - [x, y, 0], axis=1))) for x, y in
@@ -213,3 +217,40 @@ def test_drawn_curve_is_the_curve_the_fit_uses(session):
     lift = (moved - g.points)[:, 2]
     assert lift.min() > -1e-9 and lift.max() > 0.099
     np.testing.assert_allclose((moved - g.points)[:, :2], 0.0, atol=1e-9)
+
+
+def test_rotation_mode_draws_the_frame_curve_and_carries_the_samples_onto_it(session):
+    """Rotation mode (the default): the drawn curve is the Catmull-Rom spline
+    through the moved picked points, the committed deformation carries the
+    picked points exactly and every kept sample close onto it."""
+    from splatedit.deform.curve_frames import CurveFrameDisplacement, deform_points
+    s = session
+    assert s.deformation is DeformationMode.ROTATION
+    paint_support(s)
+    p = s.cloud.positions
+    picks = [int(np.argmin(np.linalg.norm(p - [x, y, 0], axis=1))) for x, y in
+             ((-0.55, -0.1), (-0.3, 0.25), (0.1, 0.3), (0.5, -0.05))]
+    s.curve_mode = True
+    for i in picks:
+        assert s.add_curve_point(p[i])
+    assert s.wait_fit()
+    g = s.basis.constraints.groups[0]
+    assert typed_move(s, 2, "0.1", curve_point=3) == "pose"
+    dc = s.current_dc()
+    assert isinstance(dc, CurveFrameDisplacement)
+    poly = s.curve_polyline(2000)
+    target = p[picks] + s.curve_moves
+    np.testing.assert_allclose(deform_points(s.basis, dc, p[picks]), target, atol=1e-9 * s.cloud.diagonal)
+    moved = deform_points(s.basis, dc, g.points)
+    gap = np.min(np.linalg.norm(moved[:, None, :] - poly[None], axis=2), axis=1)
+    assert gap.max() < 0.01 * s.cloud.diagonal
+    # the viewport draws the pose as committed: a CPU-deformed copy (the GPU pass has no frames)
+    shown, basis, shown_dc = s.display_state(False)
+    assert basis is None and shown_dc is None
+    np.testing.assert_array_equal(shown.positions, s.basis.apply(s.cloud, dc).positions)
+    assert s.display_state(False)[0] is shown                  # kept while nothing moves
+    assert s.commit()
+    np.testing.assert_array_equal(s.cloud.positions, shown.positions)
+    # the heat map redraws a committed edit from its base on the GPU; a curve-frame edit is shown as committed
+    shown, basis, _ = s.display_state(True)
+    assert shown is s.cloud and basis is s.basis

@@ -124,7 +124,7 @@ def test_gpu_sort_of_a_prefix_sorts_only_the_prefix_and_draws_the_same():
         cpu.set_gaussians(scene)
         cpu.set_draw_count(1000)
         images["cpu"] = cpu.render(cam, W, H)
-        with GaussianRenderer(sort="gpu", device=cpu.dev) as gpu:
+        with GaussianRenderer(sort="bitonic", device=cpu.dev) as gpu:
             gpu.set_gaussians(scene)
             gpu.set_draw_count(1000)
             assert gpu._sort_length() == 1024

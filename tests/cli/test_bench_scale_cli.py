@@ -45,3 +45,30 @@ def test_bench_splats_must_be_positive_counts(capsys, bad):
     assert exc.value.code == 2
     err = capsys.readouterr().err
     assert err.startswith("splatedit: error: bench: argument --splats") and "\n" == err[-1]
+
+
+def test_bench_render_case_draws_both_paths_and_names_device_and_path(tmp_path):
+    """One `bench render` case: both rasterization paths in the same run, their
+    ratio, how far apart their images are, the device and the default path."""
+    from splatedit.bench.render import bench_render
+    from splatedit.io import write
+    from tests.render.scenes import sphere
+    model = tmp_path / "ball.ply"
+    write(model, sphere(3000))
+    lines = list(bench_render(counts=(5000,), size=(96, 64), repeats=1, bunny=False, models=(str(model),),
+                              deform_max=0))
+    assert [x["model"] for x in lines] == ["sphere", "ball.ply"]
+    for x in lines:
+        assert x["device"] and x["path"] in ("raster", "compute") and (x["width"], x["height"]) == (96, 64)
+        assert x["ms_frame_raster"] > 0 and x["ms_frame_compute"] > 0
+        assert x["compute_over_raster"] == pytest.approx(x["ms_frame_compute"] / x["ms_frame_raster"], rel=0.01)
+        if x["path_compute_ran"] == "compute":
+            assert x["image_max_diff"] <= 24 and x["coverage_mismatch"] <= 0.005 * x["coverage_raster"]
+        assert "ms_frame_deformed_all" not in x                 # deform_max=0
+
+
+def test_bench_render_takes_size_and_model_flags():
+    from splatedit.cli import build_parser
+    args = build_parser().parse_args(["bench", "render", "--size", "320x200", "--model", "a.ply", "--model", "b.xyz",
+                                      "--splats", "20000000"])
+    assert args.size == (320, 200) and args.model == ["a.ply", "b.xyz"] and args.splats == [20_000_000]

@@ -141,3 +141,20 @@ def test_bad_flag_values_exit_2(small_ply, tmp_path):
     assert res.returncode == 2 and "size must look like" in res.stderr
     res = run_cli("render", small_ply, "-o", tmp_path / "x.png", "--eye", "1,2")
     assert res.returncode == 2 and "--eye" in res.stderr
+
+
+@pytest.mark.parametrize("ext,kept", [(".off", True), (".ply", True), (".xyz", False), (".pts", False),
+                                      (".pcd", False), (".las", False), (".e57", False)])
+def test_convert_of_a_mesh_says_whether_its_faces_are_kept_or_dropped(tmp_path, capsys, ext, kept):
+    """Issue 19 item 8: a mesh written to a point format reported its faces as if written."""
+    if ext == ".e57":
+        pytest.importorskip("pye57")
+    if ext == ".las":
+        pytest.importorskip("laspy")
+    mesh = tmp_path / "tet.off"
+    mesh.write_text("OFF\n4 4 0\n0 0 0\n1 0 0\n0 1 0\n0 0 1\n3 0 2 1\n3 0 1 3\n3 0 3 2\n3 1 2 3\n")
+    out = tmp_path / f"out{ext}"
+    assert main(["-q", "convert", str(mesh), str(out)]) == 0
+    said = capsys.readouterr().out
+    assert (": 4 splats, 4 faces" in said) is kept and ("faces were dropped" in said) is (not kept), said
+    assert (read(out).faces is not None) is kept

@@ -60,14 +60,23 @@ def test_gpu_edit_path_matches_rendering_the_cpu_deformed_file(tmp_path):
 
 
 CURVE_EDIT = {"version": 1, "edits": [
-    {"support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}},
+    {"support": {"sphere": {"center": [-0.07, 0.37, -0.05], "radius": 0.2}}, "deformation": "linear",
      "curves": [{"points": [[-0.12, 0.3, 0.0], [-0.07, 0.38, -0.05], [-0.02, 0.44, -0.09], [0.0, 0.48, -0.11]],
                  "move": [[0, 0, 0], [0.01, 0, 0], [0.04, -0.02, 0], [0.08, -0.05, 0]]}]}]}
 
 
 def test_gpu_curve_edit_matches_rendering_the_cpu_deformed_file(tmp_path):
+    """The linear curve edit is drawn on the GPU; the rotation mode's curve
+    frames are applied on the CPU (and say so)."""
     script = tmp_path / "curve.json"
     script.write_text(json.dumps(CURVE_EDIT))
+    frames = tmp_path / "frames.json"
+    doc = json.loads(json.dumps(CURVE_EDIT))
+    del doc["edits"][0]["deformation"]
+    frames.write_text(json.dumps(doc))
+    res = run_cli("render", default_model_path(), "-o", tmp_path / "frames.png", "--edit", frames, *CAMERA)
+    assert res.returncode == 0, res.stderr
+    assert "rotation edit is applied on the CPU" in res.stdout and "deformed on the GPU" not in res.stdout
     gpu_png, cpu_png, deformed = tmp_path / "gpu.png", tmp_path / "cpu.png", tmp_path / "deformed.ply"
     res = run_cli("render", default_model_path(), "-o", gpu_png, "--edit", script, *CAMERA)
     assert res.returncode == 0, res.stderr

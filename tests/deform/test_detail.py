@@ -160,7 +160,7 @@ def test_fixed_band_sits_on_the_base_surface():
     assert len(det.layer.outer_index) and not np.isin(det.layer.outer_index, det.indices).any()
     near = z[det.indices] < 1.4
     s = det.base_basis.B[:, :4].sum(axis=1)
-    assert np.abs(s[near]).max() < 0.1          # measured 0.067
+    assert np.abs(s[near]).max() < 0.1          # measured 0.006 (0.067 before the fit checked weak polynomial directions)
     naive = copy.copy(c)
     pos = c.positions.copy()
     pos[det.layer.index] = det.layer.base

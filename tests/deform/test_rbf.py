@@ -279,13 +279,15 @@ def test_residual_counts_merged_duplicates_and_every_column():
 # --- degenerate inputs ----------------------------------------------------
 
 @pytest.mark.parametrize("method", ["lu", "iqr"])
-def test_quadric_drops_polynomial_and_interpolates(method):
+def test_quadric_keeps_the_independent_part_of_the_polynomial_and_interpolates(method):
+    """Points on a sphere: its quadric is the one direction of Pi_2 they do
+    not determine; the other 9 are kept (the paper drops all 10)."""
     rng = np.random.default_rng(13)
     u = rng.normal(size=(200, 3))
     pts = 2.0 * u / np.linalg.norm(u, axis=1, keepdims=True) + 1.0
     vals = _smooth_values(pts)
     f = TriharmonicRBF.fit(pts, vals, method=method, tol=0.0)
-    assert not f.polynomial and f.poly_coeffs is None
+    assert f.polynomial and f.poly_rank == 9
     assert "quadric" in f.message
     np.testing.assert_allclose(f(pts), vals, atol=1e-7)
     if method == "iqr":
@@ -294,11 +296,13 @@ def test_quadric_drops_polynomial_and_interpolates(method):
         assert _rel(f(x), lu(x)) < 1e-6
 
 
-def test_planar_and_few_points_drop_polynomial():
+def test_planar_keeps_six_terms_and_reproduces_quadratics_in_the_plane_few_points_drop_it():
     rng = np.random.default_rng(14)
     plane = np.c_[rng.uniform(size=(50, 2)), np.zeros(50)]
     f = TriharmonicRBF.fit(plane, plane[:, :1] ** 2)
-    assert not f.polynomial
+    assert f.poly_rank == 6  # 1, x, y, x^2, xy, y^2
+    q = np.c_[rng.uniform(size=(20, 2)), np.zeros(20)]
+    np.testing.assert_allclose(f(q), q[:, :1] ** 2, atol=1e-9)
     few = rng.normal(size=(5, 3))
     g = TriharmonicRBF.fit(few, few[:, :2])
     assert not g.polynomial and "5 < 10" in g.message

@@ -221,6 +221,7 @@ def _fused_error(basis, cloud, d) -> float:
     ``apply_rotation``: positions over the largest position, axes per splat
     over the reference axis' length."""
     from splatedit.deform.rotation import apply_rotation
+    d = d.base() if hasattr(d, "base") else d   # moved curves: the handles' part (curve frames: test_curve_frames)
     new = basis.apply_arrays(cloud, d)
     ref = apply_rotation(basis, cloud, d.dC, d)
     pos = np.linalg.norm(new[0] - ref[0], axis=1).max() / np.linalg.norm(ref[0], axis=1).max()

@@ -115,10 +115,12 @@ def test_view_dependent_colour_changes_with_the_view(gs, bunny_gaussians):
     assert foreground_diff(img, ref) > 10 * GS_REF_MEAN_TOL
 
 
-def test_gpu_bitonic_sort_gives_the_cpu_sort_image(bunny_gaussians):
+@pytest.mark.parametrize("gpu_sort", ["gpu", "bitonic"])
+def test_gpu_sorts_give_the_cpu_sort_image(bunny_gaussians, gpu_sort):
+    """The GPU radix sort ("gpu") and the bitonic sort draw the CPU sort's image."""
     cam = view(bunny_gaussians, VIEWS[3])
     imgs = []
-    for sort in ("cpu", "gpu"):
+    for sort in ("cpu", gpu_sort):
         with GaussianRenderer(sort=sort) as r:
             r.set_gaussians(bunny_gaussians)
             imgs.append(r.render(cam, W, H))

@@ -15,8 +15,9 @@ import pytest
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.uniforms import (BASIS_GROUP, DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO, GS_GEOM, GS_PREP_PUSH,
-                                       GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH, PREPARED_PUSH,
+from splatedit.render.uniforms import (BASIS_GROUP, CRAST_PUSH, DEFORM_UBO, DETAIL_ROW, FRAME_UBO, GS_FRAME_UBO,
+                                       GS_GEOM, GS_PREP_PUSH, GS_REC, GS_SORT_PUSH, GUI_PUSH, MAX_GROUPS, PREP_PUSH,
+                                       PREPARED_PUSH, RADIX_PUSH, TILE_PUSH,
                                        SPLAT_GEOM, SPLAT_REC_A, SPLAT_REC_B, check_glsl_block, check_glsl_records,
                                        glsl_members, layout, parse_glsl_block)
 from tests.render.scenes import plane
@@ -28,19 +29,26 @@ FRAME_GLSL = SHADERS / "frame.glsl"
 BLOCKS = [("frame.glsl", "Frame", FRAME_UBO), ("deform.glsl", "Deform", DEFORM_UBO),
           ("gs_common.glsl", "GsFrame", GS_FRAME_UBO), ("gs_prepare.comp", "Push", GS_PREP_PUSH),
           ("gs_sort.comp", "Push", GS_SORT_PUSH), ("prepare_cs.glsl", "Push", PREP_PUSH),
-          ("prepared.vert", "Push", PREPARED_PUSH), ("gui.vert", "GuiPush", GUI_PUSH)]
+          ("prepared.vert", "Push", PREPARED_PUSH), ("gui.vert", "GuiPush", GUI_PUSH),
+          ("gs_radix.glsl", "RadixPush", RADIX_PUSH), ("gs_tile.glsl", "TilePush", TILE_PUSH),
+          ("splat_cs_raster.glsl", "Push", CRAST_PUSH)]
 #: (file, block, record dtype, constant prefix): flat record buffers
 RECORDS = [("gs_common.glsl", "GsGeom", GS_GEOM, "GEOM"), ("gs_common.glsl", "GsRec", GS_REC, "REC"),
            ("prepare_cs.glsl", "Geom", SPLAT_GEOM, "GEOM"), ("prepare_cs.glsl", "RecA", SPLAT_REC_A, "RECA"),
            ("prepare_cs.glsl", "RecB", SPLAT_REC_B, "RECB"), ("prepared.vert", "RecA", SPLAT_REC_A, "RECA"),
            ("prepared.vert", "RecB", SPLAT_REC_B, "RECB"), ("prepare_cs.glsl", "Basis", BASIS_GROUP, "BASIS"),
-           ("gs_prepare.comp", "GsBasis", BASIS_GROUP, "BASIS")]
+           ("gs_prepare.comp", "GsBasis", BASIS_GROUP, "BASIS"),
+           ("splat_cs_raster.glsl", "RecA", SPLAT_REC_A, "RECA"), ("splat_cs_raster.glsl", "RecB", SPLAT_REC_B, "RECB")]
 #: (file, block, row dtype): buffers of one vec4 row per item
 ROWS = [("detail.glsl", "Detail", DETAIL_ROW)]
 #: plain arrays of one value per item (block -> GLSL member type)
 PLAIN = {"GsRest": "uint[]", "GsBasisRow": "uint[]", "GsBasis": "vec4[]", "GsKeys": "uint[]", "GsOrder": "uint[]",
          "GsDraws": "uint[4]", "GsFlags": "uint[]", "Colors": "uint[]", "Flags": "uint[]", "Basis": "vec4[]",
-         "Draws": "uint[8]"}
+         "Draws": "uint[8]", "RCount": "uint[]", "RKeysIn": "uint[]", "RValsIn": "uint[]", "RKeysOut": "uint[]",
+         "RValsOut": "uint[]", "RHist": "uint[]", "RArgs": "uint[4]", "BKeys": "uint[]", "BVals": "uint[]",
+         "TPairKeys": "uint[]", "TPairVals": "uint[]", "TScan": "uint[]", "TRanges": "uvec2[]",
+         "TSortArgs": "uint[4]", "VisMin": "uint64_t[]", "VisRead": "uvec2[]", "AccC": "vec4[]",
+         "AccN": "vec4[]", "BigList": "uint[]", "TileBins": "uint[]"}
 
 
 def _source(fname: str) -> str:

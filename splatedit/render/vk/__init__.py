@@ -28,11 +28,12 @@ from splatedit.render.vk.passes import Attachment, Framebuffer, RenderPassDesc
 from splatedit.render.vk.shaders import spirv_path
 from splatedit.render.vk.graphics import GraphicsDesc, VertexAttribute, VertexBinding
 from splatedit.render.vk.pipelines import ComputeDesc, PipelineCache
+from splatedit.render.vk.capabilities import SubgroupProperties, is_cpu_device, subgroup_properties
 
 __all__ = [
     "WHOLE_SIZE", "Device", "DeviceNotFoundError", "VulkanError", "devices_created", "drain_validation_messages",
     "list_devices", "live_handles", "validation_enabled", "Buffer", "Image", "readback_array",
     "CommandBuffer", "QueryPool", "Attachment", "Binding", "ComputeDesc", "DescriptorSet", "Framebuffer",
     "GraphicsDesc", "LayoutDesc", "PipelineCache", "RenderPassDesc", "Sampler", "VertexAttribute",
-    "VertexBinding", "spirv_path",
+    "VertexBinding", "spirv_path", "SubgroupProperties", "is_cpu_device", "subgroup_properties",
 ]

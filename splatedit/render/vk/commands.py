@@ -215,6 +215,11 @@ class CommandBuffer:
     def dispatch(self, x, y=1, z=1):
         vk.vkCmdDispatch(self.handle, x, y, z)
 
+    def dispatch_indirect(self, buf, offset: int = 0):
+        """A dispatch whose group counts (3 uint32: x, y, z) the GPU reads from
+        ``buf`` (usage "indirect") at byte ``offset`` when it runs."""
+        vk.vkCmdDispatchIndirect(self.handle, buf.handle, offset)
+
     # ----------------------------------------------------------- timestamps
     def reset_queries(self, pool, first=0, count=None):
         vk.vkCmdResetQueryPool(self.handle, pool.handle, first, pool.count if count is None else count)

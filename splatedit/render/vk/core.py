@@ -285,12 +285,24 @@ class Device:
         qinfo = vk.VkDeviceQueueCreateInfo(queueFamilyIndex=self.queue_family, queueCount=1,
                                            pQueuePriorities=prio)
         avail = vk.vkGetPhysicalDeviceFeatures(self.physical)
+        atomics = self._atomic_features()
         feats = vk.VkPhysicalDeviceFeatures(
             largePoints=avail.largePoints, multiDrawIndirect=avail.multiDrawIndirect,
-            shaderFloat64=0, vertexPipelineStoresAndAtomics=avail.vertexPipelineStoresAndAtomics)
+            shaderFloat64=0, vertexPipelineStoresAndAtomics=avail.vertexPipelineStoresAndAtomics,
+            shaderInt64=1 if atomics else 0)
         self.features = feats
+        #: the device runs the compute splat rasterizer (splatedit.render.compute_raster):
+        #: 64-bit buffer atomics (atomicMin of depth << 32 | id) and float32 buffer
+        #: atomicAdd (VK_EXT_shader_atomic_float), both enabled at creation
+        self.compute_raster = atomics
+        chain = None
+        if atomics:
+            extensions = extensions + ["VK_EXT_shader_atomic_float"]
+            fl = vk.VkPhysicalDeviceShaderAtomicFloatFeaturesEXT(shaderBufferFloat32AtomicAdd=1,
+                                                                  shaderBufferFloat32Atomics=1)
+            chain = vk.VkPhysicalDeviceVulkan12Features(pNext=fl, shaderBufferInt64Atomics=1)
         info = vk.VkDeviceCreateInfo(queueCreateInfoCount=1, pQueueCreateInfos=[qinfo],
-                                     pEnabledFeatures=feats,
+                                     pEnabledFeatures=feats, pNext=chain,
                                      ppEnabledExtensionNames=extensions or None)
         self.device = call(vk.vkCreateDevice, self.physical, info, None)
         track("device", 1)
@@ -302,6 +314,26 @@ class Device:
             queueFamilyIndex=self.queue_family)
         self._pool = call(vk.vkCreateCommandPool, self.device, pinfo, None)
         track("command_pool", 1)
+
+    def _atomic_features(self) -> bool:
+        """True when the physical device offers what the compute splat
+        rasterizer needs: Vulkan 1.2 with shaderInt64 and
+        shaderBufferInt64Atomics, and VK_EXT_shader_atomic_float with
+        shaderBufferFloat32AtomicAdd (lavapipe 22.3 and NVIDIA drivers have both)."""
+        api = self.properties.apiVersion
+        if (vk.VK_VERSION_MAJOR(api), vk.VK_VERSION_MINOR(api)) < (1, 2):
+            return False
+        try:
+            names = {e.extensionName for e in vk.vkEnumerateDeviceExtensionProperties(self.physical, None)}
+        except (vk.VkError, vk.VkException):
+            return False
+        if "VK_EXT_shader_atomic_float" not in names:
+            return False
+        fl = vk.VkPhysicalDeviceShaderAtomicFloatFeaturesEXT()
+        f12 = vk.VkPhysicalDeviceVulkan12Features(pNext=fl)
+        f2 = vk.VkPhysicalDeviceFeatures2(pNext=f12)
+        vk.vkGetPhysicalDeviceFeatures2(self.physical, f2)
+        return bool(f2.features.shaderInt64 and f12.shaderBufferInt64Atomics and fl.shaderBufferFloat32AtomicAdd)
 
     # -- helpers
     def memory_type(self, type_bits: int, flags: int) -> int:

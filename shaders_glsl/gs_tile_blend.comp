@@ -1,0 +1,5 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Tile rasterizer blend into an RGBA16F accumulator.
+#define ACCUM_FORMAT rgba16f
+#include "gs_tile_blend.glsl"

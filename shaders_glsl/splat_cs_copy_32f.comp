@@ -1,0 +1,5 @@
+#version 450
+#extension GL_GOOGLE_include_directive : require
+// Compute rasterizer: the accumulation buffers into rgba32f-format accumulator images.
+#define ACCUM_FORMAT rgba32f
+#include "splat_cs_copy.glsl"
