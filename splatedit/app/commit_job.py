@@ -16,7 +16,7 @@ cancelled job (the session closed) leaves nothing behind.
 from __future__ import annotations
 
 import time
-from dataclasses import dataclass
+from dataclasses import dataclass, field
 
 from splatedit.app.gaussian_doc import commit_cloud, gaussians_of
 from splatedit.app.jobs import Cancelled, Job
@@ -65,11 +65,19 @@ class CommitPlan:
     make_edit: object
     handles: int
     label: str = "Edit"
+    #: the edit's DeformationMode (None: the basis' result as it is) and the
+    #: handles' (4, 4) maps: a translation with needles in the rotation mode
+    #: is refined (splatedit.deform.refine); ``outcome["refined"]`` then
+    #: holds its note (set by :meth:`work`)
+    mode: object = None
+    matrices: tuple = ()
+    outcome: dict = field(default_factory=dict)
 
     def work(self, progress=None):
         """The deformed document (``commit_cloud``); ``progress(stage,
         fraction)`` after each chunk.  Raises InputError on a degenerate splat."""
-        return commit_cloud(self.basis, self.cloud, self.dc, progress=progress)
+        return commit_cloud(self.basis, self.cloud, self.dc, progress=progress, mode=self.mode,
+                            matrices=self.matrices, outcome=self.outcome)
 
     def run(self, progress=None):
         """``(deformed document, script Edit)``: what a commit job computes;

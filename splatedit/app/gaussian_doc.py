@@ -40,8 +40,12 @@ def gaussians_of(cloud) -> GaussianCloud | None:
     return getattr(cloud, _ATTR, None) if cloud is not None else None
 
 
-def commit_cloud(basis, cloud, dc, progress=None):
-    """The editor's commit of one edit: ``basis.commit`` for plain splats; for
+def commit_cloud(basis, cloud, dc, progress=None, mode=None, matrices=(), outcome=None):
+    """The editor's commit of one edit: ``basis.commit`` for plain splats
+    (with ``mode`` given, the deformation mode's refinement of needles for
+    the handles' ``matrices``, as ``splatedit deform`` does:
+    :func:`~splatedit.deform.refine.refine_committed`; ``outcome``, a dict,
+    gets ``"refined"``: its note or ""); for
     a Gaussian document the Gaussians deformed on the CPU by the basis and
     ``dc`` ((K, 3) or a RotationDisplacement) and re-wrapped as a new document.
     ``progress``: optional ``progress(stage, fraction)`` after each chunk
@@ -52,7 +56,13 @@ def commit_cloud(basis, cloud, dc, progress=None):
     """
     scene = gaussians_of(cloud)
     if scene is None:
-        return basis.commit(cloud, dc, progress=progress)
+        new = basis.commit(cloud, dc, progress=progress)
+        if mode is not None:
+            from splatedit.deform.refine import refine_committed
+            new, _, note = refine_committed(basis, cloud, new, mode, matrices)
+            if outcome is not None:
+                outcome["refined"] = note
+        return new
     if not (hasattr(basis, "displacements") and hasattr(basis, "jacobians")):     # a DetailBasis
         from splatedit.errors import SplatEditError
         raise SplatEditError(DETAIL_UNAVAILABLE)

@@ -240,7 +240,8 @@ class PoseEditing:
             return Edit(idx(support), tuple(idx(h) for h in handles), matrices, "$", curves,
                         fill_holes=False,  # the editor's closed selection, replayed as is
                         deformation=mode)
-        return CommitPlan(self.s.basis, self.s.cloud, dc, make_edit, len(sel.handles), label)
+        return CommitPlan(self.s.basis, self.s.cloud, dc, make_edit, len(sel.handles), label, self.s.deformation,
+                          tuple(mats) if curve is None or not moves.any() else ())
 
     def _land(self, plan, result) -> None:
         """``result`` = (deformed cloud, script Edit) of ``plan`` becomes the
@@ -252,7 +253,12 @@ class PoseEditing:
         self.s.rig.reset_pose(plan.handles)
         self.s.rig.clear_curve()
         self.s.push(plan.label)
-        self.s.remember_edit(plan.cloud, plan.basis, plan.dc)
+        if plan.outcome.get("refined"):
+            # a refined translation (splatedit.deform.refine) is not what the basis
+            # and dC draw: its figures and heat map are not shown after the commit
+            self.s.last_edit = None
+        else:
+            self.s.remember_edit(plan.cloud, plan.basis, plan.dc)
 
     @property
     def committing(self) -> bool:

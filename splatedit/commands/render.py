@@ -225,6 +225,22 @@ def _gpu_edit(args, cloud, on_gpu=None):
     if dist.exceeds_warn:
         print(f"splatedit: warning: edit {len(script.edits) - 1} stretches {dist.n_above_warn} of {dist.n} "
               f"support splats more than {dist.warn:g}x (max {dist.max_stretch:.2f}x)", file=sys.stderr)
+    if on_gpu is _splats_draw and not detail and _would_refine(script.edits[-1], resolved, dist):
+        # a far grab with needles in the rotation mode is refined when committed
+        # (splatedit.deform.refine): drawn from the CPU as `splatedit deform` writes it
+        from splatedit.deform.refine import refine_committed
+        new, _, note = refine_committed(basis, cloud, basis.commit(cloud, d_c), script.edits[-1].deformation,
+                                        resolved.matrices, dist)
+        print(f"  {note or 'needles left as they are'}; the edit is applied on the CPU")
+        return new, None, None
     if not gpu and on_gpu is _splats_draw:
         return basis.commit(cloud, d_c), None, None
     return cloud, rows, d_c
+
+
+def _would_refine(edit, resolved, dist) -> bool:
+    """Whether ``splatedit deform`` refines this edit (:func:`~splatedit.deform.refine.refine_committed`'s rule)."""
+    from splatedit.deform.modes import DeformationMode
+    from splatedit.deform.refine import is_translation, needs_refine
+    return (edit.deformation is DeformationMode.ROTATION and is_translation(resolved.matrices, len(resolved.curves))
+            and needs_refine(dist))

@@ -12,6 +12,7 @@ import numpy as np
 
 from splatedit.deform.distortion import DistortionStats, distortion_from_axes
 from splatedit.deform.modes import DeformationMode
+from splatedit.deform.refine import refine_committed
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.script.model import Edit, EditScript, Removal, SolverSettings
 from splatedit.script.parse import _Ctx
@@ -351,15 +352,16 @@ def run_script(cloud, script: EditScript, *, method: str | None = None, tol: flo
         except InputError as exc:
             raise EditScriptError(_degenerate_message(cloud, basis, d_c, exc), json_path=edit.json_path,
                                   path=source) from None
-        disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         i_sup = basis.indices
         dist = distortion_from_axes(cloud.u[i_sup], cloud.v[i_sup], new.u[i_sup], new.v[i_sup])
+        new, dist, refined = refine_committed(basis, cloud, new, edit.deformation, r.matrices, dist)
+        disp = float(np.sqrt(((new.positions - cloud.positions) ** 2).sum(1)).max())
         stats = basis.stats
         con = basis.constraints
         rep = EditReport(i, len(con.support_index), [len(h) for h in con.handle_index], stats["n_constraints"],
                          stats["n_centers"], stats["residual"], stats["method"], stats["fit_seconds"],
                          stats["basis_seconds"] + (time.perf_counter() - t0), disp,
-                         [stats["message"]] if stats.get("message") else [],
+                         ([stats["message"]] if stats.get("message") else []) + ([refined] if refined else []),
                          [(c.n_controls, n) for c, n in zip(r.curves, stats.get("n_curve_samples", []))],
                          stats.get("closure_added", 0),
                          [f"edit {i}: {c.describe(con.spacing)}" for c in con.conflicts],

@@ -366,3 +366,78 @@ FAST_EVAL_CHUNK_ROWS = 256
 #: relative to the largest constraint value (values and gradients per
 #: normalised unit)
 FAST_EVAL_TOL = 1e-5
+
+
+# ---------------------------------------------------------------------------
+# Fewer needles in big grabs (issue 20.3): ARAP refinement of a committed edit
+# ---------------------------------------------------------------------------
+#: a rotation-mode edit is refined (splatedit.deform.refine) when more than
+#: this share of its moved support splats is stretched beyond
+#: DISTORTION_BROKEN_STRETCH (4x).  0: any needle.  Measured (bench/needles.py):
+#: the one-view arm-lift and head-bend edits have 0.5-5.3 % beyond 4x before
+#: and 0-0.03 % after three iterations; edits without a needle keep the RBF
+#: result bitwise
+NEEDLE_REFINE_MIN_SHARE = 0.0
+#: local/global ARAP iterations seeded by the RBF result.  Measured
+#: (bench/needles.py, loaded 2-core machine): splats beyond 4x on the bunny's
+#: ear lifted sideways / the hippo's leg / the bunny's head bent: 55 / 31 /
+#: 406 before, 2 / 0 / 4 after 3 iterations, 2 / 0 / 2 after 10 (p99 stretch
+#: 1.32 / 1.55 / 1.33 after 3); about 0.1 s per iteration per 10k support
+#: splats
+ARAP_ITERATIONS = 3
+#: weight of the pull of each free splat towards its RBF position, relative
+#: to one graph edge (keeps graph components without a constrained splat
+#: where the RBF put them, and the Laplacian system non-singular); 1e-4 edge
+#: weights move a connected component's solution by about 1e-4 of the move
+ARAP_ANCHOR = 1e-4
+#: a splat's tangent-plane edge fit (axes u' = J u) is degenerate when the
+#: smaller eigenvalue of its edges' 2x2 tangent Gram matrix is below this
+#: times the larger (its edges all along one line): its axes turn by its ARAP
+#: rotation instead
+ARAP_MIN_TANGENT_RANK_REL = 1e-3
+#: neighbours per splat of the refinement's graph (symmetrised k-nearest
+#: neighbours of the support splats, uniform weights).  The selection graph
+#: (which cuts long edges) left close splats uncoupled: the one-view hippo
+#: edit tore 52 neighbour pairs apart with it, 0 with this one
+ARAP_NEIGHBOURS = 10
+#: the refinement applies to edits whose handles are translated: every map's
+#: linear part within this of the identity (largest entry of A - I; as
+#: ROTATION_MIN_ANGLE, below which the rotation mode treats a map as a
+#: translation).  Rotations keep the arc blend, scales and shears the RBF
+NEEDLE_REFINE_LINEAR_TOL = 1e-6
+#: the refinement is local: only free splats within ARAP_REGION_SPACINGS
+#: point spacings of a splat stretched beyond ARAP_REGION_STRETCH move (the
+#: rest of the support holds them at the RBF result), so its cost follows
+#: the needles, not the support.  Sweep (bench/needles.py cases, splats
+#: beyond 4x / largest stretch / seconds; bunny ear 10.6k support, bunny head
+#: 16k, a 27.9k bunny support): the whole support 1 / 5.8x / 0.76 s, 5 / 7.5x
+#: / 0.61 s, 0 / 3.1x / 0.94 s; > 2x within 20 h 2 / 7.5x / 0.48 s, 5 / 7.5x
+#: / 0.52 s, 0 / 3.1x / 0.26 s; > 2x within 10 h 3 / 25x / 0.14 s (a splat on
+#: the region's rim), 4 / 7.5x / 0.52 s, 0 / 3.1x / 0.15 s; > 3x within 10 h
+#: 4 / 8.8x, 6 / 7.8x, 2 / 5.9x
+ARAP_REGION_STRETCH = 2.0
+ARAP_REGION_SPACINGS = 20.0
+#: the refinement's neighbours are searched among the splats within this many
+#: point spacings of the region's bounding box only (a commit on a 1M-splat
+#: cloud builds no tree of the whole cloud).  The 10 nearest neighbours of a
+#: surface splat lie within about 2 spacings (sqrt(10 / pi) on a regular
+#: sampling); 8 leaves room for sparse patches
+ARAP_GRAPH_MARGIN_SPACINGS = 8.0
+#: the refinement's global step: a sparse LU up to this many free splats,
+#: conjugate gradients (Jacobi preconditioner, warm start from the current
+#: positions, the three coordinates at once) above.  The LU's fill grows
+#: faster than the region: 50k free splats, 12M entries, 3.2 s to factor
+#: (loaded 2-core machine).  CG with 200 / 50 / 20 steps per global step,
+#: every free splat on CG: splats beyond 4x 2 / 2 / 1 (bunny ear), 5 / 5 / 4
+#: (bunny head), 0 / 0 / 0 (ear pushed down), the same as the LU's 2 / 5 / 0
+#: from 50 steps on (seconds 0.47 / 0.36 / 0.26 for the ear, load 12)
+ARAP_DIRECT_MAX_SPLATS = 20000
+ARAP_CG_RTOL = 1e-6
+ARAP_CG_MAXITER = 50
+#: a region of more free splats than this is not refined (the RBF result is
+#: kept and the edit's note says so): its cost grows with the region.  A
+#: synthetic smooth region on a 1M-splat bunny (splatedit.app.bench's
+#: surface), loaded 2-core machine (load 8-11): 0.9 s at 10k splats (LU),
+#: 6.6 s at 50k and 14.6 s at 100k (CG, 50 steps); 55x and 140x a copy of
+#: the 1M cloud in the same run
+ARAP_MAX_REGION_SPLATS = 100_000

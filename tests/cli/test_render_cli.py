@@ -125,3 +125,27 @@ def test_a_scan_with_one_glitch_point_1e9_away_renders_its_body_not_a_strip(tmp_
     assert cover.sum() > 5000
     width, height = cols[-1] - cols[0] + 1, rows[-1] - rows[0] + 1
     assert 0.8 < width / height < 1.25                           # round, not a strip
+
+
+def test_render_edit_of_a_refined_far_grab_matches_rendering_the_deformed_file(tmp_path):
+    """A far grab with needles in the rotation mode is refined by `splatedit
+    deform` (splatedit.deform.refine); `render --edit` draws that result too."""
+    from splatedit.bench.needles import prepare
+    cloud, basis, m, h, diag = prepare("arm-bunny-ear")
+    script = tmp_path / "grab.json"
+    script.write_text(json.dumps({"version": 1, "edits": [{
+        "support": {"indices": basis.indices.tolist(), "fill_holes": False},
+        "handle": {"indices": np.concatenate(basis.constraints.handle_index).tolist()},
+        "transform": {"translate": m[:3, 3].tolist()}}]}))
+    edit_png, cpu_png, deformed = tmp_path / "edit.png", tmp_path / "cpu.png", tmp_path / "deformed.ply"
+    cam = ["--size", "160x160", "--eye=1.6,0.5,0.6", "--target=0,0.25,0", "--up", "0,1,0", "--fov", "40"]
+    res = run_cli("render", default_model_path(), "-o", edit_png, "--edit", script, *cam)
+    assert res.returncode == 0, res.stderr
+    assert "needles refined" in res.stdout and "applied on the CPU" in res.stdout
+    res = run_cli("deform", default_model_path(), "--edit", script, "-o", deformed)
+    assert res.returncode == 0 and "needles refined" in res.stdout, res.stderr
+    assert run_cli("render", deformed, "-o", cpu_png, *cam).returncode == 0
+    a = np.asarray(Image.open(edit_png)).astype(float)
+    b = np.asarray(Image.open(cpu_png)).astype(float)
+    diff = np.abs(a - b).max(axis=2)
+    assert diff.mean() < 0.5 and (diff > 24).mean() < 0.005, (diff.mean(), (diff > 24).mean())
