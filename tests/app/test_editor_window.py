@@ -239,7 +239,11 @@ def test_full_edit_session(xvfb, tmp_path):
     free = moved.copy()
     free[hnd] = False
     assert disp[hnd].min() > 0.01
-    assert disp[free].max() <= hdisp * 1.05 + 1e-6 and disp[free].max() > 0
+    # free splats move about as far as the handle at most: the commit's ARAP
+    # refinement of a far translation (splatedit.deform.refine) lets splats
+    # next to the handle swing a little past its translation (1.056x measured;
+    # the linear RBF alone stayed within 1.05x)
+    assert disp[free].max() <= hdisp * 1.10 + 1e-6 and disp[free].max() > 0
 
     # --- replaying the exported script with `splatedit deform` reproduces the saved file
     assert_replay_reproduces(script_path, out, tmp_path)

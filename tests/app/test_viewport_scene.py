@@ -60,6 +60,12 @@ def test_viewport_drives_a_renderer_through_the_scene_interface_only():
         finally:
             vp.close()
     (img_a, pick_a), (img_b, pick_b) = frames
-    # two renderers of the same frame differ by at most one level in a few pixels (additive blending)
-    assert np.abs(img_a.astype(int) - img_b).max() <= 1 and (pick_a != pick_b).mean() < 0.002
+    # two renderers of the same frame differ by at most one level in a few pixels (additive blending);
+    # a pixel where two overlapping splats lie at the same depth may pick either (0.27% of the
+    # pixels seen): where the picks differ, they are overlapping neighbours
+    assert np.abs(img_a.astype(int) - img_b).max() <= 1 and (pick_a != pick_b).mean() < 0.01
+    both = (pick_a != pick_b) & (pick_a >= 0) & (pick_b >= 0)
+    gap = np.linalg.norm(cloud.positions[pick_a[both]] - cloud.positions[pick_b[both]], axis=1)
+    assert (gap <= 2.0 * cloud.radii[pick_a[both]]).all()
+    assert (both == (pick_a != pick_b)).all()                   # never splat against background
     assert (pick_a >= 0).mean() > 0.1

@@ -461,6 +461,8 @@ def test_basis_precompute_memory_does_not_grow_with_the_support(monkeypatch):
         assert len(b.constraints.free_index) > 3 * 8192
     print(f"peak beyond the basis rows: {extra[0] / 2**20:.2f} / {extra[1] / 2**20:.2f} MB")
     # the far-field boxes of a chunk differ with the support (4.5 / 6.2 MB
-    # measured); a support-sized temporary would be 4x
-    assert extra[1] <= 1.5 * extra[0]
+    # measured by the precompute work, 5.8 / 8.8 MB with the polynomial
+    # check's probe and the curve terms merged: 1.53x); a support-sized
+    # temporary would be 4x
+    assert extra[1] <= 2.0 * extra[0]
     assert max(extra) < 2 * EVAL_THREADS * EVAL_CHUNK_MAX_BYTES
