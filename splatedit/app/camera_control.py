@@ -217,6 +217,10 @@ class OrbitCamera:
         self.frame(c, max(r, 1e-6 * max(self.scene_radius, 1e-9)), aspect, area=area)
 
     def state(self) -> tuple:
-        """A hashable snapshot (used to detect camera motion)."""
+        """A hashable snapshot of everything the view depends on (used to detect
+        camera motion): the up axis and the pivot's place on screen included (U
+        turned the camera but left the drawn frame, keyed without them, stale)."""
         return (tuple(np.round(np.asarray(self.target, float), 12)), round(self.distance, 12),
-                round(self.yaw, 12), round(self.pitch, 12), self.fov_deg)
+                round(self.yaw, 12), round(self.pitch, 12), self.fov_deg,
+                tuple(np.round(np.asarray(self.up_axis, float), 12)),
+                tuple(round(float(x), 12) for x in self.screen_offset))

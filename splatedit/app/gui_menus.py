@@ -24,9 +24,9 @@ _VIEW_ENTRIES = (
     ("Front", "Numpad 1 / Shift+1", Action.VIEW_FRONT),
     ("Right", "Numpad 3 / Shift+3", Action.VIEW_RIGHT),
     ("Top", "Numpad 7 / Shift+7", Action.VIEW_TOP),
-    ("Back", "Ctrl+Numpad 1", Action.VIEW_BACK),
-    ("Left", "Ctrl+Numpad 3", Action.VIEW_LEFT),
-    ("Bottom", "Ctrl+Numpad 7", Action.VIEW_BOTTOM),
+    ("Back", "Ctrl+Numpad 1 / Ctrl+Shift+1", Action.VIEW_BACK),
+    ("Left", "Ctrl+Numpad 3 / Ctrl+Shift+3", Action.VIEW_LEFT),
+    ("Bottom", "Ctrl+Numpad 7 / Ctrl+Shift+7", Action.VIEW_BOTTOM),
 )
 
 

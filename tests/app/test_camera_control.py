@@ -160,3 +160,15 @@ def test_the_first_view_looks_at_the_front_render_uses_too(up):
     cam = OrbitCamera(up_axis=np.array(up, float))
     right, cam_up, back = cam.basis()
     assert np.allclose(back, front_direction(up)) and np.allclose(cam_up, up)
+
+
+def test_the_camera_state_changes_with_the_up_axis_and_the_screen_offset():
+    """The editor redraws when the camera state changes: U (a new up axis)
+    left the drawn frame stale while the gizmo moved (a tester's report)."""
+    cam = OrbitCamera()
+    before = cam.state()
+    cam.up_axis = np.array([0.0, 0.0, 1.0])
+    assert cam.state() != before
+    moved = cam.state()
+    cam.screen_offset = (0.1, 0.0)
+    assert cam.state() != moved

@@ -202,8 +202,17 @@ def test_full_edit_session(xvfb, tmp_path):
         ed.xdo("key", "shift+7")
         ed.idle(lambda s: s["camera"]["pitch"] > 1.5, "top view from Shift+7")
         ed.xdo("key", "shift+1")
-        ed.idle(lambda s: abs(s["camera"]["yaw"]) < 1e-5 and abs(s["camera"]["pitch"]) < 1e-5,
-                "front view from Shift+1")
+        s = ed.idle(lambda s: abs(s["camera"]["yaw"]) < 1e-5 and abs(s["camera"]["pitch"]) < 1e-5,
+                    "front view from Shift+1")
+        # --- U turns the view about the next up axis, and the model is drawn so (the frame
+        # used to stay as it was, keyed by a camera state without the up axis)
+        front = ed.screenshot()
+        ed.xdo("key", "u")
+        ed.idle(lambda s: s["camera"]["up"] == [0.0, 0.0, 1.0], "up axis +Z")
+        turned = ed.screenshot()
+        assert (np.abs(turned.astype(int) - front)[..., :3].max(axis=2) > 40).mean() > 0.01
+        ed.xdo("key", "u", "key", "u", "key", "u", "key", "u", "key", "u")        # back to +Y
+        ed.idle(lambda s: s["camera"]["up"] == [0.0, 1.0, 0.0], "up axis +Y again")
         ed.xdo("key", "q")
         ed.wait(lambda s: s["confirm_quit"], "quit confirmation again")
         ed.xdo("key", "y")
