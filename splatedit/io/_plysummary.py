@@ -96,8 +96,25 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
                 return None
         del rec
         report(progress, "reading", hi / n)
+    def normals_of(rec) -> np.ndarray:
+        u = np.column_stack([rec[p] for p in _AXES[:3]]).astype(np.float64)
+        v = np.column_stack([rec[p] for p in _AXES[3:]]).astype(np.float64)
+        return np.cross(u, v)
+
+    return _summary(path, layout, spec, positions, radii, (lo_b, hi_b), float(np.sqrt(shortest)),
+                    stored_origin, normals_of)
+
+
+def _summary(path, layout, spec, positions, radii, box, smallest_axis: float, stored_origin,
+             normals_of_records) -> CloudSummary | None:
+    """The common end of both lean passes: the smallest splat axis checked
+    against the diagonal (None: the full reader names the row), the extent
+    checked, the positions rebased, the summary built.  ``normals_of_records``
+    turns rows of the file's records into (m, 3) normals (any length)."""
+    body, n, dtype = layout
+    lo_b, hi_b = box
     diag = float(np.linalg.norm(hi_b - lo_b))
-    if not np.sqrt(shortest) > MIN_AXIS_LENGTH_REL * max(diag, 1e-300):
+    if not smallest_axis > MIN_AXIS_LENGTH_REL * max(diag, 1e-300):
         return None
     check_extent(lo_b, hi_b, path)
     origin = local_origin(positions, bounds=(lo_b, hi_b), stored=stored_origin)
@@ -105,11 +122,8 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
 
     def normals_of(rows: np.ndarray) -> np.ndarray:
         mm = np.memmap(path, dtype=dtype, mode="r", offset=body, shape=(n,))
-        rec = mm[rows]
-        u = np.column_stack([rec[p] for p in _AXES[:3]]).astype(np.float64)
-        v = np.column_stack([rec[p] for p in _AXES[3:]]).astype(np.float64)
+        nrm = normals_of_records(mm[rows])
         del mm
-        nrm = np.cross(u, v)
         return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
 
     names = spec.names
@@ -157,20 +171,5 @@ def _normals_radius_summary(path, layout, spec, progress, stored_origin) -> Clou
                 return None
         del rec
         report(progress, "reading", hi / n)
-    diag = float(np.linalg.norm(hi_b - lo_b))
-    if not smallest > MIN_AXIS_LENGTH_REL * max(diag, 1e-300):
-        return None
-    origin = local_origin(positions, bounds=(lo_b, hi_b), stored=stored_origin)
-    positions = rebase(positions, origin)
-
-    def normals_of(rows: np.ndarray) -> np.ndarray:
-        mm = np.memmap(path, dtype=dtype, mode="r", offset=body, shape=(n,))
-        rec = mm[rows]
-        nrm = np.column_stack([rec[p] for p in spec.normals]).astype(np.float64)
-        del mm
-        return nrm / np.linalg.norm(nrm, axis=1, keepdims=True)
-
-    names = spec.names
-    bounds = (lo_b - origin, hi_b - origin) if origin.any() else (lo_b, hi_b)
-    return CloudSummary(positions, radii, origin, None, bool(spec.colors), "intensity" in names,
-                        "classification" in names, normals_of, known_bounds=bounds)
+    return _summary(path, layout, spec, positions, radii, (lo_b, hi_b), smallest, stored_origin,
+                    lambda rec: np.column_stack([rec[p] for p in spec.normals]).astype(np.float64))

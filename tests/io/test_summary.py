@@ -119,3 +119,17 @@ def test_a_normals_and_radius_file_with_a_zero_normal_or_bad_radius_takes_the_fu
     path = _normals_radius_file(tmp_path, "neg.ply", n=3000, bad_radius_row=1234)
     with pytest.raises(InputError, match="row 1234"):
         read_summary(path, lean_above=0)
+
+
+def test_a_normals_and_radius_file_too_small_to_measure_is_refused_by_the_lean_read_too(tmp_path):
+    """The lean pass of a normals + radius file makes the full reader's extent
+    check (a model under MIN_EXTENT_ABS across): the same one-line error."""
+    rng = np.random.default_rng(4)
+    pts = rng.normal(size=(500, 3)) * 1e-60
+    nrm = rng.normal(size=(500, 3))
+    path = make_ply(tmp_path / "tiny.ply", pts, fdtype="f8", normals=nrm, radius=np.full(500, 1e-61))
+    with pytest.raises(InputError) as full:
+        read(path)
+    with pytest.raises(InputError) as lean:
+        read_summary(path, lean_above=0)
+    assert str(lean.value) == str(full.value) and "across" in str(full.value)
