@@ -75,6 +75,7 @@ class Terrain:
         y0 = np.arange(lots)[None, :] * _LOT + r.uniform(2, _LOT - 2 - d)
         h = r.uniform(5, 30, (lots, lots))
         gable = r.random((lots, lots)) < 0.4
+        present &= (x0 + w < self.side) & (y0 + d < self.side)      # inside the square
         return present, x0, y0, w, d, h, gable
 
     def _footprint(self, x, y, b):

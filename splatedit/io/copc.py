@@ -396,6 +396,12 @@ class CopcFile:
 
     # -- queries
 
+    @property
+    def structure_keys(self) -> set:
+        """Keys listed in the hierarchy without points (they have
+        descendants with points)."""
+        return self._structure
+
     def node_bounds(self, key: NodeKey) -> np.ndarray:
         """(2, 3) float64 the cube of node ``key`` (it need not exist)."""
         side = 2 * self.halfsize / (1 << key.depth)
