@@ -33,7 +33,7 @@ def cmd_convert(args) -> int:
             and not args.remove_outliers):
         # streamed, in bounded memory (any size): splatedit.io.copc.convert_to_copc
         from splatedit.io import check_readable_file
-        from splatedit.io.copc import convert_to_copc
+        from splatedit.io.copc_convert import convert_to_copc
         check_readable_file(args.input)
         rep = convert_to_copc(args.input, args.output, progress=args.progress)
         args.progress.close()

@@ -18,7 +18,6 @@ point budget; then the normal splat renderer.
 from __future__ import annotations
 
 import heapq
-import sys
 import time
 
 import numpy as np

@@ -11,8 +11,9 @@ import numpy as np
 import pytest
 
 from splatedit.errors import InputError
-from splatedit.io.copc import (CopcFile, NodeKey, build_copc, cached_copc, convert_to_copc, make_records,
-                               record_dtype, rewrite_copc, write_copc)
+from splatedit.io.copc import (CopcFile, NodeKey, build_copc, make_records, record_dtype, rewrite_copc,
+                               write_copc)
+from splatedit.io.copc_convert import cached_copc, convert_to_copc
 
 laspy = pytest.importorskip("laspy")
 
