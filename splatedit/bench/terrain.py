@@ -188,7 +188,7 @@ def write_terrain_copc(path, n: int, *, seed: int = 0, laz_path=None, progress=N
     t = Terrain.of(n, chunk_points=chunk_points, seed=seed)
     lo, hi = t.bounds
     rep = build_copc(path, t.chunks, point_format=7, scale=SCALE, offset=t.offset, mins=lo, maxs=hi,
-                     progress=progress, **layout)
+                     progress=progress, count=n, **layout)
     if laz_path is not None:
         import laspy
         hdr = laspy.LasHeader(point_format=7, version="1.4")

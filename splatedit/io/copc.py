@@ -35,6 +35,7 @@ rewritten without a move gives back the same integers.
 
 from __future__ import annotations
 
+import heapq
 import os
 import struct
 import tempfile
@@ -1096,7 +1097,7 @@ def rewrite_copc(src: CopcFile, dst_path, edit: Callable[[CopcNode, PointBlock],
 
 def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_format: int, scale, offset,
                mins, maxs, node_points: int = NODE_POINTS, leaf_points: int = LEAF_POINTS,
-               vlrs=(), progress=None, tmp_dir=None) -> WriteReport:
+               vlrs=(), progress=None, tmp_dir=None, count: int | None = None) -> WriteReport:
     """Write a COPC file from point records streamed in chunks, in bounded
     memory (about three chunks).
 
@@ -1109,6 +1110,8 @@ def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_fo
         vlrs: (user, id, description, data) VLRs to keep (a CRS).
         tmp_dir: where the bucketed points are spilled (default: beside
             ``dst_path``; about ``record_length`` bytes a point).
+        count: the number of points, when known (for the progress of the
+            first pass).
 
     Passes: (1) count the points per cell of octree level ``FINE_DEPTH``;
     (2) assign each point its node (:class:`_Octree`), sort each chunk by
@@ -1136,7 +1139,7 @@ def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_fo
             if len(xyz):
                 seen_lo = np.minimum(seen_lo, xyz.min(axis=0))
                 seen_hi = np.maximum(seen_hi, xyz.max(axis=0))
-            report(progress, "counting points", 0.0)
+            report(progress, "counting points", n_total / count if count else 0.0)
             yield probe.fine_codes(xyz)
 
     codes, counts = _count_cells(counted())
@@ -1267,3 +1270,63 @@ def cloud_of_block(src: CopcFile, block: PointBlock, progress=None):
                        intensity=rec["intensity"].copy(), classification=rec["classification"].copy(),
                        quantization=quant,
                        point_fields={"copc_block_row": np.arange(len(rec), dtype=np.int64)})
+
+
+# --------------------------------------------------------------------------- level of detail
+
+
+def choose_nodes(src, eye, target, fov_deg: float, size, *, budget: int, refine_px: float):
+    """The nodes to draw for a camera at ``eye`` looking at ``target``
+    ((3,) file units) with a vertical field of view of ``fov_deg`` degrees
+    (an image of ``size`` (w, h)), as
+    Potree chooses them: from the root, a node in front of the camera and
+    inside its view cone is drawn, and its children visited while its point
+    spacing (``src.spacing / 2**depth``) projects to more than ``refine_px``
+    pixels at the node's nearest point; the largest projected spacing first,
+    until ``budget`` points.
+
+    Returns:
+        list of NodeKey (parents before children).
+    """
+    eye = np.asarray(eye, float)
+    fwd = np.asarray(target, float) - eye
+    fwd /= np.linalg.norm(fwd)
+    focal = 0.5 * size[1] / np.tan(np.radians(fov_deg) / 2)
+    half_diag = np.hypot(size[0], size[1]) / 2 / focal          # tan of the cone's half angle
+    cone = np.arctan(half_diag)
+
+    def weight(key):
+        b = src.node_bounds(key)
+        near = np.clip(eye, b[0], b[1])
+        dist = float(np.linalg.norm(near - eye))
+        centre = b.mean(axis=0)
+        radius = float(np.linalg.norm(b[1] - b[0])) / 2
+        to = centre - eye
+        d = float(np.linalg.norm(to))
+        if d > radius:       # outside the view cone (cone widened by the node's bounding sphere)
+            ang = np.arccos(np.clip(to @ fwd / d, -1, 1))
+            if ang - np.arcsin(min(1.0, radius / d)) > cone:
+                return None
+        spacing = src.spacing / (1 << key.depth)
+        return spacing * focal / max(dist, 1e-12)
+
+    out, total = [], 0
+    w = weight(ROOT)
+    heap = [(-w, ROOT)] if ROOT in src.nodes and w is not None else []
+    structure = src.structure_keys
+    while heap:
+        negw, key = heapq.heappop(heap)
+        n = src.nodes.get(key)
+        if n is not None:
+            if total + n.point_count > budget and out:
+                break
+            out.append(key)
+            total += n.point_count
+        if -negw <= refine_px:
+            continue
+        for c in key.children():
+            if c in src.nodes or c in structure:
+                cw = weight(c)
+                if cw is not None:
+                    heapq.heappush(heap, (-cw, c))
+    return out

@@ -56,7 +56,7 @@ def convert_to_copc(src_path, dst_path, progress=None, *, chunk_points: int = 2_
         # the header's box may be stale; a pass over the points is cheap next to compression
         return build_copc(dst_path, chunks, point_format=fmt, scale=scale, offset=offset,
                           mins=mins, maxs=maxs, node_points=node_points, leaf_points=leaf_points,
-                          vlrs=crs, progress=progress)
+                          vlrs=crs, progress=progress, count=int(hdr.point_count))
     from splatedit.io import read
     cloud = read(src, progress=progress)
     xyz = cloud.positions.astype(np.float64) + np.asarray(cloud.origin, np.float64)

@@ -107,7 +107,7 @@ def test_info_of_copc_reads_header_and_hierarchy_only(scan, monkeypatch, capsys)
 
 
 def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan):
-    from splatedit.commands.outofcore import choose_nodes
+    from splatedit.io.copc import choose_nodes
     with CopcFile.open(scan[0]) as f:
         lo, hi = f.point_bounds
         eye = np.array([lo[0], lo[1], hi[2]]) + [-3.0, -3.0, 2.0]
