@@ -6,6 +6,7 @@ error line naming the file (exit 2)."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -22,7 +23,7 @@ OFFSET = np.array([500_000.0, 5_000_000.0, 0.0])
 
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=120)
 
 
 @pytest.fixture(scope="module")
@@ -186,3 +187,11 @@ def test_damaged_copc_files_give_one_error_line_naming_the_file(scan, tmp_path):
             lines = res.stderr.strip().splitlines()
             assert len(lines) == 1 and lines[0].startswith("splatedit: error: ") and str(bad) in lines[0], \
                 (bad.name, args[0], res.stderr)
+
+
+def test_a_fifo_named_copc_is_refused_without_opening_it(tmp_path):
+    fifo = tmp_path / "pipe.copc.laz"
+    os.mkfifo(fifo)
+    for args in (("info", fifo), ("render", fifo, "-o", tmp_path / "x.png")):
+        res = run_cli(*args)         # an open() of the FIFO would block until the timeout
+        assert res.returncode == 2 and "is not a regular file" in res.stderr and str(fifo) in res.stderr
