@@ -168,8 +168,9 @@ def _damaged(scan, tmp_path):
     (tmp_path / "chunk.copc.laz").write_bytes(bytes(bad))
     out.append(tmp_path / "chunk.copc.laz")
     src = laspy.read(str(scan[0]))              # a plain LAZ named .copc.laz
-    plain = laspy.LasData(laspy.LasHeader(point_format=7, version="1.4"))
-    plain.header.scales, plain.header.offsets = SCALE, OFFSET
+    hdr = laspy.LasHeader(point_format=7, version="1.4")
+    hdr.scales, hdr.offsets = SCALE, OFFSET
+    plain = laspy.LasData(hdr)
     plain.X, plain.Y, plain.Z = np.asarray(src.X), np.asarray(src.Y), np.asarray(src.Z)
     plain.write(str(tmp_path / "plain.copc.laz"))
     out.append(tmp_path / "plain.copc.laz")
