@@ -146,6 +146,7 @@ def render_copc(args, camera_from_args) -> int:
         budget = getattr(args, "budget", None) or COPC_RENDER_BUDGET
         keys = choose_nodes(src, np.asarray(camera.eye) + origin, np.asarray(camera.target) + origin,
                             camera.fov_deg, args.size, budget=budget, refine_px=COPC_REFINE_PX)
+        keys = keys or top          # nothing in view: the frame shows what the coarse points show (nothing)
         block = src.read(keys, args.progress)
         cloud = cloud_of_block(src, block, args.progress)
     finally:

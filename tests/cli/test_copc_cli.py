@@ -196,3 +196,19 @@ def test_a_fifo_named_copc_is_refused_without_opening_it(tmp_path):
     for args in (("info", fifo), ("render", fifo, "-o", tmp_path / "x.png")):
         res = run_cli(*args)         # an open() of the FIFO would block until the timeout
         assert res.returncode == 2 and "is not a regular file" in res.stderr and str(fifo) in res.stderr
+
+
+def test_convert_laz_to_copc_on_the_command_line_streams_the_same_integers(scan, tmp_path):
+    src = laspy.read(str(scan[0]))
+    hdr = laspy.LasHeader(point_format=7, version="1.4")
+    hdr.scales, hdr.offsets = SCALE, OFFSET
+    plain = laspy.LasData(hdr)
+    for nm in ("X", "Y", "Z", "gps_time", "red", "green", "blue", "intensity"):
+        plain[nm] = np.asarray(src[nm])
+    plain.write(str(tmp_path / "plain.laz"))
+    res = run_cli("convert", tmp_path / "plain.laz", tmp_path / "back.copc.laz")
+    assert res.returncode == 0, res.stderr
+    assert "octree nodes (COPC)" in res.stdout
+    assert np.array_equal(_table(tmp_path / "back.copc.laz"), _table(scan[0]))
+    with CopcFile.open(tmp_path / "back.copc.laz") as f:
+        assert f.point_count == 40_000 and f.point_format == 7    # one leaf at the default layout
