@@ -54,12 +54,12 @@ class CameraTool(Tool):
     def actions(self):
         top = math.radians(89.0)
         return {Action.FRAME_ALL: self.frame_all, Action.FRAME_SELECTION: self.frame_selection,
-                Action.VIEW_FRONT: lambda: self.view_preset(0.0, 0.0),
-                Action.VIEW_RIGHT: lambda: self.view_preset(math.pi / 2, 0.0),
-                Action.VIEW_TOP: lambda: self.view_preset(0.0, top),
-                Action.VIEW_BACK: lambda: self.view_preset(math.pi, 0.0),
-                Action.VIEW_LEFT: lambda: self.view_preset(-math.pi / 2, 0.0),
-                Action.VIEW_BOTTOM: lambda: self.view_preset(0.0, -top),
+                Action.VIEW_FRONT: lambda: self.view_preset(0.0, 0.0, "front"),
+                Action.VIEW_RIGHT: lambda: self.view_preset(math.pi / 2, 0.0, "right"),
+                Action.VIEW_TOP: lambda: self.view_preset(0.0, top, "top"),
+                Action.VIEW_BACK: lambda: self.view_preset(math.pi, 0.0, "back"),
+                Action.VIEW_LEFT: lambda: self.view_preset(-math.pi / 2, 0.0, "left"),
+                Action.VIEW_BOTTOM: lambda: self.view_preset(0.0, -top, "bottom"),
                 Action.CYCLE_UP_AXIS: self.cycle_up_axis}
 
     # ----------------------------------------------------------- up axis
@@ -122,8 +122,9 @@ class CameraTool(Tool):
         w, h = self.ed.size
         self.cam.frame(ext.center, ext.radius, w / max(h, 1), area=self.view_area())
         self.ed.motion()
-        if say and ext.note():
-            self.ed.say(f"left out of the view: {ext.note()}")
+        if say:     # a view change replaces the previous status message with the view's name
+            note = ext.note()
+            self.ed.say("view: the whole model" + (f"; left out of the view: {note}" if note else ""))
 
     def frame_selection(self) -> None:
         """F: the active handle (else the support) fills the free part of the window."""
@@ -137,11 +138,16 @@ class CameraTool(Tool):
         w, h = self.ed.size
         self.cam.frame_points(s.cloud.positions[m], w / max(h, 1), area=self.view_area())
         self.ed.motion()
+        self.ed.say(f"view: the {'active handle' if s.selection.handle.any() else 'support'}")
 
-    def view_preset(self, yaw: float, pitch: float) -> None:
-        """A numpad view: turn about the pivot (the framed model stays where it is on screen)."""
+    def view_preset(self, yaw: float, pitch: float, name: str | None = None) -> None:
+        """A numpad view: turn about the pivot (the framed model stays where it
+        is on screen); ``name`` ("front", "top", ...): the status line says it
+        (replacing whatever the previous message was)."""
         self.cam.turn_to(yaw, pitch)
         self.ed.motion()
+        if name is not None:
+            self.ed.say(f"view: {name} (about the up axis {self.up.label})")
 
     # -------------------------------------------------------------- mouse
     def press(self, e):
