@@ -222,6 +222,7 @@ class Editor(EventRouting, FileActions):
         t.update({
             Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
+            Action.EDL: self.toggle_edl,
             Action.DEFORMATION_MODE: self.cycle_deformation,
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
             Action.SPLATS_LARGER: lambda: self.scale_splats(EDITOR_SPLAT_SCALE_STEP),
@@ -253,6 +254,17 @@ class Editor(EventRouting, FileActions):
         vp.grey = not vp.grey
         grey = "uniform grey shading" if getattr(vp, "gaussians", None) is None else "grey (luminance)"
         self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
+
+    def toggle_edl(self) -> None:
+        """Shift+E: eye-dome lighting on / off (splat models; a Gaussian scene says it has none)."""
+        vp = self.viewport
+        if getattr(vp, "gaussians", None) is not None:
+            vp.edl = False
+            self.say("eye-dome lighting is for point-splat models, not Gaussian splat scenes")
+            return
+        vp.edl = not vp.edl
+        self.say("eye-dome lighting " + ("on: depth edges and creases darkened (Shift+E: off)"
+                                         if vp.edl else "off"))
 
     def scale_splats(self, factor: float) -> None:
         """Shift+[ / Shift+]: draw every splat's axes this much larger (display only)."""

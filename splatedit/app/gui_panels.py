@@ -434,6 +434,10 @@ class EditorGui(MenuBar):
             self._rect(f"display_{name.split()[0]}")
             if k < 2:
                 imgui.same_line()
+        if getattr(vp, "gaussians", None) is None:      # eye-dome lighting: a splat pass
+            if imgui.checkbox("eye-dome lighting (Shift+E)", bool(vp.edl))[0]:
+                ed.run_action(Action.EDL)
+            self._rect("display_edl")
         imgui.set_next_item_width(150)
         ch, v = imgui.slider_float("splat size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
                                    EDITOR_SPLAT_SCALE_MAX, "%.2fx", imgui.SliderFlags_.logarithmic.value)

@@ -1,0 +1,75 @@
+"""Display and feedback in the real window (Xvfb + xdotool, screenshots):
+eye-dome lighting toggled by its key darkens depth edges, the status line
+of an edge-on view, and a long selection operation (mirror) runs as a job
+while frames keep coming."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+from tests.app.window_harness import WINDOW, EditorProcess
+
+pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
+pytest.importorskip("imgui_bundle")
+
+
+def _model_area(s: dict) -> np.ndarray:
+    """(h, w) bool: the window's pixels right of the side panel and below the menu bar."""
+    w, h = WINDOW
+    m = np.zeros((h, w), bool)
+    x, y, pw, ph = s["panel_box"]
+    m[30:h - 4, x + pw + 8: w - 4] = True
+    return m
+
+
+def _eroded(mask: np.ndarray, r: int) -> np.ndarray:
+    out = mask.copy()
+    for dy in range(-r, r + 1):
+        for dx in range(-r, r + 1):
+            out &= np.roll(np.roll(mask, dy, 0), dx, 1)
+    return out
+
+
+def test_shift_e_toggles_eye_dome_lighting_which_darkens_only_depth_edges(xvfb, tmp_path):
+    """Shift+E: the frame changes; every changed pixel of the model got
+    darker (EDL only darkens), a visible share of them a lot (the far side
+    of the ear and body outlines), in thin lines (an erosion by 2 pixels
+    leaves few of them: edges, not a darker model); Shift+E again gives the
+    first frame back."""
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and s["full_quality"]
+                    and "menu_view" in s.get("gui_rects", {}), "model loaded", 90)
+        assert not s["edl"]
+        off = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        n0 = s["frames_presented"]
+        ed.xdo("key", "shift+e")
+        s = ed.idle(lambda s: s["edl"] and s["full_quality"] and s["frames_presented"] > n0, "EDL on")
+        assert s["message"].startswith("eye-dome lighting on")
+        on = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        area = _model_area(s)
+        model = area & (off.min(axis=2) < 230)
+        assert model.sum() > 5000, "the model is not visible"
+        lum_off, lum_on = off.mean(axis=2), on.mean(axis=2)
+        brighter = area & (lum_on > lum_off + 3)
+        assert brighter.sum() <= 0.002 * model.sum(), f"{brighter.sum()} pixels got brighter"
+        dark = model & (lum_on < lum_off - 40)
+        assert dark.sum() >= 0.01 * model.sum(), f"only {dark.sum()} of {model.sum()} model pixels darkened"
+        assert dark.sum() <= 0.5 * model.sum(), "the whole model got darker, not its edges"
+        assert _eroded(dark, 2).sum() <= 0.25 * dark.sum(), "the darkened pixels are not thin edges"
+        ed.xdo("key", "shift+e")
+        s = ed.idle(lambda s: not s["edl"] and s["full_quality"] and s["message"] == "eye-dome lighting off",
+                    "EDL off")
+        again = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        assert np.abs(again - off)[area].max() <= 3
+        # the View menu's entry toggles it too
+        x, y, w, h = s["gui_rects"]["menu_view"]
+        ed.xdo("mousemove", x + w // 2, y + h // 2, "click", "1")
+        s = ed.wait(lambda s: "view_edl" in s["gui_rects"] and s["gui_menu_open"], "View menu open")
+        x, y, w, h = s["gui_rects"]["view_edl"]
+        ed.xdo("mousemove", x + w // 2, y + h // 2, "sleep", "0.2", "click", "1")
+        s = ed.idle(lambda s: s["edl"], "EDL on from the View menu")
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
