@@ -182,6 +182,9 @@ class FrameScheduler:
         if w == 0 or h == 0 or ed.window.iconified():
             return
         t0 = time.perf_counter()
+        if (ed.session is not None and ed.drag is DragMode.NONE and not self.scene_interactive
+                and self.scene_key is not None and self.scene_key == self.state()):
+            ed.camera.view_hint()       # a still view drawn: does it show (almost) nothing?
         if self.gpu:
             self._draw_gpu(w, h)
         else:

@@ -96,6 +96,7 @@ def status_dict(ed) -> dict:
               history_label=s.history.labels[s.history.position],
               region_armed=ed.region.armed, region_points=len(ed.region.points),
               mirror_painting=ed.mirror.painting, mirror_axis="XYZ"[ed.mirror.axis],
+              view_hint_checked=ed.camera.hint_checked(),
               pivot=ed.pivot.mode, axes=ed.pivot.orientation,
               cursor=None if ed.pivot.cursor is None else [round(float(x), 9) for x in ed.pivot.cursor],
               manip_pivot=None if s.manip is None else [round(float(x), 9) for x in s.manip.pivot])

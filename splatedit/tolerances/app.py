@@ -322,3 +322,14 @@ GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
 #: 25% 3.43 (4.76 uncompensated), 100k sphere 10% 5.20 (7.57); the editor
 #: bench at 1280x720 (16k of 1M at half resolution): 4.92
 GS_LOD_TEST_MEAN_DIFF = 6.5
+
+
+# ---------------------------------------------------------------------------
+# The status line's hint for a view that draws (almost) nothing (app/view_coverage.py)
+# ---------------------------------------------------------------------------
+#: hint when the bound of the drawn share of the view is below this ...
+EDITOR_COVERAGE_HINT_SHARE = 0.005
+#: ... while at least this many splat centres are in view
+EDITOR_COVERAGE_HINT_MIN_IN_VIEW = 500
+#: splats looked at by the estimate (a fixed stride of the cloud)
+EDITOR_COVERAGE_SAMPLE = 16_384

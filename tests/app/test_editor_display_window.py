@@ -73,3 +73,36 @@ def test_shift_e_toggles_eye_dome_lighting_which_darkens_only_depth_edges(xvfb, 
         assert s["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_a_view_that_draws_almost_nothing_says_why_on_the_status_line(xvfb, tmp_path):
+    """A scanned post (normals horizontal and outward, no cap) from the top
+    (Shift+7): the window draws (almost) no pixel of it, and the status line
+    names the view and says that its splats are seen edge-on or from behind,
+    with the keys of other views; from the front (Shift+1) the post covers a
+    good part of the view and no hint is given."""
+    from splatedit.io import write
+    from tests.app.test_view_coverage import post_cloud
+    path = tmp_path / "post.ply"
+    write(str(path), post_cloud())
+    ed = EditorProcess(xvfb, tmp_path, str(path))
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and s["full_quality"], "post loaded", 90)
+        ed.xdo("key", "shift+7")
+        s = ed.idle(lambda s: s["full_quality"] and s["message"].startswith("view: top")
+                    and "edge-on" in s["message"], "top view with the hint")
+        assert "Shift+1" in s["message"]
+        top = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        area = _model_area(s)
+        drawn_top = (area & (top.min(axis=2) < 230)).sum() / area.sum()
+        ed.xdo("key", "shift+1")
+        s = ed.idle(lambda s: s["full_quality"] and s["message"].startswith("view: front")
+                    and s["view_hint_checked"], "front view, its coverage estimated")
+        assert "edge-on" not in s["message"], s["message"]
+        front = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        drawn_front = (area & (front.min(axis=2) < 230)).sum() / area.sum()
+        # the brush circle and its label are drawn over the view in both
+        assert drawn_top < 0.005 and drawn_front > 0.05, (drawn_top, drawn_front)
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()

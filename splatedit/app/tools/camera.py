@@ -10,6 +10,8 @@ from splatedit.app import revision
 from splatedit.app.keymap import Action, Section
 from splatedit.app.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
+from splatedit.app.view_coverage import coverage_estimate
+from splatedit.app.view_coverage import hint as coverage_hint
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, next_up
@@ -46,6 +48,7 @@ class CameraTool(Tool):
         self.zoom_anchor = None          # (x, y, world point) kept while the cursor stays put
         self.up = UpAxis(1, 1)
         self._extent = None              # (cloud revision, FramingExtent)
+        self._hint_key = None            # the view whose drawn coverage was last estimated
 
     @property
     def cam(self):
@@ -148,6 +151,39 @@ class CameraTool(Tool):
         self.ed.motion()
         if name is not None:
             self.ed.say(f"view: {name} (about the up axis {self.up.label})")
+
+    def _drawn_cloud(self):
+        cloud = getattr(self.ed.viewport, "cloud", None)
+        return self.session.cloud if cloud is None else cloud
+
+    def _view_key(self) -> tuple:
+        return (self.cam.state(), tuple(self.ed.size), revision.of(self._drawn_cloud()),
+                float(self.ed.viewport.splat_scale))
+
+    def hint_checked(self) -> bool:
+        """The current view's coverage was estimated (:meth:`view_hint` ran for it)."""
+        return self.session is not None and self._hint_key == self._view_key()
+
+    def view_hint(self) -> None:
+        """A still view that draws (almost) nothing although many splats are
+        in it (a raw scan's estimated normals seen edge-on or from behind,
+        :mod:`splatedit.app.view_coverage`): say so on the status line, after
+        the view's name when that is the message.  Estimated once per view."""
+        ed, s = self.ed, self.session
+        vp = ed.viewport
+        if s is None or getattr(vp, "gaussians", None) is not None:
+            return
+        key = self._view_key()
+        if key == self._hint_key:
+            return
+        cloud = self._drawn_cloud()
+        self._hint_key = key
+        w, h = ed.size
+        cov = coverage_estimate(cloud.positions, cloud.u, cloud.v, self.cam, w, h, self.view_area(),
+                                float(vp.splat_scale))
+        if cov.tiny:
+            text = coverage_hint(cov, "Shift+1 / Shift+3 or a middle drag")
+            ed.say(f"{ed.message}; {text}" if ed.message.startswith("view:") else text)
 
     # -------------------------------------------------------------- mouse
     def press(self, e):
