@@ -106,3 +106,74 @@ def test_a_view_that_draws_almost_nothing_says_why_on_the_status_line(xvfb, tmp_
         assert s["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_panel_lines_and_sliders_stay_readable(xvfb, tmp_path):
+    """An armed box select's state line wraps inside the panel (it was cut
+    at the panel's edge), and the brush radius and splat size sliders show
+    their value beside the slider: no text inside the slider's frame, where
+    the grab box would cover it (screenshot: no text-white pixel there)."""
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and "brush_radius_slider" in s["gui_rects"],
+                    "model loaded", 90)
+        ed.xdo("key", "ctrl+b")
+        s = ed.idle(lambda s: s["region_armed"] and "tool_status_region" in s["gui_rects"], "box select armed")
+        n = s["frames_presented"]
+        s = ed.wait(lambda s: s["frames_presented"] >= n + 2, "laid out")
+        px, py, pw, ph = s["panel_box"]
+        x, y, w, h = s["gui_rects"]["tool_status_region"]
+        assert px <= x and x + w <= px + pw - 8, (s["gui_rects"]["tool_status_region"], s["panel_box"])
+        assert h >= 2 * 13, "the line is not wrapped"
+        img = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        ed.xdo("key", "Escape")
+        for name in ("brush_radius", "splat_size"):
+            if f"{name}_slider" not in s["gui_rects"]:          # the Display section below the fold
+                continue
+            x, y, w, h = s["gui_rects"][f"{name}_slider"]
+            frame = img[y + 1:y + h - 1, x + 1:x + w - 1]
+            assert (frame.min(axis=2) > 200).sum() == 0, f"text inside the {name} slider"
+            vx, vy, vw, vh = s["gui_rects"][f"{name}_value"]
+            assert vx >= x + w and vx + vw <= px + pw, f"the {name} value is not beside its slider"
+            value = img[vy:vy + vh, vx:vx + vw]
+            assert (value.min(axis=2) > 200).sum() > 20, f"no {name} value text"
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
+
+
+def test_the_grab_readout_keeps_a_margin_from_the_window_edge(xvfb, tmp_path):
+    """G with the cursor at the window's right edge and a long typed value:
+    the readout's box ends EDITOR_READOUT_MARGIN_PX inside the window (it
+    touched the edge), and the screenshot shows its dark box there and
+    background beyond it."""
+    from splatedit.tolerances import EDITOR_READOUT_MARGIN_PX
+    from tests.app.window_harness import _foreground_centre, paint_support_stroke
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and s["full_quality"], "model loaded", 90)
+        cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
+        paint_support_stroke(ed, cx, cy)
+        ed.idle(lambda s: s["support"] > 200, "support painted")
+        ed.xdo("key", "2", "bracketleft", "bracketleft", "bracketleft", "bracketleft", "bracketleft",
+               "mousemove", cx, cy, "click", "1")
+        ed.idle(lambda s: s["handle"] > 0 and s["state"] == "ready", "handle painted and fitted")
+        ed.xdo("mousemove", cx, cy, "key", "g")
+        ed.wait(lambda s: s["manip"] == "grab", "grab started")
+        ed.xdo("mousemove", WINDOW[0] - 3, WINDOW[1] // 2, "key", "x", "1", "2", "3", "period", "4")
+        s = ed.wait(lambda s: s["readout"] and "typed" in s["readout"] and "readout" in s.get("gui_rects", {}),
+                    "typed readout shown")
+        n = s["frames_presented"]
+        s = ed.wait(lambda s: s["frames_presented"] >= n + 1, "drawn")
+        x, y, w, h = s["gui_rects"]["readout"]
+        assert x + w <= WINDOW[0] - EDITOR_READOUT_MARGIN_PX and x >= EDITOR_READOUT_MARGIN_PX
+        assert y + h <= WINDOW[1] - EDITOR_READOUT_MARGIN_PX
+        img = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        row = img[y + h // 2]
+        assert row[x + 2:x + w - 2].min() < 120                 # the readout's dark box
+        assert row[WINDOW[0] - EDITOR_READOUT_MARGIN_PX + 1:].min() > 200   # background in the margin
+        ed.xdo("key", "Escape")
+        s = ed.idle(lambda s: s["manip"] is None, "grab cancelled")
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
