@@ -325,6 +325,10 @@ def poll_jobs(ed) -> None:
         if not job.done:
             continue
         del ed.jobs[name]
+        land = getattr(job, "land", None)
+        if land is not None:          # a tool's job (ToolContext.start_job) lands itself
+            land(job)
+            continue
         if job.error is not None:
             err = job.error
             if name == "graph":

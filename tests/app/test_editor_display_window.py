@@ -177,3 +177,41 @@ def test_the_grab_readout_keeps_a_margin_from_the_window_edge(xvfb, tmp_path):
         assert s["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_mirror_runs_as_a_job_while_the_window_keeps_drawing(xvfb, tmp_path, monkeypatch):
+    """Ctrl+M on a painted support: the mirror runs as a background job
+    (held open by the jobs' test hook until the test lets it finish, so the
+    window can be watched meanwhile): the status file lists it, frames keep
+    being presented, a view key turns the view and the progress bar is on
+    screen; when it lands the support has grown by its mirror image as one
+    undo step."""
+    from tests.app.window_harness import _foreground_centre, paint_support_stroke
+    hold = tmp_path / "hold-mirror"
+    hold.write_text("")
+    monkeypatch.setenv("SPLATEDIT_TEST_HOLD_JOB", "mirroring")
+    monkeypatch.setenv("SPLATEDIT_TEST_HOLD_FILE", str(hold))
+    ed = EditorProcess(xvfb, tmp_path)
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0 and s["full_quality"], "model loaded", 90)
+        cx, cy = _foreground_centre(ed.screenshot(), s["panel_box"])
+        paint_support_stroke(ed, cx + 60, cy)
+        s = ed.idle(lambda s: s["support"] > 200, "support painted")
+        support, history = s["support"], s["history"]
+        ed.xdo("key", "ctrl+m")
+        s = ed.wait(lambda s: "mirror" in s["jobs"], "mirror job running")
+        n0, yaw0 = s["frames_presented"], s["camera"]["yaw"]
+        ed.xdo("key", "shift+3")
+        s = ed.wait(lambda s: s["camera"]["yaw"] != yaw0 and s["frames_presented"] >= n0 + 3
+                    and s["full_quality"], "frames drawn while the mirror runs")
+        assert "mirror" in s["jobs"] and s["support"] == support
+        img = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        bar = img[30:60, WINDOW[0] // 2 - 150: WINDOW[0] // 2 + 150]     # the progress window, top centre
+        assert (bar.max(axis=2) < 90).mean() > 0.3, "no progress bar on screen"
+        hold.unlink()
+        s = ed.idle(lambda s: "mirror" not in s["jobs"] and s["support"] > support, "mirror landed")
+        assert s["history"] == history + 1 and s["history_label"] == "mirror support"
+        assert s["message"].startswith("mirror support across X")
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()
