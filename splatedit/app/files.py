@@ -27,9 +27,10 @@ KEEP_FORMAT_SUFFIXES = extensions(keep_on_save=True)
 
 
 def package_folder() -> Path:
-    """The folder of the installed ``splatedit`` package (resolved)."""
-    import splatedit
-    return Path(splatedit.__file__).resolve().parent
+    """The folder of the installed ``splatedit`` package (resolved): the
+    parent of its ``data`` folder (the shipped models)."""
+    from splatedit.data import default_model_path
+    return default_model_path().resolve().parent.parent
 
 
 def inside_package(path) -> bool:
