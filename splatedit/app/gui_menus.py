@@ -113,6 +113,10 @@ class MenuBar:
                                s is not None and getattr(ed.viewport, "gaussians", None) is None)[0]:
                 ed.run_action(Action.EDL)
             self._rect("view_edl")
+            if imgui.menu_item("Two-sided splats", "T", bool(ed.viewport.two_sided),
+                               s is not None and getattr(ed.viewport, "gaussians", None) is None)[0]:
+                ed.run_action(Action.TWO_SIDED)
+            self._rect("view_two_sided")
             imgui.separator()
             for label, shortcut, action in _VIEW_ENTRIES:
                 if imgui.menu_item(label, shortcut, False, s is not None)[0]:

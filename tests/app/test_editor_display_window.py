@@ -79,8 +79,9 @@ def test_a_view_that_draws_almost_nothing_says_why_on_the_status_line(xvfb, tmp_
     """A scanned post (normals horizontal and outward, no cap) from the top
     (Shift+7): the window draws (almost) no pixel of it, and the status line
     names the view and says that its splats are seen edge-on or from behind,
-    with the keys of other views; from the front (Shift+1) the post covers a
-    good part of the view and no hint is given."""
+    with the keys of other views and T; T (two-sided splats) draws the splats
+    seen from behind: the ring of the post's wall shows; from the front
+    (Shift+1) the post covers a good part of the view and no hint is given."""
     from splatedit.io import write
     from tests.app.test_view_coverage import post_cloud
     path = tmp_path / "post.ply"
@@ -91,10 +92,18 @@ def test_a_view_that_draws_almost_nothing_says_why_on_the_status_line(xvfb, tmp_
         ed.xdo("key", "shift+7")
         s = ed.idle(lambda s: s["full_quality"] and s["message"].startswith("view: top")
                     and "edge-on" in s["message"], "top view with the hint")
-        assert "Shift+1" in s["message"]
+        assert "Shift+1" in s["message"] and "T: draw the splats seen from behind" in s["message"]
         top = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
         area = _model_area(s)
         drawn_top = (area & (top.min(axis=2) < 230)).sum() / area.sum()
+        ed.xdo("key", "t")
+        s = ed.idle(lambda s: s["two_sided"] and s["full_quality"] and s["view_hint_checked"], "two-sided")
+        assert "edge-on" not in s["message"], s["message"]
+        ring = ed.screenshot()[:WINDOW[1], :WINDOW[0]].astype(int)
+        drawn_ring = (area & (ring.min(axis=2) < 230)).sum() / area.sum()
+        assert drawn_ring > max(0.005, 5 * drawn_top), (drawn_top, drawn_ring)
+        ed.xdo("key", "t")
+        s = ed.idle(lambda s: not s["two_sided"] and s["full_quality"], "one-sided again")
         ed.xdo("key", "shift+1")
         s = ed.idle(lambda s: s["full_quality"] and s["message"].startswith("view: front")
                     and s["view_hint_checked"], "front view, its coverage estimated")

@@ -157,8 +157,9 @@ class CameraTool(Tool):
         return self.session.cloud if cloud is None else cloud
 
     def _view_key(self) -> tuple:
+        vp = self.ed.viewport
         return (self.cam.state(), tuple(self.ed.size), revision.of(self._drawn_cloud()),
-                float(self.ed.viewport.splat_scale))
+                float(vp.splat_scale), bool(getattr(vp, "two_sided", False)))
 
     def hint_checked(self) -> bool:
         """The current view's coverage was estimated (:meth:`view_hint` ran for it)."""
@@ -179,10 +180,13 @@ class CameraTool(Tool):
         cloud = self._drawn_cloud()
         self._hint_key = key
         w, h = ed.size
+        culled = not getattr(vp, "two_sided", False)
         cov = coverage_estimate(cloud.positions, cloud.u, cloud.v, self.cam, w, h, self.view_area(),
-                                float(vp.splat_scale))
+                                float(vp.splat_scale), culling=culled)
         if cov.tiny:
             text = coverage_hint(cov, "Shift+1 / Shift+3 or a middle drag")
+            if culled and cov.front < 0.5 * cov.in_view:
+                text += ", or T: draw the splats seen from behind too"
             ed.say(f"{ed.message}; {text}" if ed.message.startswith("view:") else text)
 
     # -------------------------------------------------------------- mouse
