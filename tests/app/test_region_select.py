@@ -228,3 +228,22 @@ def test_a_mirror_whose_selection_changed_while_it_ran_changes_nothing(ed):
     land_jobs(ed)
     assert (s.selection.support == other).all() and s.history.position == positions
     assert "selection changed while it ran" in ed.messages[-1]
+
+
+def test_a_mirror_landing_after_another_model_was_opened_touches_neither(ed):
+    """The mirror job of the previous model lands after another model was
+    opened: the new document's selection and history stay as they are, and
+    nothing is recorded in the closed one."""
+    s = ed.session
+    p = s.cloud.positions
+    s.set_selection((p[:, 0] > 0.5) & (p[:, 1] > 0), np.zeros(s.cloud.n, bool))
+    old_len = len(s.history)
+    key(ed, glfw.KEY_M, glfw.MOD_CONTROL)
+    new = Session(plane_cloud(12), fit_sync=True)
+    try:
+        ed.session = new
+        land_jobs(ed)
+        assert not new.selection.support.any() and len(new.history) == 1
+        assert len(s.history) == old_len
+    finally:
+        new.close()

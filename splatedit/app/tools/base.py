@@ -146,7 +146,10 @@ class ToolContext:
 
     def install(self, job, label: str) -> bool:
         """Make a finished BackgroundApply's selection the document's (one
-        undo step); False when the selection changed since it started."""
+        undo step); False when the selection changed since it started, or
+        another model was opened meanwhile."""
+        if job.session is not self._ed.session:
+            return False
         return self._ed.brush.tools.install(job, label)
 
     # ---- background work

@@ -95,6 +95,8 @@ class MirrorTool(Tool):
             return job.compute(new)
 
         def land(done) -> None:
+            if c.document is not job.session:
+                return                      # another model was opened meanwhile: nothing to say
             if done.error is not None:
                 c.say(f"mirror failed: {done.error}")
             elif not done.result:
