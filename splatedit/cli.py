@@ -91,6 +91,7 @@ def _positive_count(text: str) -> int:
 
 # ------------------------------------------------------------------ commands
 def cmd_demo(args) -> int:
+    """Run ``splatedit demo``: the headless tour into ``args.output_dir``; returns the exit status."""
     from splatedit.demo import run_demo
     run_demo(Path(args.output_dir), progress=args.progress, log=print, render=not args.no_render,
              overwrite=args.force)
@@ -98,6 +99,7 @@ def cmd_demo(args) -> int:
 
 
 def cmd_edit(args) -> int:
+    """Run ``splatedit edit``: check the paths first, then open the editor window; returns the exit status."""
     check_edit_paths(args.file, args.save_as)       # before the editor opens a window
     from splatedit.app.editor import run_editor
     from splatedit.app.options import options_from_args
@@ -148,6 +150,7 @@ def _fresh_directory(base: Path) -> Path:
 
 
 def cmd_bench(args) -> int:
+    """Run ``splatedit bench WHAT``: one JSON line per benchmark case on stdout; returns the exit status."""
     from splatedit.bench.runner import run_bench
     what = args.what
     if args.gaussians:
@@ -182,6 +185,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``splatedit`` argument parser with every subcommand (its errors follow the one-line error contract)."""
     p = _Parser(prog="splatedit", description=__doc__.split("\n")[0])
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
     sub = p.add_subparsers(dest="command")
@@ -293,6 +297,8 @@ def _route_warnings(progress: _Progress) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The console entry point: parse ``argv`` (default ``sys.argv[1:]``), run the command, map errors to one
+    ``splatedit: error: ...`` line and exit status 2; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv), VECTOR_OPTIONS))
     args.progress = _Progress(enabled=not args.quiet)

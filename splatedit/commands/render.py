@@ -63,6 +63,8 @@ def _clip_to_main_body(camera, extent) -> None:
 
 
 def cmd_render(args) -> int:
+    """Run ``splatedit render``: draw a model (optionally after an edit script) headless into a PNG;
+    returns the exit status."""
     from splatedit.io import check_output_path
     from splatedit.render.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():

@@ -37,6 +37,7 @@ PATHS = ("auto", "raster", "compute")
 
 
 def rp_accum(fmt: str) -> V.RenderPassDesc:
+    """The Gaussian accumulation render pass: one colour attachment of format ``fmt``, cleared, left readable by shaders."""
     return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final="shader_read"),))
 
 

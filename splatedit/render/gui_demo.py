@@ -31,6 +31,8 @@ _PRESS = 1
 
 @dataclass
 class DemoState:
+    """What the ImGui demo panel shows and reports (frame count, clicks, widget values, button and panel
+    rectangles in pixels): written as JSON for the window tests."""
     frame: int = 0
     clicks: int = 0
     value: float = 0.5
@@ -132,6 +134,7 @@ def run_demo(size=(800, 500), *, status_file: str | None = None, frames: int = 0
 
 
 def main(argv=None) -> int:
+    """``python -m splatedit.render.gui_demo``: Dear ImGui on our Vulkan swapchain, for tests and a quick look."""
     import argparse
     p = argparse.ArgumentParser(prog="python -m splatedit.render.gui_demo",
                                 description="Dear ImGui on splatedit's Vulkan renderer")

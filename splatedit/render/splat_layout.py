@@ -60,6 +60,8 @@ def rp_window(desc: V.RenderPassDesc, first: bool, last: bool) -> V.RenderPassDe
 
 
 def rp_attr(fmt: str, final: str) -> V.RenderPassDesc:
+    """The attribute render pass: two colour targets of format ``fmt`` (cleared; layout ``final`` after the
+    pass) and the visibility pass's depth, loaded read-only."""
     return V.RenderPassDesc(colors=(V.Attachment(fmt, "clear", final=final),
                                     V.Attachment(fmt, "clear", final=final)),
                             depth=V.Attachment("d32f", "load", initial="depth", final="depth"))

@@ -77,6 +77,7 @@ _LIVE_LOCK = threading.Lock()
 
 
 def track(kind: str, delta: int) -> None:
+    """Count ``delta`` live Vulkan handles of ``kind`` (the leak tests read the counts)."""
     with _LIVE_LOCK:
         _LIVE[kind] += delta
         if _LIVE[kind] == 0:
@@ -130,6 +131,7 @@ _MSG_LOCK = threading.Lock()
 
 
 def validation_enabled() -> bool:
+    """True when ``SPLATEDIT_VALIDATION`` asks for the Khronos validation layer."""
     return os.environ.get("SPLATEDIT_VALIDATION", "0") not in ("", "0", "false", "no")
 
 
