@@ -120,7 +120,7 @@ def cmd_deform(args) -> int:
 def _deform_gaussians(args) -> int:
     """``deform`` of a Gaussian scene: edits select centres; covariances and
     spherical harmonics follow the Jacobian; the output is a Gaussian PLY."""
-    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.script.gaussian import run_script_gaussians
     from splatedit.io import read_gaussians, write_gaussians
     from splatedit.script import load_script
     if Path(args.output).suffix.lower() != ".ply":

@@ -179,5 +179,5 @@ class EditScript:
 
     def save(self, path: str | Path) -> None:
         """Write the script as JSON (atomic: temp file + rename)."""
-        from splatedit.io.atomic import atomic_write_text
+        from splatedit.atomic import atomic_write_text
         atomic_write_text(path, json.dumps(self.to_json(), indent=1) + "\n")

@@ -293,7 +293,7 @@ class Device:
             shaderFloat64=0, vertexPipelineStoresAndAtomics=avail.vertexPipelineStoresAndAtomics,
             shaderInt64=1 if atomics else 0)
         self.features = feats
-        #: the device runs the compute splat rasterizer (splatedit.render.compute_raster):
+        #: the device runs the compute splat rasterizer (splatedit.render.splat.compute_raster):
         #: 64-bit buffer atomics (atomicMin of depth << 32 | id) and float32 buffer
         #: atomicAdd (VK_EXT_shader_atomic_float), both enabled at creation
         self.compute_raster = atomics
