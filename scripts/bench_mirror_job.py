@@ -15,8 +15,8 @@ import time
 
 import numpy as np
 
-from splatedit.app.selection_tools import SelectionTools
-from splatedit.app.session import Session
+from splatedit.app.document.selection import SelectionTools
+from splatedit.app.document.session import Session
 from splatedit.bench.render import sphere_cloud
 from splatedit.select.mirror import mirror_indices
 

@@ -53,7 +53,7 @@ def test_a_model_opened_by_a_path_inside_the_package_is_saved_in_the_users_folde
     bundled model"): the proposed save is in the current directory, never
     beside the shipped file; from a current directory inside the package it
     is the home folder; an explicit save into the package is refused."""
-    from splatedit.app.files import inside_package, package_folder, save_refusal
+    from splatedit.app.document.files import inside_package, package_folder, save_refusal
     from splatedit.data import default_model_path
     src = default_model_path()
     assert inside_package(src) and not inside_package(tmp_path)

@@ -1,5 +1,5 @@
 """The drawn-coverage estimate behind the status line's hint for views that
-show (almost) nothing (:mod:`splatedit.app.view_coverage`)."""
+show (almost) nothing (:mod:`splatedit.app.view.coverage`)."""
 
 from __future__ import annotations
 
@@ -8,8 +8,8 @@ import math
 import numpy as np
 import pytest
 
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.view_coverage import coverage_estimate
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.view.coverage import coverage_estimate
 from splatedit.model import SplatCloud
 
 W, H = 640, 400

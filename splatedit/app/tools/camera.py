@@ -6,12 +6,12 @@ from __future__ import annotations
 import math
 
 
-from splatedit.app import revision
-from splatedit.app.keymap import Action, Section
-from splatedit.app.panel import PANEL_MARGIN
+from splatedit.app.document import revision
+from splatedit.app.ui.keymap import Action, Section
+from splatedit.app.ui.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
-from splatedit.app.view_coverage import coverage_estimate
-from splatedit.app.view_coverage import hint as coverage_hint
+from splatedit.app.view.coverage import coverage_estimate
+from splatedit.app.view.coverage import hint as coverage_hint
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, next_up
@@ -168,7 +168,7 @@ class CameraTool(Tool):
     def view_hint(self) -> None:
         """A still view that draws (almost) nothing although many splats are
         in it (a raw scan's estimated normals seen edge-on or from behind,
-        :mod:`splatedit.app.view_coverage`): say so on the status line, after
+        :mod:`splatedit.app.view.coverage`): say so on the status line, after
         the view's name when that is the message.  Estimated once per view."""
         ed, s = self.ed, self.session
         vp = ed.viewport
