@@ -151,6 +151,7 @@ class CameraTool(Tool):
         self.ed.motion()
         if name is not None:
             self.ed.say(f"view: {name} (about the up axis {self.up.label})")
+            self._hint_key = None       # the view's name replaced any hint: estimate it again
 
     def _drawn_cloud(self):
         cloud = getattr(self.ed.viewport, "cloud", None)
