@@ -164,6 +164,7 @@ class ToolContext:
         self._ed.jobs[key] = job
 
     def job_running(self, key: str) -> bool:
+        """A job started under ``key`` has not landed yet."""
         return key in self._ed.jobs
 
     # ---- view
