@@ -136,22 +136,60 @@ def _hit_poles(o, d, poles):
 
 
 def _hit_wires(o, d, wires):
-    """Nearest approach of every ray to every wire segment, a hit when closer
-    than the wire's radius (thin: the ray's distance to the segment)."""
+    """A hit where a ray passes closer than the wire's radius to one of its
+    segments (thin wires: the ray's distance to the segment)."""
     t = np.full(len(d), np.inf)
     for line, r in wires:
-        for p, q in zip(line[:-1], line[1:]):
-            e = q - p
-            w0 = o - p
-            a, b, c = 1.0, d @ e, e @ e
-            dd, ee = d @ w0, e @ w0
-            den = a * c - b * b
-            u = np.clip((a * ee - b * dd) / np.maximum(den, 1e-12), 0, 1)
-            s = (u * b - dd) / a
-            gap = np.linalg.norm(w0 + s[:, None] * d - u[:, None] * e, axis=1)
-            ok = (gap < r) & (s > 0) & (s < t)
-            t[ok] = s[ok]
+        p, e = line[:-1], line[1:] - line[:-1]                 # (s, 3) segment starts, vectors
+        w0 = o - p                                             # (s, 3)
+        b = d @ e.T                                            # (n, s); |d| = 1
+        c = np.einsum("sj,sj->s", e, e)
+        dd = d @ w0.T
+        ee = np.einsum("sj,sj->s", e, w0)
+        den = np.maximum(c - b * b, 1e-12)
+        u = np.clip((ee - b * dd) / den, 0.0, 1.0)             # on the segment
+        s = u * b - dd                                         # along the ray
+        gap2 = (np.einsum("sj,sj->s", w0, w0) + s * s + u * u * c + 2 * s * dd
+                - 2 * u * ee - 2 * s * u * b)
+        ok = (gap2 < r * r) & (s > 0)
+        near = np.where(ok, s, np.inf).min(axis=1)
+        t = np.minimum(t, near)
     return t
+
+
+def _beams(el, az):
+    """(len(el) * len(az), 3) unit directions, elevation-major (radians in)."""
+    E, A = np.meshgrid(el, az, indexing="ij")
+    return np.column_stack([(np.cos(E) * np.cos(A)).ravel(), (np.cos(E) * np.sin(A)).ravel(),
+                            np.sin(E).ravel()])
+
+
+def _cast(o, d, boxes, poles, wires):
+    """Range of the first hit of every beam (inf: none) and of the boxes alone."""
+    tb = _hit_boxes(o, d, boxes)
+    t = np.minimum.reduce([_hit_ground(o, d), tb, _hit_poles(o, d, poles), _hit_wires(o, d, wires)])
+    return t, tb
+
+
+def surface_probes(kind: str = "lidar", seed: int = 0, origins=((0.0, 0.0, 1.8),),
+                   fine: int = 4) -> np.ndarray:
+    """Points of the scene's surfaces that :func:`rotating_scan` (same kind,
+    seed and origins) sees, sampled ``fine`` times more densely in azimuth
+    and elevation (between its beams), exact (no noise): probes of which
+    surface a scan's splats should cover.  Returns (m, 3) float64 (metres)."""
+    boxes, poles, wires = _scene(np.random.default_rng(seed))
+    sensor = SENSORS[kind]()
+    el = np.asarray(sensor.elevations_deg)
+    el = np.radians(np.interp(np.arange((len(el) - 1) * fine + 1) / fine, np.arange(len(el)), el))
+    az = np.radians(np.arange(0.0, 360.0, sensor.azimuth_step_deg / fine))
+    out = []
+    for origin in origins:
+        o = np.asarray(origin, dtype=np.float64)
+        d = _beams(el, az)
+        t, _ = _cast(o, d, boxes, poles, wires)
+        hit = t < sensor.max_range
+        out.append(o + t[hit, None] * d[hit])
+    return np.vstack(out)
 
 
 #: what :func:`rotating_scan` labels every point as
@@ -181,12 +219,8 @@ def rotating_scan(kind: str = "lidar", seed: int = 0, origins=((0.0, 0.0, 1.8),)
     for origin in origins:
         o = np.asarray(origin, dtype=np.float64)
         azj = az + rng.uniform(0, np.radians(sensor.azimuth_step_deg))   # sweeps do not align
-        E, A = np.meshgrid(el, azj, indexing="ij")
-        d = np.column_stack([(np.cos(E) * np.cos(A)).ravel(), (np.cos(E) * np.sin(A)).ravel(),
-                             np.sin(E).ravel()])
-        tg, tb = _hit_ground(o, d), _hit_boxes(o, d, boxes)
-        tp, tw = _hit_poles(o, d, poles), _hit_wires(o, d, wires)
-        t = np.minimum.reduce([tg, tb, tp, tw])
+        d = _beams(el, azj)
+        t, tb = _cast(o, d, boxes, poles, wires)
         hit = t < sensor.max_range
         on_wall = hit & (tb == t)
         rng_t = t + rng.normal(0.0, sensor.range_noise, len(t))
