@@ -248,6 +248,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="draw path: raster passes or compute shaders (splats: default env var SPLATEDIT_RASTER, "
                         "else auto: the faster, measured; Gaussian scenes: quads or the compute tile "
                         "rasterizer, default the device's, see docs/PERFORMANCE.md)")
+    s.add_argument("--full", action="store_true",
+                   help="draw every splat (default: where many splats fall in one pixel, a level of "
+                        "detail whose splats are about a pixel wide, see docs/commands.md)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 

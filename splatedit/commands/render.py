@@ -86,10 +86,17 @@ def cmd_render(args) -> int:
     basis_rows = d_c = None
     if args.edit is not None:
         cloud, basis_rows, d_c = _gpu_edit(args, cloud, on_gpu=_splats_draw)
-    render_to_png(cloud, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
+    drawn = cloud
+    if basis_rows is None and not getattr(args, "full", False):
+        from splatedit.render.headless import pixel_level
+        level = pixel_level(cloud, camera, args.size[1])
+        drawn = cloud if level is None else level.cloud
+    render_to_png(drawn, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
                   buffers_path=args.buffers, raster_path=getattr(args, "path", None),
                   edl=getattr(args, "edl", False))
     print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} splats"
+          + (f", drawn as a level of {drawn.n} about a pixel wide (--full: every splat)"
+             if drawn is not cloud else "")
           + (", deformed on the GPU" if basis_rows is not None else "") + ")"
           + (f" and {args.buffers}" if args.buffers else ""))
     return 0
