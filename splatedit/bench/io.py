@@ -21,6 +21,17 @@ Cases (one dict each, printed as a JSON line by the CLI):
   our read includes normal estimation, orientation and sizing of the raw
   points (``splatedit.model.estimate``), which is most of its time.
 
+* ``info_file`` / ``render_file`` (``--large`` only): issue 23's file, a
+  binary PLY of float32 x y z nx ny nz radius (28 bytes a point, 280 MB at
+  10M; a Fibonacci sphere), through the whole ``splatedit -q info`` and
+  ``splatedit -q render`` processes (1280x720; the render draws its level
+  of detail unless ``--full``), each beside Open3D's ``read_point_cloud`` of
+  the same file in a fresh process of the same run: ``seconds`` and
+  ``peak_rss_mb`` of each process (wall time, ``wait4``'s peak resident
+  memory), ``open3d_s``, ``open3d_peak_rss_mb`` and ``ratio_to_open3d``.
+  Open3D's interpreter: ``SPLATEDIT_OPEN3D_PYTHON`` if set (a separate
+  environment), else this one; skipped with a note when it has no Open3D.
+
 Sizes: 1M by default (``--quick``: 200k PLY, 20k LAS); 10M only with ``--large``.
 """
 
@@ -135,6 +146,66 @@ def bench_ply_read(counts, tmp: Path) -> Iterator[dict]:
         path.unlink()
 
 
+def write_normals_radius_ply(path: Path, n: int) -> int:
+    """Write ``n`` points of a unit Fibonacci sphere as float32 x y z nx ny nz
+    radius (the radius: 1.5x the spacing of a hexagonal sampling of the
+    sphere), ``_CHUNK`` at a time.  Returns the file size in bytes."""
+    names = ("x", "y", "z", "nx", "ny", "nz", "radius")
+    head = ["ply", "format binary_little_endian 1.0", f"element vertex {n}"]
+    head += [f"property float {p}" for p in names] + ["end_header", ""]
+    radius = 1.5 * np.sqrt(2.0 * 4.0 * np.pi / (np.sqrt(3.0) * n))
+    with open(path, "wb") as fh:
+        fh.write("\n".join(head).encode("ascii"))
+        for lo in range(0, n, _CHUNK):
+            nrm, _, _ = fibonacci_sphere(n, lo, min(n, lo + _CHUNK))
+            arr = np.empty((len(nrm), 7), dtype="<f4")
+            arr[:, :3], arr[:, 3:6], arr[:, 6] = nrm, nrm, radius
+            fh.write(arr.tobytes())
+    return path.stat().st_size
+
+
+def _process(cmd) -> dict:
+    """Run ``cmd``; its wall seconds and peak resident memory (``wait4``), or
+    ``skipped`` with its last stderr line when it fails."""
+    env = dict(os.environ)
+    env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
+    t0 = time.perf_counter()
+    proc = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
+                            env=env)
+    _, status, usage = os.wait4(proc.pid, 0)
+    dt = time.perf_counter() - t0
+    err = proc.stderr.read().decode(errors="replace")
+    proc.stderr.close()
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        return {"skipped": ((err.strip().splitlines() or ["failed"])[-1])[:200]}
+    return {"seconds": round(dt, 2), "peak_rss_mb": round(usage.ru_maxrss / 1024)}
+
+
+def bench_large_file(n: int, tmp: Path) -> Iterator[dict]:
+    """``info`` and ``render`` of a normals + radius PLY as whole processes,
+    each beside Open3D's read of the same file (module docstring)."""
+    path = tmp / f"scan{n}.ply"
+    size = write_normals_radius_ply(path, n)
+    o3d_python = os.environ.get("SPLATEDIT_OPEN3D_PYTHON") or sys.executable
+    o3d_code = "import sys, open3d as o3d; print(len(o3d.io.read_point_cloud(sys.argv[1]).points))"
+    cli = [sys.executable, "-m", "splatedit.cli", "-q"]
+    for case, cmd in (("info_file", cli + ["info", path]),
+                      ("render_file", cli + ["render", path, "-o", tmp / "render.png", "-f"])):
+        out = {"bench": "io", "case": case, "splats": n, "file_mb": round(size / 2**20)}
+        out.update(_process(cmd))
+        o3d = _process([o3d_python, "-c", o3d_code, path])
+        if "skipped" in o3d:
+            out["open3d"] = "not available: " + o3d["skipped"] + " (set SPLATEDIT_OPEN3D_PYTHON)"
+        else:
+            out["open3d_s"], out["open3d_peak_rss_mb"] = o3d["seconds"], o3d["peak_rss_mb"]
+            if "seconds" in out:
+                out["ratio_to_open3d"] = round(out["seconds"] / o3d["seconds"], 2)
+        out["load"] = round(os.getloadavg()[0], 1)
+        yield out
+    path.unlink()
+
+
 def scan_cloud(n: int, seed: int = 0):
     """A synthetic georeferenced terrain tile: ``n`` points on a 1 km
     rolling surface at UTM-like coordinates (x ~ 500,000, y ~ 5,000,000 m)
@@ -186,4 +257,6 @@ def bench_io(*, quick: bool = False, large: bool = False, counts=None, las_point
     counts = counts or ((200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,)))
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-io-") as tmp:
         yield from bench_ply_read(counts, Path(tmp))
+        if large:
+            yield from bench_large_file(max(counts), Path(tmp))
         yield from bench_las(las_points or (20_000 if quick else 1_000_000), Path(tmp))
