@@ -68,14 +68,17 @@ def keep_for_pixels(cloud: SplatCloud, camera: Camera, height: int,
     fwd = -camera.view_matrix()[2, :3]
     f = height / (2.0 * np.tan(np.radians(camera.fov_deg) / 2.0))
     out = np.empty(cloud.n)
+    scale = (f / min_radius_px) ** 2
     for lo in range(0, cloud.n, chunk):
-        p = cloud.positions[lo:lo + chunk]
         u, v = cloud.u[lo:lo + chunk], cloud.v[lo:lo + chunk]
-        r = np.sqrt(np.sqrt(np.einsum("ij,ij->i", u, u) * np.einsum("ij,ij->i", v, v)))
-        z = (p - eye) @ fwd
-        with np.errstate(divide="ignore", invalid="ignore"):
-            k = np.where(z > 0, np.square(r * f / (z * min_radius_px)), 1.0)
-        out[lo:lo + chunk] = np.minimum(np.nan_to_num(k, nan=1.0, posinf=1.0), 1.0)
+        k = np.einsum("ij,ij->i", u, u)
+        k *= np.einsum("ij,ij->i", v, v)
+        np.sqrt(k, out=k)                                    # r^2 = |u| |v|
+        z = (cloud.positions[lo:lo + chunk] - eye) @ fwd
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            k *= scale / (z * z)                             # (r f / (z m))^2
+        k[~(z > 0) | ~(k < 1.0)] = 1.0                       # behind the eye, NaN, or wide enough
+        out[lo:lo + chunk] = k
     return out
 
 
