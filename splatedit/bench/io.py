@@ -9,7 +9,8 @@ Cases (one dict each, printed as a JSON line by the CLI):
   in a fresh Python process so its peak memory is its own: ``splatedit``
   (:func:`splatedit.io.read`, the whole SplatCloud), ``plyfile`` (its plain
   ``PlyData.read``, the structured vertex array only) and ``open3d``
-  (``read_point_cloud``; skipped with a note when Open3D is not installed).
+  (``read_point_cloud``, in ``SPLATEDIT_OPEN3D_PYTHON`` when set; skipped
+  with a note when Open3D is not installed).
   Keys: ``seconds`` (the read alone), ``peak_rss_mb`` (the child's peak
   resident memory), ``base_rss_mb`` (the child's memory after its imports,
   before reading), ``kept_mb`` (bytes of the arrays the reader returns) and
@@ -114,7 +115,8 @@ def write_sphere_ply(path: Path, n: int) -> int:
 def _child(kind: str, path: Path) -> dict:
     env = dict(os.environ)
     env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")     # as the CLI runs (see splatedit.cli)
-    proc = subprocess.run([sys.executable, "-c", _CHILD, kind, str(path)], capture_output=True,
+    exe = _open3d_python() if kind == "open3d" else sys.executable
+    proc = subprocess.run([exe, "-c", _CHILD, kind, str(path)], capture_output=True,
                           text=True, env=env)
     if proc.returncode != 0:
         last = (proc.stderr.strip().splitlines() or ["failed"])[-1]
@@ -122,9 +124,15 @@ def _child(kind: str, path: Path) -> dict:
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
+def _open3d_python() -> str:
+    """The interpreter of the Open3D reads: ``SPLATEDIT_OPEN3D_PYTHON`` (an
+    environment of its own: Open3D pins its own numpy) or this one."""
+    return os.environ.get("SPLATEDIT_OPEN3D_PYTHON") or sys.executable
+
+
 def _has_open3d() -> bool:
     import importlib.util
-    return importlib.util.find_spec("open3d") is not None
+    return bool(os.environ.get("SPLATEDIT_OPEN3D_PYTHON")) or importlib.util.find_spec("open3d") is not None
 
 
 def bench_ply_read(counts, tmp: Path) -> Iterator[dict]:
@@ -187,7 +195,7 @@ def bench_large_file(n: int, tmp: Path) -> Iterator[dict]:
     each beside Open3D's read of the same file (module docstring)."""
     path = tmp / f"scan{n}.ply"
     size = write_normals_radius_ply(path, n)
-    o3d_python = os.environ.get("SPLATEDIT_OPEN3D_PYTHON") or sys.executable
+    o3d_python = _open3d_python()
     o3d_code = "import sys, open3d as o3d; print(len(o3d.io.read_point_cloud(sys.argv[1]).points))"
     cli = [sys.executable, "-m", "splatedit.cli", "-q"]
     for case, cmd in (("info_file", cli + ["info", path]),
