@@ -178,8 +178,11 @@ def _process(cmd) -> dict:
     env = dict(os.environ)
     env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
     t0 = time.perf_counter()
-    proc = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.DEVNULL, stderr=subprocess.PIPE,
-                            env=env)
+    try:
+        proc = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.PIPE, env=env)
+    except OSError as exc:                       # no such interpreter
+        return {"skipped": str(exc)[:200]}
     _, status, usage = os.wait4(proc.pid, 0)
     dt = time.perf_counter() - t0
     err = proc.stderr.read().decode(errors="replace")

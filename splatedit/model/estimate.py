@@ -147,8 +147,10 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it, and the radius of an outlier
     (:func:`splatedit.model.outliers.detect_outliers`) at
     ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of its neighbours
-    that are not outliers
-    (see :mod:`splatedit.model.sizing`).
+    that are not outliers; finally the first cap is applied again against
+    these radii (:func:`splatedit.model.sizing.settle_radii`), so a splat
+    next to shrunk ones is at most ``SIZE_CAP_REL_NEIGHBOURS`` times their
+    median too (see :mod:`splatedit.model.sizing`).
 
     Args:
         points: (n, 3) float64 positions; normals: (n, 3) float64 unit normals.

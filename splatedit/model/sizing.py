@@ -18,7 +18,11 @@ stray neighbour does not move a median) and a boundary splat at
 ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it; :func:`limit_outlier_radii` keeps
 outliers (:mod:`splatedit.model.outliers`), which may sit in clusters whose
 neighbours are strays too, at most ``OUTLIER_RADIUS_REL_MEDIAN`` times the
-median radius of their neighbours that are not outliers.  Boundary points of a point cloud
+median radius of their neighbours that are not outliers; :func:`settle_radii`
+then applies the neighbour cap again against the radii those caps left (a
+splat next to shrunk ones is capped at their new median), so that no splat
+ends more than ``SIZE_CAP_REL_NEIGHBOURS`` times its neighbours as drawn.
+Boundary points of a point cloud
 are found by :func:`boundary_points` (angular gap of the neighbours projected
 into the tangent plane, as PCL's BoundaryEstimation does), those of a mesh by
 :func:`mesh_border_ring` (vertices of the faces that touch an edge used by a
