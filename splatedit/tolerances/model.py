@@ -132,7 +132,8 @@ STRAY_CLUSTER_MAX_REL = 0.005
 #: nearest neighbours' radii (multipath ghosts and near-sensor dust of which
 #: only some points are flagged as outliers; poste_france.xyz 6.1x), 3.0x
 #: after settling; it took 1-2 rounds and shrank 0-0.1 % of the splats
-#: (poste_france 0.7 %, kitten and hippo1 none)
+#: (poste_france 0.7 %, kitten and hippo1 none); 12 more scans (seeds 2-5,
+#: radar 1 and 3 sweeps, lidar 1 sweep): 3.0x after 1-3 rounds
 SIZE_SETTLE_ROUNDS = 8
 
 
