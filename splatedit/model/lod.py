@@ -314,7 +314,7 @@ def thinned_level(cloud: SplatCloud, keep, *, margin: float = 1.0, seed: int = 0
     average), keeping each with probability ``p`` and scaling its area by
     ``1 / p`` keeps ``rho a`` (the random thinning of a point process; the
     enlarged splats stay as many per covered point).  This is the cheap level
-    of detail of a single view (:func:`splatedit.render.headless.pixel_level`
+    of detail of a single view (:func:`splatedit.render.splat.headless.pixel_level`
     chooses ``keep`` so the kept splats are about a pixel wide): one pass, no
     sort, against ~1 s per million splats for the voxel levels of
     :func:`build_level`, whose enlarged representatives cover their members

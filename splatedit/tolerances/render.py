@@ -34,7 +34,7 @@ RENDER_FRAME_MARGIN = 1.05
 RENDER_FOV_DEG = 40.0
 #: `splatedit render` draws a level of detail when many splats fall in one
 #: pixel: splats thinned at random and enlarged to about this radius in
-#: pixels (splatedit.render.headless.pixel_level; --full draws every one).
+#: pixels (splatedit.render.splat.headless.pixel_level; --full draws every one).
 #: Against the full render (lavapipe, raster path), a 2M-splat bunny surface
 #: (float32 normals + radius, data_tools/make_large_model.py --normals-radius)
 #: at 640x360, RGB levels: min radius 0.5 px keeps 53 % of the splats, mean
@@ -117,7 +117,7 @@ GS_ALPHA_MIN = 1.0 / 255.0
 #: 8-bit step)
 GS_MIN_TRANSMITTANCE = 1e-4
 #: (tile, Gaussian) pairs per Gaussian the compute tile rasterizer's buffers
-#: hold at first (gs_tiles.py; a frame that wants more grows them and is drawn
+#: hold at first (gaussian/tiles.py; a frame that wants more grows them and is drawn
 #: again).  Measured: the bench's sphere scenes at 1280x720 want 2.3 (100k
 #: Gaussians) per Gaussian, the bundled bunny at 160x120 2.1
 GS_TILE_PAIRS_PER_GAUSSIAN = 4.0

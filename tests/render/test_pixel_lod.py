@@ -13,7 +13,7 @@ from splatedit.io import write
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.tangents import splats_from_normals
 from splatedit.render.camera import Camera
-from splatedit.render.headless import keep_for_pixels, pixel_level
+from splatedit.render.splat.headless import keep_for_pixels, pixel_level
 from splatedit.tolerances import RENDER_LOD_MIN_RADIUS_PX, SPLAT_RADIUS_FACTOR
 
 
