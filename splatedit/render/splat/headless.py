@@ -69,15 +69,20 @@ def keep_for_pixels(cloud: SplatCloud, camera: Camera, height: int,
     f = height / (2.0 * np.tan(np.radians(camera.fov_deg) / 2.0))
     out = np.empty(cloud.n)
     scale = (f / min_radius_px) ** 2
+    z0 = float(eye @ fwd)
     for lo in range(0, cloud.n, chunk):
         u, v = cloud.u[lo:lo + chunk], cloud.v[lo:lo + chunk]
         k = np.einsum("ij,ij->i", u, u)
         k *= np.einsum("ij,ij->i", v, v)
         np.sqrt(k, out=k)                                    # r^2 = |u| |v|
-        z = (cloud.positions[lo:lo + chunk] - eye) @ fwd
+        z = cloud.positions[lo:lo + chunk] @ fwd
+        z -= z0                                              # depth along the view axis
+        ahead = z > 0
+        z *= z
         with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
-            k *= scale / (z * z)                             # (r f / (z m))^2
-        k[~(z > 0) | ~(k < 1.0)] = 1.0                       # behind the eye, NaN, or wide enough
+            k *= scale
+            k /= z                                           # (r f / (z m))^2
+        k[~ahead | ~(k < 1.0)] = 1.0                         # behind the eye, NaN, or wide enough
         out[lo:lo + chunk] = k
     return out
 
