@@ -2,20 +2,20 @@
 
 A glfw window presenting through a Vulkan swapchain
 (:mod:`splatedit.render.vk.swapchain`); frames come from the EWA splat
-renderer (:mod:`splatedit.app.viewport`) scheduled by
-:class:`~splatedit.app.frames.FrameScheduler`; with the Dear ImGui interface
-(:mod:`splatedit.app.gui_panels`: menu bar, panels, help) they stay on the
+renderer (:mod:`splatedit.app.view.viewport`) scheduled by
+:class:`~splatedit.app.view.frames.FrameScheduler`; with the Dear ImGui interface
+(:mod:`splatedit.app.ui.gui_panels`: menu bar, panels, help) they stay on the
 presenter's device and the GUI and the tools' overlays are drawn over them on
 the GPU; without it (``SPLATEDIT_GUI=0`` or a surface that cannot be a blit
-target) the overlay is composited on the CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
+target) the overlay is composited on the CPU (:mod:`splatedit.app.ui.overlay`).  Loading, fitting and saving run in
 worker threads; the loop polls them and stays responsive.
 
 The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve) through the event
-routing (:mod:`splatedit.app.routing`), keys are looked
-up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
+routing (:mod:`splatedit.app.ui.routing`), keys are looked
+up in the one keymap (:mod:`splatedit.app.ui.keymap`, which also generates the
 help and the manual's controls list) and run the bound action; each tool draws
-its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
+its overlay.  Files (:mod:`splatedit.app.document.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
 dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,
 :meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
@@ -34,19 +34,19 @@ import time
 from pathlib import Path
 
 from splatedit.app.crash_guard import CrashGuard
-from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
-from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
+from splatedit.app.document.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
+from splatedit.app.document.files import default_save_path as _default_save_path  # noqa: F401 (API)
 from splatedit.app.file_actions import FileActions
-from splatedit.app.frames import FrameScheduler
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.jobs import Job
-from splatedit.app.keymap import Action
-from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.panel import HelpView, compose_overlay
-from splatedit.app.session import Session
-from splatedit.app.status import StatusWriter
-from splatedit.app.recent import RecentFiles
-from splatedit.app.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
+from splatedit.app.view.frames import FrameScheduler
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.jobs import Job
+from splatedit.app.ui.keymap import Action
+from splatedit.app.ui.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
+from splatedit.app.ui.panel import HelpView, compose_overlay
+from splatedit.app.document.session import Session
+from splatedit.app.ui.status import StatusWriter
+from splatedit.app.ui.recent import RecentFiles
+from splatedit.app.ui.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
 from splatedit.app.tools.base import DragMode
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
@@ -81,12 +81,12 @@ class Editor(EventRouting, FileActions):
         self.window = Window("splatedit", *size)
         try:
             self.presenter = SwapchainPresenter(self.window.handle, vsync=vsync)
-            from splatedit.app.viewport import Viewport
+            from splatedit.app.view.viewport import Viewport
             pres = self.presenter
             if pres.gpu_targets and pres.can_blit and os.environ.get("SPLATEDIT_GUI", "1") != "0":
                 # GPU path: one device renders, draws the GUI and presents (no readback)
-                from splatedit.app.gui_panels import EditorGui
-                from splatedit.render.renderer import Renderer
+                from splatedit.app.ui.gui_panels import EditorGui
+                from splatedit.render.splat.renderer import Renderer
                 self.viewport = Viewport(budget_ms=self.frames.moving_budget_ms, renderer=Renderer(device=pres.dev))
                 self.gui = EditorGui(self, pres.dev)
             else:       # CPU fallback: frames read back, overlay blended on the CPU
@@ -222,6 +222,7 @@ class Editor(EventRouting, FileActions):
         t.update({
             Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
+            Action.EDL: self.toggle_edl, Action.TWO_SIDED: self.toggle_two_sided,
             Action.DEFORMATION_MODE: self.cycle_deformation,
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
             Action.SPLATS_LARGER: lambda: self.scale_splats(EDITOR_SPLAT_SCALE_STEP),
@@ -253,6 +254,28 @@ class Editor(EventRouting, FileActions):
         vp.grey = not vp.grey
         grey = "uniform grey shading" if getattr(vp, "gaussians", None) is None else "grey (luminance)"
         self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
+
+    def toggle_edl(self) -> None:
+        """Shift+E: eye-dome lighting on / off (splat models; a Gaussian scene says it has none)."""
+        vp = self.viewport
+        if getattr(vp, "gaussians", None) is not None:
+            vp.edl = False
+            self.say("eye-dome lighting is for point-splat models, not Gaussian splat scenes")
+            return
+        vp.edl = not vp.edl
+        self.say("eye-dome lighting " + ("on: depth edges and creases darkened (Shift+E: off)"
+                                         if vp.edl else "off"))
+
+    def toggle_two_sided(self) -> None:
+        """T: draw the splats seen from behind too (back-face culling off) / not."""
+        vp = self.viewport
+        if getattr(vp, "gaussians", None) is not None:
+            vp.two_sided = False
+            self.say("a Gaussian scene draws every Gaussian from both sides already")
+            return
+        vp.two_sided = not vp.two_sided
+        self.say("two-sided splats: " + ("on, splats seen from behind are drawn too (T: off)" if vp.two_sided
+                                         else "off, splats facing away are not drawn"))
 
     def scale_splats(self, factor: float) -> None:
         """Shift+[ / Shift+]: draw every splat's axes this much larger (display only)."""
@@ -429,7 +452,7 @@ def run_editor(path=None, **options) -> int:
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
-    from splatedit.app.frames import refine_above_ms
+    from splatedit.app.view.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "

@@ -8,7 +8,7 @@ from typing import Callable
 
 import numpy as np
 
-from splatedit.app.keymap import KEYMAP, Action, Binding, Section
+from splatedit.app.ui.keymap import KEYMAP, Action, Binding, Section
 
 
 class DragMode(enum.Enum):
@@ -34,10 +34,10 @@ class Tool:
     :meth:`press_modal` first, then to :meth:`press` in its tool order; the
     first to return a :class:`DragMode` owns the drag (:meth:`drag` on each
     move, :meth:`release` at the end).  Keys: :meth:`actions` maps keymap
-    :class:`~splatedit.app.keymap.Action` values to handlers.  Drawing:
+    :class:`~splatedit.app.ui.keymap.Action` values to handlers.  Drawing:
     :meth:`underlay` and :meth:`overlay` return overlay patches (CPU
     path only); :meth:`shapes` returns backend-neutral shapes
-    (:mod:`splatedit.app.shapes`) drawn by both the GPU and the CPU path:
+    (:mod:`splatedit.app.tools.shapes`) drawn by both the GPU and the CPU path:
     tools on the protocol use only :meth:`shapes` and :attr:`ctx`.
     """
     #: the help section of this tool's keymap rows
@@ -85,7 +85,7 @@ class Tool:
         return None
 
     def shapes(self, w: int, h: int) -> list:
-        """Overlay shapes (:mod:`splatedit.app.shapes`) drawn this frame."""
+        """Overlay shapes (:mod:`splatedit.app.tools.shapes`) drawn this frame."""
         return []
 
     def underlay(self, w: int, h: int) -> list:
@@ -113,7 +113,7 @@ class ToolContext:
     # ---- document and selection
     @property
     def document(self):
-        """The :class:`~splatedit.app.session.Session` (None: no model open)."""
+        """The :class:`~splatedit.app.document.session.Session` (None: no model open)."""
         return self._ed.session
 
     @property
@@ -123,7 +123,7 @@ class ToolContext:
 
     def target_mask(self) -> np.ndarray:
         """(n,) bool: the brush target's current mask (not a copy)."""
-        from splatedit.app.selection_tools import target_mask
+        from splatedit.app.document.selection import target_mask
         s = self._ed.session
         return target_mask(s.selection, s.brush_target)
 
@@ -138,6 +138,35 @@ class ToolContext:
         """The document cloud's neighbour graph, or None while it is built."""
         return self._ed.brush.tools.graph(self._ed.session.cloud)
 
+    def background_select(self):
+        """A :class:`~splatedit.app.document.selection.BackgroundApply` of the
+        brush target (the selection copied now, closed by its worker), or
+        None while the neighbour graph is built."""
+        return self._ed.brush.tools.background_apply(self._ed.session)
+
+    def install(self, job, label: str) -> bool:
+        """Make a finished BackgroundApply's selection the document's (one
+        undo step); False when the selection changed since it started, or
+        another model was opened meanwhile."""
+        if job.session is not self._ed.session:
+            return False
+        return self._ed.brush.tools.install(job, label)
+
+    # ---- background work
+    def start_job(self, key: str, name: str, fn, land) -> None:
+        """Run ``fn(progress)`` as an editor job (:mod:`splatedit.app.document.jobs`:
+        a worker thread, a progress bar named ``name``, the window keeps
+        drawing); when it is done, ``land(job)`` runs on the main thread
+        (its ``result`` or ``error``)."""
+        from splatedit.app.document.jobs import Job
+        job = Job(name, fn, self._ed.wake)
+        job.land = land        # set before the editor can collect it (it polls on this thread)
+        self._ed.jobs[key] = job
+
+    def job_running(self, key: str) -> bool:
+        """A job started under ``key`` has not landed yet."""
+        return key in self._ed.jobs
+
     # ---- view
     @property
     def camera(self):
@@ -149,14 +178,14 @@ class ToolContext:
         return self._ed.size
 
     def visible(self):
-        """The :class:`~splatedit.app.brush.BrushPicker` of the current view
+        """The :class:`~splatedit.app.tools.pick_brush.BrushPicker` of the current view
         (which splat is visible at each pixel)."""
         return self._ed.brush.get_picker()
 
     @property
     def through(self) -> bool:
         """The brush mode (V): True for 3D / through, False for visible only."""
-        from splatedit.app.selection_tools import BRUSH_3D
+        from splatedit.app.document.selection import BRUSH_3D
         return self._ed.brush.mode == BRUSH_3D
 
     def erasing(self, mods: int | None = None) -> bool:
