@@ -80,6 +80,8 @@ class EditorGui(MenuBar):
         self._footer_h = 60.0
         self.panel_scrolls = False         # the sections are taller than the room: they scroll
         self.help_scroll_set = None
+        self.help_width: float | None = None   # the widest help line, pixels (measured once)
+        self.help_visible_rows = 0             # help rows wholly in view (last frame)
         self._history_at: tuple[int, int] | None = None   # (position, entries) the list last scrolled to
         self._history_follow = 0                             # frames left that scroll to the current entry
         self._last = time.perf_counter()
