@@ -114,6 +114,12 @@ int prepare_splat(vec3 p, vec3 u, vec3 v, vec3 srgb, uint flags, out Splat S) {
     if ((flags & FLAG_HANDLE) != 0u) col = mix(col, F.tint_handle.rgb, F.tint_handle.a);
     if ((flags & FLAG_INACTIVE) != 0u) col *= 0.35;
     S.color = col;
-    S.normal = cn > 0.0 ? -n : n;
+    // a splat seen from behind (culling off) is shaded facing the eye: its normal mirrored in
+    // the plane across the view ray (only the component along the ray flips; the headlight's
+    // diffuse and specular terms equal those of -n).  Negating it would also turn the sideways
+    // part: at a silhouette a back rim splat (n ~ sideways) then blends with the front rim's
+    // into a normal facing the eye, a bright fringe.
+    vec3 ray = normalize(c);
+    S.normal = cn > 0.0 ? n - 2.0 * dot(n, ray) * ray : n;
     return small ? SPLAT_POINT : SPLAT_QUAD;
 }

@@ -391,3 +391,23 @@ def test_a_misspelt_required_key_is_named_with_the_missing_one():
         parse_script(script)
     assert err.value.json_path == "$.edits[0].transform.rotate"
     assert "missing key 'degrees' (is 'degress' a misspelling of it?)" in str(err.value)
+
+
+@pytest.mark.parametrize("path,typo,json_path,meant", [
+    (["edits", 0, "support"], {"sphere": {"center": [0, 0, 0], "radius": 1.0}, "fill_hole": False},
+     "$.edits[0].support.fill_hole", "fill_holes"),
+    (["edits", 0], None, "$.edits[0].transfrom", "transform"),
+])
+def test_misspelt_key_error_names_the_key_it_resembles(path, typo, json_path, meant):
+    """A typo in a key (a hand-edited saved script) is one error naming the
+    known key it resembles; a support's ``fill_holes`` is among the keys listed."""
+    doc = copy.deepcopy(GOOD)
+    if typo is None:
+        doc["edits"][0]["transfrom"] = doc["edits"][0].pop("transform")
+    else:
+        doc = _with(path, typo)
+    with pytest.raises(EditScriptError) as info:
+        parse_script(doc, source="edit.json")
+    assert info.value.json_path == json_path
+    assert f"misspelling of {meant!r}" in str(info.value)
+    assert meant in str(info.value).split("allowed: ")[1]

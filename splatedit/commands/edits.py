@@ -45,17 +45,38 @@ def cmd_convert(args) -> int:
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)
     write(args.output, cloud, overwrite=args.force, up_axis=_kept_up(args.input))
+    _z_up_output_note(cloud, args.input, args.output)
     print(f"wrote {args.output}: {cloud.n} splats" + _faces_note(cloud, args.output))
     return 0
 
 
 def _kept_up(input_path) -> str | None:
-    """The up axis a PLY input's header names ("+Z", ...; the editor writes it
-    on save), so that a converted or deformed copy opens standing the same
-    way; None when the input says nothing."""
+    """The up axis the input names: its PLY header's ("+Z", ...; the editor
+    writes it on save), else +Z for a Z-up format (LAS/LAZ, E57: scanner
+    coordinates), so that a converted or deformed PLY copy opens standing the
+    same way; None when the input says nothing."""
+    from splatedit.io.formats import is_z_up
     from splatedit.model.orientation import header_up_hint
     hint = header_up_hint(input_path)
-    return None if hint is None else hint.label
+    if hint is not None:
+        return hint.label
+    return "+Z" if is_z_up(input_path) else None
+
+
+def _z_up_output_note(cloud, input_path, output) -> None:
+    """A ``splatedit: note:`` when ``output``'s format is read Z-up (LAS/LAZ,
+    E57) but the model stands on another axis (as the editor and ``render``
+    detect it for the input): the copy will open lying on its side.  The
+    coordinates are written as they are (no silent rotation)."""
+    from splatedit.io.formats import is_z_up
+    from splatedit.model.orientation import detect_cloud_up_axis
+    if not is_z_up(output) or is_z_up(input_path):
+        return
+    up = detect_cloud_up_axis(cloud, input_path)
+    if up.label != "+Z":
+        print(f"splatedit: note: {output}: {Path(output).suffix.lower()} files are read Z-up (scanner "
+              f"coordinates), but this model's up axis is {up.label} ({up.source.value}): the copy will open "
+              f"lying on its side (a .ply copy keeps {up.label})", file=sys.stderr)
 
 
 def _faces_note(cloud, output) -> str:

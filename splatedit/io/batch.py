@@ -208,6 +208,7 @@ def convert_tile(job: TileJob, tile: Tile, bands: list, remove_outliers: bool, o
     ``bands`` (from :func:`halo_band`), optionally drop outliers (flagged
     over tile and halo), and write the tile's own points to ``job.out``."""
     from splatedit.io import cloud_from_columns, write
+    from splatedit.io.formats import is_z_up
     t0 = time.perf_counter()
     result = TileResult(job)
     try:
@@ -246,7 +247,8 @@ def convert_tile(job: TileJob, tile: Tile, bands: list, remove_outliers: bool, o
                 cloud = cloud.subset(~drop)
         if cloud.faces is not None and job.out.suffix.lower() not in (".ply", ".off"):
             result.notes.append(f"its {len(cloud.faces)} faces were dropped ({job.out.suffix} holds points only)")
-        write(job.out, cloud, overwrite=overwrite)
+        # a LAS/LAZ/E57 tile is Z-up by its format: its PLY copy says so (as `convert` of one file does)
+        write(job.out, cloud, overwrite=overwrite, up_axis="+Z" if is_z_up(job.src) else None)
         result.written = cloud.n
     except Exception as exc:        # noqa: BLE001 - reported by name, the other tiles go on
         result.error = _message(job.src, exc)

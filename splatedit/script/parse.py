@@ -39,7 +39,9 @@ class _Ctx:
         if allowed is not None:
             extra = sorted(set(value) - set(allowed))
             if extra:
-                raise self.fail(f"{jp}.{extra[0]}", f"unknown key (allowed: {', '.join(allowed)})")
+                near = difflib.get_close_matches(extra[0], [k for k in allowed if k not in value], n=1)
+                hint = f"; is it a misspelling of {near[0]!r}?" if near else ""
+                raise self.fail(f"{jp}.{extra[0]}", f"unknown key (allowed: {', '.join(allowed)}){hint}")
         return value
 
     def number(self, value, jp: str, *, positive: bool = False, nonnegative: bool = False) -> float:
@@ -82,8 +84,12 @@ def _kind(value) -> str:
     return "an object"
 
 
-def _region(ctx: _Ctx, value, jp: str) -> Region:
-    obj = ctx.obj(value, jp, allowed=("sphere", "box", "indices"))
+def _region(ctx: _Ctx, value, jp: str, flags: tuple[str, ...] = ()) -> Region:
+    """One region of ``value``: a sphere, box or index list; ``flags`` are
+    further keys the caller reads itself (an edit's support: ``fill_holes``),
+    accepted and dropped here so that an unknown key's message lists them."""
+    obj = ctx.obj(value, jp, allowed=("sphere", "box", "indices") + flags)
+    obj = {k: v for k, v in obj.items() if k not in flags}
     if len(obj) != 1:
         raise ctx.fail(jp, "must have exactly one of 'sphere', 'box', 'indices'")
     kind, body = next(iter(obj.items()))
@@ -231,8 +237,7 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
             fill_holes = sup_in["fill_holes"]
             if not isinstance(fill_holes, bool):
                 raise ctx.fail(f"{jp}.support.fill_holes", f"must be true or false, got {_kind(fill_holes)}")
-            sup_in = {k: v for k, v in sup_in.items() if k != "fill_holes"}
-        support = _region(ctx, sup_in, f"{jp}.support")
+        support = _region(ctx, sup_in, f"{jp}.support", flags=("fill_holes",))
         curves = _curves(ctx, e["curves"], f"{jp}.curves") if "curves" in e else ()
         if "handle" in e and "handles" in e:
             raise ctx.fail(jp, "needs exactly one of 'handle' or 'handles'")

@@ -146,3 +146,29 @@ def test_cpu_overlay_fallback_still_presents(xvfb, tmp_path, monkeypatch):
         assert ed.status()["validation_messages"] == 0
     finally:
         ed.close()
+
+
+def test_history_list_scrolls_to_the_current_entry(xvfb, tmp_path):
+    """More steps than the history list's 8 rows: the newest entry (where the
+    document is) is in view, and after undoing back to the start the first one is."""
+    ed = EditorProcess(xvfb, tmp_path, "--size", "1280x780")     # the History section shows unscrolled
+    try:
+        s = ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 90)
+        x, y, pw, ph = s["panel_box"]
+        ed.xdo("mousemove", x + pw + 300, y + ph // 2)
+        for k in range(5):                      # 10 selection steps after "Open"
+            ed.xdo("key", "a")
+            ed.idle(lambda s: s["history"] == 2 + 2 * k, "selected all")
+            ed.xdo("key", "c")
+            ed.idle(lambda s: s["history"] == 3 + 2 * k, "cleared")
+        s = ed.idle(lambda s: "history_10" in s["gui_rects"] or s["undo_position"] == 10, "eleven entries")
+        assert s["undo_position"] == 10
+        s = ed.wait(lambda s: s["idle"] and "history_10" in s["gui_rects"], "the newest entry shown", 10)
+        assert "history_0" not in s["gui_rects"]            # the list does scroll (8 rows)
+        for _ in range(10):
+            ed.xdo("key", "ctrl+z")
+        s = ed.idle(lambda s: s["undo_position"] == 0, "undone to the start")
+        s = ed.wait(lambda s: s["idle"] and "history_0" in s["gui_rects"], "the first entry shown", 10)
+        assert s["validation_messages"] == 0
+    finally:
+        ed.close()

@@ -25,6 +25,30 @@ def _overlap(a, b):
     return a[0] < b[0] + b[2] and b[0] < a[0] + a[2] and a[1] < b[1] + b[3] and b[1] < a[1] + a[3]
 
 
+def test_help_rows_paged_are_all_visible_above_the_horizontal_scroll_bar(xvfb, tmp_path):
+    """A window narrower than the help's lines: the horizontal scroll bar gets
+    its own room, so every row the help pages by (its last line at the end
+    included) is wholly visible, not half under the bar."""
+    ed = EditorProcess(xvfb, tmp_path, "--size", "720x480")
+    try:
+        ed.idle(lambda s: s["loaded"] and s["frames_presented"] > 0, "model loaded", 90)
+        ed.xdo("mousemove", 600, 300, "key", "F1")
+        s = ed.wait(lambda s: s["help"] and s["help_box"] and s["help_visible_rows"] > 0, "help shown")
+        assert s["help_box"][2] < 720 and s["help_rows"] < s["help_total"]
+        assert s["help_visible_rows"] >= s["help_rows"], s
+        for _ in range(12):                             # to the last page
+            if s["help_top"] + s["help_rows"] >= s["help_total"]:
+                break
+            top = s["help_top"]
+            ed.xdo("key", "Next")
+            s = ed.wait(lambda s, t=top: s["help_top"] != t, "help paged")
+        assert s["help_top"] + s["help_rows"] == s["help_total"]
+        s = ed.idle(lambda s: s["help"], "last page drawn")
+        assert s["help_visible_rows"] >= s["help_rows"] and s["validation_messages"] == 0
+    finally:
+        ed.close()
+
+
 def test_help_panel_toggle_and_view_keys(xvfb, tmp_path):
     ed = EditorProcess(xvfb, tmp_path)
     w, h = WINDOW

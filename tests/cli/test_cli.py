@@ -178,3 +178,25 @@ def test_deform_and_convert_keep_the_up_axis_the_input_header_names(tmp_path):
                                                              "transform": {"translate": [0.02, 0, 0]}}]}))
     assert main(["-q", "deform", str(src), "--edit", str(script), "-o", str(tmp_path / "def.ply")]) == 0
     assert header_up_hint(tmp_path / "def.ply").label == "+Z"
+
+
+def test_convert_between_z_up_formats_and_ply_keeps_the_model_standing(tmp_path, capsys):
+    """LAS/LAZ and E57 are read Z-up: a LAS scan converted to PLY says
+    ``up_axis +Z`` in its header, so it opens (and renders) standing as the
+    LAS did; a Y-up model converted into LAS gets a note that it will open
+    lying on its side (its coordinates are written as they are)."""
+    from splatedit.cli import main
+    from splatedit.data import default_model_path
+    from splatedit.model.orientation import detect_cloud_up_axis, header_up_hint
+    las = tmp_path / "bunny.las"
+    assert main(["-q", "convert", str(default_model_path()), str(las)]) == 0
+    err = capsys.readouterr().err
+    assert err.count("splatedit: note:") == 1 and "lying on its side" in err and "+Y" in err
+    assert detect_cloud_up_axis(read(las), las, z_up_format=True).label == "+Z"
+    back = tmp_path / "back.ply"
+    assert main(["-q", "convert", str(las), str(back)]) == 0
+    assert "lying" not in capsys.readouterr().err
+    assert header_up_hint(back) is not None and header_up_hint(back).label == "+Z"
+    assert detect_cloud_up_axis(read(back), back).label == "+Z"      # opens as the LAS did
+    assert main(["-q", "convert", str(default_model_path()), str(tmp_path / "b.ply")]) == 0
+    assert "note" not in capsys.readouterr().err                     # PLY to PLY: nothing to say

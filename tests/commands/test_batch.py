@@ -147,3 +147,18 @@ def test_independent_files_are_converted_each_alone_without_a_halo(tiles, tmp_pa
     alone = tmp_path / "alone.ply"
     assert main(["-q", "convert", str(paths[0]), str(alone)]) == 0
     np.testing.assert_array_equal(read(out / (paths[0].stem + ".ply")).u, read(alone).u)
+
+
+def test_ply_tiles_of_laz_tiles_say_they_are_z_up(tmp_path, capsys):
+    """LAZ tiles are Z-up by their format: their PLY copies name +Z in the
+    header, so each opens (and renders) standing as the tile did."""
+    from splatedit.model.orientation import header_up_hint
+    folder = tmp_path / "laz"
+    folder.mkdir()
+    paths, _ = terrain_tiles(folder, 2, 1, 800, ext=".laz", seed=5)
+    out = tmp_path / "out"
+    assert main(["-q", "convert", str(folder), str(out), "--workers", "1"]) == 0
+    capsys.readouterr()
+    for p in paths:
+        hint = header_up_hint(out / (p.stem + ".ply"))
+        assert hint is not None and hint.label == "+Z", p

@@ -80,6 +80,10 @@ class EditorGui(MenuBar):
         self._footer_h = 60.0
         self.panel_scrolls = False         # the sections are taller than the room: they scroll
         self.help_scroll_set = None
+        self.help_width: float | None = None   # the widest help line, pixels (measured once)
+        self.help_visible_rows = 0             # help rows wholly in view (last frame)
+        self._history_at: tuple[int, int] | None = None   # (position, entries) the list last scrolled to
+        self._history_follow = 0                             # frames left that scroll to the current entry
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
         self._menu_open = False
@@ -476,13 +480,24 @@ class EditorGui(MenuBar):
         labels = hist.labels
         rows = min(len(labels), 8)
         lh = imgui.get_text_line_height_with_spacing()
-        if imgui.begin_child("history", imgui.ImVec2(-1, rows * lh + 8), imgui.ChildFlags_.borders.value):
+        height = rows * lh + 8
+        if self._history_at != (hist.position, len(labels)):
+            # a new step, an undo, a redo or a jump: the list scrolls to the current entry (for two
+            # frames: ImGui applies a scroll request in the next frame, clamped to this frame's
+            # content); otherwise the user's own scrolling is left alone
+            self._history_at = (hist.position, len(labels))
+            self._history_follow = 2
+        if imgui.begin_child("history", imgui.ImVec2(-1, height), imgui.ChildFlags_.borders.value):
             for k, text in enumerate(labels):
                 here = k == hist.position
                 saved = " (saved)" if k == hist.saved_pos else ""
                 name = (text or "state")[:1].upper() + (text or "state")[1:]
                 if imgui.selectable(f"{k}. {name}{saved}##h{k}", here)[0] and not here:
                     self.jump(k)
+                if here and self._history_follow > 0:
+                    imgui.set_scroll_here_y(0.5)
+                    self._history_follow -= 1
+                    self._frames_wanted = max(self._frames_wanted, 1)   # the frame that applies it
                 if imgui.is_item_visible():
                     self._rect(f"history_{k}")
         imgui.end_child()           # always (ImGui's rule for begin_child)

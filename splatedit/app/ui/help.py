@@ -49,10 +49,19 @@ def draw_help(g, w: int, h: int) -> None:
     lh = imgui.get_text_line_height_with_spacing()
     foot = imgui.get_frame_height_with_spacing()
     avail = imgui.get_content_region_avail()
-    hv.rows = max(int((avail.y - foot) // lh), 1)
-    child_h = hv.rows * lh
+    # lines wider than the window get a horizontal scroll bar, inside the lines' child window:
+    # room for it below the rows, or it would hide the last row (the help's last line at the end)
+    bar = imgui.get_style().scrollbar_size
+    if g.help_width is None:
+        g.help_width = max(imgui.calc_text_size(text).x for text, _ in hv._lines)
+    wide = g.help_width > avail.x - bar          # (the vertical bar takes its width when paged)
+    hv.rows = max(int((avail.y - foot - (bar if wide else 0.0)) // lh), 1)
+    child_h = hv.rows * lh + (bar if wide else 0.0)
     imgui.begin_child("help_lines", imgui.ImVec2(-1, child_h), 0,
                       imgui.WindowFlags_.horizontal_scrollbar.value)
+    # what the rows' area really shows (status and tests: every paged row is visible)
+    shown_h = child_h - (bar if imgui.get_scroll_max_x() > 0 else 0.0)
+    g.help_visible_rows = int((shown_h + 0.5) // lh)
     sy = imgui.get_scroll_y()
     if g.help_scroll_set is not None and abs(sy - g.help_scroll_set) > 0.5:
         hv.top = int(round(sy / lh))            # the wheel or the scroll bar moved it

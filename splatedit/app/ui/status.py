@@ -75,6 +75,7 @@ def status_dict(ed) -> dict:
         st["gui_wants_keyboard"] = bool(gui.wants_keyboard)
         st["gui_menu_open"] = bool(gui.menu_open)
         st["gui_panel_scrolls"] = bool(gui.panel_scrolls)
+        st["help_visible_rows"] = int(gui.help_visible_rows)
         st["background"] = [round(float(x), 4) for x in vp.background[:3]]
         st["distortion_map"] = bool(vp.distortion_map)
     if s is None:
