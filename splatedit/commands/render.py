@@ -79,7 +79,7 @@ def cmd_render(args) -> int:
             check_output_path(target, overwrite=args.force, protect=args.input, extensions=(ext,))
     from splatedit.io import is_gaussian_file
     if getattr(args, "edl", False) and is_gaussian_file(args.input):
-        raise ParameterError("--edl", "eye-dome lighting is for point-splat models, not Gaussian splat scenes")
+        raise ParameterError("--edl", f"eye-dome lighting is for point-splat models; {args.input} is a Gaussian splat scene")
     from splatedit.commands.outofcore import is_copc_path, render_copc
     if is_copc_path(args.input):
         return render_copc(args, _camera_from_args)

@@ -104,6 +104,7 @@ def test_render_edl_only_darkens_depth_edges_and_is_refused_for_gaussian_scenes(
     assert cli.main(["render", str(gaussian_scene_path()), "-o", str(tmp_path / "g.png"), "--edl"]) == 2
     err = capsys.readouterr().err.strip().splitlines()
     assert len(err) == 1 and err[0].startswith("splatedit: error: ") and "--edl" in err[0]
+    assert str(gaussian_scene_path()) in err[0]                 # names the file
 
 
 def test_a_scan_with_one_glitch_point_1e9_away_renders_its_body_not_a_strip(tmp_path):
