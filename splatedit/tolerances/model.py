@@ -271,3 +271,10 @@ TILE_HALO_NEIGHBOURHOODS = 3.0
 #: of the tile's points (exact enough: a median's relative standard error is
 #: ~1/sqrt(m), 2.2 % at 2000)
 TILE_SPACING_SAMPLE = 2000
+
+# ---- octree level of detail (splatedit.model.octree_lod)
+#: an octree node is refined (its children shown) while its point spacing
+#: projects above this many pixels: Potree's default "min node size" idea in
+#: spacing terms; 1.5 px keeps neighbouring splats (about 1-2 spacings wide)
+#: overlapping on screen, finer would spend the point budget on sub-pixel detail
+OCTREE_LOD_MIN_PX = 1.5
