@@ -28,7 +28,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from splatedit.tolerances import OCTREE_LOD_MIN_PX
+from splatedit.tolerances import NODE_NORMAL_NEIGHBOURS, OCTREE_LOD_MIN_PX, SPACING_NEIGHBOUR
 
 
 @dataclass(frozen=True)
@@ -172,3 +172,84 @@ def select_nodes(nodes: dict, root_spacing: float, view: OctreeView, *, budget: 
                 if c in by_tuple and c not in seen:
                     push(c)
     return NodeChoice(tuple(chosen), total, complete)
+
+
+# ----------------------------------------------------------------- splats of shown nodes
+def node_frames(points: np.ndarray, k: int = NODE_NORMAL_NEIGHBOURS,
+                spacing_k: int = SPACING_NEIGHBOUR) -> tuple[np.ndarray, np.ndarray]:
+    """Normals and spacings of one node's points, from the node alone.
+
+    A node holds a subsample of its cube at about its depth's spacing, so its
+    own k nearest neighbours give a PCA normal (Hoppe et al. 1992) and the
+    distance to the ``spacing_k``-th neighbour (the splat size rule of
+    :func:`splatedit.model.estimate.splat_radii`) without the rest of the
+    scan: each node is estimated once, when it is loaded.  Normals are oriented
+    with a non-negative z (scans of the ground are Z-up; signs elsewhere are
+    arbitrary: the splat renderer lights both sides).
+
+    Args:
+        points: (n, 3) float64 positions (model units).
+    Returns:
+        normals (n, 3) float32 unit, spacing (n,) float32 model units (> 0;
+        1.0 for a single point).
+    """
+    from scipy.spatial import cKDTree
+
+    from splatedit.model.estimate import estimate_normals
+    pts = np.ascontiguousarray(points, dtype=np.float64)
+    n = len(pts)
+    if n < 3:
+        nrm = np.zeros((n, 3), np.float32)
+        nrm[:, 2] = 1.0
+        sp = np.full(n, float(np.ptp(pts, axis=0).max()) if n == 2 else 1.0, np.float32)
+        return nrm, np.maximum(sp, 1e-9).astype(np.float32)
+    kk = int(min(max(k, spacing_k + 1), n))
+    dist, nb = cKDTree(pts).query(pts, kk, workers=-1)
+    nrm = estimate_normals(pts, min(k, n), neighbours=nb)
+    nrm[nrm[:, 2] < 0] *= -1.0
+    sp = dist[:, min(spacing_k, kk - 1)]
+    good = sp[np.isfinite(sp) & (sp > 0)]
+    med = float(np.median(good)) if len(good) else 1.0
+    sp = np.where(np.isfinite(sp) & (sp > 0.05 * med), sp, med)
+    return nrm.astype(np.float32), sp.astype(np.float32)
+
+
+def key_codes(keys) -> np.ndarray:
+    """(m,) int64 codes of ``(depth, x, y, z)`` keys (depth < 8, coordinates
+    < 2**20): equal keys, equal codes."""
+    a = np.asarray([tuple(int(v) for v in k) for k in keys], dtype=np.int64).reshape(-1, 4)
+    return (a[:, 0] << 60) | (a[:, 1] << 40) | (a[:, 2] << 20) | a[:, 3]
+
+
+def finest_shown(points: np.ndarray, key: tuple, shown_codes: np.ndarray, cube_lo: np.ndarray,
+                 cube_size: float, max_depth: int) -> tuple[np.ndarray, np.ndarray]:
+    """For the points of node ``key``: the code and depth of the deepest shown
+    node whose cube holds each point (the node itself at least).
+
+    Args:
+        points: (n, 3) float64 positions in the octree's frame.
+        key: the points' node ``(depth, x, y, z)``.
+        shown_codes: sorted int64 :func:`key_codes` of the shown nodes.
+        cube_lo: (3,) the root cube's lower corner; ``cube_size`` its edge.
+        max_depth: the octree's deepest level.
+    Returns:
+        codes (n,) int64, depths (n,) int64.
+    """
+    d0 = int(key[0])
+    n = len(points)
+    ijk = np.tile(np.asarray(key[1:], dtype=np.int64), (n, 1))
+    code = np.full(n, key_codes([key])[0], dtype=np.int64)
+    depth = np.full(n, d0, dtype=np.int64)
+    alive = np.ones(n, bool)
+    rel = (np.asarray(points, dtype=np.float64) - cube_lo) / cube_size      # 0..1 in the root cube
+    for d in range(d0 + 1, max_depth + 1):
+        if not alive.any():
+            break
+        cells = np.clip(np.floor(rel * (1 << d)).astype(np.int64), ijk * 2, ijk * 2 + 1)
+        c = (np.int64(d) << 60) | (cells[:, 0] << 40) | (cells[:, 1] << 20) | cells[:, 2]
+        pos = np.searchsorted(shown_codes, c)
+        hit = alive & (pos < len(shown_codes)) & (shown_codes[np.minimum(pos, len(shown_codes) - 1)] == c)
+        code[hit], depth[hit] = c[hit], d
+        ijk = np.where(hit[:, None], cells, ijk)
+        alive = hit
+    return code, depth

@@ -278,3 +278,8 @@ TILE_SPACING_SAMPLE = 2000
 #: spacing terms; 1.5 px keeps neighbouring splats (about 1-2 spacings wide)
 #: overlapping on screen, finer would spend the point budget on sub-pixel detail
 OCTREE_LOD_MIN_PX = 1.5
+#: neighbours for a loaded octree node's PCA normals (the node's own points):
+#: fewer than NORMAL_NEIGHBOURS (16) because a node is estimated alone and
+#: this runs while the user waits for the view to refine; 10 neighbours on
+#: a 50k-point node took 0.35 s of k-d tree query and 0.08 s of PCA here
+NODE_NORMAL_NEIGHBOURS = 10

@@ -1,0 +1,590 @@
+"""Out-of-core documents: a COPC scan larger than memory, edited where the user works.
+
+An :class:`OutOfCoreScan` keeps a COPC file (:mod:`splatedit.io.copc`: the
+header and the octree hierarchy, no points) and the *shown* nodes: the
+session's cloud is the concatenation of their points, in the order of
+:attr:`OutOfCoreScan.segments` (node key, first splat, count), so every splat
+of the document is a point of the file, known by (node, row).
+
+* **View.** When the camera has rested :data:`EDITOR_OOC_SETTLE_S` and the view
+  asks for other nodes (:func:`splatedit.model.octree_lod.select_nodes`:
+  spacing projected above 1.5 px, nearest first, within
+  :data:`EDITOR_OOC_POINT_BUDGET`), a background job reads the missing nodes,
+  estimates each new node's normals and spacings from its own points (once per
+  node) and builds the splats (size from the finest shown node at each point,
+  as Potree's adaptive point size); the loop swaps the new cloud in when it
+  is ready.  A pristine document (no selection, no edit) takes the new node set
+  as it is; a document with a selection or edits only *appends* nodes (the
+  indices of its history, selection and edit script stay valid), up to
+  :data:`EDITOR_OOC_MAX_POINTS`.
+* **Edit region.** When a stroke leaves a support, every node intersecting
+  the support's bounding box (grown by :data:`EDITOR_OOC_REGION_MARGIN_RADII`
+  splat radii) is loaded at full resolution and appended; the support and the
+  handles spread to the new points by nearest neighbour (a new point takes
+  the flags of the nearest shown point within that point's splat radius), and
+  the session (fit, closure, handles, moves, commit, undo) works on that cloud
+  unchanged.  Moves wait until the region is there (:attr:`Session.waiting`).
+* **Save.** :func:`save_job` streams the file through
+  :func:`splatedit.io.copc.rewrite_copc`: a node whose points moved is written
+  with its new positions (by row), every other node is copied as it is.
+
+The open / refine / region work runs in :class:`~splatedit.app.jobs.Job`
+threads (progress bars in the panel); this module's loop side
+(:meth:`OutOfCoreScan.poll`) never reads the file.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from splatedit.app.jobs import Job
+from splatedit.model.cloud import SplatCloud
+from splatedit.model.octree_lod import (OctreeView, finest_shown, key_codes, node_frames,
+                                        select_nodes)
+from splatedit.model.tangents import tangent_frame
+from splatedit.tolerances import (EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_MAX_POINTS, EDITOR_OOC_POINT_BUDGET,
+                                  EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII, EDITOR_OOC_SETTLE_S,
+                                  SPLAT_RADIUS_FACTOR)
+
+#: the job names of an out-of-core document in ``Editor.jobs``
+VIEW_JOB, REGION_JOB = "nodes", "region"
+
+
+def _key(k) -> tuple:
+    return tuple(int(v) for v in k)
+
+
+@dataclass
+class LoadedNode:
+    """One node's points as read (never modified: saves compare against them).
+
+    Attributes:
+        key: (depth, x, y, z).
+        xyz: (n, 3) float64 local positions (file coordinates minus the scan's origin).
+        colors: (n, 4) uint8 RGBA, or None.
+        normals: (n, 3) float32 unit normals (:func:`node_frames`).
+        spacing: (n,) float32 distance to the 6th neighbour within the node.
+        median: the median of ``spacing``.
+    """
+    key: tuple
+    xyz: np.ndarray
+    colors: np.ndarray | None
+    normals: np.ndarray
+    spacing: np.ndarray
+    median: float
+
+    @property
+    def n(self) -> int:
+        return len(self.xyz)
+
+
+def read_nodes(copc, keys, origin: np.ndarray, progress=None, stage: str = "reading nodes") -> dict:
+    """Read ``keys`` (the file's own keys, ``copc.nodes``'s) of the COPC file and estimate each node's frames.
+
+    Returns: key tuple -> :class:`LoadedNode`.  ``progress(stage, fraction)``
+    is called after every batch of about :data:`EDITOR_OOC_READ_BATCH` points
+    (a cancelled job stops there)."""
+    keys = list(keys)
+    out: dict = {}
+    total = max(sum(int(copc.nodes[k].point_count) for k in keys), 1)
+    done = 0
+    batch: list = []
+    pts = 0
+
+    def flush():
+        nonlocal done
+        if not batch:
+            return
+        block = copc.read(batch)
+        order = np.argsort(block.node, kind="stable")
+        node_sorted = block.node[order]
+        cuts = np.searchsorted(node_sorted, np.arange(len(block.keys) + 1))
+        for j, k in enumerate(block.keys):
+            rows = order[cuts[j]:cuts[j + 1]]
+            rows = rows[np.argsort(block.row[rows], kind="stable")]
+            xyz = block.xyz[rows] - origin
+            col = None
+            if block.colour is not None:
+                col = np.empty((len(rows), 4), np.uint8)
+                col[:, :3] = block.colour[rows]
+                col[:, 3] = 255
+            nrm, sp = node_frames(xyz)
+            med = float(np.median(sp)) if len(sp) else 1.0
+            out[_key(k)] = LoadedNode(_key(k), xyz, col, nrm, sp, med)
+            done += len(rows)
+            if progress is not None:
+                progress(stage, done / total)
+        batch.clear()
+
+    for k in keys:
+        batch.append(k)
+        pts += int(copc.nodes[k].point_count)
+        if pts >= EDITOR_OOC_READ_BATCH:
+            flush()
+            pts = 0
+    flush()
+    return out
+
+
+class OutOfCoreScan:
+    """An opened COPC scan and the nodes the document shows (see the module doc).
+
+    Args:
+        copc: an open :class:`splatedit.io.copc.CopcFile`.
+        path: the file opened by the user (``copc`` may be its COPC cache).
+        budget: points to show after refinement.
+    """
+
+    def __init__(self, copc, path: Path, *, source: Path | None = None, budget: int = EDITOR_OOC_POINT_BUDGET):
+        self.copc = copc
+        self.path = Path(path)
+        #: the COPC file read (the opened file, or its COPC cache)
+        self.source = Path(source) if source is not None else self.path
+        self.budget = int(budget)
+        self.by_tuple = {_key(k): k for k in copc.nodes}
+        b = np.asarray(copc.bounds, dtype=np.float64).reshape(2, 3)
+        root = copc.nodes[self.by_tuple[(0, 0, 0, 0)]]
+        rb = np.asarray(root.bounds, dtype=np.float64).reshape(2, 3)
+        #: local origin: the centre of the data's box (float32 on the GPU keeps fine steps)
+        self.origin = np.round((b[0] + b[1]) / 2.0, 3)
+        self.cube_lo = rb[0] - self.origin
+        self.cube_size = float((rb[1] - rb[0]).max())
+        self.max_depth = int(max(k[0] for k in self.by_tuple))
+        #: loaded nodes (the shown ones): key tuple -> LoadedNode
+        self.nodes: dict = {}
+        #: (key tuple, first splat, count) in the order of the session's cloud
+        self.segments: list = []
+        self.view_state = None          # the camera state the shown nodes were chosen for
+        self.view_complete = False
+        self.moved_at = time.perf_counter()
+        self.last_cam = None
+        self.waiting_version = None     # selection version a region was last checked for
+        self.notice = ""                # why the view no longer refines (shown once)
+
+    # ------------------------------------------------------------ geometry
+    def node_bounds(self, t: tuple) -> np.ndarray:
+        """(2, 3) local bounds of node ``t``."""
+        return np.asarray(self.copc.nodes[self.by_tuple[t]].bounds, dtype=np.float64).reshape(2, 3) - self.origin
+
+    @property
+    def shown(self) -> list:
+        return [seg[0] for seg in self.segments]
+
+    def read(self, keys, progress=None, stage: str = "reading nodes") -> dict:
+        """:func:`read_nodes` of key tuples ``keys``."""
+        return read_nodes(self.copc, [self.by_tuple[t] for t in keys], self.origin, progress, stage)
+
+    def shown_points(self) -> int:
+        return sum(seg[2] for seg in self.segments)
+
+    def local_nodes(self) -> dict:
+        """key tuple -> node with local bounds (for :func:`select_nodes`)."""
+        @dataclass
+        class _N:
+            point_count: int
+            bounds: np.ndarray
+        return {t: _N(int(self.copc.nodes[k].point_count), self.node_bounds(t)) for t, k in self.by_tuple.items()}
+
+    def overview_keys(self, budget: int) -> list:
+        """Whole levels of the octree from the root down while they fit in
+        ``budget`` points (the first view, before the camera is framed)."""
+        by_depth: dict = {}
+        for t, k in self.by_tuple.items():
+            by_depth.setdefault(t[0], []).append(t)
+        out, total = [], 0
+        for d in sorted(by_depth):
+            level = sorted(by_depth[d])
+            count = sum(int(self.copc.nodes[self.by_tuple[t]].point_count) for t in level)
+            if out and total + count > budget:
+                break
+            out += level
+            total += count
+        return out
+
+    def region_keys(self, lo: np.ndarray, hi: np.ndarray) -> list:
+        """Every node (all depths) whose box meets the local box ``lo..hi``, coarse first."""
+        out = []
+        for t in self.by_tuple:
+            b = self.node_bounds(t)
+            if (b[0] <= hi).all() and (b[1] >= lo).all():
+                out.append(t)
+        return sorted(out)
+
+    # --------------------------------------------------------------- splats
+    def radii(self, keys: list, nodes: dict) -> dict:
+        """key -> (n,) splat radii of each of ``keys`` when ``keys`` are shown:
+        ``SPLAT_RADIUS_FACTOR`` x the smaller of the point's own spacing and
+        the median spacing of the finest shown node holding it."""
+        codes = key_codes(keys)
+        order = np.argsort(codes)
+        sorted_codes = codes[order]
+        medians = np.array([nodes[keys[i]].median for i in order])
+        out = {}
+        for t in keys:
+            nd = nodes[t]
+            fine, _ = finest_shown(nd.xyz, t, sorted_codes, self.cube_lo, self.cube_size, self.max_depth)
+            med = medians[np.searchsorted(sorted_codes, fine)]
+            out[t] = SPLAT_RADIUS_FACTOR * np.minimum(nd.spacing.astype(np.float64), med)
+        return out
+
+    def splats(self, keys: list, nodes: dict, radii: dict, name: str) -> SplatCloud:
+        """The splats of ``keys`` (in that order) with the given radii."""
+        xyz = np.concatenate([nodes[t].xyz for t in keys])
+        nrm = np.concatenate([nodes[t].normals for t in keys]).astype(np.float64)
+        r = np.concatenate([radii[t] for t in keys])[:, None]
+        t1, t2 = tangent_frame(nrm)
+        cols = None
+        if all(nodes[t].colors is not None for t in keys):
+            cols = np.concatenate([nodes[t].colors for t in keys])
+        return SplatCloud(xyz, t1 * r, t2 * r, cols, name=name, source=str(self.path), origin=self.origin)
+
+    def build(self, keys: list, nodes: dict) -> tuple:
+        """(cloud, segments) showing exactly ``keys`` (a new document)."""
+        radii = self.radii(keys, nodes)
+        cloud = self.splats(keys, nodes, radii, self.path.name)
+        segs, start = [], 0
+        for t in keys:
+            segs.append((t, start, nodes[t].n))
+            start += nodes[t].n
+        return cloud, segs
+
+    def extend(self, cloud: SplatCloud, segments: list, new: list, nodes: dict) -> tuple:
+        """(cloud, segments) of ``cloud`` (showing ``segments``) with the nodes
+        ``new`` appended: the old splats keep their index, position and shape,
+        only shrunk where finer nodes now cover them."""
+        old_keys = [s[0] for s in segments]
+        keys = old_keys + list(new)
+        before = self.radii(old_keys, nodes)
+        after = self.radii(keys, nodes)
+        scale = np.ones(cloud.n)
+        for t, start, count in segments:
+            f = after[t] / before[t]
+            scale[start:start + count] = np.minimum(f, 1.0)
+        u, v = cloud.u, cloud.v
+        if (scale < 1.0).any():
+            u, v = u * scale[:, None], v * scale[:, None]
+        add = self.splats(list(new), nodes, after, cloud.name)
+        cols = None
+        if cloud.colors is not None and add.colors is not None:
+            cols = np.concatenate([cloud.colors, add.colors])
+        out = SplatCloud(np.concatenate([cloud.positions, add.positions]), np.concatenate([u, add.u]),
+                         np.concatenate([v, add.v]), cols, name=cloud.name, source=cloud.source,
+                         origin=self.origin)
+        segs, start = list(segments), cloud.n
+        for t in new:
+            segs.append((t, start, nodes[t].n))
+            start += nodes[t].n
+        return out, segs
+
+    # ------------------------------------------------------------ the view
+    def view_of(self, cam, w: int, h: int) -> OctreeView:
+        """The editor camera as the node selection sees it (local frame)."""
+        return OctreeView(np.asarray(cam.eye, float), cam.view_projection(w, h), math.radians(cam.fov_deg), int(h))
+
+    def choose(self, cam, w: int, h: int, always=()):
+        return select_nodes(self.local_nodes(), float(self.copc.spacing), self.view_of(cam, w, h),
+                            budget=self.budget, always=always)
+
+    # ------------------------------------------------------------ the loop
+    def poll(self, ed) -> None:
+        """The editor loop's turn: start a region load after a stroke, or a
+        refinement once the camera has rested.  Never blocks."""
+        s = ed.session
+        if s is None or ed.viewport is None:
+            return
+        cam_state = ed.cam.state()
+        now = time.perf_counter()
+        if cam_state != self.last_cam:
+            self.last_cam, self.moved_at = cam_state, now
+        busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
+        if busy or s.manip is not None or s.committing:
+            return
+        if self.region_needed(s):
+            return self.start_region(ed)
+        if (now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state
+                and ed.drag.name == "NONE"):
+            self.view_state = cam_state
+            self.start_refine(ed)
+
+    def pristine(self, s) -> bool:
+        """No selection, no pending pose, no edit: the shown nodes may change freely."""
+        sel = s.selection
+        return not s.edits and not sel.support.any() and not len(getattr(s, "curve_points", ()))
+
+    def current_segments(self, s) -> list:
+        """The segments the session's cloud holds (an undo may have restored a shorter one)."""
+        return [seg for seg in self.segments if seg[1] + seg[2] <= s.cloud.n]
+
+    def region_needed(self, s):
+        """The full-resolution box of the support when it holds nodes not shown yet, else None."""
+        if s.version == self.waiting_version:
+            return None
+        self.waiting_version = s.version
+        sup = s.selection.support
+        if not sup.any():
+            return None
+        return self.region_box(s) is not None
+
+    def region_box(self, s):
+        sup = np.flatnonzero(s.selection.support)
+        p = s.cloud.positions[sup]
+        r = float(s.cloud.radii[sup].max()) * EDITOR_OOC_REGION_MARGIN_RADII
+        lo, hi = p.min(0) - r, p.max(0) + r
+        shown = {seg[0] for seg in self.current_segments(s)}
+        missing = [t for t in self.region_keys(lo, hi) if t not in shown]
+        return (lo, hi, missing) if missing else None
+
+    def start_refine(self, ed) -> None:
+        s = ed.session
+        w, h = ed.size
+        if w <= 0 or h <= 0:
+            return
+        segs = self.current_segments(s)
+        pristine = self.pristine(s)
+        choice = self.choose(ed.cam, w, h)
+        want = [t for t in choice.keys]
+        shown = {seg[0] for seg in segs}
+        if pristine:
+            if set(want) == shown:
+                return
+            keys = want
+        else:
+            keys = [t for t in want if t not in shown]
+            room = EDITOR_OOC_MAX_POINTS - s.cloud.n
+            out, total = [], 0
+            for t in keys:
+                c = int(self.copc.nodes[self.by_tuple[t]].point_count)
+                if total + c > room:
+                    break
+                out.append(t)
+                total += c
+            if len(out) < len(keys) and not self.notice:
+                self.notice = (f"the view no longer refines ({s.cloud.n:,} points shown with edits): "
+                               "save, then open the saved file to see more detail")
+                ed.say(self.notice)
+            keys = out
+            if not keys:
+                return
+        cloud = s.cloud
+        nodes = dict(self.nodes)
+        fresh = [t for t in keys if t not in nodes]
+
+        def work(progress):
+            progress("reading the view's nodes", 0.0)
+            nodes.update(self.read(fresh, progress, "reading the view's nodes"))
+            progress("building the view's splats", 1.0)
+            if pristine:
+                return ("swap",) + self.build(keys, nodes) + (nodes, cloud)
+            return ("append",) + self.extend(cloud, segs, keys, nodes) + (nodes, cloud)
+
+        ed.jobs[VIEW_JOB] = Job("refining the view", work, ed.wake)
+
+    def start_region(self, ed) -> None:
+        s = ed.session
+        box = self.region_box(s)
+        if box is None:
+            return
+        lo, hi, missing = box
+        segs = self.current_segments(s)
+        cloud = s.cloud
+        nodes = dict(self.nodes)
+        fresh = [t for t in missing if t not in nodes]
+        s.waiting = "loading the full-resolution region"
+
+        def work(progress):
+            progress("loading the region at full resolution", 0.0)
+            nodes.update(self.read(fresh, progress, "loading the region at full resolution"))
+            return ("append",) + self.extend(cloud, segs, missing, nodes) + (nodes, cloud)
+
+        ed.jobs[REGION_JOB] = Job("full-resolution region", work, ed.wake)
+        ed.say(f"loading {sum(int(self.copc.nodes[self.by_tuple[t]].point_count) for t in missing):,} "
+               f"points of the painted region at full resolution ...")
+
+    def landed(self, ed, name: str, result) -> None:
+        """A view or region job finished: swap its cloud in (when the document
+        is still the one it was built for)."""
+        s = ed.session
+        kind, cloud, segs, nodes, base = result
+        if name == REGION_JOB:
+            s.waiting = None
+        if s is None or s.cloud is not base or s.manip is not None or s.committing:
+            self.view_state = None       # the document changed meanwhile: choose again
+            self.waiting_version = None
+            return
+        if kind == "swap":
+            if not self.pristine(s):
+                self.view_state = self.waiting_version = None
+                return
+            replace_pristine(s, cloud)
+            keep = {t for t, _, _ in segs}
+            self.nodes = {t: nodes[t] for t in keep}
+        else:
+            adopt_appended(s, cloud, label="full resolution" if name == REGION_JOB else None)
+            self.nodes = nodes
+        self.segments = segs
+        self.view_complete = kind == "swap"
+        self.waiting_version = None if name == REGION_JOB else s.version
+        if name == REGION_JOB:
+            s.request_fit()
+            ed.say(f"region at full resolution: {cloud.n:,} points shown")
+        restart_levels(ed, cloud)
+
+    # ------------------------------------------------------------- saving
+    def moved_nodes(self, cloud: SplatCloud) -> dict:
+        """key -> ((m,) rows, (m, 3) file coordinates) of the points of ``cloud``
+        that moved from where the file has them."""
+        out = {}
+        for t, start, count in self.segments:
+            if start + count > cloud.n:
+                continue
+            cur = cloud.positions[start:start + count]
+            base = self.nodes[t].xyz
+            rows = np.flatnonzero((cur != base).any(axis=1))
+            if len(rows):
+                out[t] = (rows, cur[rows] + self.origin)
+        return out
+
+
+# ------------------------------------------------------------ the session side
+def replace_pristine(s, cloud) -> None:
+    """A pristine session shows ``cloud`` instead (no history kept: nothing was done)."""
+    from splatedit.select.selection import Selection
+    s.fit.clear()
+    s.cloud = cloud
+    s.selection = Selection(cloud.n)
+    s.last_edit = None
+    s.history.reset(s.history_part.snapshot("open"))
+    s.version += 1
+    s.on_change()
+
+
+def adopt_appended(s, cloud, label: str | None) -> None:
+    """The session's cloud grows to ``cloud`` (its first ``s.cloud.n`` splats are
+    the current ones): support and handles spread to the new splats by nearest
+    neighbour; with ``label`` it is an undo step."""
+    from scipy.spatial import cKDTree
+
+    from splatedit.select.selection import Selection
+    old = s.cloud
+    n0 = old.n
+    sel = s.selection
+    masks = [sel.support] + list(sel.handles)
+    grown = [np.concatenate([m, np.zeros(cloud.n - n0, bool)]) for m in masks]
+    if sel.support.any() and cloud.n > n0:
+        sup = np.flatnonzero(sel.support)
+        lo = old.positions[sup].min(0)
+        hi = old.positions[sup].max(0)
+        r = old.radii
+        pad = float(r[sup].max())
+        near = np.flatnonzero(((old.positions >= lo - 2 * pad) & (old.positions <= hi + 2 * pad)).all(1))
+        new_pts = cloud.positions[n0:]
+        d, j = cKDTree(old.positions[near]).query(new_pts, 1, workers=-1)
+        src = near[j]
+        ok = d <= r[src]
+        for m, g in zip(masks, grown):
+            g[n0:] = ok & m[src]
+    s.fit.clear()
+    s.cloud = cloud
+    s.selection = Selection(cloud.n, grown[0], handles=grown[1:], active=sel.active)
+    s.last_edit = None
+    s.version += 1
+    if label is not None:
+        s.push(label)
+    s.on_change()
+
+
+def restart_levels(ed, cloud) -> None:
+    """The viewport's level-of-detail pyramid for the new cloud (the old one is dropped)."""
+    from splatedit.tolerances import EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS
+    old = ed.jobs.pop("lod", None)
+    if old is not None:
+        old.cancel.set()
+    ed.viewport.set_pyramid(None)
+    ed.frames.invalidate()
+    if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
+        def work(progress):
+            from splatedit.model.lod import LodPyramid
+            return LodPyramid(cloud, EDITOR_LOD_BUDGETS, progress=progress, background=True)
+        ed.jobs["lod"] = Job("levels of detail", work, ed.wake)
+
+
+# -------------------------------------------------------------- open and save
+def is_out_of_core(path) -> bool:
+    """Whether the editor opens ``path`` out of core: a COPC file above
+    :data:`EDITOR_OOC_MIN_POINTS`, or another scan above
+    :data:`EDITOR_OOC_CONVERT_BYTES` (converted once into a COPC cache)."""
+    from splatedit import tolerances as tol
+    p = Path(path)
+    if p.name.lower().endswith(".copc.laz"):
+        from splatedit.io.copc import CopcFile
+        try:
+            return CopcFile.open(p).point_count > tol.EDITOR_OOC_MIN_POINTS
+        except Exception:  # noqa: BLE001 - not a valid COPC: the ordinary reader says why
+            return False
+    try:
+        return p.stat().st_size > tol.EDITOR_OOC_CONVERT_BYTES
+    except OSError:
+        return False
+
+
+def open_scan(path, progress, *, first: int = EDITOR_OOC_FIRST_POINTS,
+              budget: int = EDITOR_OOC_POINT_BUDGET) -> tuple:
+    """(scan, first cloud): the file's hierarchy and its coarse top (worker thread).
+    A non-COPC file is converted into its COPC cache first."""
+    from splatedit.io.copc import CopcFile, cached_copc
+    p = Path(path)
+    src = p
+    if not p.name.lower().endswith(".copc.laz"):
+        progress("converting to a COPC cache (once)", 0.0)
+        src = cached_copc(p)
+    progress("reading the octree", 0.0)
+    scan = OutOfCoreScan(CopcFile.open(src), p, source=src, budget=budget)
+    keys = scan.overview_keys(first)
+    nodes = scan.read(keys, progress, "reading the overview")
+    cloud, segs = scan.build(keys, nodes)
+    scan.nodes, scan.segments = nodes, segs
+    return scan, cloud
+
+
+def save_job(ed, scan: OutOfCoreScan, path: Path) -> Job:
+    """Write ``path``: the COPC file with the moved points replaced, streamed
+    node by node (:func:`splatedit.io.copc.rewrite_copc`), and the edit script
+    beside it.  Over the opened file itself: into a temporary file, then renamed."""
+    import dataclasses
+    import os
+
+    from splatedit.app.files import script_path_for
+    s = ed.session
+    cloud, script, pos = s.cloud, s.edit_script(), s.history.position
+    moved = scan.moved_nodes(cloud)
+    spath = script_path_for(Path(path))
+    same = Path(path).resolve() == scan.source.resolve()
+
+    def edit(node, block):
+        t = _key(node.key)
+        if t not in moved:
+            return None
+        rows, xyz = moved[t]
+        new = block.xyz.copy()
+        where = np.empty(len(block.row), np.int64)
+        where[block.row] = np.arange(len(block.row))
+        new[where[rows]] = xyz
+        return dataclasses.replace(block, xyz=new)
+
+    def work(progress):
+        from splatedit.io.copc import rewrite_copc
+        target = Path(path)
+        tmp = target.with_name(target.name + ".part") if same else target
+        progress("saving", 0.0)
+        rewrite_copc(scan.copc, tmp, edit, progress=progress)
+        if same:
+            os.replace(tmp, target)
+        script.save(spath)
+        return target, spath, pos, s
+
+    return Job("saving", work, ed.wake)
