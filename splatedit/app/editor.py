@@ -440,6 +440,8 @@ def run_editor(path=None, **options) -> int:
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
     from splatedit.app.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
+    from splatedit.app.outofcore import point_budgets
+    point_budgets()             # and a bad SPLATEDIT_OOC_BUDGET
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
                              "saves never replace it: choose another path")

@@ -43,6 +43,7 @@ from pathlib import Path
 import numpy as np
 
 from splatedit.app.jobs import Job
+from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.octree_lod import (OctreeView, finest_shown, key_codes, node_frames,
                                         select_nodes)
@@ -56,6 +57,9 @@ VIEW_JOB, REGION_JOB = "nodes", "region"
 
 
 def _key(k) -> tuple:
+    """``(depth, x, y, z)`` of a key (a :class:`splatedit.io.copc.NodeKey` or a 4-sequence)."""
+    if hasattr(k, "depth"):
+        return (int(k.depth), int(k.x), int(k.y), int(k.z))
     return tuple(int(v) for v in k)
 
 
@@ -178,6 +182,13 @@ class OutOfCoreScan:
     def read(self, keys, progress=None, stage: str = "reading nodes") -> dict:
         """:func:`read_nodes` of key tuples ``keys``."""
         return read_nodes(self.copc, [self.by_tuple[t] for t in keys], self.origin, progress, stage)
+
+    def summary(self, s) -> str:
+        """The panel's line: what is shown of the file."""
+        segs = self.current_segments(s)
+        depth = max((t[0] for t, _, _ in segs), default=0)
+        return (f"out of core: {sum(c for _, _, c in segs):,} of {int(self.copc.point_count):,} points shown "
+                f"(octree depth {depth} of {self.max_depth})")
 
     def shown_points(self) -> int:
         return sum(seg[2] for seg in self.segments)
@@ -532,18 +543,38 @@ def is_out_of_core(path) -> bool:
         return False
 
 
-def open_scan(path, progress, *, first: int = EDITOR_OOC_FIRST_POINTS,
-              budget: int = EDITOR_OOC_POINT_BUDGET) -> tuple:
+def point_budgets() -> tuple[int, int]:
+    """(first view, refined view) point budgets: :data:`EDITOR_OOC_FIRST_POINTS`,
+    :data:`EDITOR_OOC_POINT_BUDGET`, or ``SPLATEDIT_OOC_BUDGET=FIRST,BUDGET``
+    (tests and benchmarks: a small file that still refines)."""
+    import os
+    text = os.environ.get("SPLATEDIT_OOC_BUDGET", "")
+    if not text:
+        return EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_POINT_BUDGET
+    try:
+        first, budget = (int(x) for x in text.split(","))
+        if first <= 0 or budget <= 0:
+            raise ValueError
+    except ValueError:
+        raise ParameterError("SPLATEDIT_OOC_BUDGET", f"expected two positive integers FIRST,BUDGET, got {text!r}") from None
+    return first, budget
+
+
+def open_scan(path, progress, *, first: int | None = None, budget: int | None = None) -> tuple:
     """(scan, first cloud): the file's hierarchy and its coarse top (worker thread).
-    A non-COPC file is converted into its COPC cache first."""
-    from splatedit.io.copc import CopcFile, cached_copc
+    A non-COPC file is converted into its COPC cache first.  ``first`` /
+    ``budget``: points of the first and of a refined view (None: :func:`point_budgets`)."""
+    from splatedit.io import copc as copc_io
+    dfirst, dbudget = point_budgets()
+    first = dfirst if first is None else first
+    budget = dbudget if budget is None else budget
     p = Path(path)
     src = p
-    if not p.name.lower().endswith(".copc.laz"):
+    if not copc_io.is_copc(p):
         progress("converting to a COPC cache (once)", 0.0)
-        src = cached_copc(p)
+        src = copc_io.cached_copc(p)
     progress("reading the octree", 0.0)
-    scan = OutOfCoreScan(CopcFile.open(src), p, source=src, budget=budget)
+    scan = OutOfCoreScan(copc_io.CopcFile.open(src), p, source=src, budget=budget)
     keys = scan.overview_keys(first)
     nodes = scan.read(keys, progress, "reading the overview")
     cloud, segs = scan.build(keys, nodes)
