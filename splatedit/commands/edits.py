@@ -105,6 +105,11 @@ def cmd_deform(args) -> int:
     check_readable_file(args.edit)
     if is_gaussian_file(args.input):
         return _deform_gaussians(args)
+    from splatedit.commands.outofcore import deform_copc, is_copc_path
+    from splatedit.io.formats import suffix_of
+    if suffix_of(args.output) == ".copc.laz" and is_copc_path(args.input):
+        # out of core: the regions' nodes read, the rest copied compressed
+        return deform_copc(args, lambda rep: _print_edit(args, rep))
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)

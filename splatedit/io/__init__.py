@@ -15,7 +15,7 @@ Public API::
 The format follows the file extension (case-insensitive), looked up in the
 registry :data:`splatedit.io.formats.FORMATS` (its readers, writers and
 capabilities): ``.ply``; ``.xyz``, ``.txt`` (XYZ text); ``.off``; ``.las``,
-``.laz``; ``.e57`` (one scan by index: ``file.e57#2``); ``.pcd``; ``.pts``
+``.laz``; ``.copc.laz`` (COPC; out of core: :mod:`splatedit.io.copc`); ``.e57`` (one scan by index: ``file.e57#2``); ``.pcd``; ``.pts``
 (Leica); and the formats added there since.  Splats come from the file
 (our ``ux..vz`` PLY properties) or are derived: see
 :func:`splatedit.io._build.build_cloud`.  Every problem with an input file is
@@ -42,7 +42,7 @@ from splatedit.errors import InputError
 from splatedit.io._build import PointColumns, cloud_from_columns, columns_only
 from splatedit.io.atomic import atomic_open, check_writable_target
 from splatedit.io.e57 import split_scan_index
-from splatedit.io.formats import FORMATS, Format, by_extension, extensions, format_of
+from splatedit.io.formats import FORMATS, Format, by_extension, extensions, format_of, suffix_of
 from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply, write_gaussian_ply
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
@@ -66,7 +66,7 @@ FACE_EXTENSIONS = extensions(writable=True, faces=True)
 
 
 def _ext(path, allowed, what) -> str:
-    ext = Path(path).suffix.lower()
+    ext = suffix_of(path)
     if ext not in allowed:
         raise InputError(f"unsupported file extension {ext or '(none)'!r} for {what}; "
                          f"supported: {', '.join(allowed)}", path=str(path))

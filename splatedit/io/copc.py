@@ -48,6 +48,7 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.progress import report
+from splatedit.tolerances import COPC_FINE_DEPTH, COPC_LEAF_POINTS, COPC_NODE_POINTS
 
 # --------------------------------------------------------------------------- format facts
 
@@ -688,12 +689,10 @@ class _Writer:
 
 # --------------------------------------------------------------------------- octree layout
 
-#: points a node above the leaves keeps (a random sample of its subtree)
-NODE_POINTS = 20_000
-#: a subtree of at most this many points is one leaf node
-LEAF_POINTS = 60_000
-#: the finest level the layout subdivides to (cells counted at this level)
-FINE_DEPTH = 10
+#: the layout's defaults (splatedit.tolerances: COPC_NODE_POINTS, ...)
+NODE_POINTS = COPC_NODE_POINTS
+LEAF_POINTS = COPC_LEAF_POINTS
+FINE_DEPTH = COPC_FINE_DEPTH
 
 
 class _Octree:
@@ -871,27 +870,68 @@ def write_copc(dst_path, xyz, colour=None, intensity=None, *, records=None, scal
         scale = np.full(3, LAS_DEFAULT_SCALE) if scale is None else np.asarray(scale, float)
         offset = np.round((lo + hi) / 2) if offset is None else np.asarray(offset, float)
         records = make_records(xyz, scale, offset, colour, intensity)
+    with atomic_open(dst_path, "wb") as fh:
+        w = write_records(fh, records, scale, offset, node_points=node_points, leaf_points=leaf_points,
+                          progress=progress)
+        size = fh.tell()
+    return WriteReport(Path(dst_path), len(records), len(w.entries), encoded=len(w.entries), bytes=size)
+
+
+def write_records(fh, records: np.ndarray, scale, offset, *, node_points: int = NODE_POINTS,
+                  leaf_points: int = LEAF_POINTS, vlrs=(), progress=None) -> "_Writer":
+    """Write the point ``records`` (in memory) as a COPC file to the open
+    binary file ``fh``; returns the finished writer (its ``entries``)."""
     scale, offset = np.asarray(scale, float), np.asarray(offset, float)
-    fmt = {30: 6, 36: 7, 38: 8}.get(records.dtype.itemsize)
-    if "nir" in records.dtype.names:
-        fmt = 8
-    elif "red" in records.dtype.names:
-        fmt = 7
-    else:
-        fmt = 6
+    names = records.dtype.names
+    fmt = 8 if "nir" in names else 7 if "red" in names else 6
     ints = np.stack([records[c] for c in "XYZ"], axis=1).astype(np.int64)
     lo = ints.min(axis=0) * scale + offset
     hi = ints.max(axis=0) * scale + offset
     center, half = _cube(lo, hi, scale)
     del ints
     tree = _tree_for(records, scale, offset, center, half, node_points, leaf_points)
-    with atomic_open(dst_path, "wb") as fh:
-        w = _Writer(fh, point_format=fmt, record_length=records.dtype.itemsize, scale=scale, offset=offset,
-                    center=center, halfsize=half, spacing=tree.spacing)
-        _write_layout(fh, records, tree, w, progress)
-        w.finish()
-        size = fh.tell()
-    return WriteReport(Path(dst_path), len(records), len(w.entries), encoded=len(w.entries), bytes=size)
+    w = _Writer(fh, point_format=fmt, record_length=records.dtype.itemsize, scale=scale, offset=offset,
+                center=center, halfsize=half, spacing=tree.spacing, vlrs=vlrs)
+    _write_layout(fh, records, tree, w, progress)
+    w.finish()
+    return w
+
+
+def write_copc_cloud(fh, cloud, path) -> None:
+    """Write a :class:`~splatedit.model.cloud.SplatCloud` as COPC to the
+    open binary file ``fh`` (the registry's writer): the grid of the LAS/COPC
+    file it was read from (its integers back bit for bit), else
+    ``LAS_DEFAULT_SCALE`` around its origin; RGB (point format 7) when it has
+    colours, intensity, classification and the LAS fields kept in
+    ``point_fields`` (returns, GPS time, user data, point source, scan angle)."""
+    from splatedit.io.las import quantize
+    from splatedit.tolerances import LAS_DEFAULT_SCALE
+    q = cloud.quantization
+    if q is not None:
+        scale, offset = np.array(q.scale, float), np.array(q.offset, float)
+    else:
+        scale, offset = np.full(3, LAS_DEFAULT_SCALE), np.array(cloud.origin, dtype=np.float64)
+    ints = quantize(cloud, scale, offset, path)
+    fmt = 7 if cloud.colors is not None else 6
+    rec = np.zeros(len(ints), dtype=record_dtype(fmt, _RECORD_BYTES[fmt]))
+    for j, c in enumerate("XYZ"):
+        rec[c] = ints[:, j]
+    del ints
+    f = cloud.point_fields or {}
+    rn = f.get("return_number", 1)
+    nr = f.get("number_of_returns", 1)
+    rec["returns"] = (np.asarray(rn, np.uint8) & 0x0F) | ((np.asarray(nr, np.uint8) & 0x0F) << 4)
+    for nm in ("gps_time", "user_data", "point_source_id", "scan_angle"):
+        if nm in f:
+            rec[nm] = f[nm]
+    if cloud.intensity is not None:
+        rec["intensity"] = cloud.intensity
+    if cloud.classification is not None:
+        rec["classification"] = cloud.classification
+    if cloud.colors is not None:
+        for j, c in enumerate(("red", "green", "blue")):
+            rec[c] = cloud.colors[:, j].astype(np.uint16) * 257
+    write_records(fh, rec, scale, offset)
 
 
 def _tree_for(records, scale, offset, center, half, node_points, leaf_points, fine=FINE_DEPTH) -> _Octree:
@@ -899,3 +939,402 @@ def _tree_for(records, scale, offset, center, half, node_points, leaf_points, fi
     probe = _Octree(center - half, half, fine, np.zeros(1, np.int64), np.ones(1))
     codes, counts = _count_cells(iter([probe.fine_codes(xyz)]))
     return _Octree(center - half, half, fine, codes, counts, node_points, leaf_points)
+
+
+# --------------------------------------------------------------------------- streaming rewrite
+
+
+def _apply_block(src: CopcFile, records: np.ndarray, block: PointBlock) -> np.ndarray:
+    """The records of ``block`` after an edit: ``block.records`` with X/Y/Z
+    quantized from ``block.xyz`` (only where they changed, so the others keep
+    their integers bit for bit), RGB from ``block.colour`` where its high
+    byte changed, intensity from ``block.intensity``."""
+    rec = (records[block.row] if block.records is None else block.records).copy()
+    ints = np.rint((block.xyz - src.offset) / src.scale)
+    if len(ints) and (ints.min() < -2**31 or ints.max() > 2**31 - 1):
+        raise InputError("an edited point does not fit LAS's 32-bit integers", path=str(src.path))
+    for j, c in enumerate("XYZ"):
+        col = ints[:, j].astype(np.int64)
+        changed = col != rec[c]
+        rec[c][changed] = col[changed]
+    if block.colour is not None and src.has_colour:
+        for j, c in enumerate(("red", "green", "blue")):
+            changed = (rec[c] >> 8) != block.colour[:, j]
+            rec[c][changed] = block.colour[changed, j].astype(np.uint16) * 257
+    if block.intensity is not None:
+        rec["intensity"] = block.intensity
+    return rec
+
+
+def _cells_at(src: CopcFile, rec: np.ndarray, depth: int) -> np.ndarray:
+    """(n, 3) int64 the cells at ``depth`` of the points ``rec``; raises
+    :class:`InputError` for points outside the root cube."""
+    xyz = src.positions(rec)
+    n = 1 << depth
+    f = (xyz - src.bounds[0]) * (n / (2 * src.halfsize))
+    c = np.floor(f).astype(np.int64)
+    # a point on a cube's far face belongs to the cube (closed cells at the border)
+    c = np.where((c == n) & (f <= n), n - 1, c)
+    if len(c) and (c.min() < 0 or c.max() >= n):
+        bad = int(np.flatnonzero((c < 0).any(axis=1) | (c >= n).any(axis=1))[0])
+        raise InputError(f"an edit moved a point to {xyz[bad].tolist()}, outside the octree's root cube "
+                         f"{src.bounds.tolist()} (convert the result again to grow the octree)",
+                         path=str(src.path))
+    return c
+
+
+def rewrite_copc(src: CopcFile, dst_path, edit: Callable[[CopcNode, PointBlock], PointBlock | None],
+                 progress=None, *, only: Iterable[NodeKey] | None = None) -> WriteReport:
+    """Write ``src`` to ``dst_path`` node by node with ``edit`` applied.
+
+    ``edit(node, block)`` gets each node (of ``only``, by default every
+    node) with its decoded points and returns the edited block (same or
+    fewer points: ``block.take(mask)`` deletes; ``xyz``, ``colour`` and
+    ``intensity`` may change) or None to leave the node as it is.  Nodes not
+    edited (None, or not in ``only``) are copied verbatim: their compressed
+    bytes, not decoded.  A point whose new position leaves its node's cube
+    moves to the node of the same depth that contains it (decoded and
+    re-encoded with the arrivals, or created, with the hierarchy entries
+    above it); the header's count, return counts and bounds (the source's
+    box grown by the re-encoded points) follow.  Written to a temporary file
+    beside ``dst_path`` and renamed (``dst_path`` may be ``src.path``: the
+    source is read to the end first).
+
+    Memory: the edited nodes' points (the edit's region), nothing else.
+
+    Raises:
+        InputError: an edited point outside the root cube (the octree would
+        have to grow: convert the file again) or outside LAS's integers.
+    """
+    from splatedit.io.atomic import atomic_open
+    keys = list(src.nodes) if only is None else [k for k in only if k in src.nodes]
+    keys.sort(key=lambda k: src.nodes[k].offset)
+    kept: dict[NodeKey, np.ndarray] = {}
+    arrivals: dict[NodeKey, list[np.ndarray]] = {}
+    before = np.zeros(15, np.int64)
+    moved = 0
+    total_pts = max(sum(src.nodes[k].point_count for k in keys), 1)
+    done = 0
+    report(progress, "editing COPC nodes", 0.0)
+    for key in keys:
+        node = src.nodes[key]
+        _, rec = src.read_records([key])
+        block = src.block([key], rec)
+        out = edit(node, block)
+        done += node.point_count
+        report(progress, "editing COPC nodes", done / total_pts)
+        if out is None:
+            continue
+        before += np.bincount(rec["returns"] & 0x0F, minlength=16)[1:16]
+        new = _apply_block(src, rec, out)
+        cells = _cells_at(src, new, key.depth)
+        home = (cells[:, 0] == key.x) & (cells[:, 1] == key.y) & (cells[:, 2] == key.z)
+        kept[key] = new[home]
+        if not home.all():
+            away = ~home
+            moved += int(away.sum())
+            ac = cells[away]
+            ar = new[away]
+            uniq, inv = np.unique(ac, axis=0, return_inverse=True)
+            inv = inv.reshape(-1)
+            for i, (x, y, z) in enumerate(uniq.tolist()):
+                arrivals.setdefault(NodeKey(key.depth, x, y, z), []).append(ar[inv == i])
+    order = sorted(src.nodes.values(), key=lambda n: n.offset)
+    new_keys = sorted(k for k in arrivals if k not in src.nodes)
+    total_bytes = max(sum(n.byte_size for n in order), 1)
+    rep = WriteReport(Path(dst_path), 0, 0, moved=moved)
+    h = src._h
+    src_fd = src._fd
+    with atomic_open(dst_path, "wb") as fh:
+        w = _Writer(fh, point_format=src.point_format, record_length=src.record_length, scale=src.scale,
+                    offset=src.offset, center=src.center, halfsize=src.halfsize, spacing=src.spacing,
+                    laszip_vlr=src.laszip_vlr, vlrs=src._vlrs, evlrs=src._evlrs, template=h)
+        w.gps = list(src.gps_range)
+        done = 0
+        report(progress, "writing COPC", 0.0)
+        for node in order:
+            k = node.key
+            if k in kept or k in arrivals:
+                if k in kept:
+                    rec = kept.pop(k)
+                else:
+                    _, rec = src.read_records([k])
+                    before += np.bincount(rec["returns"] & 0x0F, minlength=16)[1:16]
+                parts = [rec] + arrivals.pop(k, [])
+                rec = np.concatenate(parts) if len(parts) > 1 else rec
+                if len(rec):
+                    w.add_records(k, rec)
+                    rep.encoded += 1
+            else:
+                w.add_chunk(k, node.point_count,
+                            _pread(src_fd, node.byte_size, node.offset, str(src.path), f"node {_kt(k)}"))
+                rep.copied += 1
+            done += node.byte_size
+            report(progress, "writing COPC", done / total_bytes)
+        for k in new_keys:
+            w.add_records(k, np.concatenate(arrivals.pop(k)))
+            rep.created += 1
+        # statistics: the source's, with the re-encoded nodes' replaced
+        count = sum(c for _, _, c in w.entries.values())
+        by_return = np.maximum(np.asarray(h.by_return, np.int64) - before + w.by_return, 0)
+        mins = np.minimum(src.point_bounds[0], w.mins)
+        maxs = np.maximum(src.point_bounds[1], w.maxs)
+        w.finish(point_count=count, mins=mins, maxs=maxs, by_return=by_return)
+        rep.bytes = fh.tell()
+    rep.point_count = count
+    rep.nodes = len(w.entries)
+    report(progress, "writing COPC", 1.0)
+    return rep
+
+
+# --------------------------------------------------------------------------- out-of-core build
+
+
+def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_format: int, scale, offset,
+               mins, maxs, node_points: int = NODE_POINTS, leaf_points: int = LEAF_POINTS,
+               vlrs=(), progress=None, tmp_dir=None) -> WriteReport:
+    """Write a COPC file from point records streamed in chunks, in bounded
+    memory (about three chunks).
+
+    Args:
+        chunks: ``chunks()`` yields arrays of records (:func:`record_dtype`
+            of ``point_format``, no extra bytes) on the grid ``scale`` /
+            ``offset``; it is called twice and must yield the same points.
+        mins, maxs: (3,) a box holding every point (file units; the LAS
+            header's).
+        vlrs: (user, id, description, data) VLRs to keep (a CRS).
+        tmp_dir: where the bucketed points are spilled (default: beside
+            ``dst_path``; about ``record_length`` bytes a point).
+
+    Passes: (1) count the points per cell of octree level ``FINE_DEPTH``;
+    (2) assign each point its node (:class:`_Octree`), sort each chunk by
+    node and append it to a spill file; (3) per node, gather its runs from
+    the spill file, compress, append to the COPC file.
+    """
+    from splatedit.io.atomic import atomic_open
+    scale, offset = np.asarray(scale, float), np.asarray(offset, float)
+    center, half = _cube(mins, maxs, scale)
+    probe = _Octree(center - half, half, FINE_DEPTH, np.zeros(1, np.int64), np.ones(1))
+    dt = record_dtype(point_format, _RECORD_BYTES[point_format])
+
+    def xyz_of(rec):
+        return np.stack([rec[c] * scale[j] + offset[j] for j, c in enumerate("XYZ")], axis=1)
+
+    n_total = 0
+    seen_lo, seen_hi = np.full(3, np.inf), np.full(3, -np.inf)
+
+    def counted():
+        nonlocal n_total, seen_lo, seen_hi
+        n_total = 0
+        for rec in chunks():
+            n_total += len(rec)
+            xyz = xyz_of(rec)
+            if len(xyz):
+                seen_lo = np.minimum(seen_lo, xyz.min(axis=0))
+                seen_hi = np.maximum(seen_hi, xyz.max(axis=0))
+            report(progress, "counting points", 0.0)
+            yield probe.fine_codes(xyz)
+
+    codes, counts = _count_cells(counted())
+    if n_total == 0:
+        raise InputError("zero points: nothing to write", path=str(dst_path))
+    if np.any(seen_lo < center - half) or np.any(seen_hi > center + half):
+        # the box given (a stale LAS header) does not hold the points: count again in theirs
+        center, half = _cube(seen_lo, seen_hi, scale)
+        probe = _Octree(center - half, half, FINE_DEPTH, np.zeros(1, np.int64), np.ones(1))
+        codes, counts = _count_cells(counted())
+    report(progress, "counting points", 1.0)
+    tree = _Octree(center - half, half, FINE_DEPTH, codes, counts, node_points, leaf_points)
+    tmp_dir = Path(dst_path).parent if tmp_dir is None else Path(tmp_dir)
+    runs = []
+    with tempfile.TemporaryFile(dir=tmp_dir, prefix=".splatedit-copc-spill-") as spill:
+        pos = 0
+        seen = 0
+        for ci, rec in enumerate(chunks()):
+            rec = np.asarray(rec, dtype=dt)
+            u = np.random.default_rng([0, ci]).random(len(rec))
+            depth, code = tree.assign(tree.fine_codes(xyz_of(rec)), u)
+            gid = (depth.astype(np.int64) << 40) | code
+            order = np.argsort(gid, kind="stable")
+            gid = gid[order]
+            data = rec[order]
+            ug, starts, cnt = np.unique(gid, return_index=True, return_counts=True)
+            spill.write(data.tobytes())
+            runs.append((pos, ug, starts, cnt))
+            pos += data.nbytes
+            seen += len(rec)
+            report(progress, "sorting points into the octree", seen / n_total)
+        spill.flush()
+        fd = spill.fileno()
+        all_g = np.unique(np.concatenate([r[1] for r in runs]))
+        with atomic_open(dst_path, "wb") as fh:
+            w = _Writer(fh, point_format=point_format, record_length=dt.itemsize, scale=scale, offset=offset,
+                        center=center, halfsize=half, spacing=tree.spacing, vlrs=vlrs)
+            for i, g in enumerate(all_g.tolist()):
+                parts = []
+                for rpos, ug, starts, cnt in runs:
+                    j = int(np.searchsorted(ug, g))
+                    if j < len(ug) and ug[j] == g:
+                        raw = os.pread(fd, int(cnt[j]) * dt.itemsize, rpos + int(starts[j]) * dt.itemsize)
+                        parts.append(np.frombuffer(raw, dtype=dt))
+                rec = np.concatenate(parts) if len(parts) > 1 else parts[0]
+                w.add_records(tree.key_of(g >> 40, g & ((1 << 40) - 1)), rec)
+                if i % 8 == 0:
+                    report(progress, "writing COPC", (i + 1) / len(all_g))
+            w.finish()
+            size = fh.tell()
+    report(progress, "writing COPC", 1.0)
+    return WriteReport(Path(dst_path), n_total, len(w.entries), encoded=len(w.entries), bytes=size)
+
+
+def las_records(points, point_format: int) -> np.ndarray:
+    """Records of COPC point format ``point_format`` (6, 7 or 8) from a
+    laspy point record of any LAS point format (same integers; legacy
+    formats' 3-bit return fields and scan angle rank converted to 1.4's;
+    extra bytes dropped)."""
+    names = set(points.point_format.dimension_names)
+    rec = np.zeros(len(points), dtype=record_dtype(point_format, _RECORD_BYTES[point_format]))
+    for c in "XYZ":
+        rec[c] = points[c]
+    for nm in ("intensity", "classification", "user_data", "point_source_id", "gps_time"):
+        if nm in names:
+            rec[nm] = points[nm]
+    rn = np.asarray(points["return_number"], np.uint8) if "return_number" in names else 1
+    nr = np.asarray(points["number_of_returns"], np.uint8) if "number_of_returns" in names else 1
+    rec["returns"] = (np.asarray(rn) & 0x0F) | ((np.asarray(nr) & 0x0F) << 4)
+    flags = np.zeros(len(points), np.uint8)
+    for bit, nm in ((4, "scanner_channel"), (6, "scan_direction_flag"), (7, "edge_of_flight_line")):
+        if nm in names:
+            flags |= (np.asarray(points[nm], np.uint8) << bit).astype(np.uint8)
+    for bit, nm in ((0, "synthetic"), (1, "key_point"), (2, "withheld"), (3, "overlap")):
+        if nm in names:
+            flags |= np.asarray(points[nm], np.uint8).astype(np.uint8) << bit
+    rec["flags"] = flags
+    if "scan_angle" in names:
+        rec["scan_angle"] = points["scan_angle"]
+    elif "scan_angle_rank" in names:
+        rec["scan_angle"] = np.rint(np.asarray(points["scan_angle_rank"], float) / 0.006).astype(np.int16)
+    if point_format in (7, 8) and {"red", "green", "blue"} <= names:
+        for c in ("red", "green", "blue"):
+            rec[c] = points[c]
+    if point_format == 8 and "nir" in names:
+        rec["nir"] = points["nir"]
+    return rec
+
+
+def convert_to_copc(src_path, dst_path, progress=None, *, chunk_points: int = 2_000_000,
+                    node_points: int = NODE_POINTS, leaf_points: int = LEAF_POINTS) -> WriteReport:
+    """Convert any file :func:`splatedit.io.read` reads into COPC.
+
+    LAS/LAZ is streamed (laspy's chunk iterator, ``chunk_points`` at a
+    time; the file's scale, offset, integers, returns, classes, GPS times
+    and RGB are kept; point format 7 when the file has RGB, else 6, 8 when
+    it has NIR); a COPC source is laid out anew the same way.  Other formats
+    are read whole (they are held in memory anyway) and written with
+    :func:`write_copc`: positions on a grid of ``LAS_DEFAULT_SCALE``, RGB
+    colours and intensity.
+    """
+    src = str(src_path)
+    suffix = Path(src).suffix.lower()
+    if suffix in (".las", ".laz"):
+        from splatedit.io.las import check_las_header
+        check_las_header(src_path)
+        import laspy
+        from splatedit.io._guard import library_call
+        with library_call(src, "not a readable LAS/LAZ file"):
+            with laspy.open(src) as rd:
+                hdr = rd.header
+                names = set(hdr.point_format.dimension_names)
+                fmt = 8 if "nir" in names else 7 if {"red", "green", "blue"} <= names else 6
+                scale, offset = np.asarray(hdr.scales, float), np.asarray(hdr.offsets, float)
+                mins, maxs = np.asarray(hdr.mins, float), np.asarray(hdr.maxs, float)
+                crs = [(v.user_id.encode(), v.record_id, v.description.encode() if isinstance(v.description, str)
+                        else bytes(v.description), bytes(v.record_data_bytes()))
+                       for v in hdr.vlrs if v.user_id in ("LASF_Projection",)]
+
+        def chunks():
+            with library_call(src, "not a readable LAS/LAZ file"):
+                with laspy.open(src) as rd:
+                    for pts in rd.chunk_iterator(chunk_points):
+                        yield las_records(pts, fmt)
+
+        # the header's box may be stale; a pass over the points is cheap next to compression
+        return build_copc(dst_path, chunks, point_format=fmt, scale=scale, offset=offset,
+                          mins=mins, maxs=maxs, node_points=node_points, leaf_points=leaf_points,
+                          vlrs=crs, progress=progress)
+    from splatedit.io import read
+    cloud = read(src, progress=progress)
+    xyz = cloud.positions.astype(np.float64) + np.asarray(cloud.origin, np.float64)
+    colour = None if cloud.colors is None else np.asarray(cloud.colors)[:, :3]
+    return write_copc(dst_path, xyz, colour, cloud.intensity, progress=progress,
+                      node_points=node_points, leaf_points=leaf_points)
+
+
+def cache_dir() -> Path:
+    """``$XDG_CACHE_HOME/splatedit/copc`` (default ``~/.cache``)."""
+    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
+    return Path(base) / "splatedit" / "copc"
+
+
+def cached_copc(src_path, progress=None) -> Path:
+    """A COPC file of ``src_path``: the file itself when it is COPC, else its
+    conversion (:func:`convert_to_copc`), made once into :func:`cache_dir`
+    under a hash of the resolved path, size and modification time (a changed
+    file gets a new conversion)."""
+    p = Path(src_path)
+    if is_copc(p):
+        return p
+    try:
+        st = p.stat()
+    except OSError as exc:
+        raise InputError(f"cannot read file: {exc.strerror or exc}", path=str(p)) from None
+    h = hashlib.sha256(f"{p.resolve()}\0{st.st_size}\0{st.st_mtime_ns}".encode()).hexdigest()[:24]
+    out = cache_dir() / f"{h}.copc.laz"
+    if out.exists():
+        return out
+    out.parent.mkdir(parents=True, exist_ok=True)
+    convert_to_copc(p, out, progress=progress)
+    return out
+
+
+# --------------------------------------------------------------------------- regions as splat clouds
+
+
+def file_origin(src: CopcFile) -> np.ndarray:
+    """(3,) float64 the origin :func:`splatedit.io.read` gives the whole
+    file (:func:`splatedit.io.las.grid_origin` of the header's box): a
+    region read out of core has the same local coordinates as the file read
+    whole, so edit scripts and the editor's coordinates agree."""
+    from splatedit.io.las import grid_origin
+    return grid_origin(src.point_bounds[0], src.point_bounds[1], src.scale, src.offset)
+
+
+def cloud_of_block(src: CopcFile, block: PointBlock, progress=None):
+    """A :class:`~splatedit.model.cloud.SplatCloud` of ``block``'s points
+    as :func:`splatedit.io.las.read_las` builds one (local coordinates about
+    :func:`file_origin`, the integers' exact differences times the scale;
+    RGB or grey from intensity; classification; normals and splat sizes
+    estimated from the block's own points), with the block's row of each
+    splat in ``point_fields['copc_block_row']`` (it follows subsets)."""
+    from splatedit.io._build import build_cloud
+    from splatedit.io.las import grey_from_intensity
+    from splatedit.model.cloud import Quantization
+    origin = file_origin(src)
+    rec = block.records
+    ref = np.round((origin - src.offset) / src.scale).astype(np.int64)
+    pos = np.empty((len(rec), 3), dtype=np.float64)
+    for j, c in enumerate("XYZ"):
+        if np.any(origin != 0):
+            pos[:, j] = (rec[c].astype(np.int64) - ref[j]) * src.scale[j]
+        else:
+            pos[:, j] = rec[c] * src.scale[j] + src.offset[j]
+    if block.colour is not None:
+        colors = np.full((len(rec), 4), 255, np.uint8)
+        colors[:, :3] = block.colour
+    else:
+        colors = grey_from_intensity(rec["intensity"])
+    quant = Quantization(tuple(src.scale.tolist()), tuple(src.offset.tolist()), src.point_format)
+    return build_cloud(src.path, pos, colors=colors, progress=progress, origin=origin, already_local=True,
+                       intensity=rec["intensity"].copy(), classification=rec["classification"].copy(),
+                       quantization=quant,
+                       point_fields={"copc_block_row": np.arange(len(rec), dtype=np.int64)})

@@ -12,6 +12,7 @@ from dataclasses import dataclass
 from pathlib import Path
 from typing import Callable
 
+from splatedit.io.copc import write_copc_cloud
 from splatedit.io.e57 import read_e57, write_e57
 from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply
 from splatedit.io.las import read_las, write_las
@@ -86,6 +87,10 @@ def _write_las(fh, cloud, path, *, binary, axes, comment):
     write_las(fh, cloud, path, compress=Path(path).suffix.lower() == ".laz")
 
 
+def _write_copc(fh, cloud, path, *, binary, axes, comment):
+    write_copc_cloud(fh, cloud, path)
+
+
 def _write_e57(fh, cloud, path, *, binary, axes, comment):
     write_e57(fh, cloud, path)
 
@@ -106,6 +111,12 @@ FORMATS: tuple[Format, ...] = (
            write_extensions=(".xyz",)),
     Format("Leica PTS", (".pts",), read_pts, _plain(write_pts), colours=True, intensity=True),
     Format("OFF mesh", (".off",), read_off, _plain(write_off), faces=True),
+    # before LAS/LAZ: a '.copc.laz' name is COPC (see suffix_of); COPC files are
+    # read whole by the LAS reader (a COPC file is a LAZ 1.4 file); out of core
+    # by splatedit.io.copc.CopcFile
+    Format("COPC (cloud-optimized point cloud: LAZ 1.4 in octree order)", (".copc.laz",), read_las,
+           _write_copc, colours=True, intensity=True, classification=True, origin=True, z_up=True,
+           keep_on_save=True),
     Format("LAS/LAZ", (".las", ".laz"), read_las, _write_las, colours=True, intensity=True,
            classification=True, origin=True, z_up=True, keep_on_save=True),
     Format("E57", (".e57",), read_e57, _write_e57, colours=True, intensity=True, origin=True,
@@ -117,14 +128,30 @@ FORMATS: tuple[Format, ...] = (
 _BY_EXT = {ext: f for f in FORMATS for ext in f.extensions}
 
 
+#: suffixes of two parts ('.copc.laz'), tried before the last suffix alone
+_DOUBLE = tuple(ext for ext in _BY_EXT if ext.count(".") > 1)
+
+
+def suffix_of(path) -> str:
+    """The format suffix of ``path``, lower case: a registered two-part
+    suffix (``.copc.laz``) when the name ends with one, else the last
+    suffix (``.laz``)."""
+    name = Path(str(path)).name.lower()
+    for ext in _DOUBLE:
+        if name.endswith(ext) and len(name) > len(ext):
+            return ext
+    return Path(name).suffix
+
+
 def by_extension(ext: str) -> Format | None:
     """The format of suffix ``ext`` (".las", any case), or None."""
     return _BY_EXT.get(ext.lower())
 
 
 def format_of(path) -> Format | None:
-    """The format of ``path`` by its suffix (case-insensitive), or None."""
-    return by_extension(Path(str(path)).suffix)
+    """The format of ``path`` by its suffix (case-insensitive, see
+    :func:`suffix_of`), or None."""
+    return by_extension(suffix_of(path))
 
 
 def extensions(**capabilities: bool) -> tuple[str, ...]:

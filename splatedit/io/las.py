@@ -62,6 +62,19 @@ def grey_from_intensity(intensity: np.ndarray) -> np.ndarray | None:
     return out
 
 
+def grid_origin(world_lo, world_hi, scale, offset) -> np.ndarray:
+    """(3,) float64 the origin :func:`read_las` gives a LAS file whose points
+    span ``world_lo``..``world_hi`` (file units) on the grid ``scale`` /
+    ``offset``: zeros for a file near 0, else ``offset + X0 * scale`` (see
+    the module docstring).  The out-of-core COPC path gives a region of a
+    file the origin of the whole file this way."""
+    world_lo, world_hi = np.asarray(world_lo, float), np.asarray(world_hi, float)
+    if max(np.abs(world_lo).max(), np.abs(world_hi).max()) <= REBASE_MIN_ABS:
+        return np.zeros(3)
+    scale, offset = np.asarray(scale, float), np.asarray(offset, float)
+    return offset + _origin_step(world_lo, world_hi, scale, offset) * scale
+
+
 def _origin_step(world_lo, world_hi, scale, offset) -> np.ndarray:
     """(3,) int64 ``X0`` of the origin ``offset + X0 * scale`` of a far
     LAS file (world box ``world_lo``..``world_hi``): 0, the offset itself,

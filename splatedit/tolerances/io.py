@@ -144,3 +144,27 @@ E57_MAX_POINTS_PER_BYTE = 8
 #: keeps a factor 1e10 from the first failure; all points in one place
 #: (extent 0) stay valid
 MIN_EXTENT_ABS = 1e-50
+
+
+# --- COPC and out-of-core scans (issue 23) -----------------------------------
+#: points an octree node above the leaves keeps when splatedit lays out a
+#: COPC file (a random sample of its subtree): 20k, so that a level-of-detail
+#: read of a 100M-point terrain's top levels (a few hundred nodes) is a few
+#: million points, and a node decodes in a few ms (lazrs: 200k points in
+#: 0.03 s measured)
+COPC_NODE_POINTS = 20_000
+#: a subtree of at most this many points is one leaf node (3x a node's
+#: sample: leaves are not split for a few points)
+COPC_LEAF_POINTS = 60_000
+#: the deepest level the layout subdivides to (cells are counted there;
+#: 2**10 cells a side: 20 cm cells on a 200 m tile)
+COPC_FINE_DEPTH = 10
+#: out-of-core deform: the box of the script's regions is grown by this
+#: fraction of its longest side before the nodes are read (the fit's fixed
+#: border ring and the neighbours that size the rim's splats lie there)
+COPC_EDIT_MARGIN_REL = 0.25
+#: out-of-core render: a node's children are read while its point spacing
+#: projects to more than this many pixels (Potree's rule, ~1 px)
+COPC_REFINE_PX = 1.0
+#: out-of-core render: at most this many points are read and drawn
+COPC_RENDER_BUDGET = 3_000_000
