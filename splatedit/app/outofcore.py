@@ -151,11 +151,12 @@ class OutOfCoreScan:
         self.source = Path(source) if source is not None else self.path
         self.budget = int(budget)
         self.by_tuple = {_key(k): k for k in copc.nodes}
-        b = np.asarray(copc.bounds, dtype=np.float64).reshape(2, 3)
         root = copc.nodes[self.by_tuple[(0, 0, 0, 0)]]
         rb = np.asarray(root.bounds, dtype=np.float64).reshape(2, 3)
-        #: local origin: the centre of the data's box (float32 on the GPU keeps fine steps)
-        self.origin = np.round((b[0] + b[1]) / 2.0, 3)
+        #: local origin: the one reading the whole file gives (io.copc.file_origin), so the
+        #: editor's coordinates, its edit scripts and ``splatedit deform`` agree
+        from splatedit.io.copc import file_origin
+        self.origin = np.asarray(file_origin(copc), dtype=np.float64)
         self.cube_lo = rb[0] - self.origin
         self.cube_size = float((rb[1] - rb[0]).max())
         self.max_depth = int(max(k[0] for k in self.by_tuple))
@@ -169,6 +170,12 @@ class OutOfCoreScan:
         self.last_cam = None
         self.waiting_version = None     # selection version a region was last checked for
         self.notice = ""                # why the view no longer refines (shown once)
+        #: frames presented and seconds spent while view or region jobs ran (the
+        #: window stays live: tests and the benchmark read these)
+        self.loading_frames = 0
+        self.loading_seconds = 0.0
+        self._loading_since = None
+        self._frames_seen = None
 
     # ------------------------------------------------------------ geometry
     def node_bounds(self, t: tuple) -> np.ndarray:
@@ -313,6 +320,7 @@ class OutOfCoreScan:
         if cam_state != self.last_cam:
             self.last_cam, self.moved_at = cam_state, now
         busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
+        self._count_frames(ed, busy, now)
         if busy or s.manip is not None or s.committing:
             return
         if self.region_needed(s):
@@ -321,6 +329,18 @@ class OutOfCoreScan:
                 and ed.drag.name == "NONE"):
             self.view_state = cam_state
             self.start_refine(ed)
+
+    def _count_frames(self, ed, busy: bool, now: float) -> None:
+        frames = getattr(ed.presenter, "frames_presented", 0) if ed.presenter is not None else 0
+        if busy:
+            if self._loading_since is None:
+                self._loading_since, self._frames_seen = now, frames
+            self.loading_frames += frames - self._frames_seen
+            self._frames_seen = frames
+            self.loading_seconds += now - self._loading_since
+            self._loading_since = now
+        else:
+            self._loading_since = None
 
     def pristine(self, s) -> bool:
         """No selection, no pending pose, no edit: the shown nodes may change freely."""
@@ -446,6 +466,42 @@ class OutOfCoreScan:
         restart_levels(ed, cloud)
 
     # ------------------------------------------------------------- saving
+    def file_indices(self, n: int) -> np.ndarray:
+        """(n,) int64: for each of the first ``n`` splats of the document, its
+        index in the whole file as :func:`splatedit.io.read` reads it (nodes
+        in file order, each node's rows in order)."""
+        first, at = {}, 0
+        for node in sorted(self.copc.nodes.values(), key=lambda nd: nd.offset):
+            first[_key(node.key)] = at
+            at += int(node.point_count)
+        out = np.empty(n, np.int64)
+        for t, start, count in self.segments:
+            if start + count <= n:
+                out[start:start + count] = first[t] + np.arange(count)
+        return out
+
+    def file_script(self, script, n: int):
+        """``script`` (the session's, indices of its ``n``-splat cloud) with
+        every index list turned into indices of the whole file: ``splatedit
+        deform FILE --edit`` replays it on the file read whole."""
+        import dataclasses
+
+        from splatedit.select.regions import Indices
+        glob = self.file_indices(n)
+
+        def region(r):
+            if isinstance(r, Indices):
+                return Indices(tuple(int(i) for i in np.sort(glob[np.asarray(r.indices, np.int64)])))
+            return r
+        items = []
+        for e in script.edits:
+            if hasattr(e, "handles"):
+                e = dataclasses.replace(e, support=region(e.support), handles=tuple(region(h) for h in e.handles))
+            else:
+                e = dataclasses.replace(e, region=region(e.region))
+            items.append(e)
+        return dataclasses.replace(script, edits=tuple(items))
+
     def moved_nodes(self, cloud: SplatCloud) -> dict:
         """key -> ((m,) rows, (m, 3) file coordinates) of the points of ``cloud``
         that moved from where the file has them."""
@@ -591,7 +647,8 @@ def save_job(ed, scan: OutOfCoreScan, path: Path) -> Job:
 
     from splatedit.app.files import script_path_for
     s = ed.session
-    cloud, script, pos = s.cloud, s.edit_script(), s.history.position
+    cloud, pos = s.cloud, s.history.position
+    script = scan.file_script(s.edit_script(), cloud.n)
     moved = scan.moved_nodes(cloud)
     spath = script_path_for(Path(path))
     same = Path(path).resolve() == scan.source.resolve()

@@ -110,7 +110,8 @@ def status_dict(ed) -> dict:
         "points": int(oc.copc.point_count), "nodes_shown": len(oc.segments), "shown": oc.shown_points(),
         "max_depth_shown": max((t[0] for t in oc.shown), default=0), "view_chosen": oc.view_state is not None,
         "refined": oc.view_state == ed.cam.state() and "nodes" not in ed.jobs,
-        "waiting": s.waiting}
+        "waiting": s.waiting, "loading_frames": oc.loading_frames,
+        "loading_seconds": round(oc.loading_seconds, 3)}
     cp = ss.commit
     #: a commit running in the background: its stage and fraction done
     st["commit"] = None if cp is None else {"stage": cp.stage, "fraction": round(cp.fraction, 3)}
