@@ -135,6 +135,12 @@ def read_nodes(copc, keys, origin: np.ndarray, progress=None, stage: str = "read
     return out
 
 
+@dataclass(frozen=True)
+class _LocalNode:
+    point_count: int
+    bounds: np.ndarray
+
+
 class OutOfCoreScan:
     """An opened COPC scan and the nodes the document shows (see the module doc).
 
@@ -160,6 +166,12 @@ class OutOfCoreScan:
         self.cube_lo = rb[0] - self.origin
         self.cube_size = float((rb[1] - rb[0]).max())
         self.max_depth = int(max(k[0] for k in self.by_tuple))
+        #: every node's key tuple, local bounds (m, 2, 3) and point count, in one order
+        self.key_list = sorted(self.by_tuple)
+        self.bounds_arr = np.stack([np.asarray(copc.nodes[self.by_tuple[t]].bounds, dtype=np.float64).reshape(2, 3)
+                                    for t in self.key_list]) - self.origin
+        self.counts = {t: int(copc.nodes[self.by_tuple[t]].point_count) for t in self.key_list}
+        self._local = None
         #: loaded nodes (the shown ones): key tuple -> LoadedNode
         self.nodes: dict = {}
         #: (key tuple, first splat, count) in the order of the session's cloud
@@ -176,11 +188,13 @@ class OutOfCoreScan:
         self.loading_seconds = 0.0
         self._loading_since = None
         self._frames_seen = None
+        #: (2, 3) file coordinates of the last full-resolution region asked for, or None
+        self.region_world = None
 
     # ------------------------------------------------------------ geometry
     def node_bounds(self, t: tuple) -> np.ndarray:
         """(2, 3) local bounds of node ``t``."""
-        return np.asarray(self.copc.nodes[self.by_tuple[t]].bounds, dtype=np.float64).reshape(2, 3) - self.origin
+        return self.bounds_arr[self.key_list.index(t)]
 
     @property
     def shown(self) -> list:
@@ -201,12 +215,10 @@ class OutOfCoreScan:
         return sum(seg[2] for seg in self.segments)
 
     def local_nodes(self) -> dict:
-        """key tuple -> node with local bounds (for :func:`select_nodes`)."""
-        @dataclass
-        class _N:
-            point_count: int
-            bounds: np.ndarray
-        return {t: _N(int(self.copc.nodes[k].point_count), self.node_bounds(t)) for t, k in self.by_tuple.items()}
+        """key tuple -> node with local bounds (for :func:`select_nodes`; built once)."""
+        if self._local is None:
+            self._local = {t: _LocalNode(self.counts[t], self.bounds_arr[i]) for i, t in enumerate(self.key_list)}
+        return self._local
 
     def overview_keys(self, budget: int) -> list:
         """Whole levels of the octree from the root down while they fit in
@@ -217,7 +229,7 @@ class OutOfCoreScan:
         out, total = [], 0
         for d in sorted(by_depth):
             level = sorted(by_depth[d])
-            count = sum(int(self.copc.nodes[self.by_tuple[t]].point_count) for t in level)
+            count = sum(self.counts[t] for t in level)
             if out and total + count > budget:
                 break
             out += level
@@ -226,12 +238,9 @@ class OutOfCoreScan:
 
     def region_keys(self, lo: np.ndarray, hi: np.ndarray) -> list:
         """Every node (all depths) whose box meets the local box ``lo..hi``, coarse first."""
-        out = []
-        for t in self.by_tuple:
-            b = self.node_bounds(t)
-            if (b[0] <= hi).all() and (b[1] >= lo).all():
-                out.append(t)
-        return sorted(out)
+        b = self.bounds_arr
+        hit = (b[:, 0] <= hi).all(axis=1) & (b[:, 1] >= lo).all(axis=1)
+        return [self.key_list[i] for i in np.flatnonzero(hit)]
 
     # --------------------------------------------------------------- splats
     def radii(self, keys: list, nodes: dict) -> dict:
@@ -321,12 +330,11 @@ class OutOfCoreScan:
             self.last_cam, self.moved_at = cam_state, now
         busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
         self._count_frames(ed, busy, now)
-        if busy or s.manip is not None or s.committing:
-            return
+        if busy or s.manip is not None or s.committing or ed.drag.name != "NONE":
+            return                  # (a stroke being painted: its region is loaded when it ends)
         if self.region_needed(s):
             return self.start_region(ed)
-        if (now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state
-                and ed.drag.name == "NONE"):
+        if now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state:
             self.view_state = cam_state
             self.start_refine(ed)
 
@@ -389,7 +397,7 @@ class OutOfCoreScan:
             room = EDITOR_OOC_MAX_POINTS - s.cloud.n
             out, total = [], 0
             for t in keys:
-                c = int(self.copc.nodes[self.by_tuple[t]].point_count)
+                c = self.counts[t]
                 if total + c > room:
                     break
                 out.append(t)
@@ -421,6 +429,7 @@ class OutOfCoreScan:
         if box is None:
             return
         lo, hi, missing = box
+        self.region_world = np.stack([lo, hi]) + self.origin
         segs = self.current_segments(s)
         cloud = s.cloud
         nodes = dict(self.nodes)
@@ -433,7 +442,7 @@ class OutOfCoreScan:
             return ("append",) + self.extend(cloud, segs, missing, nodes) + (nodes, cloud)
 
         ed.jobs[REGION_JOB] = Job("full-resolution region", work, ed.wake)
-        ed.say(f"loading {sum(int(self.copc.nodes[self.by_tuple[t]].point_count) for t in missing):,} "
+        ed.say(f"loading {sum(self.counts[t] for t in missing):,} "
                f"points of the painted region at full resolution ...")
 
     def landed(self, ed, name: str, result) -> None:
@@ -460,8 +469,8 @@ class OutOfCoreScan:
         self.segments = segs
         self.view_complete = kind == "swap"
         self.waiting_version = None if name == REGION_JOB else s.version
+        s.request_fit()         # a grown cloud: the selection's basis is fitted again
         if name == REGION_JOB:
-            s.request_fit()
             ed.say(f"region at full resolution: {cloud.n:,} points shown")
         restart_levels(ed, cloud)
 

@@ -111,7 +111,8 @@ def status_dict(ed) -> dict:
         "max_depth_shown": max((t[0] for t in oc.shown), default=0), "view_chosen": oc.view_state is not None,
         "refined": oc.view_state == ed.cam.state() and "nodes" not in ed.jobs,
         "waiting": s.waiting, "loading_frames": oc.loading_frames,
-        "loading_seconds": round(oc.loading_seconds, 3)}
+        "loading_seconds": round(oc.loading_seconds, 3),
+        "region": None if oc.region_world is None else oc.region_world.tolist()}
     cp = ss.commit
     #: a commit running in the background: its stage and fraction done
     st["commit"] = None if cp is None else {"stage": cp.stage, "fraction": round(cp.fraction, 3)}
