@@ -186,8 +186,7 @@ class OutOfCoreScan:
         #: window stays live: tests and the benchmark read these)
         self.loading_frames = 0
         self.loading_seconds = 0.0
-        self._loading_since = None
-        self._frames_seen = None
+        self._job_start = None          # (time, frames presented) when the running job started
         #: (2, 3) file coordinates of the last full-resolution region asked for, or None
         self.region_world = None
 
@@ -329,7 +328,6 @@ class OutOfCoreScan:
         if cam_state != self.last_cam:
             self.last_cam, self.moved_at = cam_state, now
         busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
-        self._count_frames(ed, busy, now)
         if busy or s.manip is not None or s.committing or ed.drag.name != "NONE":
             return                  # (a stroke being painted: its region is loaded when it ends)
         if self.region_needed(s):
@@ -338,17 +336,19 @@ class OutOfCoreScan:
             self.view_state = cam_state
             self.start_refine(ed)
 
-    def _count_frames(self, ed, busy: bool, now: float) -> None:
-        frames = getattr(ed.presenter, "frames_presented", 0) if ed.presenter is not None else 0
-        if busy:
-            if self._loading_since is None:
-                self._loading_since, self._frames_seen = now, frames
-            self.loading_frames += frames - self._frames_seen
-            self._frames_seen = frames
-            self.loading_seconds += now - self._loading_since
-            self._loading_since = now
-        else:
-            self._loading_since = None
+    @staticmethod
+    def _frames(ed) -> int:
+        return getattr(ed.presenter, "frames_presented", 0) if getattr(ed, "presenter", None) is not None else 0
+
+    def _started(self, ed) -> None:
+        self._job_start = (time.perf_counter(), self._frames(ed))
+
+    def _ended(self, ed) -> None:
+        if self._job_start is not None:
+            t, f = self._job_start
+            self.loading_seconds += time.perf_counter() - t
+            self.loading_frames += self._frames(ed) - f
+            self._job_start = None
 
     def pristine(self, s) -> bool:
         """No selection, no pending pose, no edit: the shown nodes may change freely."""
@@ -422,6 +422,7 @@ class OutOfCoreScan:
             return ("append",) + self.extend(cloud, segs, keys, nodes) + (nodes, cloud)
 
         ed.jobs[VIEW_JOB] = Job("refining the view", work, ed.wake)
+        self._started(ed)
 
     def start_region(self, ed) -> None:
         s = ed.session
@@ -442,6 +443,7 @@ class OutOfCoreScan:
             return ("append",) + self.extend(cloud, segs, missing, nodes) + (nodes, cloud)
 
         ed.jobs[REGION_JOB] = Job("full-resolution region", work, ed.wake)
+        self._started(ed)
         ed.say(f"loading {sum(self.counts[t] for t in missing):,} "
                f"points of the painted region at full resolution ...")
 
@@ -449,6 +451,7 @@ class OutOfCoreScan:
         """A view or region job finished: swap its cloud in (when the document
         is still the one it was built for)."""
         s = ed.session
+        self._ended(ed)
         kind, cloud, segs, nodes, base = result
         if name == REGION_JOB:
             s.waiting = None
