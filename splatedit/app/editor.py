@@ -2,20 +2,20 @@
 
 A glfw window presenting through a Vulkan swapchain
 (:mod:`splatedit.render.vk.swapchain`); frames come from the EWA splat
-renderer (:mod:`splatedit.app.viewport`) scheduled by
-:class:`~splatedit.app.frames.FrameScheduler`; with the Dear ImGui interface
-(:mod:`splatedit.app.gui_panels`: menu bar, panels, help) they stay on the
+renderer (:mod:`splatedit.app.view.viewport`) scheduled by
+:class:`~splatedit.app.view.frames.FrameScheduler`; with the Dear ImGui interface
+(:mod:`splatedit.app.ui.gui_panels`: menu bar, panels, help) they stay on the
 presenter's device and the GUI and the tools' overlays are drawn over them on
 the GPU; without it (``SPLATEDIT_GUI=0`` or a surface that cannot be a blit
-target) the overlay is composited on the CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
+target) the overlay is composited on the CPU (:mod:`splatedit.app.ui.overlay`).  Loading, fitting and saving run in
 worker threads; the loop polls them and stays responsive.
 
 The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve) through the event
-routing (:mod:`splatedit.app.routing`), keys are looked
-up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
+routing (:mod:`splatedit.app.ui.routing`), keys are looked
+up in the one keymap (:mod:`splatedit.app.ui.keymap`, which also generates the
 help and the manual's controls list) and run the bound action; each tool draws
-its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
+its overlay.  Files (:mod:`splatedit.app.document.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
 dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,
 :meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
@@ -34,19 +34,19 @@ import time
 from pathlib import Path
 
 from splatedit.app.crash_guard import CrashGuard
-from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
-from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
+from splatedit.app.document.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
+from splatedit.app.document.files import default_save_path as _default_save_path  # noqa: F401 (API)
 from splatedit.app.file_actions import FileActions
-from splatedit.app.frames import FrameScheduler
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.jobs import Job
-from splatedit.app.keymap import Action
-from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.panel import HelpView, compose_overlay
-from splatedit.app.session import Session
-from splatedit.app.status import StatusWriter
-from splatedit.app.recent import RecentFiles
-from splatedit.app.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
+from splatedit.app.view.frames import FrameScheduler
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.jobs import Job
+from splatedit.app.ui.keymap import Action
+from splatedit.app.ui.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
+from splatedit.app.ui.panel import HelpView, compose_overlay
+from splatedit.app.document.session import Session
+from splatedit.app.ui.status import StatusWriter
+from splatedit.app.ui.recent import RecentFiles
+from splatedit.app.ui.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
 from splatedit.app.tools.base import DragMode
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
@@ -84,12 +84,12 @@ class Editor(EventRouting, FileActions):
         self.window = Window("splatedit", *size)
         try:
             self.presenter = SwapchainPresenter(self.window.handle, vsync=vsync)
-            from splatedit.app.viewport import Viewport
+            from splatedit.app.view.viewport import Viewport
             pres = self.presenter
             if pres.gpu_targets and pres.can_blit and os.environ.get("SPLATEDIT_GUI", "1") != "0":
                 # GPU path: one device renders, draws the GUI and presents (no readback)
-                from splatedit.app.gui_panels import EditorGui
-                from splatedit.render.renderer import Renderer
+                from splatedit.app.ui.gui_panels import EditorGui
+                from splatedit.render.splat.renderer import Renderer
                 self.viewport = Viewport(budget_ms=self.frames.moving_budget_ms, renderer=Renderer(device=pres.dev))
                 self.gui = EditorGui(self, pres.dev)
             else:       # CPU fallback: frames read back, overlay blended on the CPU
@@ -438,7 +438,7 @@ def run_editor(path=None, **options) -> int:
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
-    from splatedit.app.frames import refine_above_ms
+    from splatedit.app.view.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
     from splatedit.app.outofcore import point_budgets
     point_budgets()             # and a bad SPLATEDIT_OOC_BUDGET

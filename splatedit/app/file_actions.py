@@ -5,7 +5,7 @@ edit script and quitting with unsaved changes.
 A part of :class:`~splatedit.app.editor.Editor` (mixed into it; the state
 it uses -- ``path``, ``jobs``, ``prompt``, ``confirm_quit``, ``saved_path``
 ... -- is the editor's, read by the panels and the status file).  The work
-itself (worker jobs, checks, error boxes) is in :mod:`splatedit.app.files`;
+itself (worker jobs, checks, error boxes) is in :mod:`splatedit.app.document.files`;
 these are the entry points keys, the GUI's File menu and drops call.
 """
 
@@ -13,7 +13,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from splatedit.app import files
+from splatedit.app.document import files
 from splatedit.errors import SplatEditError
 
 

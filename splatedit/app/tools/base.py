@@ -8,7 +8,7 @@ from typing import Callable
 
 import numpy as np
 
-from splatedit.app.keymap import KEYMAP, Action, Binding, Section
+from splatedit.app.ui.keymap import KEYMAP, Action, Binding, Section
 
 
 class DragMode(enum.Enum):
@@ -34,10 +34,10 @@ class Tool:
     :meth:`press_modal` first, then to :meth:`press` in its tool order; the
     first to return a :class:`DragMode` owns the drag (:meth:`drag` on each
     move, :meth:`release` at the end).  Keys: :meth:`actions` maps keymap
-    :class:`~splatedit.app.keymap.Action` values to handlers.  Drawing:
+    :class:`~splatedit.app.ui.keymap.Action` values to handlers.  Drawing:
     :meth:`underlay` and :meth:`overlay` return overlay patches (CPU
     path only); :meth:`shapes` returns backend-neutral shapes
-    (:mod:`splatedit.app.shapes`) drawn by both the GPU and the CPU path:
+    (:mod:`splatedit.app.tools.shapes`) drawn by both the GPU and the CPU path:
     tools on the protocol use only :meth:`shapes` and :attr:`ctx`.
     """
     #: the help section of this tool's keymap rows
@@ -85,7 +85,7 @@ class Tool:
         return None
 
     def shapes(self, w: int, h: int) -> list:
-        """Overlay shapes (:mod:`splatedit.app.shapes`) drawn this frame."""
+        """Overlay shapes (:mod:`splatedit.app.tools.shapes`) drawn this frame."""
         return []
 
     def underlay(self, w: int, h: int) -> list:
@@ -113,7 +113,7 @@ class ToolContext:
     # ---- document and selection
     @property
     def document(self):
-        """The :class:`~splatedit.app.session.Session` (None: no model open)."""
+        """The :class:`~splatedit.app.document.session.Session` (None: no model open)."""
         return self._ed.session
 
     @property
@@ -123,7 +123,7 @@ class ToolContext:
 
     def target_mask(self) -> np.ndarray:
         """(n,) bool: the brush target's current mask (not a copy)."""
-        from splatedit.app.selection_tools import target_mask
+        from splatedit.app.document.selection import target_mask
         s = self._ed.session
         return target_mask(s.selection, s.brush_target)
 
@@ -149,14 +149,14 @@ class ToolContext:
         return self._ed.size
 
     def visible(self):
-        """The :class:`~splatedit.app.brush.BrushPicker` of the current view
+        """The :class:`~splatedit.app.tools.pick_brush.BrushPicker` of the current view
         (which splat is visible at each pixel)."""
         return self._ed.brush.get_picker()
 
     @property
     def through(self) -> bool:
         """The brush mode (V): True for 3D / through, False for visible only."""
-        from splatedit.app.selection_tools import BRUSH_3D
+        from splatedit.app.document.selection import BRUSH_3D
         return self._ed.brush.mode == BRUSH_3D
 
     def erasing(self, mods: int | None = None) -> bool:

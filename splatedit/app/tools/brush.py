@@ -6,12 +6,12 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.app import overlay as ov
-from splatedit.app import revision
-from splatedit.app import selection_tools as seltools
-from splatedit.app.brush import BrushPicker, picker_for_view, stroke_points
+from splatedit.app.ui import overlay as ov
+from splatedit.app.document import revision
+from splatedit.app.document import selection as seltools
+from splatedit.app.tools.pick_brush import BrushPicker, picker_for_view, stroke_points
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.keymap import Action, Section
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.tolerances import (EDITOR_BRUSH_KEY_STEP, EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX,
                                   EDITOR_BRUSH_WHEEL_STEP, EDITOR_PICK_TOL_PX)

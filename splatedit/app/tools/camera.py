@@ -6,9 +6,9 @@ from __future__ import annotations
 import math
 
 
-from splatedit.app import revision
-from splatedit.app.keymap import Action, Section
-from splatedit.app.panel import PANEL_MARGIN
+from splatedit.app.document import revision
+from splatedit.app.ui.keymap import Action, Section
+from splatedit.app.ui.panel import PANEL_MARGIN
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent

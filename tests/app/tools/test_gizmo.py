@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
 from splatedit.app.tools.base import DragMode
-from splatedit.app.session import GRAB, ROTATE, SCALE, Session
+from splatedit.app.document.session import GRAB, ROTATE, SCALE, Session
 from splatedit.tolerances import EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_SCALE_PX
 from tests.app.sessions import plane_cloud
 
