@@ -74,7 +74,7 @@ class Editor(EventRouting, FileActions):
         self.method, self.tol, self.max_centers = method, tol, max_centers
         self.status = StatusWriter(Path(status_file) if status_file else None)
         self.use_lod = lod
-        #: open scans out of core: True / False, None: by size (:func:`splatedit.app.outofcore.is_out_of_core`)
+        #: open scans out of core: True / False, None: by size (:func:`splatedit.app.document.outofcore.is_out_of_core`)
         self.out_of_core = out_of_core
         self.max_seconds = max_seconds
         self.offer_recent = offer_recent
@@ -105,7 +105,7 @@ class Editor(EventRouting, FileActions):
         #: the Dear ImGui interface (None: the CPU overlay fallback, or no window)
         self.gui = None
         self.session: Session | None = None
-        #: the out-of-core scan behind the session (:mod:`splatedit.app.outofcore`), or None
+        #: the out-of-core scan behind the session (:mod:`splatedit.app.document.outofcore`), or None
         self.ooc = None
         #: the central exception guard, recovery copies and the restore question
         #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
@@ -427,7 +427,7 @@ def run_editor(path=None, **options) -> int:
     environment variable ``SPLATEDIT_EDITOR_STATUS``), ``budget_ms`` (frame
     budget while moving, default 100 ms = 10 fps), ``lod`` (default True),
     ``max_seconds`` (quit after this long; tests), ``out_of_core`` (True /
-    False; None: by the file's size, see :mod:`splatedit.app.outofcore`).
+    False; None: by the file's size, see :mod:`splatedit.app.document.outofcore`).
     Returns the process exit code.
     """
     bundled = False
@@ -440,7 +440,7 @@ def run_editor(path=None, **options) -> int:
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
     from splatedit.app.view.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
-    from splatedit.app.outofcore import point_budgets
+    from splatedit.app.document.outofcore import point_budgets
     point_budgets()             # and a bad SPLATEDIT_OOC_BUDGET
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "

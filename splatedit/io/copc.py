@@ -860,7 +860,7 @@ def write_copc(dst_path, xyz, colour=None, intensity=None, *, records=None, scal
             box centre rounded to whole units).
         node_points, leaf_points: the layout (see :class:`_Octree`).
     """
-    from splatedit.io.atomic import atomic_open
+    from splatedit.atomic import atomic_open
     from splatedit.tolerances import LAS_DEFAULT_SCALE
     if records is None:
         xyz = np.asarray(xyz, dtype=np.float64)
@@ -1006,7 +1006,7 @@ def rewrite_copc(src: CopcFile, dst_path, edit: Callable[[CopcNode, PointBlock],
         InputError: an edited point outside the root cube (the octree would
         have to grow: convert the file again) or outside LAS's integers.
     """
-    from splatedit.io.atomic import atomic_open
+    from splatedit.atomic import atomic_open
     keys = list(src.nodes) if only is None else [k for k in only if k in src.nodes]
     keys.sort(key=lambda k: src.nodes[k].offset)
     kept: dict[NodeKey, np.ndarray] = {}
@@ -1111,7 +1111,7 @@ def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_fo
     node and append it to a spill file; (3) per node, gather its runs from
     the spill file, compress, append to the COPC file.
     """
-    from splatedit.io.atomic import atomic_open
+    from splatedit.atomic import atomic_open
     scale, offset = np.asarray(scale, float), np.asarray(offset, float)
     center, half = _cube(mins, maxs, scale)
     probe = _Octree(center - half, half, FINE_DEPTH, np.zeros(1, np.int64), np.ones(1))

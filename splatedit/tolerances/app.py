@@ -323,7 +323,7 @@ GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
 #: bench at 1280x720 (16k of 1M at half resolution): 4.92
 GS_LOD_TEST_MEAN_DIFF = 6.5
 
-# ---- out-of-core documents (splatedit.app.outofcore): large COPC scans
+# ---- out-of-core documents (splatedit.app.document.outofcore): large COPC scans
 #: a COPC file with more points than this opens out of core (an octree level of
 #: detail; a smaller one is read whole like any LAZ): at ~110 B per splat in the
 #: editor (positions, axes, colours, selection, graph) 3M points are ~330 MB

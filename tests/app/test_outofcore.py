@@ -1,4 +1,4 @@
-"""The out-of-core document (splatedit.app.outofcore) without a window: the
+"""The out-of-core document (splatedit.app.document.outofcore) without a window: the
 shown nodes are real points of the file, appending keeps every index, the
 selection spreads to a loaded region, moved points are found by node and row,
 and a session waiting for its region neither fits nor moves."""
@@ -8,8 +8,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.outofcore import adopt_appended, open_scan
-from splatedit.app.session import Session
+from splatedit.app.document.outofcore import adopt_appended, open_scan
+from splatedit.app.document.session import Session
 from splatedit.select.selection import HANDLE
 from tests.app.copc_scans import terrain_copc
 

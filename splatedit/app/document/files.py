@@ -96,10 +96,10 @@ def check_model_file(path) -> None:
 def load_job(path: Path, wake, out_of_core: bool | None = None) -> Job:
     """Read ``path`` in the background (the job's ``key`` is the path).  Its
     result is the cloud, or (scan, cloud) for a scan opened out of core
-    (:mod:`splatedit.app.outofcore`; ``out_of_core`` None: by its size)."""
+    (:mod:`splatedit.app.document.outofcore`; ``out_of_core`` None: by its size)."""
     def work(progress):
         from splatedit.io import is_gaussian_file, read, read_gaussians
-        from splatedit.app import outofcore
+        from splatedit.app.document import outofcore
         if out_of_core or (out_of_core is None and outofcore.is_out_of_core(path)):
             return outofcore.open_scan(path, progress)
         if is_gaussian_file(path):      # a 3DGS/2DGS scene: its splat proxy with the Gaussians attached
@@ -214,9 +214,9 @@ def save(ed, path: Path) -> None:
         ed.say(refusal)
         return
     if getattr(ed, "ooc", None) is not None:          # a scan out of core: streamed, the edited nodes replaced
-        from splatedit.app.outofcore import save_job
+        from splatedit.app.document.outofcore import save_job
         ed.save_as = path
-        ed.jobs["save"] = save_job(ed, ed.ooc, Path(path))
+        ed.jobs["save"] = save_job(ed, ed.ooc, Path(path), script_path_for(Path(path)))
         ed.say(f"saving {path} ...")
         return
     cloud, script, pos = s.cloud, s.edit_script(), s.history.position

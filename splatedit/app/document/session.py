@@ -164,7 +164,7 @@ class Session:
         self.last_edit: LastEdit | None = None
         self._erasing = False       # the stroke being painted erases (its history name)
         #: why moves and fits wait (e.g. an out-of-core document loading the
-        #: support's region at full resolution, :mod:`splatedit.app.outofcore`); None: they do not
+        #: support's region at full resolution, :mod:`splatedit.app.document.outofcore`); None: they do not
         self.waiting: str | None = None
         #: why splats cannot be deleted or cropped (an out-of-core document keeps
         #: every point of its file); None: they can

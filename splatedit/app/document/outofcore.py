@@ -28,7 +28,7 @@ of the document is a point of the file, known by (node, row).
   :func:`splatedit.io.copc.rewrite_copc`: a node whose points moved is written
   with its new positions (by row), every other node is copied as it is.
 
-The open / refine / region work runs in :class:`~splatedit.app.jobs.Job`
+The open / refine / region work runs in :class:`~splatedit.app.document.jobs.Job`
 threads (progress bars in the panel); this module's loop side
 (:meth:`OutOfCoreScan.poll`) never reads the file.
 """
@@ -42,7 +42,7 @@ from pathlib import Path
 
 import numpy as np
 
-from splatedit.app.jobs import Job
+from splatedit.app.document.jobs import Job
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.octree_lod import (OctreeView, finest_shown, key_codes, node_frames,
@@ -650,19 +650,17 @@ def open_scan(path, progress, *, first: int | None = None, budget: int | None = 
     return scan, cloud
 
 
-def save_job(ed, scan: OutOfCoreScan, path: Path) -> Job:
+def save_job(ed, scan: OutOfCoreScan, path: Path, spath: Path) -> Job:
     """Write ``path``: the COPC file with the moved points replaced, streamed
     node by node (:func:`splatedit.io.copc.rewrite_copc`), and the edit script
-    beside it.  Over the opened file itself: into a temporary file, then renamed."""
+    at ``spath``.  Over the opened file itself: into a temporary file, then renamed."""
     import dataclasses
     import os
 
-    from splatedit.app.files import script_path_for
     s = ed.session
     cloud, pos = s.cloud, s.history.position
     script = scan.file_script(s.edit_script(), cloud.n)
     moved = scan.moved_nodes(cloud)
-    spath = script_path_for(Path(path))
     same = Path(path).resolve() == scan.source.resolve()
 
     def edit(node, block):
