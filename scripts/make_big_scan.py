@@ -17,7 +17,6 @@ from pathlib import Path
 sys.path.insert(0, str(Path(__file__).resolve().parent.parent))
 
 from splatedit.bench.terrain import write_terrain_copc  # noqa: E402
-from splatedit.progress import report  # noqa: F401,E402
 
 
 def main(argv=None) -> int:

@@ -165,8 +165,10 @@ def cmd_bench(args) -> int:
                                        "(bench render compares both paths in every case)")
     if args.model and what != "render":
         raise ParameterError("--model", f"applies to 'bench render', not 'bench {what}'")
+    if args.file is not None and what != "outofcore":
+        raise ParameterError("--file", f"applies to 'bench outofcore', not 'bench {what}'")
     for line in run_bench(what, quick=args.quick, progress=args.progress, counts=args.splats, large=args.large,
-                          size=args.size, path=args.path, models=args.model):
+                          size=args.size, path=args.path, models=args.model, file=args.file):
         print(json.dumps(line), flush=True)
     return 0
 
@@ -278,6 +280,8 @@ def build_parser() -> argparse.ArgumentParser:
                    help="gaussian-render: only this draw path (default: both, compared in the same run)")
     s.add_argument("--model", action="append", default=[], metavar="FILE",
                    help="render: also this model (e.g. a real scan); repeatable")
+    s.add_argument("--file", metavar="FILE.copc.laz", default=None,
+                   help="outofcore: this COPC file (default: a generated terrain, 1M points, 200k with --quick)")
     s.set_defaults(func=cmd_bench)
     return p
 

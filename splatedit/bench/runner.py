@@ -152,6 +152,12 @@ def _batch(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     yield from bench_batch(5, 2, n)
 
 
+def _outofcore(quick: bool, progress=None, counts=None, file=None) -> Iterator[dict]:
+    from splatedit.bench.outofcore import bench_outofcore
+    n = int(counts[0]) if counts else (200_000 if quick else 1_000_000)
+    yield from bench_outofcore(file, points=n)
+
+
 #: the benchmark cases by name (`splatedit bench NAME`; "all" runs each in this order)
 BENCHES = {
     "solve": _solve,
@@ -172,6 +178,7 @@ BENCHES = {
     "gpu-sort": _gpu_sort,
     "gaussian-editor": _gaussian_editor,
     "curves": _curves,
+    "outofcore": _outofcore,
 }
 
 
@@ -290,12 +297,18 @@ def _tiny_curves():
     yield {"bench": "curves", **cost(0.04, repeats=1)}
 
 
+def _tiny_outofcore():
+    from splatedit.bench.outofcore import bench_outofcore
+    yield from bench_outofcore(None, points=20_000, levels=1)
+
+
 #: the tiny form of every case of BENCHES (same keys)
 TINY = {"solve": _tiny_solve, "basis": _tiny_basis, "groups": _tiny_groups, "qr": _tiny_qr,
         "accuracy": _tiny_accuracy, "closure": _tiny_closure, "render": _tiny_render,
         "editor": _tiny_editor, "estimate": _tiny_estimate, "io": _tiny_io, "batch": _tiny_batch, "detail": _tiny_detail,
         "gui": _tiny_gui, "gaussians": _tiny_gaussians, "gaussian-render": _tiny_gaussian_render,
-        "gaussian-editor": _tiny_gaussian_editor, "gpu-sort": _tiny_gpu_sort, "curves": _tiny_curves}
+        "gaussian-editor": _tiny_gaussian_editor, "gpu-sort": _tiny_gpu_sort, "curves": _tiny_curves,
+        "outofcore": _tiny_outofcore}
 
 
 #: benchmarks that take an image size and a draw path (``--size``, ``--path``)
@@ -303,14 +316,16 @@ SIZED = ("gaussian-render",)
 
 
 def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
-              large: bool = False, size=None, path=None, models=(), tiny: bool = False) -> Iterator[dict]:
+              large: bool = False, size=None, path=None, models=(), tiny: bool = False,
+              file=None) -> Iterator[dict]:
     """Yield the result dicts of benchmark ``what`` (a key of BENCHES, or "all");
     ``counts``: splat/point counts for ``estimate``, ``render``, ``editor``, ``closure`` and
     support splats for ``basis`` and ``solve`` (its grab cases)
     (default: each benchmark's own); ``large`` adds the 10M-splat cases of ``io``;
     ``size`` (width, height) applies to ``render`` and :data:`SIZED`, ``path`` ("raster" /
     "compute") to :data:`SIZED`, ``models`` (extra model files, e.g. a real scan) to ``render``;
-    ``tiny``: each case's smallest form (:data:`TINY`, for the tests)."""
+    ``tiny``: each case's smallest form (:data:`TINY`, for the tests); ``file``: the COPC
+    file of ``outofcore`` (default: a generated one)."""
     names = list(BENCHES) if what == "all" else [what]
     for name in names:
         if tiny:
@@ -319,6 +334,8 @@ def run_bench(what: str, *, quick: bool = False, progress=None, counts=None,
             yield from _io(quick, progress, counts, large=large)
         elif name == "render":
             yield from _render(quick, progress, counts, size=size, models=models)
+        elif name == "outofcore":
+            yield from _outofcore(quick, progress, counts, file=file)
         elif name in SIZED:
             yield from BENCHES[name](quick, progress, counts, size=size, path=path)
         else:

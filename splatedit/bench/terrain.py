@@ -75,6 +75,7 @@ class Terrain:
         y0 = np.arange(lots)[None, :] * _LOT + r.uniform(2, _LOT - 2 - d)
         h = r.uniform(5, 30, (lots, lots))
         gable = r.random((lots, lots)) < 0.4
+        present &= (x0 + w < self.side) & (y0 + d < self.side)      # inside the square
         return present, x0, y0, w, d, h, gable
 
     def _footprint(self, x, y, b):
@@ -187,7 +188,7 @@ def write_terrain_copc(path, n: int, *, seed: int = 0, laz_path=None, progress=N
     t = Terrain.of(n, chunk_points=chunk_points, seed=seed)
     lo, hi = t.bounds
     rep = build_copc(path, t.chunks, point_format=7, scale=SCALE, offset=t.offset, mins=lo, maxs=hi,
-                     progress=progress, **layout)
+                     progress=progress, count=n, **layout)
     if laz_path is not None:
         import laspy
         hdr = laspy.LasHeader(point_format=7, version="1.4")

@@ -30,6 +30,17 @@ def cmd_convert(args) -> int:
         write_gaussians(args.output, g, overwrite=args.force, up_axis=_kept_up(args.input))
         print(f"wrote {args.output}: {len(g)} Gaussians ({g.kind.value}, SH degree {g.sh_degree})")
         return 0
+    from splatedit.io.formats import suffix_of
+    if (suffix_of(args.output) == ".copc.laz" and suffix_of(args.input) in (".las", ".laz", ".copc.laz")
+            and not args.remove_outliers):
+        # streamed, in bounded memory (any size): splatedit.io.copc.convert_to_copc
+        from splatedit.io import check_readable_file
+        from splatedit.io.copc_convert import convert_to_copc
+        check_readable_file(args.input)
+        rep = convert_to_copc(args.input, args.output, progress=args.progress)
+        args.progress.close()
+        print(f"wrote {args.output}: {rep.point_count} points in {rep.nodes} octree nodes (COPC)")
+        return 0
     cloud = read(args.input, progress=args.progress)
     if args.remove_outliers:
         cloud = _remove_outliers(args, cloud)

@@ -10,15 +10,13 @@ runs on it as in memory (:func:`splatedit.script.run_script`), and
 nodes with changed points and copying every other node's compressed bytes.
 
 Render: the nodes are chosen for the camera as Potree does
-(:func:`choose_nodes`): a node's children are read while its point spacing
+(:func:`splatedit.io.copc.choose_nodes`): a node's children are read while its point spacing
 projects to more than ``COPC_REFINE_PX`` pixels, nearest first, within a
 point budget; then the normal splat renderer.
 """
 
 from __future__ import annotations
 
-import heapq
-import sys
 import time
 
 import numpy as np
@@ -125,57 +123,38 @@ def deform_copc(args, print_edit) -> int:
 # --------------------------------------------------------------------------- render
 
 
-def choose_nodes(src, camera, size, *, budget: int, refine_px: float):
-    """The nodes to draw for ``camera`` (an image of ``size`` (w, h)), as
-    Potree chooses them: from the root, a node in front of the camera and
-    inside its view cone is drawn, and its children visited while its point
-    spacing (``src.spacing / 2**depth``) projects to more than ``refine_px``
-    pixels at the node's nearest point; the largest projected spacing first,
-    until ``budget`` points.
-
-    Returns:
-        list of NodeKey (parents before children).
-    """
-    from splatedit.io.copc import ROOT
-    eye = np.asarray(camera.eye, float)
-    fwd = np.asarray(camera.target, float) - eye
-    fwd /= np.linalg.norm(fwd)
-    focal = 0.5 * size[1] / np.tan(np.radians(camera.fov_deg) / 2)
-    half_diag = np.hypot(size[0], size[1]) / 2 / focal          # tan of the cone's half angle
-    cone = np.arctan(half_diag)
-
-    def weight(key):
-        b = src.node_bounds(key)
-        near = np.clip(eye, b[0], b[1])
-        dist = float(np.linalg.norm(near - eye))
-        centre = b.mean(axis=0)
-        radius = float(np.linalg.norm(b[1] - b[0])) / 2
-        to = centre - eye
-        d = float(np.linalg.norm(to))
-        if d > radius:       # outside the view cone (cone widened by the node's bounding sphere)
-            ang = np.arccos(np.clip(to @ fwd / d, -1, 1))
-            if ang - np.arcsin(min(1.0, radius / d)) > cone:
-                return None
-        spacing = src.spacing / (1 << key.depth)
-        return spacing * focal / max(dist, 1e-12)
-
-    out, total = [], 0
-    w = weight(ROOT)
-    heap = [(-w, ROOT)] if ROOT in src.nodes and w is not None else []
-    structure = src._structure if hasattr(src, "_structure") else set()
-    while heap:
-        negw, key = heapq.heappop(heap)
-        n = src.nodes.get(key)
-        if n is not None:
-            if total + n.point_count > budget and out:
-                break
-            out.append(key)
-            total += n.point_count
-        if -negw <= refine_px:
-            continue
-        for c in key.children():
-            if c in src.nodes or c in structure:
-                cw = weight(c)
-                if cw is not None:
-                    heapq.heappush(heap, (-cw, c))
-    return out
+def render_copc(args, camera_from_args) -> int:
+    """``splatedit render IN.copc.laz -o x.png`` out of core: the camera from
+    the root node's points (the default view of the whole model, or the
+    flags), then the nodes of :func:`choose_nodes` read into one cloud and
+    drawn by the splat renderer (``--edl`` available)."""
+    from splatedit.io.copc import ROOT, CopcFile, choose_nodes, cloud_of_block, file_origin
+    from splatedit.render.headless import render_to_png
+    from splatedit.tolerances import COPC_REFINE_PX, COPC_RENDER_BUDGET
+    if args.edit is not None:
+        raise ParameterError("--edit", "a COPC file is rendered out of core without an edit: apply the script "
+                                       "with 'splatedit deform' (out of core too) and render the result")
+    if args.buffers is not None:
+        raise ParameterError("--buffers", "is not available for a COPC file rendered out of core")
+    t0 = time.perf_counter()
+    src = CopcFile.open(args.input)
+    try:
+        origin = file_origin(src)
+        top = [ROOT] if ROOT in src.nodes else [n.key for n in src.select(max_depth=1)]
+        coarse = cloud_of_block(src, src.read(top))
+        camera = camera_from_args(args, coarse)
+        budget = getattr(args, "budget", None) or COPC_RENDER_BUDGET
+        keys = choose_nodes(src, np.asarray(camera.eye) + origin, np.asarray(camera.target) + origin,
+                            camera.fov_deg, args.size, budget=budget, refine_px=COPC_REFINE_PX)
+        block = src.read(keys, args.progress)
+        cloud = cloud_of_block(src, block, args.progress)
+    finally:
+        src.close()
+    render_to_png(cloud, args.output, size=args.size, camera=camera, raster_path=getattr(args, "path", None),
+                  edl=getattr(args, "edl", False))
+    args.progress.close()
+    depth = max((k.depth for k in keys), default=0)
+    print(f"wrote {args.output} ({args.size[0]}x{args.size[1]}, {cloud.n} of {src.point_count} points from "
+          f"{len(keys)} of {len(src.nodes)} nodes, levels 0..{depth}, out of core, "
+          f"{time.perf_counter() - t0:.2f} s)")
+    return 0

@@ -78,6 +78,9 @@ def cmd_render(args) -> int:
     from splatedit.io import is_gaussian_file
     if getattr(args, "edl", False) and is_gaussian_file(args.input):
         raise ParameterError("--edl", "eye-dome lighting is for point-splat models, not Gaussian splat scenes")
+    from splatedit.commands.outofcore import is_copc_path, render_copc
+    if is_copc_path(args.input):
+        return render_copc(args, _camera_from_args)
     if args.edit is not None and not is_gaussian_file(args.input):
         check_gpu_columns(args.edit)        # before the read and the fit (seconds, gigabytes)
     cloud = _read_model(args.input, args.progress)

@@ -35,11 +35,10 @@ rewritten without a move gives back the same integers.
 
 from __future__ import annotations
 
-import hashlib
+import heapq
 import os
 import struct
 import tempfile
-from concurrent.futures import ThreadPoolExecutor
 from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Callable, Iterable, Iterator
@@ -395,6 +394,12 @@ class CopcFile:
         return cls(src, h, info, vlrs, laszip, nodes, structure, evlrs, fd)
 
     # -- queries
+
+    @property
+    def structure_keys(self) -> set:
+        """Keys listed in the hierarchy without points (they have
+        descendants with points)."""
+        return self._structure
 
     def node_bounds(self, key: NodeKey) -> np.ndarray:
         """(2, 3) float64 the cube of node ``key`` (it need not exist)."""
@@ -1092,7 +1097,7 @@ def rewrite_copc(src: CopcFile, dst_path, edit: Callable[[CopcNode, PointBlock],
 
 def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_format: int, scale, offset,
                mins, maxs, node_points: int = NODE_POINTS, leaf_points: int = LEAF_POINTS,
-               vlrs=(), progress=None, tmp_dir=None) -> WriteReport:
+               vlrs=(), progress=None, tmp_dir=None, count: int | None = None) -> WriteReport:
     """Write a COPC file from point records streamed in chunks, in bounded
     memory (about three chunks).
 
@@ -1105,6 +1110,8 @@ def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_fo
         vlrs: (user, id, description, data) VLRs to keep (a CRS).
         tmp_dir: where the bucketed points are spilled (default: beside
             ``dst_path``; about ``record_length`` bytes a point).
+        count: the number of points, when known (for the progress of the
+            first pass).
 
     Passes: (1) count the points per cell of octree level ``FINE_DEPTH``;
     (2) assign each point its node (:class:`_Octree`), sort each chunk by
@@ -1132,7 +1139,7 @@ def build_copc(dst_path, chunks: Callable[[], Iterator[np.ndarray]], *, point_fo
             if len(xyz):
                 seen_lo = np.minimum(seen_lo, xyz.min(axis=0))
                 seen_hi = np.maximum(seen_hi, xyz.max(axis=0))
-            report(progress, "counting points", 0.0)
+            report(progress, "counting points", n_total / count if count else 0.0)
             yield probe.fine_codes(xyz)
 
     codes, counts = _count_cells(counted())
@@ -1222,81 +1229,6 @@ def las_records(points, point_format: int) -> np.ndarray:
     return rec
 
 
-def convert_to_copc(src_path, dst_path, progress=None, *, chunk_points: int = 2_000_000,
-                    node_points: int = NODE_POINTS, leaf_points: int = LEAF_POINTS) -> WriteReport:
-    """Convert any file :func:`splatedit.io.read` reads into COPC.
-
-    LAS/LAZ is streamed (laspy's chunk iterator, ``chunk_points`` at a
-    time; the file's scale, offset, integers, returns, classes, GPS times
-    and RGB are kept; point format 7 when the file has RGB, else 6, 8 when
-    it has NIR); a COPC source is laid out anew the same way.  Other formats
-    are read whole (they are held in memory anyway) and written with
-    :func:`write_copc`: positions on a grid of ``LAS_DEFAULT_SCALE``, RGB
-    colours and intensity.
-    """
-    src = str(src_path)
-    suffix = Path(src).suffix.lower()
-    if suffix in (".las", ".laz"):
-        from splatedit.io.las import check_las_header
-        check_las_header(src_path)
-        import laspy
-        from splatedit.io._guard import library_call
-        with library_call(src, "not a readable LAS/LAZ file"):
-            with laspy.open(src) as rd:
-                hdr = rd.header
-                names = set(hdr.point_format.dimension_names)
-                fmt = 8 if "nir" in names else 7 if {"red", "green", "blue"} <= names else 6
-                scale, offset = np.asarray(hdr.scales, float), np.asarray(hdr.offsets, float)
-                mins, maxs = np.asarray(hdr.mins, float), np.asarray(hdr.maxs, float)
-                crs = [(v.user_id.encode(), v.record_id, v.description.encode() if isinstance(v.description, str)
-                        else bytes(v.description), bytes(v.record_data_bytes()))
-                       for v in hdr.vlrs if v.user_id in ("LASF_Projection",)]
-
-        def chunks():
-            with library_call(src, "not a readable LAS/LAZ file"):
-                with laspy.open(src) as rd:
-                    for pts in rd.chunk_iterator(chunk_points):
-                        yield las_records(pts, fmt)
-
-        # the header's box may be stale; a pass over the points is cheap next to compression
-        return build_copc(dst_path, chunks, point_format=fmt, scale=scale, offset=offset,
-                          mins=mins, maxs=maxs, node_points=node_points, leaf_points=leaf_points,
-                          vlrs=crs, progress=progress)
-    from splatedit.io import read
-    cloud = read(src, progress=progress)
-    xyz = cloud.positions.astype(np.float64) + np.asarray(cloud.origin, np.float64)
-    colour = None if cloud.colors is None else np.asarray(cloud.colors)[:, :3]
-    return write_copc(dst_path, xyz, colour, cloud.intensity, progress=progress,
-                      node_points=node_points, leaf_points=leaf_points)
-
-
-def cache_dir() -> Path:
-    """``$XDG_CACHE_HOME/splatedit/copc`` (default ``~/.cache``)."""
-    base = os.environ.get("XDG_CACHE_HOME") or os.path.join(os.path.expanduser("~"), ".cache")
-    return Path(base) / "splatedit" / "copc"
-
-
-def cached_copc(src_path, progress=None) -> Path:
-    """A COPC file of ``src_path``: the file itself when it is COPC, else its
-    conversion (:func:`convert_to_copc`), made once into :func:`cache_dir`
-    under a hash of the resolved path, size and modification time (a changed
-    file gets a new conversion)."""
-    p = Path(src_path)
-    if is_copc(p):
-        return p
-    try:
-        st = p.stat()
-    except OSError as exc:
-        raise InputError(f"cannot read file: {exc.strerror or exc}", path=str(p)) from None
-    h = hashlib.sha256(f"{p.resolve()}\0{st.st_size}\0{st.st_mtime_ns}".encode()).hexdigest()[:24]
-    out = cache_dir() / f"{h}.copc.laz"
-    if out.exists():
-        return out
-    out.parent.mkdir(parents=True, exist_ok=True)
-    convert_to_copc(p, out, progress=progress)
-    return out
-
-
 # --------------------------------------------------------------------------- regions as splat clouds
 
 
@@ -1338,3 +1270,63 @@ def cloud_of_block(src: CopcFile, block: PointBlock, progress=None):
                        intensity=rec["intensity"].copy(), classification=rec["classification"].copy(),
                        quantization=quant,
                        point_fields={"copc_block_row": np.arange(len(rec), dtype=np.int64)})
+
+
+# --------------------------------------------------------------------------- level of detail
+
+
+def choose_nodes(src, eye, target, fov_deg: float, size, *, budget: int, refine_px: float):
+    """The nodes to draw for a camera at ``eye`` looking at ``target``
+    ((3,) file units) with a vertical field of view of ``fov_deg`` degrees
+    (an image of ``size`` (w, h)), as
+    Potree chooses them: from the root, a node in front of the camera and
+    inside its view cone is drawn, and its children visited while its point
+    spacing (``src.spacing / 2**depth``) projects to more than ``refine_px``
+    pixels at the node's nearest point; the largest projected spacing first,
+    until ``budget`` points.
+
+    Returns:
+        list of NodeKey (parents before children).
+    """
+    eye = np.asarray(eye, float)
+    fwd = np.asarray(target, float) - eye
+    fwd /= np.linalg.norm(fwd)
+    focal = 0.5 * size[1] / np.tan(np.radians(fov_deg) / 2)
+    half_diag = np.hypot(size[0], size[1]) / 2 / focal          # tan of the cone's half angle
+    cone = np.arctan(half_diag)
+
+    def weight(key):
+        b = src.node_bounds(key)
+        near = np.clip(eye, b[0], b[1])
+        dist = float(np.linalg.norm(near - eye))
+        centre = b.mean(axis=0)
+        radius = float(np.linalg.norm(b[1] - b[0])) / 2
+        to = centre - eye
+        d = float(np.linalg.norm(to))
+        if d > radius:       # outside the view cone (cone widened by the node's bounding sphere)
+            ang = np.arccos(np.clip(to @ fwd / d, -1, 1))
+            if ang - np.arcsin(min(1.0, radius / d)) > cone:
+                return None
+        spacing = src.spacing / (1 << key.depth)
+        return spacing * focal / max(dist, 1e-12)
+
+    out, total = [], 0
+    w = weight(ROOT)
+    heap = [(-w, ROOT)] if ROOT in src.nodes and w is not None else []
+    structure = src.structure_keys
+    while heap:
+        negw, key = heapq.heappop(heap)
+        n = src.nodes.get(key)
+        if n is not None:
+            if total + n.point_count > budget and out:
+                break
+            out.append(key)
+            total += n.point_count
+        if -negw <= refine_px:
+            continue
+        for c in key.children():
+            if c in src.nodes or c in structure:
+                cw = weight(c)
+                if cw is not None:
+                    heapq.heappush(heap, (-cw, c))
+    return out

@@ -13,7 +13,7 @@ import pytest
 from splatedit.bench.runner import BENCHES, TINY, run_bench
 
 #: the cases that draw with the Vulkan renderer
-GPU = {"render", "editor", "detail", "gui", "gaussian-render", "gaussian-editor"}
+GPU = {"render", "editor", "detail", "gui", "gaussian-render", "gaussian-editor", "outofcore"}
 
 
 def test_every_bench_case_has_a_tiny_form():
