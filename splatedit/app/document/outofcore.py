@@ -639,8 +639,9 @@ def open_scan(path, progress, *, first: int | None = None, budget: int | None = 
     p = Path(path)
     src = p
     if not copc_io.is_copc(p):
+        from splatedit.io.copc_convert import cached_copc
         progress("converting to a COPC cache (once)", 0.0)
-        src = copc_io.cached_copc(p)
+        src = cached_copc(p, progress)
     progress("reading the octree", 0.0)
     scan = OutOfCoreScan(copc_io.CopcFile.open(src), p, source=src, budget=budget)
     keys = scan.overview_keys(first)
