@@ -349,5 +349,9 @@ EDITOR_OOC_SETTLE_S = 0.3
 #: selection's rim, transferred to the finer points by nearest neighbour,
 #: is loaded whole)
 EDITOR_OOC_REGION_MARGIN_RADII = 2.0
+#: most points a support's full-resolution region may add to the document: a
+#: larger support cannot be edited (moves wait; the panel says to paint less):
+#: editing only its shown points would leave the file's other points behind
+EDITOR_OOC_REGION_MAX_POINTS = 2_000_000
 #: points read per batch (a progress step, a cancellation point)
 EDITOR_OOC_READ_BATCH = 250_000

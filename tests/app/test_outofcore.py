@@ -113,3 +113,22 @@ def test_a_waiting_session_neither_fits_nor_moves_and_keeps_its_splats(scan_file
     s.waiting = None
     s.request_fit()
     assert s.wait_fit() and s.fit_error is None and s.basis is not None and s.begin("grab", view(), (100.0, 100.0))
+
+
+def test_a_support_too_large_for_full_resolution_waits_until_it_shrinks(scan_file, monkeypatch):
+    import types
+
+    from splatedit.app.document import outofcore
+    monkeypatch.setattr(outofcore, "EDITOR_OOC_REGION_MAX_POINTS", 1000)
+    scan, cloud = open_scan(scan_file, lambda *a: None, first=5000, budget=20_000)
+    s = Session(cloud, fit_sync=True)
+    said = []
+    ed = types.SimpleNamespace(session=s, jobs={}, say=said.append, wake=lambda: None)
+    s.end_stroke(s.paint(np.arange(cloud.n)))          # everything: the whole file's nodes are missing
+    box = scan.region_needed(s)
+    assert box is not None
+    scan.start_region(ed, box)
+    assert not ed.jobs and s.waiting and "paint a smaller support" in said[-1]
+    assert s.state == "waiting" and s.stats().error == s.waiting
+    s.clear()
+    assert scan.region_needed(s) is None and s.waiting is None

@@ -49,7 +49,8 @@ from splatedit.model.octree_lod import (OctreeView, finest_shown, key_codes, nod
                                         select_nodes)
 from splatedit.model.tangents import tangent_frame
 from splatedit.tolerances import (EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_MAX_POINTS, EDITOR_OOC_POINT_BUDGET,
-                                  EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII, EDITOR_OOC_SETTLE_S,
+                                  EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII,
+                                  EDITOR_OOC_REGION_MAX_POINTS, EDITOR_OOC_SETTLE_S,
                                   SPLAT_RADIUS_FACTOR)
 
 #: the job names of an out-of-core document in ``Editor.jobs``
@@ -181,6 +182,7 @@ class OutOfCoreScan:
         self.moved_at = time.perf_counter()
         self.last_cam = None
         self.waiting_version = None     # selection version a region was last checked for
+        self.too_large = False          # the session waits because its support's region is too large
         self.notice = ""                # why the view no longer refines (shown once)
         #: frames presented and seconds spent while view or region jobs ran (the
         #: window stays live: tests and the benchmark read these)
@@ -330,8 +332,9 @@ class OutOfCoreScan:
         busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
         if busy or s.manip is not None or s.committing or ed.drag.name != "NONE":
             return                  # (a stroke being painted: its region is loaded when it ends)
-        if self.region_needed(s):
-            return self.start_region(ed)
+        box = self.region_needed(s)
+        if box is not None:
+            return self.start_region(ed, box)
         if now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state:
             self.view_state = cam_state
             self.start_refine(ed)
@@ -360,14 +363,17 @@ class OutOfCoreScan:
         return [seg for seg in self.segments if seg[1] + seg[2] <= s.cloud.n]
 
     def region_needed(self, s):
-        """The full-resolution box of the support when it holds nodes not shown yet, else None."""
+        """(lo, hi, missing keys) of the support's full-resolution region when it
+        holds nodes not shown yet, else None (checked once per selection version)."""
         if s.version == self.waiting_version:
             return None
         self.waiting_version = s.version
-        sup = s.selection.support
-        if not sup.any():
-            return None
-        return self.region_box(s) is not None
+        box = self.region_box(s) if s.selection.support.any() else None
+        if self.too_large and box is None:        # the support shrank to what is loaded: moves may start
+            self.too_large = False
+            s.waiting = None
+            s.request_fit()
+        return box
 
     def region_box(self, s):
         sup = np.flatnonzero(s.selection.support)
@@ -424,12 +430,18 @@ class OutOfCoreScan:
         ed.jobs[VIEW_JOB] = Job("refining the view", work, ed.wake)
         self._started(ed)
 
-    def start_region(self, ed) -> None:
+    def start_region(self, ed, box) -> None:
         s = ed.session
-        box = self.region_box(s)
-        if box is None:
-            return
         lo, hi, missing = box
+        extra = sum(self.counts[t] for t in missing)
+        if extra > EDITOR_OOC_REGION_MAX_POINTS:
+            self.too_large = True
+            s.waiting = (f"the support's region holds {extra:,} more points at full resolution (at most "
+                         f"{EDITOR_OOC_REGION_MAX_POINTS:,}): paint a smaller support (zoom in) to edit it")
+            s.fit.clear()
+            ed.say(s.waiting)
+            return
+        self.too_large = False
         self.region_world = np.stack([lo, hi]) + self.origin
         segs = self.current_segments(s)
         cloud = s.cloud
@@ -444,8 +456,7 @@ class OutOfCoreScan:
 
         ed.jobs[REGION_JOB] = Job("full-resolution region", work, ed.wake)
         self._started(ed)
-        ed.say(f"loading {sum(self.counts[t] for t in missing):,} "
-               f"points of the painted region at full resolution ...")
+        ed.say(f"loading {extra:,} points of the painted region at full resolution ...")
 
     def landed(self, ed, name: str, result) -> None:
         """A view or region job finished: swap its cloud in (when the document

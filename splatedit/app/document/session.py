@@ -627,7 +627,8 @@ class Session:
             handle_sizes=sizes, curve_points=len(self.curve_points),
             pose_pending=self.pose_pending,
             columns=fit.columns if fit is not None else columns_needed(len(sel.nonempty()), len(self.curve_points)),
-            fit=fit, progress=self.fit.progress(), error=self.fit_error, commit=self.committer.progress())
+            fit=fit, progress=self.fit.progress(), error=self.waiting or self.fit_error,
+            commit=self.committer.progress())
 
     def close(self) -> None:
         """Cancel the running fit and commit (a commit's result is dropped:
