@@ -121,10 +121,17 @@ def laspy_read(scan: Path, *, levels: int | None = None, box=None) -> tuple[floa
     return time.perf_counter() - t, n
 
 
+def note(rows: list, row: tuple) -> None:
+    """Keep a result row and show it at once on stderr (a run cut short keeps its rows)."""
+    rows.append(row)
+    print(f"  {row[0]}: {row[1]:.2f} {row[2]}", file=sys.stderr, flush=True)
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description=__doc__.splitlines()[0])
     ap.add_argument("scan", type=Path)
     ap.add_argument("--size", default="1280x720")
+    ap.add_argument("--zoom", type=int, default=14, help="wheel steps toward the centre before the edit")
     ap.add_argument("--budget", help="FIRST,BUDGET points (SPLATEDIT_OOC_BUDGET; default the editor's)")
     a = ap.parse_args(argv)
     for tool in ("Xvfb", "xdotool"):
@@ -140,7 +147,7 @@ def main(argv=None) -> int:
             ed = Editor(a.scan.resolve(), tmp, display, a.size, a.budget)
             s, t = ed.wait(lambda s: s["loaded"] and s["frames_presented"] > 0 and s["out_of_core"], "first frame")
             first = s["out_of_core"]
-            rows.append(("open to first frame", t - ed.t0, f"{first['shown']:,} of {first['points']:,} points "
+            note(rows, ("open to first frame", t - ed.t0, f"{first['shown']:,} of {first['points']:,} points "
                          f"(depth <= {first['max_depth_shown']})"))
             w, h = s["window"]
             cx, cy = (w + (s["panel_box"][0] + s["panel_box"][2])) // 2, h // 2
@@ -148,19 +155,18 @@ def main(argv=None) -> int:
             s, t = ed.wait(lambda s: s["out_of_core"]["refined"] and "nodes" not in s["jobs"]
                            and s["out_of_core"]["nodes_shown"] != first["nodes_shown"], "top view refined")
             oc = s["out_of_core"]
-            rows.append(("top view refined (numpad 7)", t - t0, f"{oc['shown']:,} points, {oc['nodes_shown']} nodes, "
+            note(rows, ("top view refined (numpad 7)", t - t0, f"{oc['shown']:,} points, {oc['nodes_shown']} nodes, "
                          f"depth <= {oc['max_depth_shown']}; {oc['loading_frames']} frames during "
                          f"{oc['loading_seconds']:.1f} s of loading"))
             d0 = s["camera"]["distance"]
-            t0 = ed.xdo("mousemove", cx, cy, *(["click", "4"] * 6))
+            t0 = ed.xdo("mousemove", cx, cy, *(["click", "4"] * a.zoom))
             s, t = ed.wait(lambda s: s["out_of_core"]["refined"] and "nodes" not in s["jobs"]
                            and s["camera"]["distance"] < 0.99 * d0, "zoomed view refined")
             oc = s["out_of_core"]
-            rows.append(("zoom in x6 refined", t - t0, f"{oc['shown']:,} points, depth <= {oc['max_depth_shown']}; "
+            note(rows, (f"zoom in x{a.zoom} refined", t - t0, f"{oc['shown']:,} points, depth <= {oc['max_depth_shown']}; "
                          f"{oc['loading_frames']} frames during {oc['loading_seconds']:.1f} s of loading (total)"))
             ed.wait(lambda s: s["idle"], "idle")
             n0 = ed.status()["n"]
-            ed.xdo("mousemove", cx, cy, "key", "bracketright", "bracketright", "bracketright")
             ed.xdo("mousemove", cx - 40, cy - 10, "mousedown", "1", "mousemove", cx, cy - 10,
                    "mousemove", cx + 40, cy - 10, "mousemove", cx + 40, cy + 15, "mousemove", cx - 40, cy + 15,
                    "sleep", "0.1")
@@ -168,33 +174,33 @@ def main(argv=None) -> int:
             s, t = ed.wait(lambda s: s["support"] > 0 and s["n"] > n0 and s["out_of_core"]["waiting"] is None
                            and "region" not in s["jobs"], "region at full resolution")
             region = s["out_of_core"]["region"]
-            rows.append(("stroke to preview (region at full resolution)", t - t0,
+            note(rows, ("stroke to preview (region at full resolution)", t - t0,
                          f"support {s['support']:,}, {s['n'] - n0:,} points loaded"))
             t0 = ed.xdo("key", "2", "mousemove", cx, cy, "click", "1")
             s, t = ed.wait(lambda s: s["handle"] > 0 and s["state"] == "ready", "handle fitted")
-            rows.append(("handle to fitted", t - t0, f"handle {s['handle']:,}"))
+            note(rows, ("handle to fitted", t - t0, f"handle {s['handle']:,}"))
             t0 = ed.xdo("mousemove", cx + 30, cy, "key", "g", "z", "2", "Return")
             s, t = ed.wait(lambda s: s["edits"] == 1 and s["state"] != "committing", "commit")
-            rows.append(("G Z 2 Enter to committed", t - t0, ""))
+            note(rows, ("G Z 2 Enter to committed", t - t0, ""))
             t0 = ed.xdo("key", "ctrl+s")
             s, t = ed.wait(lambda s: s["saved"] and not s["dirty"], "saved")
             size = Path(s["saved"]).stat().st_size / 2**20
-            rows.append(("edit to saved (Ctrl+S, streamed)", t - t0, f"{size:,.0f} MiB written"))
+            note(rows, ("edit to saved (Ctrl+S, streamed)", t - t0, f"{size:,.0f} MiB written"))
             rss = ed.peak_rss_mb()
-            rows.append(("peak resident memory (VmHWM)", rss / 1024.0, "GiB"))
+            note(rows, ("peak resident memory (VmHWM)", rss / 1024.0, "GiB"))
         finally:
             if ed is not None:
                 ed.close()
             xvfb.kill()
             xvfb.wait(10)
     lt, ln = laspy_read(a.scan, levels=first["max_depth_shown"] + 1)
-    rows.append(("laspy CopcReader: the first view's levels", lt, f"{ln:,} points"))
+    note(rows, ("laspy CopcReader: the first view's levels", lt, f"{ln:,} points"))
     if region is not None:
         lt, ln = laspy_read(a.scan, box=region)
-        rows.append(("laspy CopcReader: the region's box, all levels", lt, f"{ln:,} points"))
-    print(f"| step | seconds | notes |\n|---|---|---|")
-    for name, sec, note in rows:
-        print(f"| {name} | {sec:.2f} | {note} |")
+        note(rows, ("laspy CopcReader: the region's box, all levels", lt, f"{ln:,} points"))
+    print("| step | seconds | notes |\n|---|---|---|")
+    for name, sec, text in rows:
+        print(f"| {name} | {sec:.2f} | {text} |")
     print(f"\nload average at start {load0:.2f}, at end {os.getloadavg()[0]:.2f}; {os.cpu_count()} cores")
     return 0
 

@@ -132,3 +132,29 @@ def test_a_support_too_large_for_full_resolution_waits_until_it_shrinks(scan_fil
     assert s.state == "waiting" and s.stats().error == s.waiting
     s.clear()
     assert scan.region_needed(s) is None and s.waiting is None
+
+
+def test_a_large_non_copc_scan_opens_through_its_copc_cache(tmp_path, monkeypatch):
+    import laspy
+
+    from splatedit import tolerances
+    from splatedit.app.document.outofcore import is_out_of_core
+    from tests.app.copc_scans import terrain_points
+    monkeypatch.setenv("XDG_CACHE_HOME", str(tmp_path / "cache"))
+    xyz, _ = terrain_points(20_000, seed=3)
+    las = laspy.create(point_format=6, file_version="1.4")
+    las.header.scales = [0.001] * 3
+    las.header.offsets = np.round(xyz.min(0))
+    las.x, las.y, las.z = xyz[:, 0], xyz[:, 1], xyz[:, 2]
+    path = tmp_path / "tile.las"
+    las.write(path)
+    assert not is_out_of_core(path)
+    monkeypatch.setattr(tolerances, "EDITOR_OOC_CONVERT_BYTES", path.stat().st_size - 1)
+    assert is_out_of_core(path)
+    stages = []
+    scan, cloud = open_scan(path, lambda st, f: stages.append(st), first=5000, budget=20_000)
+    assert scan.path == path and scan.source != path and (tmp_path / "cache") in scan.source.parents
+    assert "converting to a COPC cache (once)" in stages and scan.copc.point_count == 20_000
+    from scipy.spatial import cKDTree
+    d, _ = cKDTree(xyz).query(cloud.positions + scan.origin)
+    assert d.max() < 1e-3 and cloud.n == 20_000    # the scan on its 0.001 grid (one 20k leaf node: the root)
