@@ -665,15 +665,14 @@ def open_scan(path, progress, *, first: int | None = None, budget: int | None = 
 def save_job(ed, scan: OutOfCoreScan, path: Path, spath: Path) -> Job:
     """Write ``path``: the COPC file with the moved points replaced, streamed
     node by node (:func:`splatedit.io.copc.rewrite_copc`), and the edit script
-    at ``spath``.  Over the opened file itself: into a temporary file, then renamed."""
+    at ``spath``.  Only the nodes with moved points are decoded (``rewrite_copc``'s
+    ``only``); the output is written to a temporary file and renamed."""
     import dataclasses
-    import os
 
     s = ed.session
     cloud, pos = s.cloud, s.history.position
     script = scan.file_script(s.edit_script(), cloud.n)
     moved = scan.moved_nodes(cloud)
-    same = Path(path).resolve() == scan.source.resolve()
 
     def edit(node, block):
         t = _key(node.key)
@@ -689,11 +688,8 @@ def save_job(ed, scan: OutOfCoreScan, path: Path, spath: Path) -> Job:
     def work(progress):
         from splatedit.io.copc import rewrite_copc
         target = Path(path)
-        tmp = target.with_name(target.name + ".part") if same else target
         progress("saving", 0.0)
-        rewrite_copc(scan.copc, tmp, edit, progress=progress)
-        if same:
-            os.replace(tmp, target)
+        rewrite_copc(scan.copc, target, edit, progress=progress, only=[scan.by_tuple[t] for t in moved])
         script.save(spath)
         return target, spath, pos, s
 
