@@ -283,3 +283,9 @@ OCTREE_LOD_MIN_PX = 1.5
 #: this runs while the user waits for the view to refine; 10 neighbours on
 #: a 50k-point node took 0.35 s of k-d tree query and 0.08 s of PCA here
 NODE_NORMAL_NEIGHBOURS = 10
+#: a shown octree point whose spacing exceeds this many times its node's median
+#: spacing is isolated (noise above a terrain, a stray return: a far 6th
+#: neighbour) and gets the median instead: such points drew as discs tens of
+#: metres wide over the 100M test terrain (ground nodes' medians 1.3-1.5x the
+#: COPC spacing of their depth); up to 2x the sparser parts of a node stay closed
+OCTREE_SPACING_MAX_MEDIAN = 2.0

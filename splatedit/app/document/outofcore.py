@@ -51,7 +51,7 @@ from splatedit.model.tangents import tangent_frame
 from splatedit.tolerances import (EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_MAX_POINTS, EDITOR_OOC_POINT_BUDGET,
                                   EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII,
                                   EDITOR_OOC_REGION_MAX_POINTS, EDITOR_OOC_SETTLE_S,
-                                  SPLAT_RADIUS_FACTOR)
+                                  OCTREE_SPACING_MAX_MEDIAN, SPLAT_RADIUS_FACTOR)
 
 #: the job names of an out-of-core document in ``Editor.jobs``
 VIEW_JOB, REGION_JOB = "nodes", "region"
@@ -246,8 +246,11 @@ class OutOfCoreScan:
     # --------------------------------------------------------------- splats
     def radii(self, keys: list, nodes: dict) -> dict:
         """key -> (n,) splat radii of each of ``keys`` when ``keys`` are shown:
-        ``SPLAT_RADIUS_FACTOR`` x the smaller of the point's own spacing and
-        the median spacing of the finest shown node holding it."""
+        ``SPLAT_RADIUS_FACTOR`` x the point's own spacing in its node (the
+        node's median for an isolated point, one whose spacing exceeds
+        ``OCTREE_SPACING_MAX_MEDIAN`` x the median),
+        or, where a finer shown node holds the point, the smaller of that and
+        the finer node's median spacing (its points fill in between)."""
         codes = key_codes(keys)
         order = np.argsort(codes)
         sorted_codes = codes[order]
@@ -255,9 +258,11 @@ class OutOfCoreScan:
         out = {}
         for t in keys:
             nd = nodes[t]
-            fine, _ = finest_shown(nd.xyz, t, sorted_codes, self.cube_lo, self.cube_size, self.max_depth)
+            fine, depth = finest_shown(nd.xyz, t, sorted_codes, self.cube_lo, self.cube_size, self.max_depth)
+            own = nd.spacing.astype(np.float64)
+            own = np.where(own > OCTREE_SPACING_MAX_MEDIAN * nd.median, nd.median, own)   # isolated: the median
             med = medians[np.searchsorted(sorted_codes, fine)]
-            out[t] = SPLAT_RADIUS_FACTOR * np.minimum(nd.spacing.astype(np.float64), med)
+            out[t] = SPLAT_RADIUS_FACTOR * np.where(depth > t[0], np.minimum(own, med), own)
         return out
 
     def splats(self, keys: list, nodes: dict, radii: dict, name: str) -> SplatCloud:
