@@ -14,9 +14,10 @@ of the document is a point of the file, known by (node, row).
   node) and builds the splats (size from the finest shown node at each point,
   as Potree's adaptive point size); the loop swaps the new cloud in when it
   is ready.  A pristine document (no selection, no edit) takes the new node set
-  as it is; a document with a selection or edits only *appends* nodes (the
-  indices of its history, selection and edit script stay valid), up to
-  :data:`EDITOR_OOC_MAX_POINTS`.
+  as it is; a document with edits only *appends* nodes (the indices of its
+  history and edit script stay valid), up to :data:`EDITOR_OOC_MAX_POINTS`;
+  while a selection exists the view does not refine (a grown cloud would
+  restart the fit).
 * **Edit region.** When a stroke leaves a support, every node intersecting
   the support's bounding box (grown by :data:`EDITOR_OOC_REGION_MARGIN_RADII`
   splat radii) is loaded at full resolution and appended; the support and the
@@ -340,7 +341,9 @@ class OutOfCoreScan:
         box = self.region_needed(s)
         if box is not None:
             return self.start_region(ed, box)
-        if now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state:
+        if (now - self.moved_at >= EDITOR_OOC_SETTLE_S and cam_state != self.view_state
+                and not s.selection.support.any() and not len(getattr(s, "curve_points", ()))):
+            # (with a selection the view stays: a grown cloud would refit its basis)
             self.view_state = cam_state
             self.start_refine(ed)
 
@@ -469,9 +472,11 @@ class OutOfCoreScan:
         s = ed.session
         self._ended(ed)
         kind, cloud, segs, nodes, base = result
+        if s is None:
+            return
         if name == REGION_JOB:
             s.waiting = None
-        if s is None or s.cloud is not base or s.manip is not None or s.committing:
+        if s.cloud is not base or s.manip is not None or s.committing:
             self.view_state = None       # the document changed meanwhile: choose again
             self.waiting_version = None
             return
