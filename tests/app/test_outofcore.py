@@ -158,3 +158,16 @@ def test_a_large_non_copc_scan_opens_through_its_copc_cache(tmp_path, monkeypatc
     from scipy.spatial import cKDTree
     d, _ = cKDTree(xyz).query(cloud.positions + scan.origin)
     assert d.max() < 1e-3 and cloud.n == 20_000    # the scan on its 0.001 grid (one 20k leaf node: the root)
+
+
+def test_file_indices_point_at_the_same_points_in_the_file_read_whole(scan_file):
+    from splatedit.io import read
+    scan, cloud = open_scan(scan_file, lambda *a: None, first=5000, budget=20_000)
+    kids = [t for t in scan.by_tuple if t[0] == 1][:3]
+    nodes = dict(scan.nodes)
+    nodes.update(scan.read(kids))
+    grown, scan.segments = scan.extend(cloud, scan.segments, kids, nodes)
+    whole = read(str(scan_file))
+    idx = scan.file_indices(grown.n)
+    assert len(np.unique(idx)) == grown.n
+    np.testing.assert_allclose(whole.world_positions(idx), grown.positions + scan.origin, rtol=0, atol=1e-6)
