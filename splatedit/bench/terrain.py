@@ -46,12 +46,15 @@ class Terrain:
 
     @classmethod
     def of(cls, n: int, *, density: float = 25.0, chunk_points: int = 2_000_000, seed: int = 0) -> "Terrain":
+        """The terrain of ``n`` points at ``density`` points per square
+        metre, in tiles of about ``chunk_points``."""
         side = float(np.sqrt(n / density))
         tiles = max(1, int(np.ceil(np.sqrt(n / chunk_points))))
         return cls(n, side, tiles, seed)
 
     @property
     def offset(self) -> np.ndarray:
+        """(3,) the LAS offset: the square's centre at height 0."""
         return ORIGIN + [self.side / 2, self.side / 2, 0.0]
 
     @property

@@ -33,7 +33,7 @@ def cmd_convert(args) -> int:
     from splatedit.io.formats import suffix_of
     if (suffix_of(args.output) == ".copc.laz" and suffix_of(args.input) in (".las", ".laz", ".copc.laz")
             and not args.remove_outliers):
-        # streamed, in bounded memory (any size): splatedit.io.copc.convert_to_copc
+        # streamed, in bounded memory (any size): splatedit.io.copc_convert.convert_to_copc
         from splatedit.io import check_readable_file
         from splatedit.io.copc_convert import convert_to_copc
         check_readable_file(args.input)

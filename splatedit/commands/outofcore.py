@@ -129,7 +129,7 @@ def render_copc(args, camera_from_args) -> int:
     flags), then the nodes of :func:`choose_nodes` read into one cloud and
     drawn by the splat renderer (``--edl`` available)."""
     from splatedit.io.copc import ROOT, CopcFile, choose_nodes, cloud_of_block, file_origin
-    from splatedit.render.headless import render_to_png
+    from splatedit.render.splat.headless import render_to_png
     from splatedit.tolerances import COPC_REFINE_PX, COPC_RENDER_BUDGET
     if args.edit is not None:
         raise ParameterError("--edit", "a COPC file is rendered out of core without an edit: apply the script "
@@ -146,11 +146,22 @@ def render_copc(args, camera_from_args) -> int:
         budget = getattr(args, "budget", None) or COPC_RENDER_BUDGET
         keys = choose_nodes(src, np.asarray(camera.eye) + origin, np.asarray(camera.target) + origin,
                             camera.fov_deg, args.size, budget=budget, refine_px=COPC_REFINE_PX)
+        keys = keys or top          # nothing in view: the frame shows what the coarse points show (nothing)
         block = src.read(keys, args.progress)
         cloud = cloud_of_block(src, block, args.progress)
     finally:
         src.close()
-    render_to_png(cloud, args.output, size=args.size, camera=camera, raster_path=getattr(args, "path", None),
+    drawn, path = cloud, getattr(args, "path", None)
+    if not getattr(args, "full", False):      # as for any model: a level about a pixel wide where splats crowd
+        import os
+        from splatedit.render.splat.headless import pixel_level
+        from splatedit.tolerances import RENDER_LOD_PATH
+        level = pixel_level(cloud, camera, args.size[1])
+        if level is not None:
+            drawn = level.cloud
+            if path is None and not os.environ.get("SPLATEDIT_RASTER"):
+                path = RENDER_LOD_PATH
+    render_to_png(drawn, args.output, size=args.size, camera=camera, raster_path=path,
                   edl=getattr(args, "edl", False))
     args.progress.close()
     depth = max((k.depth for k in keys), default=0)

@@ -303,6 +303,18 @@ class CopcFile:
             add up to the header's).
         """
         src = str(path)
+        import stat
+        try:
+            mode = os.stat(src).st_mode
+        except OSError as exc:
+            raise InputError(f"cannot read file: {exc.strerror or exc}", path=src) from None
+        except ValueError as exc:
+            raise InputError(f"not a usable file name: {exc}", path=repr(src)) from None
+        if stat.S_ISDIR(mode):
+            raise InputError("is a directory, not a file", path=src)
+        if not stat.S_ISREG(mode):        # a FIFO would block the open
+            raise InputError("is not a regular file (a FIFO, device or socket); splatedit reads files",
+                             path=src)
         from splatedit.io.las import check_las_header
         check_las_header(path)
         try:
@@ -539,11 +551,15 @@ def _read_vlr(fd: int, pos: int, src: str, size: int):
 
 def is_copc(path) -> bool:
     """True when ``path`` is a LAS 1.4 file whose first VLR is the COPC info
-    record (a cheap sniff: 429 bytes)."""
+    record (a cheap sniff: 429 bytes).  Anything but a regular file is
+    False, unopened (a FIFO would block the open)."""
+    import stat
     try:
+        if not stat.S_ISREG(os.stat(path).st_mode):
+            return False
         with open(path, "rb") as fh:
             head = fh.read(375 + 54)
-    except OSError:
+    except (OSError, ValueError):
         return False
     if len(head) < 429 or head[:4] != b"LASF":
         return False

@@ -6,6 +6,7 @@ error line naming the file (exit 2)."""
 from __future__ import annotations
 
 import json
+import os
 import subprocess
 import sys
 
@@ -22,7 +23,7 @@ OFFSET = np.array([500_000.0, 5_000_000.0, 0.0])
 
 def run_cli(*args):
     return subprocess.run([sys.executable, "-m", "splatedit.cli", "-q", *map(str, args)],
-                          capture_output=True, text=True, timeout=300)
+                          capture_output=True, text=True, timeout=120)
 
 
 @pytest.fixture(scope="module")
@@ -167,8 +168,9 @@ def _damaged(scan, tmp_path):
     (tmp_path / "chunk.copc.laz").write_bytes(bytes(bad))
     out.append(tmp_path / "chunk.copc.laz")
     src = laspy.read(str(scan[0]))              # a plain LAZ named .copc.laz
-    plain = laspy.LasData(laspy.LasHeader(point_format=7, version="1.4"))
-    plain.header.scales, plain.header.offsets = SCALE, OFFSET
+    hdr = laspy.LasHeader(point_format=7, version="1.4")
+    hdr.scales, hdr.offsets = SCALE, OFFSET
+    plain = laspy.LasData(hdr)
     plain.X, plain.Y, plain.Z = np.asarray(src.X), np.asarray(src.Y), np.asarray(src.Z)
     plain.write(str(tmp_path / "plain.copc.laz"))
     out.append(tmp_path / "plain.copc.laz")
@@ -186,3 +188,27 @@ def test_damaged_copc_files_give_one_error_line_naming_the_file(scan, tmp_path):
             lines = res.stderr.strip().splitlines()
             assert len(lines) == 1 and lines[0].startswith("splatedit: error: ") and str(bad) in lines[0], \
                 (bad.name, args[0], res.stderr)
+
+
+def test_a_fifo_named_copc_is_refused_without_opening_it(tmp_path):
+    fifo = tmp_path / "pipe.copc.laz"
+    os.mkfifo(fifo)
+    for args in (("info", fifo), ("render", fifo, "-o", tmp_path / "x.png")):
+        res = run_cli(*args)         # an open() of the FIFO would block until the timeout
+        assert res.returncode == 2 and "is not a regular file" in res.stderr and str(fifo) in res.stderr
+
+
+def test_convert_laz_to_copc_on_the_command_line_streams_the_same_integers(scan, tmp_path):
+    src = laspy.read(str(scan[0]))
+    hdr = laspy.LasHeader(point_format=7, version="1.4")
+    hdr.scales, hdr.offsets = SCALE, OFFSET
+    plain = laspy.LasData(hdr)
+    for nm in ("X", "Y", "Z", "gps_time", "red", "green", "blue", "intensity"):
+        plain[nm] = np.asarray(src[nm])
+    plain.write(str(tmp_path / "plain.laz"))
+    res = run_cli("convert", tmp_path / "plain.laz", tmp_path / "back.copc.laz")
+    assert res.returncode == 0, res.stderr
+    assert "octree nodes (COPC)" in res.stdout
+    assert np.array_equal(_table(tmp_path / "back.copc.laz"), _table(scan[0]))
+    with CopcFile.open(tmp_path / "back.copc.laz") as f:
+        assert f.point_count == 40_000 and f.point_format == 7    # one leaf at the default layout

@@ -240,3 +240,51 @@ def test_record_dtype_matches_laspy_point_formats():
     assert record_dtype(6, 33)["extra"].shape == (3,)
     assert NodeKey(2, 3, 1, 0).parent() == NodeKey(1, 1, 0, 0)
     assert NodeKey(1, 1, 0, 0) in [c.parent() for c in NodeKey(1, 1, 0, 0).children()]
+
+
+#: a COPC hierarchy entry (the specification's layout)
+ENTRY = np.dtype([("d", "<i4"), ("x", "<i4"), ("y", "<i4"), ("z", "<i4"), ("offset", "<u8"),
+                  ("byte_size", "<i4"), ("point_count", "<i4")])
+
+
+def _split_hierarchy(src, dst):
+    """``src`` with its one hierarchy page split as other writers (PDAL,
+    untwine) lay it out: a root page with the root and one -1 entry per
+    depth-1 node pointing at a child page with that node and its subtree."""
+    import struct
+    data = bytearray(src.read_bytes())
+    root_off, root_size = struct.unpack_from("<QQ", data, 375 + 54 + 40)
+    e = np.frombuffer(bytes(data[root_off:root_off + root_size]), dtype=ENTRY)
+    assert root_off - 60 + 60 + root_size == len(data)          # the page is the file's last EVLR
+    d1 = e[e["d"] == 1]
+    root = [e[e["d"] == 0]]
+    body = root_off + (1 + len(d1)) * 32
+    children = []
+    for k in d1:
+        sub = e[(e["d"] >= 1) & ((e["x"] >> (e["d"] - 1)) == k["x"]) & ((e["y"] >> (e["d"] - 1)) == k["y"])
+                & ((e["z"] >> (e["d"] - 1)) == k["z"])]
+        ptr = k.copy()
+        ptr["offset"], ptr["byte_size"], ptr["point_count"] = body, len(sub) * 32, -1
+        root.append(np.array([ptr], dtype=ENTRY))
+        children.append(sub)
+        body += len(sub) * 32
+    pages = np.concatenate(root).tobytes() + b"".join(c.tobytes() for c in children)
+    out = data[:root_off] + pages
+    struct.pack_into("<QQ", out, 375 + 54 + 40, root_off, (1 + len(d1)) * 32)
+    struct.pack_into("<Q", out, root_off - 60 + 20, len(pages))       # the EVLR's record length
+    dst.write_bytes(bytes(out))
+
+
+def test_a_hierarchy_in_several_pages_reads_like_one(copc_path, tmp_path):
+    path, rec = copc_path
+    split = tmp_path / "paged.copc.laz"
+    _split_hierarchy(path, split)
+    f, g = CopcFile.open(path), CopcFile.open(split)
+    assert {k: (n.offset, n.point_count) for k, n in f.nodes.items()} == \
+        {k: (n.offset, n.point_count) for k, n in g.nodes.items()}
+    with laspy.CopcReader.open(str(split)) as rd:
+        assert len(rd.root_page.entries) < len(f.nodes)             # laspy must follow the child pages
+        assert np.array_equal(_ints(rd.query()), _ints(rec))
+    lo, hi = OFFSET + [10, 10, 0], OFFSET + [30, 30, 20]
+    assert np.array_equal(_ints(g.read(g.select(np.stack([lo, hi]))).records),
+                          _ints(f.read(f.select(np.stack([lo, hi]))).records))

@@ -138,6 +138,35 @@ class ToolContext:
         """The document cloud's neighbour graph, or None while it is built."""
         return self._ed.brush.tools.graph(self._ed.session.cloud)
 
+    def background_select(self):
+        """A :class:`~splatedit.app.document.selection.BackgroundApply` of the
+        brush target (the selection copied now, closed by its worker), or
+        None while the neighbour graph is built."""
+        return self._ed.brush.tools.background_apply(self._ed.session)
+
+    def install(self, job, label: str) -> bool:
+        """Make a finished BackgroundApply's selection the document's (one
+        undo step); False when the selection changed since it started, or
+        another model was opened meanwhile."""
+        if job.session is not self._ed.session:
+            return False
+        return self._ed.brush.tools.install(job, label)
+
+    # ---- background work
+    def start_job(self, key: str, name: str, fn, land) -> None:
+        """Run ``fn(progress)`` as an editor job (:mod:`splatedit.app.document.jobs`:
+        a worker thread, a progress bar named ``name``, the window keeps
+        drawing); when it is done, ``land(job)`` runs on the main thread
+        (its ``result`` or ``error``)."""
+        from splatedit.app.document.jobs import Job
+        job = Job(name, fn, self._ed.wake)
+        job.land = land        # set before the editor can collect it (it polls on this thread)
+        self._ed.jobs[key] = job
+
+    def job_running(self, key: str) -> bool:
+        """A job started under ``key`` has not landed yet."""
+        return key in self._ed.jobs
+
     # ---- view
     @property
     def camera(self):

@@ -17,9 +17,21 @@ from splatedit.app.tools.base import DragMode, Tool
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX,
                                   EDITOR_GIZMO_RING_MIN_COS, EDITOR_GIZMO_RING_PX, EDITOR_GIZMO_RING_SEGMENTS,
-                                  EDITOR_GIZMO_SCALE_PX)
+                                  EDITOR_GIZMO_SCALE_PX, EDITOR_READOUT_MARGIN_PX, EDITOR_READOUT_OFFSET_PX)
 
 READOUT_RGB = (255, 230, 120)
+
+
+def readout_box(mouse, box_w: float, box_h: float, w: int, h: int) -> tuple[float, float]:
+    """Top-left (x, y) pixels of the live readout's box (``box_w`` x
+    ``box_h`` pixels, its padding included) in a ``w`` x ``h`` window:
+    EDITOR_READOUT_OFFSET_PX right of and below the cursor ``mouse``, moved
+    so that the whole box keeps EDITOR_READOUT_MARGIN_PX from every window
+    edge (a box wider than the window starts at the left margin)."""
+    m, off = EDITOR_READOUT_MARGIN_PX, EDITOR_READOUT_OFFSET_PX
+    x = min(float(mouse[0]) + off, w - m - box_w)
+    y = min(float(mouse[1]) + off, h - m - box_h)
+    return max(x, m), max(y, m)
 
 
 class GizmoTool(Tool):
@@ -413,8 +425,6 @@ class GizmoTool(Tool):
         if text is None:
             return []
         img = ov.text_panel((text,), size=13, fg=READOUT_RGB + (255,), pad=3, bg=(20, 22, 28, 200))
-        mx, my = self.ed.mouse
         w, h = self.ed.size
-        x = int(min(max(mx + 18, 0), max(w - img.shape[1], 0)))
-        y = int(min(max(my + 18, 0), max(h - img.shape[0], 0)))
-        return [ov.Patch(x, y, img)]
+        x, y = readout_box(self.ed.mouse, img.shape[1], img.shape[0], w, h)
+        return [ov.Patch(int(x), int(y), img)]

@@ -16,9 +16,10 @@ from imgui_bundle import imgui
 
 from splatedit.app.ui import overlay as ov
 from splatedit.app.tools.curve import CURVE_RGB
-from splatedit.app.tools.gizmo import READOUT_RGB
+from splatedit.app.tools.gizmo import READOUT_RGB, readout_box
 from splatedit.app.document import selection as seltools
 from splatedit.app.tools.shapes import Polyline
+from splatedit.app.ui.panel import Box
 from splatedit.tolerances import EDITOR_GUI_MAX_HIGHLIGHT_DOTS
 
 _SHADOW = (0, 0, 0, 160)
@@ -184,10 +185,12 @@ def draw_readout(ed, dl, w: int, h: int) -> None:
     if text is None:
         return
     size = imgui.calc_text_size(text)
-    mx, my = ed.mouse
-    x = min(max(mx + 18, 3), max(w - size.x - 3, 3))
-    y = min(max(my + 18, 2), max(h - size.y - 2, 2))
-    label(dl, (x, y), text, READOUT_RGB)
+    bw, bh = size.x + 6, size.y + 4              # label()'s box: 3 / 2 pixels around the text
+    bx, by = readout_box(ed.mouse, bw, bh, w, h)
+    label(dl, (bx + 3, by + 2), text, READOUT_RGB)
+    gui = getattr(ed, "gui", None)
+    if gui is not None:                          # where it is (the status file's gui_rects)
+        gui.rects["readout"] = Box(int(bx), int(by), int(round(bw)), int(round(bh)))
 
 
 def draw_shapes(dl, shapes) -> None:
