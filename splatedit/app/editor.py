@@ -62,7 +62,8 @@ from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN
 class Editor(EventRouting, FileActions):
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
-                 budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
+                 budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False,
+                 out_of_core=None):
         import glfw
         from splatedit.render.vk.swapchain import SwapchainPresenter
         from splatedit.render.vk.window import Window
@@ -73,6 +74,8 @@ class Editor(EventRouting, FileActions):
         self.method, self.tol, self.max_centers = method, tol, max_centers
         self.status = StatusWriter(Path(status_file) if status_file else None)
         self.use_lod = lod
+        #: open scans out of core: True / False, None: by size (:func:`splatedit.app.document.outofcore.is_out_of_core`)
+        self.out_of_core = out_of_core
         self.max_seconds = max_seconds
         self.offer_recent = offer_recent
         self.window = self.presenter = self.viewport = None
@@ -102,6 +105,8 @@ class Editor(EventRouting, FileActions):
         #: the Dear ImGui interface (None: the CPU overlay fallback, or no window)
         self.gui = None
         self.session: Session | None = None
+        #: the out-of-core scan behind the session (:mod:`splatedit.app.document.outofcore`), or None
+        self.ooc = None
         #: the central exception guard, recovery copies and the restore question
         #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
         self.crash_guard = CrashGuard(self)
@@ -345,7 +350,7 @@ class Editor(EventRouting, FileActions):
             while self.running:
                 s = self.session
                 busy = bool(self.jobs) or (s is not None and (s.fit_job is not None or s.manip is not None
-                                                              or s.committing))
+                                                              or s.committing)) or self.ooc is not None
                 pending = fr.pending() or (self.gui is not None and self.gui.needs_frames())
                 busy = busy or fr.busy()
                 w, h = self.size
@@ -355,6 +360,9 @@ class Editor(EventRouting, FileActions):
                 self.handle_events(events)          # each event guarded on its own
                 with guarded("collecting a finished job"):
                     self.poll_jobs()
+                if self.ooc is not None:
+                    with guarded("refining the out-of-core view"):
+                        self.ooc.poll(self)
                 if self.session is not None:
                     with guarded("landing a fit or an edit"):
                         self.session.poll()
@@ -441,7 +449,8 @@ def run_editor(path=None, **options) -> int:
     file rewritten whenever the editor's state changes; also read from the
     environment variable ``SPLATEDIT_EDITOR_STATUS``), ``budget_ms`` (frame
     budget while moving, default 100 ms = 10 fps), ``lod`` (default True),
-    ``max_seconds`` (quit after this long; tests).
+    ``max_seconds`` (quit after this long; tests), ``out_of_core`` (True /
+    False; None: by the file's size, see :mod:`splatedit.app.document.outofcore`).
     Returns the process exit code.
     """
     bundled = False
@@ -454,6 +463,8 @@ def run_editor(path=None, **options) -> int:
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
     from splatedit.app.view.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
+    from splatedit.app.document.outofcore import point_budgets
+    point_budgets()             # and a bad SPLATEDIT_OOC_BUDGET
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "
                              "saves never replace it: choose another path")

@@ -22,7 +22,7 @@ class FileActions:
 
     # -------------------------------------------------------------- loading
     def start_load(self) -> None:
-        self.jobs["load"] = files.load_job(self.path, self.wake)
+        self.jobs["load"] = files.load_job(self.path, self.wake, getattr(self, "out_of_core", None))
 
     def on_loaded(self, cloud, path=None) -> None:
         files.on_loaded(self, cloud, path)

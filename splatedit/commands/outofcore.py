@@ -72,6 +72,81 @@ def edit_region(script, source: str) -> np.ndarray:
     return np.stack([lo - m, hi + m])
 
 
+def _index_regions(script) -> list:
+    """The index-list regions of ``script`` (support, handles, delete regions)."""
+    from splatedit.select.regions import Indices
+    out = []
+    for item in script.edits:
+        regions = [item.region] if hasattr(item, "region") else [item.support, *item.handles]
+        out += [r for r in regions if isinstance(r, Indices)]
+    return out
+
+
+def file_order(src):
+    """(keys in file order, (m,) int64 index of each node's first point in the
+    file read whole): points are numbered node by node in chunk order, each
+    node's rows in order, as :func:`splatedit.io.read` reads a COPC file."""
+    nodes = sorted(src.nodes.values(), key=lambda n: n.offset)
+    counts = np.array([n.point_count for n in nodes], dtype=np.int64)
+    return [n.key for n in nodes], np.cumsum(counts) - counts
+
+
+def indexed_box(src, script, origin) -> np.ndarray | None:
+    """(2, 3) local box around the points an index-list script names (whole-file
+    indices, as the editor writes them for a scan opened out of core), grown by
+    ``COPC_EDIT_MARGIN_REL`` like :func:`edit_region`; None without index lists."""
+    from splatedit.tolerances import COPC_EDIT_MARGIN_REL
+    regions = _index_regions(script)
+    if not regions:
+        return None
+    idx = np.unique(np.concatenate([np.asarray(r.indices, dtype=np.int64) for r in regions]))
+    keys, first = file_order(src)
+    if len(idx) and (idx[0] < 0 or idx[-1] >= src.point_count):
+        raise EditScriptError(f"an index list names point {int(idx[-1] if idx[-1] >= 0 else idx[0])} of a "
+                              f"{src.point_count}-point file", json_path="$", path=str(src.path))
+    at = np.searchsorted(first, idx, side="right") - 1
+    lo, hi = np.full(3, np.inf), np.full(3, -np.inf)
+    for j in np.unique(at):
+        block = src.read([keys[j]])
+        rows = idx[at == j] - first[j]
+        pts = block.xyz[np.argsort(block.row)][rows] - origin
+        lo, hi = np.minimum(lo, pts.min(0)), np.maximum(hi, pts.max(0))
+    m = COPC_EDIT_MARGIN_REL * float(np.max(hi - lo))
+    return np.stack([lo - m, hi + m])
+
+
+def localize_indices(src, script, block):
+    """``script`` with its whole-file index lists turned into indices of
+    ``block``'s points (in block order); every named point must be in it."""
+    import dataclasses
+
+    from splatedit.select.regions import Indices
+    keys, first = file_order(src)
+    pos = {k: i for i, k in enumerate(keys)}
+    glob = np.array([first[pos[k]] for k in block.keys], dtype=np.int64)[block.node] + block.row
+    order = np.argsort(glob, kind="stable")
+    sorted_glob = glob[order]
+
+    def region(r):
+        if not isinstance(r, Indices):
+            return r
+        idx = np.asarray(r.indices, dtype=np.int64)
+        at = np.searchsorted(sorted_glob, idx)
+        ok = (at < len(sorted_glob)) & (sorted_glob[np.minimum(at, len(sorted_glob) - 1)] == idx)
+        if not ok.all():
+            raise EditScriptError("an index list names points outside the region read", json_path="$",
+                                  path=str(src.path))
+        return Indices(tuple(int(i) for i in np.sort(order[at])))
+    items = []
+    for e in script.edits:
+        if hasattr(e, "region"):
+            e = dataclasses.replace(e, region=region(e.region))
+        else:
+            e = dataclasses.replace(e, support=region(e.support), handles=tuple(region(h) for h in e.handles))
+        items.append(e)
+    return dataclasses.replace(script, edits=tuple(items))
+
+
 def deform_copc(args, print_edit) -> int:
     """``splatedit deform IN.copc.laz SCRIPT -o OUT.copc.laz`` out of core."""
     from splatedit.io.copc import CopcFile, cloud_of_block, file_origin, rewrite_copc
@@ -79,14 +154,19 @@ def deform_copc(args, print_edit) -> int:
     t0 = time.perf_counter()
     script = load_script(args.edit)
     source = str(args.edit)
-    box = edit_region(script, source)
     src = CopcFile.open(args.input)
     try:
         origin = file_origin(src)
+        # an index-list script (the editor's, for a scan opened out of core) names
+        # points of the whole file: its box comes from those points
+        box = indexed_box(src, script, origin)
+        box = edit_region(script, source) if box is None else box
         nodes = src.select(box + origin)
         if not nodes:
             raise EditScriptError("the script's regions lie outside the model", json_path="$", path=source)
         block = src.read(nodes, args.progress)
+        if _index_regions(script):
+            script = localize_indices(src, script, block)
         cloud = cloud_of_block(src, block, args.progress)
         out, reports = run_script(cloud, script, method=args.method, tol=args.tol, source=source,
                                   progress=args.progress, on_edit=print_edit)

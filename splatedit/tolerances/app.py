@@ -347,3 +347,39 @@ EDITOR_COVERAGE_SAMPLE = 16_384
 EDITOR_READOUT_MARGIN_PX = 8
 #: its box's top-left corner from the cursor (pixels), right and down
 EDITOR_READOUT_OFFSET_PX = 18
+
+
+# ---------------------------------------------------------------------------
+# Out-of-core documents: large COPC scans (app/document/outofcore.py)
+# ---------------------------------------------------------------------------
+#: a COPC file with more points than this opens out of core (an octree level of
+#: detail; a smaller one is read whole like any LAZ): at ~110 B per splat in the
+#: editor (positions, axes, colours, selection, graph) 3M points are ~330 MB
+EDITOR_OOC_MIN_POINTS = 3_000_000
+#: another scan file larger than this (bytes) is converted once into a COPC cache
+#: (io.copc.cached_copc) and opened out of core
+EDITOR_OOC_CONVERT_BYTES = 1 << 30
+#: points of the first view (the coarse top of the octree, loaded before the
+#: first frame): per-node normals took ~9 us per point on 2 loaded cores, so
+#: 200k is ~2 s of the 10 s open-to-first-frame goal
+EDITOR_OOC_FIRST_POINTS = 200_000
+#: points shown after refinement where the camera looks: the editor draws 1M
+#: splats at 21-45 fps moving (levels of detail) on lavapipe (PERFORMANCE.md,
+#: "Editor frame rate"); 800k leaves room for a full-resolution edit region
+EDITOR_OOC_POINT_BUDGET = 800_000
+#: a document with edits or a selection only ever adds nodes (indices stay
+#: valid for the history); it stops refining at this many points
+EDITOR_OOC_MAX_POINTS = 2_500_000
+#: the view is refined this long after the camera stopped (seconds)
+EDITOR_OOC_SETTLE_S = 0.3
+#: the full-resolution region around a painted support: its bounding box
+#: grown by this many of the painted splats' largest radius (so the
+#: selection's rim, transferred to the finer points by nearest neighbour,
+#: is loaded whole)
+EDITOR_OOC_REGION_MARGIN_RADII = 2.0
+#: most points a support's full-resolution region may add to the document: a
+#: larger support cannot be edited (moves wait; the panel says to paint less):
+#: editing only its shown points would leave the file's other points behind
+EDITOR_OOC_REGION_MAX_POINTS = 2_000_000
+#: points read per batch (a progress step, a cancellation point)
+EDITOR_OOC_READ_BATCH = 250_000

@@ -63,6 +63,8 @@ def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
     stem = Path(name).stem if name else (src.stem if src else "model")
     suffix = Path(name).suffix.lower() if name else (src.suffix.lower() if src else "")
     ext = suffix if suffix in KEEP_FORMAT_SUFFIXES else ".ply"
+    if stem.lower().endswith(".copc") and suffix == ".laz":      # a COPC stays a COPC
+        stem, ext = stem[:-5], ".copc.laz"
     folder = user_folder()
     if (src is not None and not bundled and not inside_package(src)
             and os.access(src.parent, os.W_OK)):
@@ -126,10 +128,15 @@ def check_model_file(path) -> None:
         raise InputError(f"cannot read the file ({exc.strerror or exc})", path=str(path)) from None
 
 
-def load_job(path: Path, wake) -> Job:
-    """Read ``path`` in the background (the job's ``key`` is the path)."""
+def load_job(path: Path, wake, out_of_core: bool | None = None) -> Job:
+    """Read ``path`` in the background (the job's ``key`` is the path).  Its
+    result is the cloud, or (scan, cloud) for a scan opened out of core
+    (:mod:`splatedit.app.document.outofcore`; ``out_of_core`` None: by its size)."""
     def work(progress):
         from splatedit.io import is_gaussian_file, read, read_gaussians
+        from splatedit.app.document import outofcore
+        if out_of_core or (out_of_core is None and outofcore.is_out_of_core(path)):
+            return outofcore.open_scan(path, progress)
         if is_gaussian_file(path):      # a 3DGS/2DGS scene: its splat proxy with the Gaussians attached
             from splatedit.app.document.gaussian import gaussian_document
             scene = read_gaussians(str(path), progress=progress)
@@ -165,7 +172,7 @@ def open_path(ed, path, *, confirmed: bool = False) -> bool:
         ed.say(f"unsaved changes: press Y to open {p.name} without saving, N or Esc to stay")
         return False
     ed.confirm_open = None
-    ed.jobs["load"] = load_job(p, ed.wake)
+    ed.jobs["load"] = load_job(p, ed.wake, getattr(ed, "out_of_core", None))
     ed.say(f"opening {p} ...")
     return True
 
@@ -212,6 +219,11 @@ def _replace_session(ed, path: Path) -> None:
     ed.frames.invalidate()
     ed.path, ed.bundled = path, False
     ed.save_as = ed.saved_path = ed.saved_script = None
+    for name in ("nodes", "region"):        # an out-of-core scan's jobs
+        job = ed.jobs.pop(name, None)
+        if job is not None:
+            job.cancel.set()
+    ed.ooc = None
 
 
 def remember(ed, path: Path) -> None:
@@ -235,6 +247,12 @@ def save(ed, path: Path) -> None:
     refusal = save_refusal(path, ed.path)
     if refusal:
         ed.say(refusal)
+        return
+    if getattr(ed, "ooc", None) is not None:          # a scan out of core: streamed, the edited nodes replaced
+        from splatedit.app.document.outofcore import save_job
+        ed.save_as = path
+        ed.jobs["save"] = save_job(ed, ed.ooc, Path(path), script_path_for(Path(path)))
+        ed.say(f"saving {path} ...")
         return
     cloud, script, pos = s.cloud, s.edit_script(), s.history.position
     ed.save_as = path
@@ -352,15 +370,31 @@ def poll_jobs(ed) -> None:
                 ed.show_error(f"not opened: {text}")
             elif name in ("save", "export"):
                 ed.show_error(f"{job.name} failed: {err}")
+            elif name == "region" and ed.session is not None:
+                ed.session.waiting = None
+                ed.show_error(f"{job.name} failed: {err}")
             else:
                 ed.say(f"{job.name} failed: {err}")
             continue
         if name == "load":
-            ed.on_loaded(job.result, job.key)
+            result = job.result
+            if isinstance(result, tuple):       # (scan, cloud): out of core
+                scan, result = result
+                ed.on_loaded(result, job.key)
+                ed.ooc = scan
+                ed.session.splats_fixed = "not for a scan opened out of core (every point stays in its file)"
+                ed.say(f"opened {ed.cloud_name} out of core: {scan.copc.point_count:,} points, "
+                       f"{result.n:,} shown; the view refines where the camera looks")
+            else:
+                ed.ooc = None
+                ed.on_loaded(result, job.key)
             guard = getattr(ed, "crash_guard", None)
             entry = None if guard is None else guard.restoring
             if entry is not None and Path(job.key) == Path(os.path.abspath(entry.model)):
                 guard.on_restored()         # a recovery entry: its edits and source come with it
+        elif name in ("nodes", "region"):
+            if getattr(ed, "ooc", None) is not None:
+                ed.ooc.landed(ed, name, job.result)
         elif name == "lod" and hasattr(job.result, "rank"):      # a GaussianLod
             ed.viewport.set_gaussian_lod(job.result)
             ed.say(f"level of detail ready (moving: up to {job.result.m:,} of {job.result.n:,} Gaussians)")

@@ -163,6 +163,12 @@ class Session:
         self._distortion = DistortionFeed(self.on_change, sync=fit_sync)
         self.last_edit: LastEdit | None = None
         self._erasing = False       # the stroke being painted erases (its history name)
+        #: why moves and fits wait (e.g. an out-of-core document loading the
+        #: support's region at full resolution, :mod:`splatedit.app.document.outofcore`); None: they do not
+        self.waiting: str | None = None
+        #: why splats cannot be deleted or cropped (an out-of-core document keeps
+        #: every point of its file); None: they can
+        self.splats_fixed: str | None = None
 
     # ------------------------------------------------------------ history
     # (the session's face of its history_part, SessionHistory)
@@ -383,7 +389,7 @@ class Session:
         from splatedit.app.document.gaussian import subset_document
         from splatedit.script import Removal
         from splatedit.select.regions import Indices
-        if self.manip is not None or self.committing or self.pose_pending:
+        if self.manip is not None or self.committing or self.pose_pending or self.splats_fixed:
             return 0
         sup = self.selection.support
         kept = sup.copy() if keep else ~sup
@@ -410,7 +416,7 @@ class Session:
         """Start (or restart) a background fit of all non-empty handles and
         the curve (when it has at least 2 points)."""
         key = self.selection_key()
-        if self.fit.current(key) or self.committing:    # a landing commit refits
+        if self.fit.current(key) or self.committing or self.waiting:    # a landing commit refits
             return
         self.fit.clear()
         if self.fit.recall(key):      # undo / redo back to a fitted selection: no refit
@@ -466,6 +472,8 @@ class Session:
             return "committing"
         if self.manip is not None:
             return "manipulate"
+        if self.waiting:
+            return "waiting"
         if self.fit_job is not None:
             return "fitting"
         if self.basis is not None:
@@ -619,7 +627,8 @@ class Session:
             handle_sizes=sizes, curve_points=len(self.curve_points),
             pose_pending=self.pose_pending,
             columns=fit.columns if fit is not None else columns_needed(len(sel.nonempty()), len(self.curve_points)),
-            fit=fit, progress=self.fit.progress(), error=self.fit_error, commit=self.committer.progress())
+            fit=fit, progress=self.fit.progress(), error=self.waiting or self.fit_error,
+            commit=self.committer.progress())
 
     def close(self) -> None:
         """Cancel the running fit and commit (a commit's result is dropped:

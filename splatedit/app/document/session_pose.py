@@ -100,7 +100,7 @@ class PoseEditing:
         """Start G/R/S of the active handle (needs a basis that includes it)
         about ``pivot`` ((3,) model units; None: the handle's posed centroid),
         constraint axes the columns of ``frame`` ((3, 3); None: the world's)."""
-        if self.s.manip is not None or self.committing or not self.active_fitted():
+        if self.s.manip is not None or self.committing or self.s.waiting or not self.active_fitted():
             return False
         piv = self.handle_centroid() if pivot is None else np.asarray(pivot, float)
         self.s.manip = Manipulation(mode, piv, view, mouse, frame=None if frame is None else np.asarray(frame, float),

@@ -34,6 +34,9 @@ class DeleteTool(Tool):
         if doc.pose_pending or doc.manip is not None:
             c.say(f"{what}: apply or discard the pending moves first (Enter / Esc)")
             return 0
+        if doc.splats_fixed:
+            c.say(f"{what}: {doc.splats_fixed}")
+            return 0
         if sup == doc.cloud.n:
             c.say(f"{what}: the support is the whole model: nothing would " + ("change" if keep else "be left"))
             return 0

@@ -300,6 +300,8 @@ class EditorGui(MenuBar):
         st = s.stats()
         imgui.push_text_wrap_pos(0.0)
         imgui.text(f"{model_summary(s.cloud)}   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
+        if getattr(self.ed, "ooc", None) is not None:
+            imgui.text_disabled(self.ed.ooc.summary(s))
         imgui.pop_text_wrap_pos()
         self._rect("panel_summary")
         if s.manip is not None:               # the live readout of a running move

@@ -78,10 +78,15 @@ def add_arguments(p) -> None:
                    help="frame-time budget (default 100 ms = 10 fps; moving frames aim at 30 fps "
                         "unless this is smaller)")
     p.add_argument("--status-file", help="test hook: a JSON file rewritten when the state changes")
+    p.add_argument("--out-of-core", choices=("auto", "on", "off"), default="auto",
+                   help="open the scan as an octree level of detail refined where the camera looks, "
+                        "edited region by region (auto: COPC files over 3M points and other scans "
+                        "over 1 GiB, converted once into a COPC cache)")
 
 
 def options_from_args(a) -> dict:
     """The :func:`splatedit.app.editor.run_editor` keyword options of parsed
     :func:`add_arguments` arguments."""
     return dict(size=tuple(a.size), save_as=a.save_as, method=a.method, tol=a.tol, vsync=not a.no_vsync,
-                lod=not a.no_lod, budget_ms=a.budget_ms, status_file=a.status_file)
+                lod=not a.no_lod, budget_ms=a.budget_ms, status_file=a.status_file,
+                out_of_core={"auto": None, "on": True, "off": False}[a.out_of_core])

@@ -68,6 +68,8 @@ def panel_lines(ed) -> list:
     st = s.stats()
     brush = ed.brush
     lines = [f"{ed.cloud_name}   {model_summary(s.cloud)}"]
+    if getattr(ed, "ooc", None) is not None:
+        lines.append(ed.ooc.summary(s))
     tgt = "SUPPORT" if s.brush_target == SUPPORT else "HANDLE"
     erase = "  ERASE" if brush.erase_toggle else ""
     mode = "3D" if brush.mode == seltools.BRUSH_3D else "VISIBLE"

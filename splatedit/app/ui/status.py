@@ -107,6 +107,15 @@ def status_dict(ed) -> dict:
                     "position": None if ft.position is None else [round(float(x), 9) for x in ft.position]}
     st["curve_positions"] = [[round(float(x), 9) for x in q] for q in s.curve_point_positions()]
     st["idle"] = bool(ed.idle())
+    oc = getattr(ed, "ooc", None)
+    #: an out-of-core scan: its points, the shown nodes and points, the camera state they were chosen for
+    st["out_of_core"] = None if oc is None else {
+        "points": int(oc.copc.point_count), "nodes_shown": len(oc.segments), "shown": oc.shown_points(),
+        "max_depth_shown": max((t[0] for t in oc.shown), default=0), "view_chosen": oc.view_state is not None,
+        "refined": oc.view_state == ed.cam.state() and "nodes" not in ed.jobs,
+        "waiting": s.waiting, "loading_frames": oc.loading_frames,
+        "loading_seconds": round(oc.loading_seconds, 3),
+        "region": None if oc.region_world is None else oc.region_world.tolist()}
     cp = ss.commit
     #: a commit running in the background: its stage and fraction done
     st["commit"] = None if cp is None else {"stage": cp.stage, "fraction": round(cp.fraction, 3)}
