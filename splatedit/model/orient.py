@@ -42,9 +42,9 @@ from splatedit.errors import ParameterError
 from splatedit.model.sizing import neighbour_indices
 from splatedit.progress import report
 from splatedit.tolerances import (ESTIMATE_CHUNK_POINTS, ORIENT_CHUNK_POINTS, ORIENT_FOREST_NEIGHBOURS, ORIENT_NEIGHBOURS,
-                                  ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_VOTE_MIN_MEAN_NZ,
-                                  ORIENT_VOTE_MIN_VOTERS, ORIENT_VOTE_SAMPLE, ORIENT_VOTE_TOP_FRACTION,
-                                  ORIENT_WEIGHT_EPS)
+                                  ORIENT_SAFE_ANGLE_DEG, ORIENT_SEED_MIN_NZ, ORIENT_VOTE_SAMPLE,
+                                  ORIENT_COLUMN_CELL_SPACINGS, ORIENT_COLUMN_MIN_AGREEMENT,
+                                  ORIENT_COLUMN_MIN_NZ, ORIENT_COLUMN_MIN_VOTERS, ORIENT_WEIGHT_EPS)
 
 
 def _edges(nrm, nb, lo, hi):
@@ -147,70 +147,125 @@ def orient_normals(points, normals, k: int = ORIENT_NEIGHBOURS, *, tree=None,
     key, hw, g = _lightest(*(np.concatenate(x) for x in zip(*pieces)))
     del pieces, i, j, w, neg
     a, b = key // n, key % n
-    # 3. MST over the pieces, seeds
-    qtree = minimum_spanning_tree(csr_matrix((hw.astype(np.float64), (a, b)), shape=(ncl, ncl))).tocoo()
+    # 3. the tops of the xy-columns vote per piece; strongly voted pieces hang
+    #    from a virtual "sky" node (ncl) by the lightest edges, the MST over
+    #    pieces + sky, every other component seeded at its highest point
+    voters, want = _column_voters(pts, nrm, nb, rel)
+    vflip, strong = _piece_votes(lab[voters], want, ncl)
+    sky = np.flatnonzero(strong)
+    nodes = ncl + (len(sky) > 0)
+    wq = hw.astype(np.float64)
+    if len(sky):
+        a, b = np.concatenate([a, sky]), np.concatenate([b, np.full(len(sky), ncl)])
+        # lighter than any k-NN edge (those weigh >= ORIENT_WEIGHT_EPS): Kruskal takes them all first
+        wq = np.concatenate([wq, np.full(len(sky), 0.5 * ORIENT_WEIGHT_EPS)])
+    qtree = minimum_spanning_tree(csr_matrix((wq, (a, b)), shape=(nodes, nodes))).tocoo()
+    del wq, a, b
     ncomp, qlab = connected_components(qtree, directed=False)
-    seeds, seed_flip = _component_seeds(pts, nrm, lab, qlab, ncl, ncomp, chunk)
-    qparent = _rooted_forest(ncl, qtree.row, qtree.col, lab[seeds])
-    qbody = np.flatnonzero(qparent != np.arange(ncl))
-    qflip = np.zeros(ncl, dtype=bool)
+    seeds, seed_flip = _component_seeds(pts, nrm, lab, qlab[:ncl], ncl, ncomp, chunk)
+    roots = lab[seeds]
+    if len(sky):
+        roots[qlab[ncl]] = ncl
+    qparent = _rooted_forest(nodes, qtree.row, qtree.col, roots)
+    qbody = np.flatnonzero(qparent != np.arange(nodes))
+    qflip = np.zeros(nodes, dtype=bool)
     if len(qbody):
-        pa, pb = np.minimum(qbody, qparent[qbody]), np.maximum(qbody, qparent[qbody])
-        qflip[qbody] = g[np.searchsorted(key, pa * n + pb)]
+        up = qparent[qbody]
+        to_sky = up == ncl
+        qflip[qbody[to_sky]] = vflip[qbody[to_sky]]
+        qb, up = qbody[~to_sky], up[~to_sky]
+        pa, pb = np.minimum(qb, up), np.maximum(qb, up)
+        qflip[qb] = g[np.searchsorted(key, pa * n + pb)]
     qflip = _path_xor(qparent, qflip)
-    # 4. flips relative to the seeds
+    # 4. flips relative to the seeds (the sky's component: relative to the sky)
     comp_flip = (rel[seeds] ^ qflip[lab[seeds]]) ^ seed_flip          # (ncomp,)
+    if len(sky):
+        comp_flip[qlab[ncl]] = False
     qflip ^= comp_flip[qlab]
+    # 5. a component without a strongly voted piece: its column tops vote
+    #    together (a stray above it can be its highest point, the seed)
+    turn = _component_turns(qflip[lab[voters]] != want, qlab[lab[voters]], ncomp)
+    if len(sky):
+        turn[qlab[ncl]] = False
+    qflip ^= turn[qlab]
     for lo in range(0, n, chunk):
         hi = min(lo + chunk, n)
         flip = rel[lo:hi] ^ qflip[lab[lo:hi]]
         nrm[lo:hi][flip] *= -1.0
-    # 5. the top of every large component votes (a stray above the surface
-    #    can be the highest point: alone it would turn the whole surface in)
-    turn = _top_vote_flips(pts, nrm, lab, qlab, ncomp)
-    if turn.any():
-        qturn = turn[qlab]
-        for lo in range(0, n, chunk):
-            hi = min(lo + chunk, n)
-            nrm[lo:hi][qturn[lab[lo:hi]]] *= -1.0
     report(progress, "orienting normals", 1.0)
     return nrm
 
 
-def _top_vote_flips(pts, nrm, lab, qlab, ncomp) -> np.ndarray:
-    """(ncomp,) bool: components whose highest points, voting, say the
-    orientation from the single highest point (the seed) was wrong.
+#: cells per row of the column grid's int64 key (any odd multiplier spreads the keys)
+_CELL_ROW = (1 << 31) + 11
 
-    On a deterministic sample of at most ``ORIENT_VOTE_SAMPLE`` points, every
-    component with at least ``ORIENT_VOTE_MIN_VOTERS`` sampled points lets
-    its highest ``ORIENT_VOTE_TOP_FRACTION`` (at least that many points)
-    vote with their oriented n_z; a mean n_z below ``-ORIENT_VOTE_MIN_MEAN_NZ``
-    turns the component (a stray seed had pointed it inward), a mean near 0
-    (a vertical wall: the seed used the centroid rule) changes nothing.
+
+def _column_voters(pts, nrm, nb, rel):
+    """The points seen from above and the sign each asks for.
+
+    On a deterministic sample of at most ``ORIENT_VOTE_SAMPLE`` points
+    (every ``n // ORIENT_VOTE_SAMPLE``-th), an xy grid of cells
+    ``ORIENT_COLUMN_CELL_SPACINGS`` sample spacings wide (the spacing from
+    the median distance to the k-th neighbour in ``nb``) keeps the highest
+    sampled point of every cell whose normal is clearly not horizontal
+    (``|n_z| > ORIENT_COLUMN_MIN_NZ``).  Such a point lies on the upper
+    envelope of whatever the column holds: on a closed surface its outward
+    normal has n_z >= 0 (a vertical ray from above enters the solid there),
+    and in a scan taken from above or from the side (aerial or terrestrial
+    LiDAR: ground, roofs, the tops of objects) it is the side the sensor saw.
+    So each asks for n_z > 0.
+
+    Returns:
+        voters: (v,) int64 point indices; want: (v,) bool, True where the
+        voter's normal, taken relative to its piece's root (``rel``), asks
+        the root to flip.
     """
     n = len(pts)
-    turn = np.zeros(ncomp, dtype=bool)
     step = max(1, n // ORIENT_VOTE_SAMPLE)
-    sample = np.arange(0, n, step)
-    comp = qlab[lab[sample]]
-    count = np.bincount(comp, minlength=ncomp)
-    voting = count >= ORIENT_VOTE_MIN_VOTERS
-    if not voting.any():
-        return turn
-    keep = voting[comp]
-    sample, comp = sample[keep], comp[keep]
-    order = np.lexsort((-pts[sample, 2], comp))           # by component, highest first
-    sample, comp = sample[order], comp[order]
-    start = np.r_[0, np.flatnonzero(np.diff(comp)) + 1]
-    rank = np.arange(len(comp)) - np.repeat(start, np.diff(np.r_[start, len(comp)]))
-    quota = np.maximum(ORIENT_VOTE_MIN_VOTERS,
-                       np.ceil(ORIENT_VOTE_TOP_FRACTION * count)).astype(np.int64)
-    top = rank < quota[comp]
-    votes = np.bincount(comp[top], nrm[sample[top], 2], minlength=ncomp)
-    voters = np.bincount(comp[top], minlength=ncomp)
-    mean_nz = np.divide(votes, voters, out=np.zeros(ncomp), where=voters > 0)
-    turn[:] = voting & (mean_nz < -ORIENT_VOTE_MIN_MEAN_NZ)
-    return turn
+    s = np.arange(0, n, step)
+    dk = np.linalg.norm(pts[nb[s, -1]] - pts[s], axis=1)
+    # k neighbours within dk on a surface of density rho: k = pi dk^2 rho
+    spacing = float(np.median(dk)) * np.sqrt(np.pi / nb.shape[1]) * np.sqrt(n / len(s))
+    cell = ORIENT_COLUMN_CELL_SPACINGS * spacing
+    none = np.zeros(0, np.int64), np.zeros(0, bool)
+    if not (np.isfinite(cell) and cell > 0):
+        return none
+    c = np.floor(np.minimum((pts[s, :2] - pts[s, :2].min(axis=0)) / cell, 2.0 ** 40)).astype(np.int64)
+    # one int64 per cell; a far stray can make the product wrap and two cells
+    # share a key: the higher of their tops still tops its own column
+    key = c[:, 0] * _CELL_ROW + c[:, 1]
+    o = np.argsort(key)
+    key, z = key[o], pts[s[o], 2]
+    start = np.r_[0, np.flatnonzero(key[1:] != key[:-1]) + 1]
+    zmax = np.maximum.reduceat(z, start)
+    cell_of = np.repeat(np.arange(len(start)), np.diff(np.r_[start, len(o)]))
+    hit = np.flatnonzero(z == zmax[cell_of])
+    first = np.r_[True, cell_of[hit[1:]] != cell_of[hit[:-1]]]      # one top per cell
+    top = s[o[hit[first]]]
+    nz = nrm[top, 2]
+    clear = np.abs(nz) > ORIENT_COLUMN_MIN_NZ
+    top = top[clear]
+    return top, (nz[clear] < 0) ^ rel[top]
+
+
+def _piece_votes(piece, want, ncl):
+    """(ncl,) flip asked by the majority and (ncl,) bool: strongly voted
+    pieces (at least ``ORIENT_COLUMN_MIN_VOTERS`` voters, the majority ahead
+    by ``ORIENT_COLUMN_MIN_AGREEMENT`` of them).  ``piece``: (v,) the
+    voters' pieces; ``want``: (v,) bool, the flip each asks for."""
+    total = np.bincount(piece, minlength=ncl)
+    down = np.bincount(piece, want, minlength=ncl)
+    margin = np.abs(total - 2 * down)
+    strong = (total >= ORIENT_COLUMN_MIN_VOTERS) & (margin >= ORIENT_COLUMN_MIN_AGREEMENT * total)
+    return 2 * down > total, strong
+
+
+def _component_turns(wrong, comp, ncomp) -> np.ndarray:
+    """(ncomp,) bool: components whose column tops, oriented, mostly face
+    down (``wrong``: (v,) bool per voter; ``comp``: (v,) its component),
+    by the rule of :func:`_piece_votes`."""
+    turn, strong = _piece_votes(comp, wrong, ncomp)
+    return turn & strong
 
 
 def _piece_edges(lab, rel, n, i, j, w, neg):

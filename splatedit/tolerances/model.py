@@ -222,13 +222,14 @@ TILE_RETRY_LEVELS = 1
 # out 0.03% outward (the highest point was a stray); with the vote 100%.
 #: points of the deterministic sample the vote is taken on (every n // this-th point)
 ORIENT_VOTE_SAMPLE = 200_000
-#: a component with fewer sampled points keeps its seed's orientation
-ORIENT_VOTE_MIN_VOTERS = 64
-#: share of a component's sampled points (its highest) that vote
-ORIENT_VOTE_TOP_FRACTION = 0.01
-#: the voters' mean oriented n_z must be below minus this to turn a component
-#: (the tops of the closed test scans give +0.6..+0.9; a vertical wall about 0)
-ORIENT_VOTE_MIN_MEAN_NZ = 0.2
+#: column vote (splatedit.model.orient._column_voters): xy cell side in sample spacings
+ORIENT_COLUMN_CELL_SPACINGS = 3.0
+#: a column top votes only when |n_z| of its normal exceeds this
+ORIENT_COLUMN_MIN_NZ = 0.3
+#: a piece (or component) with fewer column voters keeps the MST's (seed's) sign
+ORIENT_COLUMN_MIN_VOTERS = 8
+#: ... and so does one whose majority leads by less than this share of its voters
+ORIENT_COLUMN_MIN_AGREEMENT = 0.5
 
 
 # ---------------------------------------------------------------------------
