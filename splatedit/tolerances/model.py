@@ -223,7 +223,7 @@ TILE_RETRY_LEVELS = 1
 #: points of the deterministic sample the vote is taken on (every n // this-th point)
 ORIENT_VOTE_SAMPLE = 200_000
 #: column vote (splatedit.model.orient._column_voters): xy cell side in sample spacings
-ORIENT_COLUMN_CELL_SPACINGS = 3.0
+ORIENT_COLUMN_CELL_SPACINGS = 4.0
 #: a column top votes only when |n_z| of its normal exceeds this
 ORIENT_COLUMN_MIN_NZ = 0.3
 #: a piece (or component) with fewer column voters keeps the MST's (seed's) sign
