@@ -114,3 +114,14 @@ def test_settle_radii_caps_against_the_shrunk_neighbours():
     out = settle_radii(r, nb, changed, cap=3.0)
     np.testing.assert_array_equal(out, [3.0, 1.0, 1.0, 1.0, 1.0, 1.0])
     assert np.array_equal(settle_radii(r, nb, np.zeros(6, bool), cap=3.0), r)
+
+
+@pytest.mark.parametrize("kind, seed, sweeps", [("lidar", 0, 1), ("lidar", 3, 1), ("radar", 0, 2)])
+def test_rotating_scan_ground_faces_up(scans, kind, seed, sweeps):
+    """The ground a rotating sensor sees faces up (the side it was seen
+    from).  Before the column vote: 82%, 64% and 11% up (the MST carried the
+    sign across the corners at the walls' feet)."""
+    p, tag = scans.rotating_scan(kind, seed, _origins(sweeps), labels=True)
+    ground = (tag == scans.SURFACE) & (np.abs(p[:, 2]) < 0.05)
+    nz = estimate_splats(p).normals[:, 2]
+    assert (nz[ground] > 0).mean() > 0.99
