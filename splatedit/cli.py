@@ -229,7 +229,9 @@ def build_parser() -> argparse.ArgumentParser:
     s = sub.add_parser("deform", help="apply a JSON edit script to a model")
     s.add_argument("input")
     s.add_argument("--edit", required=True, type=Path, help="edit script (JSON)")
-    s.add_argument("-o", "--output", required=True, help="output PLY")
+    s.add_argument("-o", "--output", required=True,
+                   help="output file, any writable format by its extension (a COPC input and a .copc.laz "
+                        "output run out of core)")
     s.add_argument("--method", choices=("auto", "lu", "iqr"), help="override the script's solver method")
     s.add_argument("--tol", type=positive_float, help="override the script's IQR tolerance")
     s.add_argument("-f", "--force", action="store_true", help="overwrite OUTPUT if it exists (even the input)")
@@ -272,7 +274,8 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("--gaussians", action="store_true",
                    help="with 'render': the Gaussian splatting renderer (100k and 1M Gaussians, both sorts)")
     s.add_argument("--splats", type=_positive_count, nargs="+", metavar="N",
-                   help="point/splat counts of estimate, render, editor, closure and the Gaussian benches, "
+                   help="point/splat counts of estimate, render, editor, closure, batch, gpu-sort, outofcore "
+                        "(its generated scan) and the Gaussian benches, "
                         "support splats of basis and of solve's grab cases (on a cloud 2.5x as large) "
                         "(e.g. --splats 1000000 10000000)")
     s.add_argument("--large", action="store_true",

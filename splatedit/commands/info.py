@@ -75,9 +75,10 @@ def _gaussian_info(args) -> dict:
 def _copc_info(args) -> dict:
     """``info`` of a COPC file from its header and hierarchy alone (no point
     is decompressed, whatever the file's size): counts, bounds, the octree's
-    cube, levels, nodes and points per level, root spacing."""
+    cube, levels, nodes and points per level, root spacing, and the local
+    origin edit scripts' coordinates are relative to."""
     import os
-    from splatedit.io.copc import CopcFile
+    from splatedit.io.copc import CopcFile, file_origin
     with CopcFile.open(args.file) as f:
         per_level = [0] * (f.max_depth + 1)
         nodes_level = [0] * (f.max_depth + 1)
@@ -97,6 +98,9 @@ def _copc_info(args) -> dict:
             "diagonal": _sig(float(((hi - lo) ** 2).sum()) ** 0.5),
             "scale": [_sig(x) for x in f.scale],
             "offset": [_sig(x, 15) for x in f.offset],
+            # the local origin of the editor and of edit scripts (coordinates = file - origin),
+            # as for the file read whole
+            "origin": [_sig(x, 15) for x in file_origin(f)],
             "octree_center": [_sig(x, 10) for x in f.center],
             "octree_halfsize": _sig(f.halfsize),
             "root_spacing": _sig(f.spacing),

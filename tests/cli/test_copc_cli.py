@@ -105,6 +105,9 @@ def test_info_of_copc_reads_header_and_hierarchy_only(scan, monkeypatch, capsys)
     info = json.loads(capsys.readouterr().out)
     assert info["kind"] == "COPC" and info["points"] == 40_000
     assert sum(info["points_per_level"]) == 40_000 and info["nodes"] == sum(info["nodes_per_level"])
+    # the origin edit scripts are relative to: the one the file read whole gets
+    from splatedit.io import read
+    assert np.allclose(info["origin"], read(path).origin, rtol=0, atol=1e-9)
 
 
 def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan):
