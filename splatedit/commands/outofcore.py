@@ -224,8 +224,13 @@ def render_copc(args, camera_from_args) -> int:
         coarse = cloud_of_block(src, src.read(top))
         camera = camera_from_args(args, coarse)
         budget = getattr(args, "budget", None) or COPC_RENDER_BUDGET
-        keys = choose_nodes(src, np.asarray(camera.eye) + origin, np.asarray(camera.target) + origin,
-                            camera.fov_deg, args.size, budget=budget, refine_px=COPC_REFINE_PX)
+        lo, hi = np.asarray(src.point_bounds, dtype=np.float64) - origin
+        near, far = camera.clip_range(lo, hi)
+        to_local = np.eye(4)
+        to_local[:3, 3] = -origin                  # file units -> the camera's local frame
+        vp = camera.projection_matrix(args.size[0] / args.size[1], near, far) @ camera.view_matrix() @ to_local
+        keys = choose_nodes(src, np.asarray(camera.eye) + origin, vp, camera.fov_deg, args.size,
+                            budget=budget, refine_px=COPC_REFINE_PX)
         keys = keys or top          # nothing in view: the frame shows what the coarse points show (nothing)
         block = src.read(keys, args.progress)
         cloud = cloud_of_block(src, block, args.progress)

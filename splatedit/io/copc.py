@@ -35,7 +35,7 @@ rewritten without a move gives back the same integers.
 
 from __future__ import annotations
 
-import heapq
+import math
 import os
 import struct
 import tempfile
@@ -1291,58 +1291,35 @@ def cloud_of_block(src: CopcFile, block: PointBlock, progress=None):
 # --------------------------------------------------------------------------- level of detail
 
 
-def choose_nodes(src, eye, target, fov_deg: float, size, *, budget: int, refine_px: float):
-    """The nodes to draw for a camera at ``eye`` looking at ``target``
-    ((3,) file units) with a vertical field of view of ``fov_deg`` degrees
-    (an image of ``size`` (w, h)), as
-    Potree chooses them: from the root, a node in front of the camera and
-    inside its view cone is drawn, and its children visited while its point
-    spacing (``src.spacing / 2**depth``) projects to more than ``refine_px``
-    pixels at the node's nearest point; the largest projected spacing first,
-    until ``budget`` points.
+def choose_nodes(src, eye, view_projection, fov_deg: float, size, *, budget: int,
+                 refine_px: float) -> list[NodeKey]:
+    """The nodes to draw for a camera at ``eye`` ((3,) file units) with the
+    world -> clip matrix ``view_projection`` ((4, 4), file units, Vulkan depth
+    0..1) and a vertical field of view of ``fov_deg`` degrees, for an image of
+    ``size`` (w, h): Potree's rule as the editor applies it
+    (:func:`splatedit.model.octree_lod.select_nodes`, one rule for both):
+    from the root, the candidate whose point spacing (``src.spacing /
+    2**depth``) projects largest at its nearest point is taken while the
+    points stay within ``budget``, and its children become candidates while
+    that spacing projects above ``refine_px`` pixels; nodes outside the view
+    frustum are not refined.  Empty nodes the hierarchy lists (structure
+    keys) are walked through, so their children stay reachable.
 
     Returns:
-        list of NodeKey (parents before children).
+        list of NodeKey with points (parents before children).
     """
-    eye = np.asarray(eye, float)
-    fwd = np.asarray(target, float) - eye
-    fwd /= np.linalg.norm(fwd)
-    focal = 0.5 * size[1] / np.tan(np.radians(fov_deg) / 2)
-    half_diag = np.hypot(size[0], size[1]) / 2 / focal          # tan of the cone's half angle
-    cone = np.arctan(half_diag)
+    from splatedit.model.octree_lod import OctreeView, select_nodes
+    keyed = {(k.depth, k.x, k.y, k.z): k for k in list(src.nodes) + list(src.structure_keys)}
+    nodes = {t: _LodNode(src.nodes[k].point_count if k in src.nodes else 0, src.node_bounds(k))
+             for t, k in keyed.items()}
+    view = OctreeView(np.asarray(eye, dtype=np.float64), np.asarray(view_projection, dtype=np.float64),
+                      math.radians(fov_deg), int(size[1]))
+    choice = select_nodes(nodes, float(src.spacing), view, budget=budget, min_px=refine_px)
+    return [keyed[t] for t in choice.keys if keyed[t] in src.nodes]
 
-    def weight(key):
-        b = src.node_bounds(key)
-        near = np.clip(eye, b[0], b[1])
-        dist = float(np.linalg.norm(near - eye))
-        centre = b.mean(axis=0)
-        radius = float(np.linalg.norm(b[1] - b[0])) / 2
-        to = centre - eye
-        d = float(np.linalg.norm(to))
-        if d > radius:       # outside the view cone (cone widened by the node's bounding sphere)
-            ang = np.arccos(np.clip(to @ fwd / d, -1, 1))
-            if ang - np.arcsin(min(1.0, radius / d)) > cone:
-                return None
-        spacing = src.spacing / (1 << key.depth)
-        return spacing * focal / max(dist, 1e-12)
 
-    out, total = [], 0
-    w = weight(ROOT)
-    heap = [(-w, ROOT)] if ROOT in src.nodes and w is not None else []
-    structure = src.structure_keys
-    while heap:
-        negw, key = heapq.heappop(heap)
-        n = src.nodes.get(key)
-        if n is not None:
-            if total + n.point_count > budget and out:
-                break
-            out.append(key)
-            total += n.point_count
-        if -negw <= refine_px:
-            continue
-        for c in key.children():
-            if c in src.nodes or c in structure:
-                cw = weight(c)
-                if cw is not None:
-                    heapq.heappush(heap, (-cw, c))
-    return out
+@dataclass(frozen=True)
+class _LodNode:
+    """A node as :func:`~splatedit.model.octree_lod.select_nodes` reads it."""
+    point_count: int
+    bounds: np.ndarray

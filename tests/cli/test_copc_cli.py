@@ -110,8 +110,15 @@ def test_info_of_copc_reads_header_and_hierarchy_only(scan, monkeypatch, capsys)
     assert np.allclose(info["origin"], read(path).origin, rtol=0, atol=1e-9)
 
 
-def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan):
+def _choose(f, eye, target, budget, refine_px):
     from splatedit.io.copc import choose_nodes
+    from splatedit.render.camera import Camera
+    cam = Camera(eye, target, up=(0.0, 0.0, 1.0), fov_deg=40.0, near=1e-3, far=1e5)
+    vp = cam.projection_matrix(640 / 360, cam.near, cam.far) @ cam.view_matrix()
+    return choose_nodes(f, eye, vp, 40.0, (640, 360), budget=budget, refine_px=refine_px)
+
+
+def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan):
     with CopcFile.open(scan[0]) as f:
         lo, hi = f.point_bounds
         eye = np.array([lo[0], lo[1], hi[2]]) + [-3.0, -3.0, 2.0]
@@ -122,7 +129,7 @@ def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan
             b = f.node_bounds(k)
             return f.spacing / (1 << k.depth) * focal / np.linalg.norm(np.clip(eye, b[0], b[1]) - eye)
 
-        keys = choose_nodes(f, eye, target, 40.0, (640, 360), budget=10**9, refine_px=10.0)
+        keys = _choose(f, eye, target, 10**9, 10.0)
         chosen = set(keys)
         assert keys[0].depth == 0 and len(chosen) == len(keys)
         for k in keys:
@@ -133,11 +140,11 @@ def test_node_choice_refines_where_the_spacing_projects_above_the_threshold(scan
         for k in refined:    # ... and such a parent's children are all drawn (they all face the camera here)
             assert all(c in chosen for c in k.children() if c in f.nodes)
         assert any(k.depth == f.max_depth for k in keys) and any(px(k) <= 10.0 for k in keys if k.depth < f.max_depth)
-        small = choose_nodes(f, eye, target, 40.0, (640, 360), budget=5000, refine_px=1.0)
+        small = _choose(f, eye, target, 5000, 1.0)
         assert sum(f.nodes[k].point_count for k in small) <= max(5000, f.nodes[keys[0]].point_count)
         far_eye = target + [0, -5000.0, 0]         # from 5 km the root alone is below a pixel
-        assert choose_nodes(f, far_eye, target, 40.0, (640, 360), budget=10**9, refine_px=1.0) == [keys[0]]
-        behind = choose_nodes(f, eye, eye - (target - eye), 40.0, (640, 360), budget=10**9, refine_px=1.0)
+        assert _choose(f, far_eye, target, 10**9, 1.0) == [keys[0]]
+        behind = _choose(f, eye, eye - (target - eye), 10**9, 1.0)
         assert len(behind) <= 1                    # looking away: nothing but (at most) the root
 
 
