@@ -17,9 +17,9 @@ up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
 help and the manual's controls list) and run the bound action; each tool draws
 its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
-dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,
-:meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
-File menu calls; load / save errors stay in an error box until dismissed.
+dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) ``open_dialog``,
+``open_path`` and ``recent_files`` are the API a GUI
+File menu calls (on :attr:`Editor.file_actions`); load / save errors stay in an error box until dismissed.
 Entry point: :func:`run_editor`.
 """
 
@@ -46,7 +46,7 @@ from splatedit.app.panel import HelpView, compose_overlay
 from splatedit.app.session import Session
 from splatedit.app.status import StatusWriter
 from splatedit.app.recent import RecentFiles
-from splatedit.app.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
+from splatedit.app.routing import HELP_WHEEL_LINES, EventRouter  # noqa: F401 (API)
 from splatedit.app.tools.base import DragMode
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
@@ -59,7 +59,17 @@ from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN
                                   IQR_DEFAULT_TOL)
 
 
-class Editor(EventRouting, FileActions):
+class Editor:
+    """The editor window's loop and the state its parts share.
+
+    It owns its parts and delegates to them: :attr:`routing` (window events
+    to the GUI, the questions and the tools; keys through the keymap,
+    :class:`~splatedit.app.routing.EventRouter`), :attr:`file_actions`
+    (load / open / save / export / quit,
+    :class:`~splatedit.app.file_actions.FileActions`), the tools
+    (:mod:`splatedit.app.tools`), the frame scheduler and the crash guard.
+    """
+
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
                  budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False):
@@ -105,6 +115,10 @@ class Editor(EventRouting, FileActions):
         #: the central exception guard, recovery copies and the restore question
         #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
         self.crash_guard = CrashGuard(self)
+        #: window events and key actions (:class:`~splatedit.app.routing.EventRouter`)
+        self.routing = EventRouter(self)
+        #: the File menu API (:class:`~splatedit.app.file_actions.FileActions`)
+        self.file_actions = FileActions(self)
         self.cloud_name = self.path.name if self.path else "model"
         self.jobs: dict[str, Job] = {}
         self.running = True
@@ -219,8 +233,9 @@ class Editor(EventRouting, FileActions):
             t.update(tool.actions())
         s = lambda: self.session  # noqa: E731
         t.update(self.browser.actions())
+        fa = self.file_actions
         t.update({
-            Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
+            Action.OPEN: fa.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
             Action.DEFORMATION_MODE: self.cycle_deformation,
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
@@ -230,8 +245,8 @@ class Editor(EventRouting, FileActions):
             Action.HELP_CLOSE: self.help.toggle,
             Action.UNDO: lambda: self.say("undo" if s().undo() else "undo: nothing to do"),
             Action.REDO: lambda: self.say("redo" if s().redo() else "redo: nothing to do"),
-            Action.SAVE: self.save_edits, Action.SAVE_AS: self.ask_save_as,
-            Action.EXPORT_SCRIPT: self.export_script, Action.QUIT: self.request_quit})
+            Action.SAVE: fa.save_edits, Action.SAVE_AS: fa.ask_save_as,
+            Action.EXPORT_SCRIPT: fa.export_script, Action.QUIT: fa.request_quit})
         return t
 
     def cycle_deformation(self) -> None:
@@ -262,6 +277,11 @@ class Editor(EventRouting, FileActions):
 
     def toggle_panel(self) -> None:
         self.panel_visible = not self.panel_visible
+
+    def run_action(self, action: Action) -> None:
+        """Run the handler bound to ``action`` (keys and GUI buttons share it;
+        :meth:`~splatedit.app.routing.EventRouter.run_action`)."""
+        self.routing.run_action(action)
 
     def finish_manip(self) -> None:
         self.gizmo.finish_manip()
@@ -297,10 +317,11 @@ class Editor(EventRouting, FileActions):
         (KeyboardInterrupt), after writing a recovery copy of unsaved edits."""
         if self.path is None:
             raise SplatEditError("no model to open")
-        self.start_load()
+        fa = self.file_actions
+        fa.start_load()
         guard = self.crash_guard
-        if not guard.offer_recovery() and self.offer_recent and self.recent_files():
-            self.open_dialog(Path.cwd())
+        if not guard.offer_recovery() and self.offer_recent and fa.recent_files():
+            fa.open_dialog(Path.cwd())
         restore_sigterm = _sigterm_as_interrupt()
         try:
             self._loop()
@@ -329,9 +350,9 @@ class Editor(EventRouting, FileActions):
                 if w == 0 or h == 0 or self.window.iconified():
                     pending = False          # minimized: nothing to draw, do not spin
                 events = self.window.poll(0.0 if pending else (0.05 if busy else 0.5))
-                self.handle_events(events)          # each event guarded on its own
+                self.routing.handle_events(events)          # each event guarded on its own
                 with guarded("collecting a finished job"):
-                    self.poll_jobs()
+                    self.file_actions.poll_jobs()
                 if self.session is not None:
                     with guarded("landing a fit or an edit"):
                         self.session.poll()

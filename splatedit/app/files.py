@@ -156,7 +156,7 @@ def on_drop(ed, paths: list[Path]) -> None:
     if len(paths) > 1:
         ed.say(f"{len(paths)} files dropped: opening only {first.name}")
     if first.is_dir():
-        ed.open_dialog(first)
+        ed.file_actions.open_dialog(first)
     else:
         open_path(ed, first)
 
@@ -317,7 +317,7 @@ def poll_jobs(ed) -> None:
                 ed.say(f"{job.name} failed: {err}")
             continue
         if name == "load":
-            ed.on_loaded(job.result, job.key)
+            ed.file_actions.on_loaded(job.result, job.key)
             guard = getattr(ed, "crash_guard", None)
             entry = None if guard is None else guard.restoring
             if entry is not None and Path(job.key) == Path(os.path.abspath(entry.model)):

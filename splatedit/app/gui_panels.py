@@ -5,7 +5,7 @@ presenter's Vulkan device.  Each presented frame it builds, between
 ``new_frame`` and ``render``:
 
 * the **menu bar** (:mod:`splatedit.app.gui_menus`): File
-  (:attr:`EditorGui.file_menu`, a list of :class:`MenuEntry` that other
+  (:attr:`EditorGui.menus.file_menu <splatedit.app.gui_menus.MenuBar.file_menu>`, a list of :class:`MenuEntry` that other
   parts of the editor extend: Open..., Open recent, Save ...), Edit (undo /
   redo), View (panels, help, frame all);
 * the **side panel** (collapsible sections; P hides it, as before; placed at
@@ -55,26 +55,19 @@ ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 MESSAGE_SECONDS = 8.0
 
 
-class EditorGui(MenuBar):
+class EditorGui:
     def __init__(self, ed, device):
         from splatedit.render.gui import Gui
         self.ed = ed
         self.gui = Gui(device)
         imgui.get_io().config_flags &= ~imgui.ConfigFlags_.nav_enable_keyboard.value   # keys are the editor's
-        has = lambda: ed.session is not None  # noqa: E731
-        #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
-        self.file_menu: list[MenuEntry] = [
-            MenuEntry("Open...", lambda: ed.run_action(Action.OPEN), "Ctrl+O", name="menu_open"),
-            MenuEntry("Open recent", None, submenu=self._recent_menu, name="menu_recent"),
-            MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
-            MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
-            MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
-            MenuEntry("Quit", lambda: ed.run_action(Action.QUIT), "Q")]
+        #: the menu bar (an owned part, :class:`~splatedit.app.gui_menus.MenuBar`;
+        #: its ``file_menu`` rows may be extended)
+        self.menus = MenuBar(ed, self._rect)
         self.transform = TransformSection(ed)
         self.rects: dict[str, Box] = {}
         self.panel_box: Box | None = None
         self.help_box: Box | None = None
-        self.menu_height = 0.0
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
         self._sections_h = 400.0           # the panel's scrolling part / footer heights (last frame)
         self._footer_h = 60.0
@@ -82,7 +75,6 @@ class EditorGui(MenuBar):
         self.help_scroll_set = None
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
-        self._menu_open = False
         self._close_menus = False          # Esc was pressed with a menu open
         self._press_in_gui = False
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
@@ -102,18 +94,18 @@ class EditorGui(MenuBar):
         self.gui.feed(ev)
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
         kind = ev.kind
-        if kind == "key" and self._menu_open and ev.key == self.ed.g.KEY_ESCAPE:
+        if kind == "key" and self.menus.open and ev.key == self.ed.g.KEY_ESCAPE:
             # Esc closes an open menu (ImGui does not without keyboard navigation, and
             # the menu would then swallow the next click: the first stroke did nothing);
             # the key is the menu's, it cancels nothing else
             if ev.action == 1:
-                self._close_menus, self._menu_open = True, False
+                self._close_menus, self.menus.open = True, False
             return True
         if kind in ("key", "char"):
             return self.wants_keyboard
         if kind == "button":
             if ev.action == 1:                    # press
-                self._press_in_gui = self._menu_open or self.owns_point(ev.x, ev.y)
+                self._press_in_gui = self.menus.open or self.owns_point(ev.x, ev.y)
                 return self._press_in_gui
             taken, self._press_in_gui = self._press_in_gui, False
             return taken
@@ -150,7 +142,12 @@ class EditorGui(MenuBar):
     @property
     def menu_open(self) -> bool:
         """A menu of the menu bar was open in the last frame."""
-        return self._menu_open
+        return self.menus.open
+
+    @property
+    def menu_height(self) -> float:
+        """The menu bar's height in pixels (last frame)."""
+        return self.menus.height
 
     @property
     def wants_keyboard(self) -> bool:
@@ -171,12 +168,13 @@ class EditorGui(MenuBar):
         self._last = now
         self.rects = {}
         self.windows = []
-        self._menu_open = False
         if self._close_menus:
             imgui.internal.close_popups_except_modals()
             self._close_menus = False
         gui_overlay.draw_tools(self.ed, w, h)
-        self._menu_bar(w)
+        bar = self.menus.draw(w)
+        if bar is not None:
+            self.windows.append(bar)
         help_full = self.ed.help.shown and self._help_area(w, h)[1]
         if self.ed.panel_visible and not help_full:
             self._panel(w, h)

@@ -29,7 +29,7 @@ def ed():
 def drag(ed, pts, mods=0):
     press(ed, glfw.MOUSE_BUTTON_LEFT, mods, *pts[0])
     for x, y in pts[1:]:
-        ed.on_move(types.SimpleNamespace(x=float(x), y=float(y)))
+        ed.routing.on_move(types.SimpleNamespace(x=float(x), y=float(y)))
     press(ed, glfw.MOUSE_BUTTON_LEFT, mods, *pts[-1], action=glfw.RELEASE)
 
 
@@ -124,7 +124,7 @@ def test_right_click_cancels_an_armed_box_and_the_brush_paints_again(ed):
 def test_the_region_outline_is_a_closed_shape_while_dragging(ed):
     key(ed, glfw.KEY_B, glfw.MOD_CONTROL)
     press(ed, glfw.MOUSE_BUTTON_LEFT, 0, 100, 100)
-    ed.on_move(types.SimpleNamespace(x=200.0, y=150.0))
+    ed.routing.on_move(types.SimpleNamespace(x=200.0, y=150.0))
     (shape,) = ed.region.shapes(640, 480)
     assert shape.closed and shape.strip().shape == (5, 2)
     from splatedit.app.shapes import to_patches

@@ -41,14 +41,14 @@ class StubEditor(Editor):
 
 
 def button(ed, x, y, action):
-    ed.on_button(types.SimpleNamespace(x=x, y=y, action=action, button=G.MOUSE_BUTTON_LEFT, mods=0))
+    ed.routing.on_button(types.SimpleNamespace(x=x, y=y, action=action, button=G.MOUSE_BUTTON_LEFT, mods=0))
 
 
 def drag(ed, points):
     """Left press at points[0], moves through the rest, release at the last."""
     button(ed, *points[0], G.PRESS)
     for x, y in points[1:]:
-        ed.on_move(types.SimpleNamespace(x=x, y=y))
+        ed.routing.on_move(types.SimpleNamespace(x=x, y=y))
     m = None if ed.session.manip is None else ed.session.manip.matrix()
     button(ed, *points[-1], G.RELEASE)
     return m
