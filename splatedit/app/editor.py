@@ -33,6 +33,7 @@ import threading
 import time
 from pathlib import Path
 
+from splatedit.app.brush import ViewPicking
 from splatedit.app.crash_guard import CrashGuard
 from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
 from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
@@ -42,12 +43,13 @@ from splatedit.app.camera_control import OrbitCamera
 from splatedit.app.jobs import Job
 from splatedit.app.keymap import Action
 from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.panel import HelpView, compose_overlay
+from splatedit.app.panel import PANEL_MARGIN, HelpView, compose_overlay
+from splatedit.app.selection_tools import SelectionTools
 from splatedit.app.session import Session
 from splatedit.app.status import StatusWriter
 from splatedit.app.recent import RecentFiles
 from splatedit.app.routing import HELP_WHEEL_LINES, EventRouter  # noqa: F401 (API)
-from splatedit.app.tools.base import DragMode
+from splatedit.app.tools.base import DragMode, free_area
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
@@ -55,7 +57,8 @@ from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
 from splatedit.app.tools import protocol_tools
 from splatedit.errors import ParameterError, SplatEditError
-from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
+from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN,
+                                  EDITOR_SPLAT_SCALE_STEP,
                                   IQR_DEFAULT_TOL)
 
 
@@ -152,6 +155,11 @@ class Editor:
         if not hasattr(self, "frames"):
             self.frames = FrameScheduler(self, 100.0)
         self.debug_enabled = os.environ.get("SPLATEDIT_EDITOR_DEBUG", "") not in ("", "0")
+        #: the neighbour graphs of the document's clouds (built in the background) and
+        #: the closure of selection edits (:class:`~splatedit.app.selection_tools.SelectionTools`)
+        self.selection_tools = SelectionTools(self.start_graph_job)
+        #: the pick map of the current view (:class:`~splatedit.app.brush.ViewPicking`)
+        self.picking = ViewPicking(self)
         # tools: press order (after every tool's press_modal)
         self.camera = CameraTool(self)
         self.brush = BrushTool(self)
@@ -196,6 +204,19 @@ class Editor:
     @property
     def size(self) -> tuple[int, int]:
         return self.window.framebuffer_size()
+
+    def view_area(self) -> tuple[float, float, float, float]:
+        """The part of the window framing fills, (x0, y0, x1, y1) fractions
+        (:func:`~splatedit.app.tools.base.free_area`): beside the side panel
+        when it is shown, below the GUI's menu bar."""
+        w, h = self.size
+        box = self.panel_box if self.panel_visible else None
+        if box is not None and tuple(box) == (0, 0, 0, 0):
+            # no frame laid out yet (a model opened before the first GUI frame): the GUI
+            # panel's first place, at the left; the CPU text panel's size is not known
+            box = (PANEL_MARGIN, 0, EDITOR_GUI_PANEL_WIDTH, 0) if self.gui is not None else None
+        top = self.gui.menu_height if self.gui is not None else 0.0
+        return free_area(w, h, box, top)
 
     def motion(self) -> None:
         self.frames.motion()
@@ -290,6 +311,14 @@ class Editor:
         self.gizmo.commit_pose()
 
     # -------------------------------------------------------------- overlay
+    def overlay_shapes(self, w: int, h: int) -> list:
+        """Every tool's overlay shapes of a ``w`` x ``h`` frame
+        (:mod:`splatedit.app.shapes`), in tool order (none without a model);
+        the GPU path and the CPU fallback paint this one list."""
+        if self.session is None:
+            return []
+        return [shape for tool in self.tools for shape in tool.shapes(w, h)]
+
     def overlay_patches(self, w: int, h: int) -> list:
         return compose_overlay(self, w, h)
 
@@ -396,7 +425,7 @@ class Editor:
         for j in list(self.jobs.values()):
             if j.name == "saving":
                 j.wait()     # never leave a half-written file behind
-        self.brush.tools.cancel()   # a graph build stops at its next tile (its pool would hold up the exit)
+        self.selection_tools.cancel()   # a graph build stops at its next tile (its pool would hold up the exit)
         self.frames.close()
         if self.gui is not None:
             if self.presenter is not None:

@@ -249,7 +249,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.cloud_name = cloud.name or ed.cloud_name
     from splatedit.app.session import Session
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
-                           on_change=ed.wake)
+                           on_change=ed.wake, graphs=ed.selection_tools)
     ed.viewport.set_cloud(cloud)
     # the heat map shows an edit's stretch: a freshly opened model has none (it
     # would draw as a flat grey silhouette), so it opens shaded
@@ -275,7 +275,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
             from splatedit.model.gaussian_lod import build_gaussian_lod
             return build_gaussian_lod(scene, progress=progress)
         ed.jobs["lod"] = Job("Gaussian level of detail", rank, ed.wake)
-    ed.brush.tools.prepare(cloud)
+    ed.selection_tools.prepare(cloud)
     guard = getattr(ed, "crash_guard", None)
     if guard is None or guard.restoring is None:      # a recovery file is not a recent model
         remember(ed, ed.path)
@@ -296,7 +296,7 @@ def poll_jobs(ed) -> None:
             if name == "graph":
                 if not isinstance(err, Cancelled):
                     ed.say(f"{job.name} failed: {err}")
-                ed.brush.tools.poll()
+                ed.selection_tools.poll()
                 continue
             if isinstance(err, Cancelled):
                 continue
@@ -344,5 +344,8 @@ def poll_jobs(ed) -> None:
             ed.saved_script = job.result
             ed.say(f"edit script written to {job.result}")
         elif name == "graph":
-            if ed.brush.tools.poll() and ed.brush.tools.closure_pending and ed.session is not None:
-                ed.brush.close_pending_selection()
+            graphs = ed.selection_tools
+            if graphs.poll() and graphs.closure_pending and ed.session is not None:
+                added = ed.session.selection_edit.close_pending()    # the selection waiting for it
+                if added:
+                    ed.say(f"closure added {added:,} splats")

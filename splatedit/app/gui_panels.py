@@ -34,6 +34,7 @@ import time
 from imgui_bundle import imgui
 
 from splatedit.app import gui_help, gui_overlay, gui_questions
+from splatedit.app import overlay as ov
 from splatedit.app.gaussian_doc import model_summary
 from splatedit.app.gui_menus import MenuBar, MenuEntry  # noqa: F401 (MenuEntry: the File menu's rows)
 from splatedit.app import selection_tools as seltools
@@ -386,7 +387,7 @@ class EditorGui:
         if d is not None:
             imgui.text_colored(RED if d.exceeds_warn else imgui.ImVec4(0.92, 0.92, 0.92, 1.0),
                                f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
-            source = gui_overlay.ov.distortion_source(s)
+            source = ov.distortion_source(s)
             if source:
                 imgui.push_text_wrap_pos(0.0)
                 imgui.text_disabled(source)

@@ -266,11 +266,7 @@ def compose_overlay(ed, w: int, h: int) -> list:
     patches = []
     s = ed.session
     if s is not None:
-        patches += ed.brush.underlay(w, h)
-        for tool in (ed.curve, ed.gizmo, ed.brush):
-            patches += tool.overlay(w, h)
-        for tool in ed.tools:          # the protocol's shapes, painted on the CPU
-            patches += to_patches(tool.shapes(w, h))
+        patches += to_patches(ed.overlay_shapes(w, h), (w, h))   # the tools' shapes, painted on the CPU
     panel = ov.text_panel(tuple(panel_lines(ed))) if ed.panel_visible else None
     box = None
     if panel is not None:

@@ -128,7 +128,7 @@ def test_the_region_outline_is_a_closed_shape_while_dragging(ed):
     (shape,) = ed.region.shapes(640, 480)
     assert shape.closed and shape.strip().shape == (5, 2)
     from splatedit.app.shapes import to_patches
-    (patch,) = to_patches([shape])
+    (patch,) = to_patches([shape], (640, 480))
     assert patch.rgba[..., 3].max() == 255 and patch.x <= 100 and patch.y <= 100
     press(ed, glfw.MOUSE_BUTTON_LEFT, 0, 200, 150, action=glfw.RELEASE)
     assert ed.region.shapes(640, 480) == []
@@ -202,3 +202,17 @@ def test_protocol_tools_register_themselves_and_use_only_their_context(ed):
         src = inspect.getsource(inspect.getmodule(cls))
         # on the protocol: the narrow context, no reach into the editor or its other tools
         assert "self.ed." not in src and "self.session" not in src, cls.__name__
+
+
+def test_every_view_tool_is_on_the_protocol_and_draws_only_shapes(ed):
+    """The built-in tools too (camera, curve, gizmo, brush): only the tool
+    context (no ``ed.*`` reach-ins), and their overlays are shapes that one
+    painter draws on both paths (no separate ``overlay`` / ``underlay``)."""
+    import inspect
+
+    from splatedit.app.tools.base import Tool
+    for tool in ed.tools:
+        src = inspect.getsource(inspect.getmodule(type(tool)))
+        assert "self.ed" not in src and "self.session" not in src, type(tool).__name__
+        assert not hasattr(tool, "overlay") and not hasattr(tool, "underlay"), type(tool).__name__
+    assert not hasattr(Tool, "overlay") and not hasattr(Tool, "ed")

@@ -118,6 +118,7 @@ class FileBrowserTool(Tool):
 
     def __init__(self, ed):
         super().__init__(ed)
+        self.ed = ed                 # a modal dialog of the editor's files, not a view tool
         self.shown = False
         self.folder = Path.cwd()
         self.entries: list[Entry] = []

@@ -91,7 +91,7 @@ def test_rotate_about_the_support_rim_keeps_the_rim_fixed_and_the_gizmo_sits_on_
     key(ed, glfw.KEY_PERIOD)
     assert ed.pivot.mode == SUPPORT_RIM
     rim = ed.pivot.point()
-    g = ed.brush.tools.graph(s.cloud)
+    g = ed.selection_tools.graph(s.cloud)
     assert np.allclose(rim, rim_centroid(s.cloud.positions, s.selection.support, g))
     assert np.linalg.norm(rim - s.handle_centroid()) > 0.2
     px, _ = ed.cam.project(rim, W, H)
