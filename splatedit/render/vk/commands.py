@@ -7,7 +7,8 @@ import vulkan as vk
 
 from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
 
-_LAYOUTS = {
+#: image layouts by the short names the recording helpers and passes take
+IMAGE_LAYOUTS = {
     "undefined": vk.VK_IMAGE_LAYOUT_UNDEFINED,
     "general": vk.VK_IMAGE_LAYOUT_GENERAL,
     "color": vk.VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -133,7 +134,7 @@ class CommandBuffer:
     def image_barrier(self, image, new_layout: str, src_stage: str, src_access: str,
                       dst_stage: str, dst_access: str):
         """Transition ``image`` from its recorded layout to ``new_layout``."""
-        new = _LAYOUTS[new_layout]
+        new = IMAGE_LAYOUTS[new_layout]
         sub = vk.VkImageSubresourceRange(aspectMask=image.aspect, baseMipLevel=0, levelCount=1,
                                          baseArrayLayer=0, layerCount=1)
         ib = vk.VkImageMemoryBarrier(srcAccessMask=_access(src_access), dstAccessMask=_access(dst_access),

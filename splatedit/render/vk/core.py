@@ -48,7 +48,9 @@ class DeviceNotFoundError(VulkanError):
         self.result = "VK_ERROR_INITIALIZATION_FAILED"
 
 
-def _result_name(exc: BaseException) -> str:
+def result_name(exc: BaseException) -> str:
+    """The Vulkan result code name of a python-vulkan exception
+    (``VkErrorOutOfDeviceMemory`` -> ``VK_ERROR_OUT_OF_DEVICE_MEMORY``)."""
     name = type(exc).__name__  # e.g. VkErrorOutOfDeviceMemory, VkTimeout
     out = ["VK"]
     word = ""
@@ -68,7 +70,7 @@ def call(fn, *args, name: str | None = None):
     try:
         return fn(*args)
     except (vk.VkError, vk.VkException) as exc:
-        raise VulkanError(name or getattr(fn, "__name__", "vulkan call"), _result_name(exc)) from None
+        raise VulkanError(name or getattr(fn, "__name__", "vulkan call"), result_name(exc)) from None
 
 
 # ---------------------------------------------------------- live handles
@@ -231,7 +233,7 @@ class Device:
         try:
             self.instance = vk.vkCreateInstance(info, None)
         except (vk.VkError, vk.VkException, OSError) as exc:
-            name = _result_name(exc) if isinstance(exc, (vk.VkError, vk.VkException)) else str(exc)
+            name = result_name(exc) if isinstance(exc, (vk.VkError, vk.VkException)) else str(exc)
             if "INCOMPATIBLE_DRIVER" in name:
                 raise DeviceNotFoundError(
                     "no Vulkan driver is installed (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER); "

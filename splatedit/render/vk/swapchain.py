@@ -36,7 +36,7 @@ import numpy as np
 import vulkan as vk
 
 from splatedit.errors import SplatEditError
-from splatedit.render.vk.core import Device, VulkanError, _result_name, call, track
+from splatedit.render.vk.core import Device, VulkanError, result_name, call, track
 from splatedit.render.vk.resources import Buffer
 from splatedit.render.vk.swapchain_target import SwapchainTarget
 
@@ -299,7 +299,7 @@ class SwapchainPresenter:
             # the image *was* acquired (suboptimal is a success code): use it, recreate after
             self.needs_recreate = True
         except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkAcquireNextImageKHR", _result_name(exc)) from None
+            raise VulkanError("vkAcquireNextImageKHR", result_name(exc)) from None
         return int(idx_ptr[0])
 
     def _begin_commands(self):
@@ -327,7 +327,7 @@ class SwapchainPresenter:
         except (vk.VkErrorOutOfDateKhr, vk.VkSuboptimalKhr):
             self.needs_recreate = True
         except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkQueuePresentKHR", _result_name(exc)) from None
+            raise VulkanError("vkQueuePresentKHR", result_name(exc)) from None
         self.frames_presented += 1
 
     def render_frame(self, record) -> bool:
