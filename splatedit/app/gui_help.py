@@ -61,7 +61,7 @@ def draw_help(g, w: int, h: int) -> None:
     if abs(sy - target) > 0.5:
         imgui.set_scroll_y(target)
     g.help_scroll_set = target
-    for text, title in hv._lines:
+    for text, title in hv.lines:
         if title:
             imgui.text_colored(BLUE, text)
         else:

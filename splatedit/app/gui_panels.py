@@ -64,7 +64,7 @@ class EditorGui:
         imgui.get_io().config_flags &= ~imgui.ConfigFlags_.nav_enable_keyboard.value   # keys are the editor's
         #: the menu bar (an owned part, :class:`~splatedit.app.gui_menus.MenuBar`;
         #: its ``file_menu`` rows may be extended)
-        self.menus = MenuBar(ed, self._rect)
+        self.menus = MenuBar(ed, self.rect)
         self.transform = TransformSection(ed)
         self.rects: dict[str, Box] = {}
         self.panel_box: Box | None = None
@@ -157,7 +157,7 @@ class EditorGui:
         holds while a clicked window keeps the focus, which would swallow the
         editor's keys (Esc after a palette button) though ImGui does nothing
         with them (keyboard navigation is off)."""
-        self.gui._current()
+        self.gui.make_current()
         return bool(imgui.get_io().want_text_input)
 
     # ---------------------------------------------------------------- frame
@@ -202,7 +202,7 @@ class EditorGui:
     def close(self) -> None:
         self.gui.close()
 
-    def _rect(self, name: str) -> None:
+    def rect(self, name: str) -> None:
         """Record the last widget's rectangle as ``name`` when it is wholly
         shown (one scrolled out of the panel's sections, or under the footer,
         is not: it cannot be clicked)."""
@@ -296,7 +296,7 @@ class EditorGui:
         imgui.push_text_wrap_pos(0.0)
         imgui.text(f"{model_summary(s.cloud)}   edits {len(s.edits)}" + ("   unsaved" if s.dirty else ""))
         imgui.pop_text_wrap_pos()
-        self._rect("panel_summary")
+        self.rect("panel_summary")
         if s.manip is not None:               # the live readout of a running move
             imgui.text_colored(YELLOW, s.manip.readout())
             imgui.push_text_wrap_pos(0.0)
@@ -310,7 +310,7 @@ class EditorGui:
         if imgui.collapsing_header("Deformation", open_):
             self._deformation()
         if imgui.collapsing_header("Transform", open_):
-            self.transform.draw(self._rect)
+            self.transform.draw(self.rect)
         # History before Display: at 1280x720 the History section was always
         # below the fold (issue 19 item 8); the display options are set once
         if imgui.collapsing_header("History", open_):
@@ -325,7 +325,7 @@ class EditorGui:
             self.ed.run_action(action)
         if on:
             imgui.pop_style_color()
-        self._rect(name)
+        self.rect(name)
 
     def _palette(self) -> None:
         s = self.ed.session
@@ -392,7 +392,7 @@ class EditorGui:
                 imgui.push_text_wrap_pos(0.0)
                 imgui.text_disabled(source)
                 imgui.pop_text_wrap_pos()
-                self._rect("distortion_source")
+                self.rect("distortion_source")
 
     def _deformation(self) -> None:
         ed, s = self.ed, self.ed.session
@@ -403,7 +403,7 @@ class EditorGui:
             if imgui.radio_button(m.value, s.deformation is m) and s.deformation is not m:
                 s.set_deformation(m)
                 ed.say(f"deformation: {m.value}")
-            self._rect(f"mode_{m.value}")
+            self.rect(f"mode_{m.value}")
             if m is DeformationMode.DETAIL and not detail_ok:
                 imgui.end_disabled()
             imgui.same_line()
@@ -430,7 +430,7 @@ class EditorGui:
                     ed.run_action(Action.DISTORTION_MAP)
                 if k < 2 and vp.grey != (k == 1):
                     ed.run_action(Action.COLOUR_MODE)
-            self._rect(f"display_{name.split()[0]}")
+            self.rect(f"display_{name.split()[0]}")
             if k < 2:
                 imgui.same_line()
         imgui.set_next_item_width(150)
@@ -463,7 +463,7 @@ class EditorGui:
                 if imgui.selectable(f"{k}. {name}{saved}##h{k}", here)[0] and not here:
                     self.jump(k)
                 if imgui.is_item_visible():
-                    self._rect(f"history_{k}")
+                    self.rect(f"history_{k}")
         imgui.end_child()           # always (ImGui's rule for begin_child)
 
     def jump(self, k: int) -> None:

@@ -57,11 +57,11 @@ def draw_question(gui, w: int, h: int) -> None:
     clicked = None
     if imgui.button(yes[0]):
         clicked = yes[1]
-    gui._rect("question_yes")
+    gui.rect("question_yes")
     imgui.same_line()
     if imgui.button(no[0]):
         clicked = no[1]
-    gui._rect("question_no")
+    gui.rect("question_no")
     p, s = imgui.get_window_pos(), imgui.get_window_size()
     gui.windows.append(Box(int(p.x), int(p.y), int(s.x), int(s.y)))
     imgui.end()

@@ -136,12 +136,13 @@ class HelpView:
         self.rows = 0                # lines that fit (last layout)
         self.box: Box | None = None
         self.covers_panel = False    # the window is too small for both: the panel steps aside
-        self._lines = help_lines()
+        #: the help's rows, (text, rgb) (:func:`~splatedit.app.keymap.help_lines`)
+        self.lines = help_lines()
         self._cache = None
 
     @property
     def total(self) -> int:
-        return len(self._lines)
+        return len(self.lines)
 
     def toggle(self) -> None:
         self.shown = not self.shown
@@ -156,7 +157,7 @@ class HelpView:
     def _measure(self, size: int) -> tuple[int, int]:
         f = ov.font(size)
         asc, desc = f.getmetrics()
-        width = max(int(f.getlength(t)) + 1 for t, _ in self._lines)
+        width = max(int(f.getlength(t)) + 1 for t, _ in self.lines)
         return width + 16, asc + desc + 2
 
     def layout(self, win: tuple[int, int], panel: Box | None) -> tuple[Box, int, int]:
@@ -192,7 +193,7 @@ class HelpView:
         self.scroll(0)                     # keep top in range after a resize
         key = (box, size, rows, self.top)
         if self._cache is None or self._cache[0] != key:
-            shown = self._lines[self.top:self.top + rows]
+            shown = self.lines[self.top:self.top + rows]
             lines = [(t, HELP_TITLE_RGB) if title else t for t, title in shown]
             end = self.top + len(shown)
             more = "PageDown / PageUp, arrows or wheel: scroll   " if rows < self.total else ""

@@ -470,7 +470,7 @@ class Renderer:
     def fb_attr_readback(self, t: SplatTargets):
         if getattr(t, "fb_attr_rb", None) is None:
             rp = self.cache.render_pass(rp_attr(self.accum_format, "transfer_src"))
-            t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
+            t.fb_attr_rb = t.framebuffer(rp, [t.accum_color, t.accum_normal, t.depth])
         return t.fb_attr_rb
 
     # ------------------------------------------------- frames as pass lists
@@ -630,9 +630,9 @@ class Renderer:
         self.require_cloud()
         t = self.targets_for(width, height)
         if getattr(t, "fb_points", None) is None:
-            t.points_color = t._add(V.Image(self.dev, width, height, "rgba8", ("color",)))
-            t.points_depth = t._add(V.Image(self.dev, width, height, "d32f", ("depth",)))
-            t.fb_points = t._fb(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
+            t.points_color = t.add(V.Image(self.dev, width, height, "rgba8", ("color",)))
+            t.points_depth = t.add(V.Image(self.dev, width, height, "d32f", ("depth",)))
+            t.fb_points = t.framebuffer(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
         desc = V.GraphicsDesc("points.vert", "points.frag", RP_POINTS, V.LayoutDesc(sets=(SPLAT_SET,)),
                               topology="point_list", bindings=(V.VertexBinding(0, GEOM_STRIDE, per_instance=False),),
                               attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),

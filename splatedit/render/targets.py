@@ -80,19 +80,19 @@ class SizedTargets:
     def _create(self, r) -> None:
         raise NotImplementedError
 
-    def _add(self, obj):
+    def add(self, obj):
         self.objects.append(obj)
         return obj
 
-    def _fb(self, rp, atts):
+    def framebuffer(self, rp, atts):
         """A framebuffer of this size on render pass ``rp`` with attachments ``atts``."""
-        return self._add(V.Framebuffer(self._r.dev, rp, atts, self.width, self.height))
+        return self.add(V.Framebuffer(self._r.dev, rp, atts, self.width, self.height))
 
     def target_fb(self, target: RenderTarget):
         """The (cached) framebuffer of :func:`rp_resolve` writing ``target``."""
         hit = self.target_fbs.get(target.serial)
         if hit is None:
-            fb = self._fb(self._r.cache.render_pass(rp_resolve(target)), [target.attachment])
+            fb = self.framebuffer(self._r.cache.render_pass(rp_resolve(target)), [target.attachment])
             hit = self.target_fbs[target.serial] = (target, fb)
         return hit[1]
 
@@ -113,11 +113,11 @@ class SizedTargets:
             dev = self._r.dev
             first = len(self.objects)
             try:
-                self.pick_index = self._add(V.Image(dev, self.width, self.height, "r32ui",
+                self.pick_index = self.add(V.Image(dev, self.width, self.height, "r32ui",
                                                     ("color", "transfer_src")))
-                self.pick_depth = self._add(V.Image(dev, self.width, self.height, "d32f",
+                self.pick_depth = self.add(V.Image(dev, self.width, self.height, "d32f",
                                                     ("depth", "transfer_src")))
-                self.fb_pick = self._fb(self._r.cache.render_pass(RP_PICK), [self.pick_index, self.pick_depth])
+                self.fb_pick = self.framebuffer(self._r.cache.render_pass(RP_PICK), [self.pick_index, self.pick_depth])
             except BaseException:
                 for o in reversed(self.objects[first:]):
                     o.destroy()
@@ -179,7 +179,7 @@ class SplatTargets(SizedTargets):
         width, height = self.width, self.height
 
         def img(fmt, usage):
-            return self._add(V.Image(dev, width, height, fmt, usage))
+            return self.add(V.Image(dev, width, height, fmt, usage))
 
         self.depth = img("d32f", ("depth", "transfer_src"))
         # storage: the compute rasterizer's copy pass writes them (splatedit.render.compute_raster)
@@ -190,9 +190,9 @@ class SplatTargets(SizedTargets):
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
         rp_depth = r.cache.render_pass(RP_DEPTH)
         rp_attr_pass = r.cache.render_pass(rp_attr(r.accum_format, "shader_read"))
-        self.fb_depth = self._fb(rp_depth, [self.depth])
-        self.fb_attr = self._fb(rp_attr_pass, [self.accum_color, self.accum_normal, self.depth])
-        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(RESOLVE_SET)))
+        self.fb_depth = self.framebuffer(rp_depth, [self.depth])
+        self.fb_attr = self.framebuffer(rp_attr_pass, [self.accum_color, self.accum_normal, self.depth])
+        self.resolve_set = self.add(V.DescriptorSet(dev, r.cache.set_layout(RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
 
 

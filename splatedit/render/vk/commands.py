@@ -39,7 +39,7 @@ class CommandBuffer:
             self.handle = handle
             return
         d = device.device
-        info = vk.VkCommandBufferAllocateInfo(commandPool=device._pool,
+        info = vk.VkCommandBufferAllocateInfo(commandPool=device.command_pool,
                                               level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
                                               commandBufferCount=1)
         self.handle = call(vk.vkAllocateCommandBuffers, d, info)[0]
@@ -77,7 +77,7 @@ class CommandBuffer:
             track("fence", -1)
             self._fence = None
         if self.handle is not None:
-            vk.vkFreeCommandBuffers(d, self.dev._pool, 1, [self.handle])
+            vk.vkFreeCommandBuffers(d, self.dev.command_pool, 1, [self.handle])
             track("command_buffer", -1)
             self.handle = None
 

@@ -194,7 +194,8 @@ class Device:
         self.instance = None
         self.device = None
         self._messenger = None
-        self._pool = None
+        #: the device's command pool (command buffers are allocated from it)
+        self.command_pool = None
         self._closed = False
         if validation is None:
             validation = validation_enabled()
@@ -314,7 +315,7 @@ class Device:
         pinfo = vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
             queueFamilyIndex=self.queue_family)
-        self._pool = call(vk.vkCreateCommandPool, self.device, pinfo, None)
+        self.command_pool = call(vk.vkCreateCommandPool, self.device, pinfo, None)
         track("command_pool", 1)
 
     def _atomic_features(self) -> bool:
@@ -385,10 +386,10 @@ class Device:
                 vk.vkDeviceWaitIdle(self.device)
             except Exception:
                 pass
-            if self._pool is not None:
-                vk.vkDestroyCommandPool(self.device, self._pool, None)
+            if self.command_pool is not None:
+                vk.vkDestroyCommandPool(self.device, self.command_pool, None)
                 track("command_pool", -1)
-                self._pool = None
+                self.command_pool = None
             vk.vkDestroyDevice(self.device, None)
             track("device", -1)
             self.device = None

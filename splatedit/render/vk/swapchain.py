@@ -148,7 +148,7 @@ class SwapchainPresenter:
     def _create_sync(self) -> None:
         d = self.device
         self._cmd = call(vk.vkAllocateCommandBuffers, d, vk.VkCommandBufferAllocateInfo(
-            commandPool=self.dev._pool, level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+            commandPool=self.dev.command_pool, level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
             commandBufferCount=1))[0]
         track("command_buffer", 1)
         self._fence = call(vk.vkCreateFence, d,
@@ -490,7 +490,7 @@ class SwapchainPresenter:
                 track("fence", -1)
                 self._fence = None
             if self._cmd is not None:
-                vk.vkFreeCommandBuffers(d, dev._pool, 1, [self._cmd])
+                vk.vkFreeCommandBuffers(d, dev.command_pool, 1, [self._cmd])
                 track("command_buffer", -1)
                 self._cmd = None
             if self.swapchain is not None:
