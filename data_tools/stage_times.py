@@ -21,7 +21,7 @@ import time
 import numpy as np
 
 import splatedit
-from splatedit.app.bench import bunny_surface_cloud
+from splatedit.bench.editor import bunny_surface_cloud
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.pca import morton_order
 from splatedit.deform.basis import DeformationBasis

@@ -6,8 +6,8 @@ current folder); docs/gaussians.md explains the renderer."""
 from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.data import default_model_path
 from splatedit.io import read
-from splatedit.render.gaussians import GaussianRenderer
-from splatedit.render.gs_headless import default_camera, render_gaussians_to_png
+from splatedit.render.gaussian.renderer import GaussianRenderer
+from splatedit.render.gaussian.headless import default_camera, render_gaussians_to_png
 
 scene = gaussians_from_splats(read(default_model_path()))    # synthetic Gaussians on the bunny's splats
 with GaussianRenderer() as r:                  # sort="gpu": the GPU radix sort; path="compute": the tile rasterizer

@@ -15,7 +15,7 @@ import time
 
 import numpy as np
 
-from splatedit.app.session import Session
+from splatedit.app.document.session import Session
 
 
 def rig(cloud, frac=1 / 3):
@@ -36,7 +36,7 @@ def posed(cloud, method):
     return s, int(sup.sum())
 
 def one(cloud, label, method="auto"):
-    from splatedit.app.commit_job import estimate_ms
+    from splatedit.app.document.commit_job import estimate_ms
     s, sup = posed(cloud, method)
     est = estimate_ms(cloud, sup)
     s.commit(); s.close()                    # warm-up (first-call imports)
@@ -57,10 +57,10 @@ if which == "bunny":
     from splatedit.data import default_model_path
     one(read(default_model_path()), "bundled bunny")
 elif which == "big":
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     one(bunny_surface_cloud(1_000_000), "bunny resampled, splats", "iqr")
 elif which == "gs":
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.bench.gs_scenes import gaussians_from_splats
-    from splatedit.app.gaussian_doc import gaussian_document
+    from splatedit.app.document.gaussian import gaussian_document
     one(gaussian_document(gaussians_from_splats(bunny_surface_cloud(100_000))), "3DGS (bunny resampled, SH 3)")

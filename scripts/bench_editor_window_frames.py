@@ -60,7 +60,7 @@ def _model(spec: str, folder: Path) -> Path:
     n = int(float(spec))
     path = folder / f"bench_fps_bunny{n}.ply"
     if not path.exists():
-        from splatedit.app.bench import bunny_surface_cloud
+        from splatedit.bench.editor import bunny_surface_cloud
         from splatedit.io import write
         write(path, bunny_surface_cloud(n))
     return path

@@ -17,7 +17,7 @@ from splatedit.data import default_model_path  # noqa: E402
 from splatedit.deform.rotation import HandleRotation, RotationDisplacement  # noqa: E402
 from splatedit.io import read  # noqa: E402
 from splatedit.render.gpu_units import pack_deform_block  # noqa: E402
-from splatedit.render.gs_resources import pack_geometry  # noqa: E402
+from splatedit.render.gaussian.resources import pack_geometry  # noqa: E402
 from splatedit.render.uniforms import GS_FRAME_UBO, SPLAT_GEOM  # noqa: E402
 
 

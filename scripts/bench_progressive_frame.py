@@ -16,10 +16,10 @@ import time
 
 
 def measure(n: int, size: tuple[int, int], chunks: list[int], repeats: int, vertex: bool) -> dict:
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.render.camera import Camera
-    from splatedit.render.progressive import ProgressiveFrame
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.progressive import ProgressiveFrame
+    from splatedit.render.splat.renderer import Renderer
     cloud = bunny_surface_cloud(n)
     w, h = size
     cam = Camera.frame(*cloud.bounds(), aspect=w / h, direction=(0.3, 0.4, 1.0))

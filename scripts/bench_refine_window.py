@@ -69,7 +69,7 @@ def _wait(path: Path, cond, timeout: float, proc=None) -> dict:
 
 
 def measure(n: int, size: tuple[int, int], folder: Path, display: str, mode: str) -> dict:
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.io import write
     model = folder / f"refine_bench_{n}.ply"
     if not model.exists():

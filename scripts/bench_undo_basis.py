@@ -2,8 +2,8 @@
 
 Run from the repository root: `.venv/bin/python scripts/bench_undo_basis.py` (docs/PERFORMANCE.md)."""
 import time, numpy as np
-from splatedit.app.session import Session, GRAB, ViewInfo
-from splatedit.app.bench import bunny_surface_cloud
+from splatedit.app.document.session import Session, GRAB, ViewInfo
+from splatedit.bench.editor import bunny_surface_cloud
 from splatedit.io import read
 from splatedit.data import default_model_path
 from splatedit.select.selection import SUPPORT, HANDLE

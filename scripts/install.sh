@@ -4,7 +4,7 @@
 #   glslang (shader compiler, for the SPIR-V staleness test), the Khronos
 #   validation layer (the test suite runs with it on), Xvfb + xdotool (window
 #   tests) and the DejaVu fonts (editor overlay).
-#   Python: this package and its test extras from PyPI, at the exact versions
+#   Python: this package and its test and docs extras from PyPI, at the exact versions
 #   of constraints.txt.
 #   Node.js (Debian's nodejs + npm when no node is on PATH) and PlayCanvas's
 #   splat-transform into ./.node: the independent reader of our Gaussian PLYs
@@ -38,7 +38,7 @@ fi
 # update them on purpose.
 export PIP_CONSTRAINT="$PWD/constraints.txt"
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q -e '.[test]'
+.venv/bin/python -m pip install -q -e '.[test,docs]'
 unset PIP_CONSTRAINT
 
 splat_transform_version=2.7.1

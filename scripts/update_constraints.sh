@@ -13,7 +13,7 @@ scratch=$(mktemp -d)
 trap 'rm -rf "$scratch"' EXIT
 python3 -m venv "$scratch/venv"
 "$scratch/venv/bin/python" -m pip install -q --upgrade pip setuptools
-"$scratch/venv/bin/python" -m pip install -q -e '.[test]'
+"$scratch/venv/bin/python" -m pip install -q -e '.[test,docs]'
 echo "update_constraints: newest allowed versions:"
 "$scratch/venv/bin/python" -m pip freeze --exclude-editable | sed 's/^/  /'
 if ! "$scratch/venv/bin/python" -m pytest -q -p no:cacheprovider; then

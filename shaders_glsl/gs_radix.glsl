@@ -1,5 +1,5 @@
 // Device-wide LSD radix sort of (key, value) uint pairs, 8-bit digits
-// (splatedit/render/gpu_sort.py): per pass an upsweep (per-block digit
+// (splatedit/render/gaussian/gpu_sort.py): per pass an upsweep (per-block digit
 // histograms), a scan (per digit over the blocks, reduce-then-scan: one
 // workgroup per digit) and a stable scatter (local ranks in the block).
 // The element count is read on the GPU (gs_radix_setup.comp writes it and the

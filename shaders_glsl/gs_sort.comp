@@ -1,7 +1,7 @@
 #version 450
 // One compare-exchange step (k, j) of a bitonic sort of (keys, values) in
 // ascending key order, sort length n a power of two (the sort the radix sort
-// replaced; splatedit/render/gpu_sort.py keeps it for comparison).
+// replaced; splatedit/render/gaussian/gpu_sort.py keeps it for comparison).
 
 layout(local_size_x = 256) in;
 layout(push_constant) uniform Push { uint k; uint j; uint n; } P;

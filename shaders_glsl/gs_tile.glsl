@@ -1,4 +1,4 @@
-// Gaussian splatting, compute tile rasterizer (splatedit/render/gs_tiles.py):
+// Gaussian splatting, compute tile rasterizer (splatedit/render/gaussian/tiles.py):
 // set 1 of its passes.  After the depth sort (order[0, n visible) front to
 // back), every visible Gaussian emits one (tile id, Gaussian) pair per
 // TILE x TILE tile its ellipse of alpha >= floor touches, in depth order (a
@@ -6,7 +6,7 @@
 // slots); a stable radix sort by tile id keeps depth order inside a tile; the
 // ranges pass finds each tile's run of pairs; one workgroup per tile blends
 // its Gaussians front to back (gs_tile_blend.glsl).  The layout is TILE_SET in
-// gs_tiles.py, the push constants TILE_PUSH in splatedit/render/uniforms.py.
+// gaussian/tiles.py, the push constants TILE_PUSH in splatedit/render/uniforms.py.
 
 const uint TILE = 16u;
 const uint TBLOCK = 2048u;           // visible Gaussians per scan workgroup (256 x 8)

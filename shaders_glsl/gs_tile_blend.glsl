@@ -3,7 +3,7 @@
 // shared memory in batches of 256; each pixel sums C += T alpha c, T *= 1 -
 // alpha with the quad path's alpha (gs.frag: min(ceiling, opacity exp(power)),
 // skipped below the floor) and stops before the Gaussian that would take T
-// below t_min (the 3DGS reference's rule, gaussians_reference.py); the
+// below t_min (the 3DGS reference's rule, gaussian/reference.py); the
 // workgroup stops when every pixel has.  It stores (C, 1 - T) into the
 // accumulator that gs_resolve.frag reads (the quad path's premultiplied
 // colour and alpha).  Define ACCUM_FORMAT (rgba16f / rgba32f) before the include.

@@ -1,5 +1,5 @@
 // Compute rasterizer of EWA splats (the compute path of the splat renderer,
-// splatedit/render/compute_raster.py): it draws the pre-pass records
+// splatedit/render/splat/compute_raster.py): it draws the pre-pass records
 // (prepare_cs.glsl) that the raster path draws with prepared.vert, with the
 // same per-pixel test (splat_pixel.glsl).  The including file defines
 // CRAST_PASS:

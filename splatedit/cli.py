@@ -22,7 +22,7 @@ from pathlib import Path
 # 10M-splat read.  Set before numpy is imported (the user's setting wins)
 os.environ.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
 
-from splatedit.app.options import join_negative_values, parse_size, positive_float
+from splatedit.app.ui.options import join_negative_values, parse_size, positive_float
 from splatedit.bench.runner import BENCHES
 from splatedit.commands.edits import cmd_convert, cmd_deform
 from splatedit.commands.info import cmd_info
@@ -91,23 +91,25 @@ def _positive_count(text: str) -> int:
 
 # ------------------------------------------------------------------ commands
 def cmd_demo(args) -> int:
-    from splatedit.demo import run_demo
+    """Run ``splatedit demo``: the headless tour into ``args.output_dir``; returns the exit status."""
+    from splatedit.commands.demo import run_demo
     run_demo(Path(args.output_dir), progress=args.progress, log=print, render=not args.no_render,
              overwrite=args.force)
     return 0
 
 
 def cmd_edit(args) -> int:
+    """Run ``splatedit edit``: check the paths first, then open the editor window; returns the exit status."""
     check_edit_paths(args.file, args.save_as)       # before the editor opens a window
     from splatedit.app.editor import run_editor
-    from splatedit.app.options import options_from_args
+    from splatedit.app.ui.options import options_from_args
     return run_editor(args.file, **options_from_args(args))
 
 
 def check_edit_paths(model, save_as) -> None:
     """The checks ``splatedit edit`` makes before any window, the same the
     other commands make: the model must be a readable regular file of a known
-    format (:func:`splatedit.app.files.check_model_file`: a FIFO is refused
+    format (:func:`splatedit.app.document.files.check_model_file`: a FIFO is refused
     by stat, never opened, as opening it blocks until a writer comes), and
     ``--save-as`` a writable target of a format the editor writes (its
     folder exists; it may replace an older save).
@@ -117,7 +119,7 @@ def check_edit_paths(model, save_as) -> None:
     """
     from splatedit.io import WRITE_EXTENSIONS, check_output_path
     if model is not None:
-        from splatedit.app.files import check_model_file
+        from splatedit.app.document.files import check_model_file
         check_model_file(model)
     if save_as:
         try:
@@ -148,6 +150,7 @@ def _fresh_directory(base: Path) -> Path:
 
 
 def cmd_bench(args) -> int:
+    """Run ``splatedit bench WHAT``: one JSON line per benchmark case on stdout; returns the exit status."""
     from splatedit.bench.runner import run_bench
     what = args.what
     if args.gaussians:
@@ -182,6 +185,7 @@ class _Parser(argparse.ArgumentParser):
 
 
 def build_parser() -> argparse.ArgumentParser:
+    """The ``splatedit`` argument parser with every subcommand (its errors follow the one-line error contract)."""
     p = _Parser(prog="splatedit", description=__doc__.split("\n")[0])
     p.add_argument("--quiet", "-q", action="store_true", help="no progress bars")
     sub = p.add_subparsers(dest="command")
@@ -251,7 +255,7 @@ def build_parser() -> argparse.ArgumentParser:
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 
-    from splatedit.app.options import CONTROLS, add_arguments
+    from splatedit.app.ui.options import CONTROLS, add_arguments
     s = sub.add_parser("edit", help="interactive editor (a window; F1 in it lists the controls)",
                        epilog=CONTROLS, formatter_class=argparse.RawDescriptionHelpFormatter)
     add_arguments(s)
@@ -293,6 +297,8 @@ def _route_warnings(progress: _Progress) -> None:
 
 
 def main(argv: list[str] | None = None) -> int:
+    """The console entry point: parse ``argv`` (default ``sys.argv[1:]``), run the command, map errors to one
+    ``splatedit: error: ...`` line and exit status 2; returns the exit status."""
     parser = build_parser()
     args = parser.parse_args(join_negative_values(sys.argv[1:] if argv is None else list(argv), VECTOR_OPTIONS))
     args.progress = _Progress(enabled=not args.quiet)

@@ -39,7 +39,8 @@ def _requirement_names(reqs: list[str]) -> set[str]:
 
 def test_constraints_pin_every_runtime_and_test_dependency():
     project = tomllib.loads((REPO_ROOT / "pyproject.toml").read_text())["project"]
-    needed = _requirement_names(project["dependencies"] + project["optional-dependencies"]["test"])
+    needed = _requirement_names(project["dependencies"] + project["optional-dependencies"]["test"]
+                               + project["optional-dependencies"]["docs"])
     missing = needed - set(_pins())
     assert not missing, f"constraints.txt does not pin {sorted(missing)}"
 

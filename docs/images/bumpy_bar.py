@@ -23,7 +23,7 @@ from splatedit.deform.modes import DeformationMode
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.estimate import estimate_splats
 from splatedit.render.camera import Camera
-from splatedit.render.headless import render_to_png
+from splatedit.render.splat.headless import render_to_png
 
 HEIGHT, WIDTH = 0.2, 0.12          # bump height and Gaussian width (model units)
 DEGREES = 120.0                    # the bend

@@ -2,7 +2,7 @@
 
 An object the :class:`~splatedit.app.editor.Editor` owns (``editor.crash_guard``).  The loop
 dispatches work in a few places -- each window event
-(:meth:`~splatedit.app.routing.EventRouter.handle_events`), the landing of
+(:meth:`~splatedit.app.ui.routing.EventRouter.handle_events`), the landing of
 finished jobs (load, save, levels of detail, graph), the session's poll
 (fits and background commits landing), each frame (scene, GUI and its
 buttons' actions, present) and the status file -- and each runs inside
@@ -13,7 +13,7 @@ handled where they arise) is a bug; the guard
 * prints its traceback on stderr,
 * cancels a running G/R/S move and drag (they may be half done; the
   document is not touched: every document change is one history step),
-* writes a recovery entry (:mod:`splatedit.app.recovery`) when there are
+* writes a recovery entry (:mod:`splatedit.app.document.recovery`) when there are
   unsaved edits (once per history state),
 * shows the error box: what failed, that the document is kept and where
   the recovery copy is.
@@ -32,7 +32,8 @@ import sys
 import traceback
 from pathlib import Path
 
-from splatedit.app import recovery, revision
+from splatedit.app.document import recovery
+from splatedit.app.document import revision
 from splatedit.app.tools.base import DragMode
 from splatedit.errors import SplatEditError
 

@@ -2,20 +2,20 @@
 
 A glfw window presenting through a Vulkan swapchain
 (:mod:`splatedit.render.vk.swapchain`); frames come from the EWA splat
-renderer (:mod:`splatedit.app.viewport`) scheduled by
-:class:`~splatedit.app.frames.FrameScheduler`; with the Dear ImGui interface
-(:mod:`splatedit.app.gui_panels`: menu bar, panels, help) they stay on the
+renderer (:mod:`splatedit.app.view.viewport`) scheduled by
+:class:`~splatedit.app.view.frames.FrameScheduler`; with the Dear ImGui interface
+(:mod:`splatedit.app.ui.gui_panels`: menu bar, panels, help) they stay on the
 presenter's device and the GUI and the tools' overlays are drawn over them on
 the GPU; without it (``SPLATEDIT_GUI=0`` or a surface that cannot be a blit
-target) the overlay is composited on the CPU (:mod:`splatedit.app.overlay`).  Loading, fitting and saving run in
+target) the overlay is composited on the CPU (:mod:`splatedit.app.ui.overlay`).  Loading, fitting and saving run in
 worker threads; the loop polls them and stays responsive.
 
 The :class:`Editor` is a thin loop: window events go to the tools
 (:mod:`splatedit.app.tools`: camera, brush, gizmo, curve) through the event
-routing (:mod:`splatedit.app.routing`), keys are looked
-up in the one keymap (:mod:`splatedit.app.keymap`, which also generates the
+routing (:mod:`splatedit.app.ui.routing`), keys are looked
+up in the one keymap (:mod:`splatedit.app.ui.keymap`, which also generates the
 help and the manual's controls list) and run the bound action; each tool draws
-its overlay.  Files (:mod:`splatedit.app.files`): Ctrl+O shows the file
+its overlay.  Files (:mod:`splatedit.app.document.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
 dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) ``open_dialog``,
 ``open_path`` and ``recent_files`` are the API a GUI
@@ -33,22 +33,22 @@ import threading
 import time
 from pathlib import Path
 
-from splatedit.app.brush import ViewPicking
+from splatedit.app.tools.pick_brush import ViewPicking
 from splatedit.app.crash_guard import CrashGuard
-from splatedit.app.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
-from splatedit.app.files import default_save_path as _default_save_path  # noqa: F401 (API)
+from splatedit.app.document.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
+from splatedit.app.document.files import default_save_path as _default_save_path  # noqa: F401 (API)
 from splatedit.app.file_actions import FileActions
-from splatedit.app.frames import FrameScheduler
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.jobs import Job
-from splatedit.app.keymap import Action
-from splatedit.app.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.panel import PANEL_MARGIN, HelpView, compose_overlay
-from splatedit.app.selection_tools import SelectionTools
-from splatedit.app.session import Session
-from splatedit.app.status import StatusWriter
-from splatedit.app.recent import RecentFiles
-from splatedit.app.routing import HELP_WHEEL_LINES, EventRouter  # noqa: F401 (API)
+from splatedit.app.view.frames import FrameScheduler
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.jobs import Job
+from splatedit.app.ui.keymap import Action
+from splatedit.app.ui.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
+from splatedit.app.ui.panel import PANEL_MARGIN, HelpView, compose_overlay
+from splatedit.app.document.selection import SelectionTools
+from splatedit.app.document.session import Session
+from splatedit.app.ui.status import StatusWriter
+from splatedit.app.ui.recent import RecentFiles
+from splatedit.app.ui.routing import HELP_WHEEL_LINES, EventRouter  # noqa: F401 (API)
 from splatedit.app.tools.base import DragMode, free_area
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
@@ -67,7 +67,7 @@ class Editor:
 
     It owns its parts and delegates to them: :attr:`routing` (window events
     to the GUI, the questions and the tools; keys through the keymap,
-    :class:`~splatedit.app.routing.EventRouter`), :attr:`file_actions`
+    :class:`~splatedit.app.ui.routing.EventRouter`), :attr:`file_actions`
     (load / open / save / export / quit,
     :class:`~splatedit.app.file_actions.FileActions`), the tools
     (:mod:`splatedit.app.tools`), the frame scheduler and the crash guard.
@@ -94,12 +94,12 @@ class Editor:
         self.window = Window("splatedit", *size)
         try:
             self.presenter = SwapchainPresenter(self.window.handle, vsync=vsync)
-            from splatedit.app.viewport import Viewport
+            from splatedit.app.view.viewport import Viewport
             pres = self.presenter
             if pres.gpu_targets and pres.can_blit and os.environ.get("SPLATEDIT_GUI", "1") != "0":
                 # GPU path: one device renders, draws the GUI and presents (no readback)
-                from splatedit.app.gui_panels import EditorGui
-                from splatedit.render.renderer import Renderer
+                from splatedit.app.ui.gui_panels import EditorGui
+                from splatedit.render.splat.renderer import Renderer
                 self.viewport = Viewport(budget_ms=self.frames.moving_budget_ms, renderer=Renderer(device=pres.dev))
                 self.gui = EditorGui(self, pres.dev)
             else:       # CPU fallback: frames read back, overlay blended on the CPU
@@ -118,7 +118,7 @@ class Editor:
         #: the central exception guard, recovery copies and the restore question
         #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
         self.crash_guard = CrashGuard(self)
-        #: window events and key actions (:class:`~splatedit.app.routing.EventRouter`)
+        #: window events and key actions (:class:`~splatedit.app.ui.routing.EventRouter`)
         self.routing = EventRouter(self)
         #: the File menu API (:class:`~splatedit.app.file_actions.FileActions`)
         self.file_actions = FileActions(self)
@@ -156,9 +156,9 @@ class Editor:
             self.frames = FrameScheduler(self, 100.0)
         self.debug_enabled = os.environ.get("SPLATEDIT_EDITOR_DEBUG", "") not in ("", "0")
         #: the neighbour graphs of the document's clouds (built in the background) and
-        #: the closure of selection edits (:class:`~splatedit.app.selection_tools.SelectionTools`)
+        #: the closure of selection edits (:class:`~splatedit.app.document.selection.SelectionTools`)
         self.selection_tools = SelectionTools(self.start_graph_job)
-        #: the pick map of the current view (:class:`~splatedit.app.brush.ViewPicking`)
+        #: the pick map of the current view (:class:`~splatedit.app.tools.pick_brush.ViewPicking`)
         self.picking = ViewPicking(self)
         # tools: press order (after every tool's press_modal)
         self.camera = CameraTool(self)
@@ -301,7 +301,7 @@ class Editor:
 
     def run_action(self, action: Action) -> None:
         """Run the handler bound to ``action`` (keys and GUI buttons share it;
-        :meth:`~splatedit.app.routing.EventRouter.run_action`)."""
+        :meth:`~splatedit.app.ui.routing.EventRouter.run_action`)."""
         self.routing.run_action(action)
 
     def finish_manip(self) -> None:
@@ -313,7 +313,7 @@ class Editor:
     # -------------------------------------------------------------- overlay
     def overlay_shapes(self, w: int, h: int) -> list:
         """Every tool's overlay shapes of a ``w`` x ``h`` frame
-        (:mod:`splatedit.app.shapes`), in tool order (none without a model);
+        (:mod:`splatedit.app.tools.shapes`), in tool order (none without a model);
         the GPU path and the CPU fallback paint this one list."""
         if self.session is None:
             return []
@@ -479,7 +479,7 @@ def run_editor(path=None, **options) -> int:
     if options.get("status_file") is None and os.environ.get("SPLATEDIT_EDITOR_STATUS"):
         options["status_file"] = os.environ["SPLATEDIT_EDITOR_STATUS"]
     check_model_file(path)      # before any window: a bad path is one error line, exit 2
-    from splatedit.app.frames import refine_above_ms
+    from splatedit.app.view.frames import refine_above_ms
     refine_above_ms()           # so is a bad SPLATEDIT_REFINE_ABOVE_MS
     if options.get("save_as") and save_refusal(options["save_as"], path):
         raise ParameterError("--save-as", f"{options['save_as']} is the model being edited; "

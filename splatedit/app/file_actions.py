@@ -6,7 +6,7 @@ An owned part of :class:`~splatedit.app.editor.Editor`
 (``editor.file_actions``, a :class:`FileActions`; the state it uses --
 ``path``, ``jobs``, ``prompt``, ``confirm_quit``, ``saved_path`` ... -- is the
 editor's, read by the panels and the status file).  The work
-itself (worker jobs, checks, error boxes) is in :mod:`splatedit.app.files`;
+itself (worker jobs, checks, error boxes) is in :mod:`splatedit.app.document.files`;
 these are the entry points keys, the GUI's File menu and drops call.
 """
 
@@ -14,7 +14,7 @@ from __future__ import annotations
 
 from pathlib import Path
 
-from splatedit.app import files
+from splatedit.app.document import files
 from splatedit.errors import SplatEditError
 
 
@@ -109,7 +109,7 @@ class FileActions:
         return self.ed.save_as
 
     def save(self, path: Path) -> None:
-        """Save the edited model to ``path`` in the background (:func:`splatedit.app.files.save`)."""
+        """Save the edited model to ``path`` in the background (:func:`splatedit.app.document.files.save`)."""
         files.save(self.ed, path)
 
     def save_edits(self) -> None:

@@ -104,7 +104,7 @@ class _Stages:
 def support_scene(support_splats: int):
     """``(cloud, support, handle)`` of the bench: the bunny with about
     ``support_splats`` support splats (Morton order)."""
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.model.cloud import SplatCloud
     from splatedit.model.pca import morton_order
 

@@ -2,7 +2,7 @@
 (``--splats N ...`` for other sizes).
 
 The scene is the bundled bunny resampled to ``n`` surface splats
-(:func:`splatedit.app.bench.bunny_surface_cloud`).  The selection is a user's
+(:func:`splatedit.bench.editor.bunny_surface_cloud`).  The selection is a user's
 first strokes from one view (:func:`splatedit.select.view.one_view_disc`,
 visible-only) over the tall ear, closed once; then one more stroke (a dab of
 the same brush further down the ear, a thin part, or on the flank the view
@@ -82,7 +82,7 @@ def _best(fn, repeats: int) -> tuple[float, object]:
 
 def bench_closure(counts=(100_000, 1_000_000), repeats: int = 3):
     """Yield one dict per model size (see the module docstring)."""
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     for n in counts:
         cloud = bunny_surface_cloud(n)
         pos = cloud.positions

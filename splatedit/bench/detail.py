@@ -79,7 +79,7 @@ def bench_detail(sizes=((300, 300), (1000, 1000)), repeats: int = 3, gpu: bool =
 
 def _prepass_ms(cloud, basis, dc, repeats):
     from splatedit.render.camera import Camera
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     with Renderer() as r:
         r.set_cloud(cloud)
         r.set_basis(*basis.rows_for_gpu())

@@ -22,7 +22,7 @@ from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.errors import ParameterError
 from splatedit.bench.render import smooth_basis, load_average, turned_handle_displacement, sphere_cloud
 from splatedit.render.camera import Camera
-from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
+from splatedit.render.gaussian.renderer import GaussianRenderer, gaussian_bounds
 
 
 def _frames(r: GaussianRenderer, cam, w, h, repeats) -> dict:
@@ -67,7 +67,7 @@ def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int 
     * a count the device cannot hold (lavapipe: above 2,097,152) gives one
       line with ``skipped`` (the reason) instead of its cases.
     """
-    from splatedit.render.gaussians import choose_path, choose_sort
+    from splatedit.render.gaussian.renderer import choose_path, choose_sort
     w, h = size
     for n in counts:
         g = gaussians_from_splats(sphere_cloud(int(n), overlap=1.0), seed=0)

@@ -20,7 +20,7 @@ import numpy as np
 
 from splatedit.bench.render import load_average
 from splatedit.render import vk as V
-from splatedit.render.gpu_sort import BitonicSort, RadixSort, default_scatter, subgroup_scatter_supported
+from splatedit.render.gaussian.gpu_sort import BitonicSort, RadixSort, default_scatter, subgroup_scatter_supported
 
 
 def _gpu_times(dev, record, restore, repeats: int) -> float:

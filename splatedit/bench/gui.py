@@ -14,7 +14,7 @@ issue 10's panels) over a ``size`` target, validation off:
 * ``clear_ms``: the same submission with an empty pass (clear only): the
   fixed cost of a submission, measured in the same run;
 * ``cpu_overlay_ms``: today's CPU path for a text panel of the same number
-  of lines (``splatedit.app.overlay.text_panel`` + ``blend`` into the frame),
+  of lines (``splatedit.app.ui.overlay.text_panel`` + ``blend`` into the frame),
   without the readback it also needs.
 
 Medians over ``repeats`` frames after warm-up.  The machine is shared: compare
@@ -64,7 +64,7 @@ def editor_panel(state: dict) -> int:
 
 def bench_gui(size=(1280, 720), repeats: int = 30) -> Iterator[dict]:
     from splatedit.render import vk as V
-    from splatedit.render.gui import Gui
+    from splatedit.render.gui.gui import Gui
     w, h = size
     dev = V.Device(validation=False)
     img = fb = gui = pool = None
@@ -129,7 +129,7 @@ def _cpu_overlay_ms(lines: int, w: int, h: int, repeats: int) -> float | None:
     """Median ms of today's CPU overlay for a panel of ``lines`` text lines
     (the panel image is cached by text, as in the editor: mostly the blend)."""
     try:
-        from splatedit.app import overlay
+        from splatedit.app.ui import overlay
     except ImportError:           # the editor package is optional for this comparison
         return None
     frame = np.zeros((h, w, 4), np.uint8)

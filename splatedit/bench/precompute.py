@@ -61,7 +61,7 @@ def grab_scene(splats: int, support: int):
     """``(cloud, support mask, handle mask)``: the bunny resampled to
     ``splats`` splats, the ``support`` splats nearest the ear tip, and the
     splats within 5% of the diagonal of the tip."""
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.model.cloud import SplatCloud
     from splatedit.model.pca import morton_order
 

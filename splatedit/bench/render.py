@@ -20,7 +20,7 @@ import numpy as np
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import Renderer
+from splatedit.render.splat.renderer import Renderer
 
 
 def fibonacci_sphere(n: int, start: int = 0, stop: int | None = None):

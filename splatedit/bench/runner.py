@@ -69,7 +69,7 @@ def _gpu_sort(quick: bool, progress=None, counts=None) -> Iterator[dict]:
 
 def _gaussian_editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
-        from splatedit.app.bench_gaussians import bench_gaussian_editor_frames
+        from splatedit.bench.editor_gaussians import bench_gaussian_editor_frames
     except ImportError:
         return
     yield from bench_gaussian_editor_frames(counts=counts or ((20_000, 100_000) if quick else (100_000, 1_000_000)),
@@ -78,13 +78,13 @@ def _gaussian_editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
 
 def _editor(quick: bool, progress=None, counts=None) -> Iterator[dict]:
     try:
-        from splatedit.app.bench import bench_editor_frames
+        from splatedit.bench.editor import bench_editor_frames
     except ImportError:
         return
     counts = counts or ((100_000,) if quick else (100_000, 1_000_000, 2_000_000))
     for line in bench_editor_frames(counts=[n for n in counts if n <= 2_000_000]):
         yield {"bench": "editor", **line}
-    from splatedit.app.bench import bench_editor_first_image
+    from splatedit.bench.editor import bench_editor_first_image
     for n in counts:
         yield {"bench": "editor", **bench_editor_first_image(int(n))}
 
@@ -230,7 +230,7 @@ def _tiny_render():
 
 
 def _tiny_editor():
-    from splatedit.app.bench import bench_editor_first_image, bench_editor_frames
+    from splatedit.bench.editor import bench_editor_first_image, bench_editor_frames
     for line in bench_editor_frames(counts=(4000,), size=(96, 64), frames=2):
         yield {"bench": "editor", **line}
     yield {"bench": "editor", **bench_editor_first_image(4000, size=(96, 64), frames=2)}
@@ -273,7 +273,7 @@ def _tiny_gaussian_render():
 
 
 def _tiny_gaussian_editor():
-    from splatedit.app.bench_gaussians import bench_gaussian_editor_frames
+    from splatedit.bench.editor_gaussians import bench_gaussian_editor_frames
     yield from bench_gaussian_editor_frames(counts=(2000,), size=(96, 64), frames=2)
 
 

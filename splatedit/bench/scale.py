@@ -23,7 +23,7 @@ import time
 from splatedit.bench.render import sphere_cloud
 from splatedit.model.lod import LodPyramid
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import Renderer
+from splatedit.render.splat.renderer import Renderer
 
 
 def bench_upload_lod(n: int, size=(1280, 720), cloud=None) -> dict:

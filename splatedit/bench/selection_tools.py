@@ -30,7 +30,7 @@ import numpy as np
 def run(n: int, seed: int = 0) -> dict:
     from scipy.spatial import cKDTree
 
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     from splatedit.app.tools.region import polygon_mask, splats_through
     from splatedit.select.mirror import mirror_indices, plane_centre, reflect
     from splatedit.tolerances import MIRROR_MATCH_SPACINGS

@@ -112,7 +112,7 @@ def render_figures(out_dir, cloud, basis, moves, size=(480, 480)) -> list:
     from pathlib import Path
 
     from splatedit.render.camera import Camera
-    from splatedit.render.headless import render_to_png
+    from splatedit.render.splat.headless import render_to_png
     out_dir = Path(out_dir)
     out_dir.mkdir(parents=True, exist_ok=True)
     cam = Camera((0.2, 3.2, 0.45), (0.2, 0.0, 0.45), up=(0.0, 0.0, 1.0), fov_deg=30.0)

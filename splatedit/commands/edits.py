@@ -12,6 +12,8 @@ from splatedit.errors import ParameterError
 
 
 def cmd_convert(args) -> int:
+    """Run ``splatedit convert``: one file (format change, normals, sizes, outlier removal) or, for a folder
+    or glob, a batch on Dask; returns the exit status."""
     from splatedit.commands.batch import cmd_convert_batch, is_batch_input
     if is_batch_input(args.input):
         return cmd_convert_batch(args)
@@ -100,6 +102,8 @@ def _run_edits(args, cloud, script_path):
 
 
 def cmd_deform(args) -> int:
+    """Run ``splatedit deform``: apply an edit script to a model and write the result (never over the
+    input unless asked); returns the exit status."""
     from splatedit.io import check_output_path, check_readable_file, is_gaussian_file, read, write
     check_output_path(args.output, overwrite=args.force, protect=args.input)
     check_readable_file(args.edit)
@@ -116,7 +120,7 @@ def cmd_deform(args) -> int:
 def _deform_gaussians(args) -> int:
     """``deform`` of a Gaussian scene: edits select centres; covariances and
     spherical harmonics follow the Jacobian; the output is a Gaussian PLY."""
-    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.script.gaussian import run_script_gaussians
     from splatedit.io import read_gaussians, write_gaussians
     from splatedit.script import load_script
     if Path(args.output).suffix.lower() != ".ply":

@@ -63,8 +63,10 @@ def _clip_to_main_body(camera, extent) -> None:
 
 
 def cmd_render(args) -> int:
+    """Run ``splatedit render``: draw a model (optionally after an edit script) headless into a PNG;
+    returns the exit status."""
     from splatedit.io import check_output_path
-    from splatedit.render.headless import check_render_memory, render_to_png
+    from splatedit.render.splat.headless import check_render_memory, render_to_png
     if args.buffers is not None and Path(args.buffers).resolve() == Path(args.output).resolve():
         raise ParameterError("--buffers", "must differ from the PNG path (-o)")
     check_render_memory(args.size, args.buffers is not None)    # before reading anything
@@ -138,7 +140,7 @@ def _render_gaussians(args, cloud) -> int:
     edit script's single edit fitted on the Gaussians' splat proxy and applied
     on the GPU (centres, covariances, SH frames)."""
     import numpy as np
-    from splatedit.render.gs_headless import render_gaussians_to_png
+    from splatedit.render.gaussian.headless import render_gaussians_to_png
     if args.buffers is not None:
         raise ParameterError("--buffers", "is not available for Gaussian splatting scenes")
     proxy = cloud.proxy_splats()
@@ -160,7 +162,7 @@ def _render_gaussians(args, cloud) -> int:
         if not gpu_can_draw(basis_rows, d_c):
             # the Gaussian GPU pass draws a plain dC only: a turning handle (rotation mode) or the
             # detail mode is applied on the CPU as `splatedit deform` does, then drawn undeformed
-            from splatedit.gaussian_script import run_script_gaussians
+            from splatedit.script.gaussian import run_script_gaussians
             cloud, _ = run_script_gaussians(cloud, load_script(args.edit), source=str(args.edit),
                                             progress=args.progress)
             basis_rows = d_c = None

@@ -72,7 +72,8 @@ from scipy.spatial import cKDTree
 from scipy.spatial.transform import Rotation
 
 from splatedit.deform.curves import ControlCurve, catmull_rom_weights, segment_index
-from splatedit.deform.rotation import RotationDisplacement, blend_terms, handle_blocks
+from splatedit.deform.modes import DeformationMode
+from splatedit.deform.rotation import HandleRotation, RotationDisplacement, blend_terms, handle_blocks
 from splatedit.deform.rotation_centre import rotation_displacement
 from splatedit.tolerances import CURVE_FRAME_MIN_RAMP_SPACINGS
 

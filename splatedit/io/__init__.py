@@ -40,7 +40,7 @@ from pathlib import Path
 
 from splatedit.errors import InputError
 from splatedit.io._build import PointColumns, cloud_from_columns, columns_only
-from splatedit.io.atomic import atomic_open, check_writable_target
+from splatedit.atomic import atomic_open, check_writable_target
 from splatedit.io.e57 import split_scan_index
 from splatedit.io.formats import FORMATS, Format, by_extension, extensions, format_of
 from splatedit.io.gaussians import is_gaussian_ply, read_gaussian_ply, write_gaussian_ply
@@ -235,7 +235,7 @@ def _up_comment(up_axis: str | None) -> str:
 
 def write(path, cloud: SplatCloud, *, overwrite: bool = False, binary: bool = True,
           axes: bool = True, progress=None, up_axis: str | None = None) -> Path:
-    """Save ``cloud`` atomically (:func:`splatedit.io.atomic.atomic_open`).
+    """Save ``cloud`` atomically (:func:`splatedit.atomic.atomic_open`).
 
     Args:
         path: target ``.ply`` (lossless), ``.xyz``, ``.off``, ``.las``,

@@ -88,6 +88,7 @@ def stored_origin(path) -> np.ndarray | None:
 
 
 def warn_trailing(path, what: str, nv: int, nf: int | None) -> None:
+    """Warn (``InputWarning``) that rows after the header's counts (``nv`` vertices, ``nf`` faces) were ignored."""
     counts = f"'vertex {nv}'" + ("" if nf is None else f" and 'face {nf}'")
     warnings.warn(InputWarning(f"{path}: {what} after the rows the header declares ({counts}) "
                                f"were ignored: is a count in the header wrong?"), stacklevel=3)

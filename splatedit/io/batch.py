@@ -278,6 +278,8 @@ def _neighbours(tiles: list[Tile]) -> list[list[tuple[int, np.ndarray, np.ndarra
 
 @dataclass
 class BatchOptions:
+    """How a batch conversion runs: outlier removal, overwriting, the Dask scheduler (``"local"`` or an
+    address), the worker count (None: one per core) and whether tiles share an overlap halo."""
     remove_outliers: bool = False
     overwrite: bool = False
     scheduler: str = DEFAULT_SCHEDULER

@@ -2,7 +2,7 @@
 
 The editor draws a 3DGS scene's *most important* Gaussians while the camera
 moves or a handle is dragged, as many as fit the frame budget, then all of
-them when motion stops (:class:`splatedit.app.viewport.Viewport`).
+them when motion stops (:class:`splatedit.app.view.viewport.Viewport`).
 
 Importance (view-independent) = opacity x sigma_1 sigma_2, the two largest
 standard deviations: proportional to the opacity-weighted area of the
@@ -113,7 +113,7 @@ class GaussianLod:
 def build_gaussian_lod(scene: GaussianCloud, progress=None) -> GaussianLod:
     """Rank ``scene``'s Gaussians by :func:`importance` (ties: lower index
     first), keeping the largest level's; ``progress(stage, fraction)`` as
-    :class:`splatedit.app.jobs.Job`'s (may raise to cancel)."""
+    :class:`splatedit.app.document.jobs.Job`'s (may raise to cancel)."""
     n = len(scene)
     if n == 0:
         raise ParameterError("scene", "has no Gaussians")

@@ -33,6 +33,7 @@ from splatedit.tolerances import (FRONT_VIEW_Z_UP_COS, UP_AXIS_ALIGNED_COS, UP_A
                                   UP_AXIS_TALL_Z_RATIO)
 
 class UpSource(enum.Enum):
+    """Where a model's up axis came from (shown to the user beside the axis)."""
     FILE_HEADER = "file header"
     FILE_FORMAT = "file format"
     GROUND = "ground normals"

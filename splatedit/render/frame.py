@@ -8,12 +8,12 @@ written by an earlier pass or is an input of the frame) and records the
 list with a GPU timestamp after every pass; :meth:`Frame.read_timings` sums
 them per timing bucket.
 
-The splat renderer's passes live in :mod:`splatedit.render.frame_passes`,
-the Gaussian renderer's in :mod:`splatedit.render.gs_passes`; the shading
+The splat renderer's passes live in :mod:`splatedit.render.splat.passes`,
+the Gaussian renderer's in :mod:`splatedit.render.gaussian.passes`; the shading
 pass :class:`Resolve` is shared (each renderer names its resolve shader and
 descriptor-set layout: ``resolve_shader``, ``resolve_set_layout``).
-Progressive refinement (:mod:`splatedit.render.progressive`,
-:mod:`splatedit.render.gs_progressive`) records chunks of the same pass
+Progressive refinement (:mod:`splatedit.render.splat.progressive`,
+:mod:`splatedit.render.gaussian.progressive`) records chunks of the same pass
 objects.  docs/dev/architecture.md says how to add a pass.
 
 Only :mod:`splatedit.render.vk` calls Vulkan.
@@ -35,8 +35,8 @@ RESOURCES = ("cloud", "records", "order", "depth", "accum", "vis_buffer", "accum
 @dataclass
 class FrameContext:
     """What a pass records against: the renderer ``r`` (a
-    :class:`~splatedit.render.renderer.Renderer` or a
-    :class:`~splatedit.render.gaussians.GaussianRenderer`), its per-size
+    :class:`~splatedit.render.splat.renderer.Renderer` or a
+    :class:`~splatedit.render.gaussian.renderer.GaussianRenderer`), its per-size
     targets ``t``, the output ``target`` (a
     :class:`~splatedit.render.targets.RenderTarget` or None), whether the
     splats go through the pre-pass (``prepared``) and the pre-pass windows of

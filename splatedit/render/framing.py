@@ -1,5 +1,5 @@
 """The default camera of an offscreen render (``splatedit render`` without
-camera flags, :func:`~splatedit.render.headless.render_to_png` without a
+camera flags, :func:`~splatedit.render.splat.headless.render_to_png` without a
 camera): the editor's first view.
 
 It frames the model's main body (:func:`splatedit.model.extent.framing_extent`:

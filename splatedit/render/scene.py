@@ -1,13 +1,13 @@
 """The one interface the editor's viewport drives: :class:`SceneRenderer`
 (issue 18, item 1).
 
-Both renderers implement it: :class:`splatedit.render.renderer.Renderer`
-(EWA surface splats) and :class:`splatedit.render.gaussians.GaussianRenderer`
+Both renderers implement it: :class:`splatedit.render.splat.renderer.Renderer`
+(EWA surface splats) and :class:`splatedit.render.gaussian.renderer.GaussianRenderer`
 (3D Gaussian Splatting scenes).  The viewport
-(:mod:`splatedit.app.viewport`) keeps a renderer in step with the document
-only through these members (:func:`splatedit.app.view_scenes.sync_slot`), so
+(:mod:`splatedit.app.view.viewport`) keeps a renderer in step with the document
+only through these members (:func:`splatedit.app.view.scenes.sync_slot`), so
 a new kind of scene is a new renderer with this interface plus a scene
-adapter (:mod:`splatedit.app.view_scenes`) for its level-of-detail policy.
+adapter (:mod:`splatedit.app.view.scenes`) for its level-of-detail policy.
 """
 
 from __future__ import annotations

@@ -1,6 +1,6 @@
 """Render targets and per-size images shared by the splat renderer
-(:mod:`splatedit.render.renderer`) and the Gaussian renderer
-(:mod:`splatedit.render.gaussians`): the :class:`RenderTarget` the final pass
+(:mod:`splatedit.render.splat.renderer`) and the Gaussian renderer
+(:mod:`splatedit.render.gaussian.renderer`): the :class:`RenderTarget` the final pass
 writes, the base of both renderers' per-size image sets (framebuffers per
 target, the pick images), and the decoding of a pick readback.
 
@@ -16,7 +16,7 @@ import numpy as np
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.gpu_units import DEFORM_UBO_BYTES
-from splatedit.render.splat_layout import RP_PICK, RESOLVE_SET, RP_DEPTH, rp_attr
+from splatedit.render.splat.layout import RP_PICK, RESOLVE_SET, RP_DEPTH, rp_attr
 
 #: largest image side (pixels) either renderer accepts
 MAX_SIZE = 16384
@@ -171,7 +171,7 @@ class SizedTargets:
 
 class SplatTargets(SizedTargets):
     """Per-size images and framebuffers of the splat renderer ``r``
-    (:class:`splatedit.render.renderer.Renderer`): depth, the two attribute
+    (:class:`splatedit.render.splat.renderer.Renderer`): depth, the two attribute
     accumulators, the RGBA8 output and the resolve pass's descriptor set."""
 
     def _create(self, r):
@@ -182,7 +182,7 @@ class SplatTargets(SizedTargets):
             return self.add(V.Image(dev, width, height, fmt, usage))
 
         self.depth = img("d32f", ("depth", "transfer_src"))
-        # storage: the compute rasterizer's copy pass writes them (splatedit.render.compute_raster)
+        # storage: the compute rasterizer's copy pass writes them (splatedit.render.splat.compute_raster)
         accum_usage = ("color", "sampled", "transfer_src") + (("storage",) if r.dev.compute_raster else ())
         self.accum_color = img(r.accum_format, accum_usage)
         self.accum_normal = img(r.accum_format, accum_usage)

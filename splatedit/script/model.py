@@ -109,6 +109,8 @@ class Removal:
 
 @dataclass(frozen=True)
 class SolverSettings:
+    """The script's ``solver`` object: fitting method (``auto``, ``lu``, ``iqr``), the IQR tolerance and an
+    optional cap on the number of centres."""
     method: str = "auto"
     tol: float = IQR_DEFAULT_TOL
     max_centers: int | None = None
@@ -116,6 +118,8 @@ class SolverSettings:
 
 @dataclass(frozen=True)
 class EditScript:
+    """A whole edit script: its edits and removals in order, and the solver settings; ``to_json`` writes
+    the documented format."""
     edits: tuple[Edit | Removal, ...]
     solver: SolverSettings = field(default_factory=SolverSettings)
 
@@ -175,5 +179,5 @@ class EditScript:
 
     def save(self, path: str | Path) -> None:
         """Write the script as JSON (atomic: temp file + rename)."""
-        from splatedit.io.atomic import atomic_write_text
+        from splatedit.atomic import atomic_write_text
         atomic_write_text(path, json.dumps(self.to_json(), indent=1) + "\n")

@@ -2,7 +2,7 @@
 masks inside it (the paper's Sect. 3: the *support* (blue) is painted first,
 then one or more disjoint *handles* (green; the active one brighter) inside
 it; a handle splat is always a support splat, erasing support erases the
-handles there too).  Pure numpy; the brush (:mod:`splatedit.app.brush`) and
+handles there too).  Pure numpy; the brush (:mod:`splatedit.app.tools.pick_brush`) and
 the selection tools paint through :meth:`Selection.paint`.
 
 The selection also remembers what the user's strokes said beyond the masks,

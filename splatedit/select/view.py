@@ -4,7 +4,7 @@ A user's first stroke paints from one view and reaches only the splats that
 face the viewer and are not hidden: :func:`one_view_disc` reproduces it for an
 orthographic view without a renderer (a z-buffer of ``cell``-sized pixels).
 The editor's own brush works on the renderer's pick map instead
-(:mod:`splatedit.app.brush`).
+(:mod:`splatedit.app.tools.pick_brush`).
 """
 
 from __future__ import annotations

@@ -52,7 +52,7 @@ EDITOR_BRUSH_KEY_STEP = 1.2
 #: seconds without motion after which the full-quality frame is drawn
 EDITOR_REFINE_DELAY_S = 0.2
 #: full-quality frames predicted slower than this (ms) are refined progressively after
-#: motion stops (app/progressive_refine.py; SPLATEDIT_REFINE_ABOVE_MS overrides it)
+#: motion stops (app/view/progressive_refine.py; SPLATEDIT_REFINE_ABOVE_MS overrides it)
 EDITOR_ASYNC_REFINE_MS = 400.0
 #: assumed full-quality cost (ms per splat at the window size) before the first measurement
 EDITOR_GUESS_MS_PER_SPLAT = 6e-4

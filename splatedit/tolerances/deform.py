@@ -436,7 +436,7 @@ ARAP_CG_RTOL = 1e-6
 ARAP_CG_MAXITER = 50
 #: a region of more free splats than this is not refined (the RBF result is
 #: kept and the edit's note says so): its cost grows with the region.  A
-#: synthetic smooth region on a 1M-splat bunny (splatedit.app.bench's
+#: synthetic smooth region on a 1M-splat bunny (splatedit.bench.editor's
 #: surface), loaded 2-core machine (load 8-11): 0.9 s at 10k splats (LU),
 #: 6.6 s at 50k and 14.6 s at 100k (CG, 50 steps); 55x and 140x a copy of
 #: the 1M cloud in the same run

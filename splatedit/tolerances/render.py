@@ -90,7 +90,7 @@ GS_ALPHA_MIN = 1.0 / 255.0
 #: 8-bit step)
 GS_MIN_TRANSMITTANCE = 1e-4
 #: (tile, Gaussian) pairs per Gaussian the compute tile rasterizer's buffers
-#: hold at first (gs_tiles.py; a frame that wants more grows them and is drawn
+#: hold at first (gaussian/tiles.py; a frame that wants more grows them and is drawn
 #: again).  Measured: the bench's sphere scenes at 1280x720 want 2.3 (100k
 #: Gaussians) per Gaussian, the bundled bunny at 160x120 2.1
 GS_TILE_PAIRS_PER_GAUSSIAN = 4.0

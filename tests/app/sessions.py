@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.app.session import ViewInfo
+from splatedit.app.document.session import ViewInfo
 from splatedit.model import SplatCloud
 
 

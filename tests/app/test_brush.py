@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from splatedit.app.brush import BrushPicker, indices_in_circle, stroke_points
+from splatedit.app.tools.pick_brush import BrushPicker, indices_in_circle, stroke_points
 
 
 def grid_pick(h=40, w=60):

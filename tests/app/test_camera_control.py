@@ -5,7 +5,7 @@ import math
 import numpy as np
 import pytest
 
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 
 
 def make_cam():

@@ -9,10 +9,10 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.commit_job import estimate_ms
-from splatedit.app.gaussian_doc import gaussian_document, gaussians_of
-from splatedit.app.jobs import Cancelled
-from splatedit.app.session import GRAB, Session
+from splatedit.app.document.commit_job import estimate_ms
+from splatedit.app.document.gaussian import gaussian_document, gaussians_of
+from splatedit.app.document.jobs import Cancelled
+from splatedit.app.document.session import GRAB, Session
 from splatedit.deform.modes import DeformationMode
 from splatedit.tolerances import EDITOR_COMMIT_SYNC_MS
 from tests.app.sessions import view
@@ -20,7 +20,7 @@ from tests.app.test_editor_review_fixes import _plane_with_tiny_corner_splats, p
 
 
 def _bunny(n: int = 40_000):
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     return bunny_surface_cloud(n)
 
 

@@ -7,7 +7,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.session import GRAB, Session
+from splatedit.app.document.session import GRAB, Session
 from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.modes import DeformationMode
 from tests.app.sessions import plane_cloud, view

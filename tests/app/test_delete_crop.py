@@ -10,7 +10,7 @@ import json
 import numpy as np
 import pytest
 
-from splatedit.app.session import Session
+from splatedit.app.document.session import Session
 from splatedit.errors import EditScriptError
 from splatedit.script import parse_script, run_script
 from tests.app.sessions import plane_cloud
@@ -100,10 +100,10 @@ def test_bad_delete_and_crop_items_name_their_json_path(item, path, text):
 
 
 def test_a_gaussian_scene_crops_with_its_properties_and_the_saved_file_replays(tmp_path):
-    from splatedit.app import files
-    from splatedit.app.gaussian_doc import gaussian_document, gaussians_of
+    from splatedit.app.document import files
+    from splatedit.app.document.gaussian import gaussian_document, gaussians_of
     from splatedit.data import gaussian_scene_path
-    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.script.gaussian import run_script_gaussians
     from splatedit.io import read_gaussians
     scene = read_gaussians(gaussian_scene_path())
     s = Session(gaussian_document(scene), fit_sync=True)

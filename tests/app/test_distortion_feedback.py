@@ -6,8 +6,8 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app import overlay as ov
-from splatedit.app.session import GRAB, SCALE, Session
+from splatedit.app.ui import overlay as ov
+from splatedit.app.document.session import GRAB, SCALE, Session
 from splatedit.deform.distortion import basis_distortion
 from tests.app.sessions import plane_cloud, view
 from tests.app.test_session import paint_regions
@@ -60,8 +60,8 @@ def test_panel_line_format_and_colour(session):
 
 
 def test_viewport_toggle_draws_the_heat_map(session):
-    from splatedit.app.camera_control import OrbitCamera
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.camera_control import OrbitCamera
+    from splatedit.app.view.viewport import Viewport
     s = session
     paint_regions(s)
     assert s.wait_fit()
@@ -99,8 +99,8 @@ def test_the_last_committed_edit_keeps_its_figures_and_heat_map_until_the_docume
     """A one-handle move commits on release; its stretch figures, the panel's
     "of edit N" line and the heat map (same warm pixels as during the move)
     stay until undo or the next stroke."""
-    from splatedit.app.camera_control import OrbitCamera
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.camera_control import OrbitCamera
+    from splatedit.app.view.viewport import Viewport
     s = session
     paint_regions(s)
     assert s.wait_fit()
@@ -124,7 +124,7 @@ def test_the_last_committed_edit_keeps_its_figures_and_heat_map_until_the_docume
         # the viewport draws the edit's cloud + basis + dC: the same surface, coloured as during the move
         cloud, basis, dc = s.display_state(True)
         assert cloud is not s.cloud and basis is not s.basis
-        from splatedit.app.gaussian_doc import commit_cloud
+        from splatedit.app.document.gaussian import commit_cloud
         assert np.allclose(commit_cloud(basis, cloud, dc).positions, s.cloud.positions, rtol=0, atol=1e-12)
         _show(vp, s, True)
         kept = vp.render(cam, 128, 128)[..., :3].astype(int)

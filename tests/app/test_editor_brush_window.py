@@ -26,7 +26,7 @@ pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]
 
 
 def _camera(status: dict):
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     c = status["camera"]
     return OrbitCamera(np.array(c["target"], float), c["distance"], c["yaw"], c["pitch"])
 

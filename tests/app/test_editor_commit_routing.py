@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.session import GRAB, Session
+from splatedit.app.document.session import GRAB, Session
 from splatedit.app.tools.base import DragMode
 from tests.app.sessions import view
 from tests.app.test_commit_job import _bunny, _posed

@@ -36,7 +36,7 @@ SIZE = (560, 360)
 
 @pytest.fixture(scope="module")
 def scene_path(tmp_path_factory):
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.bench.gs_scenes import gaussians_from_splats
     from splatedit.io import write_gaussians
     path = tmp_path_factory.mktemp("commit-scene") / "bunny80k-gs.ply"

@@ -2,7 +2,7 @@
 commit or a frame takes the editor down.  Each is caught by the editor's
 central guard (:mod:`splatedit.app.crash_guard`): shown in the error box,
 the traceback on stderr, the document kept, and a recovery copy (model +
-edit script, :mod:`splatedit.app.recovery`) written when there are unsaved
+edit script, :mod:`splatedit.app.document.recovery`) written when there are unsaved
 edits; the next start offers to restore it.  Without a window: the editor's
 loop runs against a stub window and frame scheduler."""
 
@@ -13,13 +13,13 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app import recovery
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.document import recovery
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
-from splatedit.app.jobs import Job
-from splatedit.app.keymap import Action
-from splatedit.app.session import GRAB, Session
-from splatedit.app.status import StatusWriter
+from splatedit.app.document.jobs import Job
+from splatedit.app.ui.keymap import Action
+from splatedit.app.document.session import GRAB, Session
+from splatedit.app.ui.status import StatusWriter
 from splatedit.io import read
 from splatedit.script import load_script
 from splatedit.select.selection import HANDLE, SUPPORT
@@ -176,7 +176,7 @@ def test_an_exception_in_a_commit_cancels_the_move_and_keeps_the_document(ed, mo
     s = ed.session
     edited(s)
     cloud, edits = s.cloud, s.edits
-    import splatedit.app.commit_job as cj
+    import splatedit.app.document.commit_job as cj
 
     def broken(*a, **k):
         raise AttributeError("'DetailBasis' object has no attribute 'displacements'")

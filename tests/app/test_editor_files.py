@@ -11,11 +11,11 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
-from splatedit.app.session import Session
+from splatedit.app.document.session import Session
 from splatedit.io import write
-from splatedit.app.manipulation import GRAB
+from splatedit.app.document.manipulation import GRAB
 from tests.app.sessions import plane_cloud, view
 from tests.app.test_session import paint_regions
 
@@ -199,7 +199,7 @@ def test_a_failed_save_shows_an_error_box(ed, tmp_path, capsys):
     assert ed.error_box is not None and "saving failed" in ed.error_box and "no-such-folder" in ed.error_box
     assert "splatedit: error: saving failed" in capsys.readouterr().err
     assert ed.error_rect is None
-    from splatedit.app.panel import error_box
+    from splatedit.app.ui.panel import error_box
     (patch,) = error_box(ed, W, H, 8)          # drawn: a click inside it closes it
     assert ed.error_rect == patch.box
     x, y, bw, bh = ed.error_rect
@@ -266,7 +266,7 @@ def test_save_as_prompt_backspace_deletes_one_character_and_typing_appends(ed, m
     """The proposed path is edited, not replaced: Backspace x3 and "las" turn
     the suggested .ply into .las; Ctrl+A selects all (typing replaces it,
     Backspace clears it); Ctrl+U and Ctrl+Backspace clear; Esc cancels."""
-    from splatedit.app.panel import save_prompt_lines
+    from splatedit.app.ui.panel import save_prompt_lines
     key(ed, glfw.KEY_S, glfw.MOD_CONTROL | glfw.MOD_SHIFT)
     proposed = ed.prompt
     assert proposed == str(models / "a_plane-edited.ply")

@@ -10,8 +10,8 @@ import time
 import numpy as np
 import pytest
 
-from splatedit.app.bench import bunny_surface_cloud
-from splatedit.app.frames import FrameScheduler, moving_budget
+from splatedit.bench.editor import bunny_surface_cloud
+from splatedit.app.view.frames import FrameScheduler, moving_budget
 from splatedit.model.lod import LodPyramid
 from splatedit.tolerances import EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS, EDITOR_MOVING_BUDGET_MS
 
@@ -41,7 +41,7 @@ def test_window_size_and_iconified_state_are_kept_from_callbacks_not_queried_per
 
 
 def test_panel_stats_count_the_selection_once_per_change(monkeypatch):
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     cloud = bunny_surface_cloud(5000)
     s = Session(cloud)
     try:
@@ -77,8 +77,8 @@ def test_a_100k_model_moves_as_a_level_whose_measured_frame_fits_the_moving_budg
     full frames measured at three times the moving budget, the viewport's
     choice for a moving frame is a level (not all splats) predicted within the
     budget, and once that level is measured the next choice stays within it."""
-    from splatedit.app.camera_control import OrbitCamera
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.camera_control import OrbitCamera
+    from splatedit.app.view.viewport import Viewport
     n = 100_000
     assert n >= EDITOR_LOD_MIN_SPLATS
     cloud = bunny_surface_cloud(n)

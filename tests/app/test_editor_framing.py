@@ -10,7 +10,7 @@ import copy
 import numpy as np
 import pytest
 
-from splatedit.app.session import Session
+from splatedit.app.document.session import Session
 from tests.app.sessions import plane_cloud
 
 pytest.importorskip("glfw")

@@ -157,7 +157,7 @@ def test_gaussian_scene_edit_rotate_save(xvfb, tmp_path):
     assert np.abs(again.covariances() - saved.covariances()).max() < 1e-6
     assert np.abs(again.sh - saved.sh).max() < 1e-5
     # --- splatedit render of the saved file: only the ear's region changed
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     eye = OrbitCamera(np.array(cam["target"]), cam["distance"], cam["yaw"], cam["pitch"],
                       up_axis=np.array(cam["up"])).eye      # the editor's view (the default frames each box)
     pngs = []

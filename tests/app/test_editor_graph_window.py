@@ -25,7 +25,7 @@ def _percent(s: dict) -> float | None:
 
 
 def test_brush_says_visible_only_while_the_graph_builds_and_quit_does_not_wait(xvfb, tmp_path):
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.io import write
 
     path = write(tmp_path / "big.ply", bunny_surface_cloud(N_SPLATS))

@@ -12,7 +12,7 @@ import time
 import numpy as np
 import pytest
 
-from splatedit.app.panel import PANEL_MARGIN
+from splatedit.app.ui.panel import PANEL_MARGIN
 from tests.app.window_harness import EditorProcess, _foreground_centre, paint_support_stroke
 
 pytestmark = [pytest.mark.window, pytest.mark.gpu, pytest.mark.slow]

@@ -57,7 +57,7 @@ def _open_recent_0(ed) -> None:
 
 
 def test_file_menu_open_recent_asks_first_and_the_questions_have_buttons(xvfb, tmp_path):
-    from splatedit.app.recent import RecentFiles
+    from splatedit.app.ui.recent import RecentFiles
     from splatedit.io import write
     plane = tmp_path / "plane.ply"
     write(str(plane), plane_cloud(40))

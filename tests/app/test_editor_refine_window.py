@@ -18,7 +18,7 @@ pytestmark = [pytest.mark.window, pytest.mark.gpu]
 
 
 def test_refinement_after_motion_uses_the_editors_one_device(xvfb, tmp_path, monkeypatch):
-    from splatedit.app.bench import bunny_surface_cloud
+    from splatedit.bench.editor import bunny_surface_cloud
     from splatedit.io import write
     from splatedit.tolerances import EDITOR_LOD_MIN_SPLATS
 

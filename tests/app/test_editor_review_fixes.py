@@ -12,11 +12,11 @@ import numpy as np
 import pytest
 
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor, check_model_file, save_refusal
 from splatedit.app.file_actions import FileActions
-from splatedit.app.jobs import Cancelled, Job
-from splatedit.app.session import GRAB, SCALE, Manipulation, Session, ViewInfo
+from splatedit.app.document.jobs import Cancelled, Job
+from splatedit.app.document.session import GRAB, SCALE, Manipulation, Session, ViewInfo
 from splatedit.errors import InputError, SplatEditError
 from splatedit.model import SplatCloud
 from splatedit.render.camera import Camera, perspective

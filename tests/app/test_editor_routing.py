@@ -11,9 +11,9 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
-from splatedit.app.session import Session
+from splatedit.app.document.session import Session
 from splatedit.app.tools.base import DragMode
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.sessions import plane_cloud

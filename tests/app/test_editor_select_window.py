@@ -22,7 +22,7 @@ pytest.importorskip("imgui_bundle")
 
 
 def _camera(status: dict):
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     c = status["camera"]
     return OrbitCamera(np.array(c["target"], float), c["distance"], c["yaw"], c["pitch"])
 

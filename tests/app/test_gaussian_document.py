@@ -11,10 +11,10 @@ import numpy as np
 import pytest
 from scipy.spatial.transform import Rotation
 
-from splatedit.app import files
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.gaussian_doc import commit_cloud, gaussian_document, gaussians_of
-from splatedit.app.session import Session
+from splatedit.app.document import files
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.gaussian import commit_cloud, gaussian_document, gaussians_of
+from splatedit.app.document.session import Session
 from splatedit.data import gaussian_scene_path
 from splatedit.deform.gaussians import deform_with_evaluator
 from splatedit.deform.modes import DeformationMode
@@ -95,7 +95,7 @@ def test_live_gpu_frame_equals_the_committed_scene(scene):
     (centres, J Sigma J^T, SH frames by the polar rotation of J); after the
     commit it draws the CPU-deformed Gaussians undeformed: the two frames
     agree within GS_REF_MEAN_TOL (mean 8-bit steps over RGB)."""
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     from splatedit.tolerances import GS_REF_MEAN_TOL
     s = _ear_session(scene)
     _turn(s, 90.0)
@@ -131,7 +131,7 @@ def test_live_gpu_frame_equals_the_committed_scene(scene):
 
 
 def test_save_writes_a_3dgs_file_and_the_script_replays_it(scene, tmp_path):
-    from splatedit.gaussian_script import run_script_gaussians
+    from splatedit.script.gaussian import run_script_gaussians
     s = _ear_session(scene)
     _turn(s, 90.0)
     assert s.commit()
@@ -170,7 +170,7 @@ def test_two_handles_and_a_curve_draw_live_and_commit_as_one_edit(scene):
     curve across the back, all pending together: the live GPU frame and the
     frame of the committed Gaussians agree, and the commit is the CPU
     deformation of the same basis and pose."""
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     from splatedit.tolerances import GS_REF_MEAN_TOL
     doc = gaussian_document(scene)
     s = Session(doc, fit_sync=True)
@@ -220,7 +220,7 @@ def test_two_handles_and_a_curve_draw_live_and_commit_as_one_edit(scene):
 def test_the_panel_names_gaussians_as_gaussians(scene):
     """The panel's first line says "5,000 Gaussians (3dgs, SH degree 3)" as
     the load message and README do, a plain cloud "N splats"."""
-    from splatedit.app.gaussian_doc import model_summary
+    from splatedit.app.document.gaussian import model_summary
     doc = gaussian_document(scene)
     assert model_summary(doc) == f"{len(scene):,} Gaussians ({scene.kind.value}, SH degree {scene.sh_degree})"
     assert "splats" not in model_summary(doc)

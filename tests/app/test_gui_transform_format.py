@@ -3,7 +3,7 @@ three fields of a 1280x720 panel are not cut off ("-0.00060034" was)."""
 
 from __future__ import annotations
 
-from splatedit.app.gui_transform import length_format
+from splatedit.app.ui.gui_transform import length_format
 
 
 def test_lengths_are_shown_to_a_fixed_share_of_the_diagonal():

@@ -1,4 +1,4 @@
-"""The GUI demo (python -m splatedit.render.gui_demo --demo) in a real window under
+"""The GUI demo (python -m splatedit.render.gui.demo --demo) in a real window under
 Xvfb: ImGui drawn on the GPU into the swapchain image, clicked with xdotool."""
 
 from __future__ import annotations
@@ -39,11 +39,11 @@ def _wait(path, cond, what, proc, timeout=60.0):
 
 
 def test_demo_button_click_and_gpu_drawn_panel(xvfb, tmp_path):
-    from splatedit.render.gui_demo import DEMO_BACKGROUND
+    from splatedit.render.gui.demo import DEMO_BACKGROUND
     status = tmp_path / "status.json"
     env = dict(os.environ, DISPLAY=xvfb["display"], SPLATEDIT_VALIDATION="1")
     log = open(tmp_path / "demo.log", "w")
-    proc = subprocess.Popen([sys.executable, "-m", "splatedit.render.gui_demo", "--demo", "--size", "640x400",
+    proc = subprocess.Popen([sys.executable, "-m", "splatedit.render.gui.demo", "--demo", "--size", "640x400",
                              "--status-file", str(status)], env=env, stdout=log, stderr=subprocess.STDOUT,
                             cwd=tmp_path)
     xdo = lambda *a: subprocess.run(["xdotool", *map(str, a)], env=env, check=True, timeout=30)  # noqa: E731

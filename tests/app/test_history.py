@@ -2,7 +2,7 @@
 
 import numpy as np
 
-from splatedit.app.history import History, Snapshot
+from splatedit.app.document.history import History, Snapshot
 from splatedit.model import SplatCloud
 
 

@@ -9,8 +9,8 @@ from pathlib import Path
 
 import pytest
 
-from splatedit.app import keymap
-from splatedit.app.keymap import KEYMAP, Action, Chord, Context, Section
+from splatedit.app.ui import keymap
+from splatedit.app.ui.keymap import KEYMAP, Action, Chord, Context, Section
 
 README = Path(__file__).resolve().parents[2] / "docs" / "editor.md"
 
@@ -19,7 +19,7 @@ def test_readme_controls_are_the_generated_block():
     block = keymap.readme_controls(README.read_text())
     assert block is not None, "README lacks the controls markers"
     assert block == keymap.readme_block(), \
-        "docs/editor.md's controls list is out of date: run `python -m splatedit.app.keymap --write-readme`"
+        "docs/editor.md's controls list is out of date: run `python -m splatedit.app.ui.keymap --write-readme`"
 
 
 def test_write_readme_fixes_a_stale_list(tmp_path):
@@ -33,7 +33,7 @@ def test_write_readme_fixes_a_stale_list(tmp_path):
 
 
 def _stub_editor():
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     from splatedit.app.editor import Editor
 
     class Stub(Editor):

@@ -7,7 +7,7 @@ import math
 
 import numpy as np
 
-from splatedit.app.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo
+from splatedit.app.document.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo
 
 
 def _view(wpp=0.01):

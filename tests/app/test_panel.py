@@ -6,8 +6,8 @@ from __future__ import annotations
 
 import pytest
 
-from splatedit.app.keymap import help_lines
-from splatedit.app.panel import Box, HelpView, place_panel
+from splatedit.app.ui.keymap import help_lines
+from splatedit.app.ui.panel import Box, HelpView, place_panel
 
 #: the panel's size at the default window (measured: 598 x 206 px with a fitted handle)
 PANEL = (598, 206)

@@ -9,9 +9,9 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.bench import bunny_surface_cloud
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.frames import FrameScheduler
+from splatedit.bench.editor import bunny_surface_cloud
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.view.frames import FrameScheduler
 from splatedit.app.tools.base import DragMode
 from splatedit.model.lod import LodPyramid
 
@@ -29,8 +29,8 @@ class _Presenter:
 
 
 def _editor(n=60000, cloud=None, budgets=(8000, 2000), **session):
-    from splatedit.app.session import Session
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.document.session import Session
+    from splatedit.app.view.viewport import Viewport
     cloud = bunny_surface_cloud(n) if cloud is None else cloud
     vp = Viewport(budget_ms=100.0)
     vp.set_pyramid(LodPyramid(cloud, budgets=budgets))
@@ -50,8 +50,8 @@ def _editor(n=60000, cloud=None, budgets=(8000, 2000), **session):
 @pytest.fixture
 def ed(monkeypatch):
     # chunks of 8000 splats (about 8 steps per phase) whatever this machine's speed
-    import splatedit.app.frames as frames
-    import splatedit.app.progressive_refine as pr
+    import splatedit.app.view.frames as frames
+    import splatedit.app.view.progressive_refine as pr
     monkeypatch.setattr(frames, "EDITOR_PROGRESSIVE_MIN_CHUNK", 8000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 8000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
@@ -104,7 +104,7 @@ def test_still_view_sharpens_monotonically_and_ends_equal_to_the_full_frame(ed):
     changed = np.array([int((s != lod).any(axis=2).sum()) for s in shown])
     assert changed[0] > 0 and changed[0] < 0.9 * changed[-2]
     assert (np.diff(changed[:-1]) >= -0.01 * changed[-2]).all(), changed     # grows (a pixel may match by chance)
-    from splatedit.app.viewport import render_camera
+    from splatedit.app.view.viewport import render_camera
     assert p.frame.prepared                         # the chunks went through the compute pre-pass
     ref = vp.full.r.render(render_camera(ed.cam), W, H)
     # the pre-pass tolerance (tests/render/test_paths.py): records blend in atomic order
@@ -145,7 +145,7 @@ def test_several_chunks_per_presented_frame_up_to_the_budget(ed, monkeypatch):
     chunks as fit: more steps than presented frames, every frame's steps stay
     within the budget plus one step, and the refinement still ends in the
     full frame."""
-    import splatedit.app.progressive_refine as pr
+    import splatedit.app.view.progressive_refine as pr
     monkeypatch.undo()
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 4000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
@@ -172,7 +172,7 @@ def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
     ends equal to the one-submit detail frame."""
     from splatedit.deform.modes import DeformationMode
     from tests.deform.detail_scene import bend, bumpy_plane
-    import splatedit.app.progressive_refine as pr
+    import splatedit.app.view.progressive_refine as pr
     monkeypatch.setattr(pr.ProgressiveRefinement, "budget_ms", lambda self: 0.0)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_MIN_CHUNK", 1000)
     monkeypatch.setattr(pr, "EDITOR_PROGRESSIVE_CHUNK_MAX_GROWTH", 1.0)
@@ -199,7 +199,7 @@ def test_the_detail_mode_is_refined_progressively_too(monkeypatch):
         p = fr.last_progressive
         assert p is not None and p.done and len(p.step_ms) >= 4
         assert vp.full.r.uploads.detail_buf is not None and p.frame.prepared
-        from splatedit.app.viewport import render_camera
+        from splatedit.app.view.viewport import render_camera
         ref = vp.full.r.render(render_camera(ed.cam), W, H)
         diff = np.abs(ed.presenter.frames[-1][..., :3].astype(int) - ref[..., :3].astype(int))
         assert diff.mean() < 0.6 and (diff.max(axis=2) > 24).mean() < 0.003

@@ -5,7 +5,7 @@ from __future__ import annotations
 
 import json
 
-from splatedit.app.recent import RECENT_MAX, RecentFiles, recent_path
+from splatedit.app.ui.recent import RECENT_MAX, RecentFiles, recent_path
 
 
 def _models(tmp_path, n):

@@ -9,8 +9,8 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.brush import BrushPicker
-from splatedit.app.session import Session
+from splatedit.app.tools.pick_brush import BrushPicker
+from splatedit.app.document.session import Session
 from splatedit.app.tools.region import box_polygon, polygon_mask, splats_through, splats_visible
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.sessions import plane_cloud
@@ -127,7 +127,7 @@ def test_the_region_outline_is_a_closed_shape_while_dragging(ed):
     ed.routing.on_move(types.SimpleNamespace(x=200.0, y=150.0))
     (shape,) = ed.region.shapes(640, 480)
     assert shape.closed and shape.strip().shape == (5, 2)
-    from splatedit.app.shapes import to_patches
+    from splatedit.app.tools.shapes import to_patches
     (patch,) = to_patches([shape], (640, 480))
     assert patch.rgba[..., 3].max() == 255 and patch.x <= 100 and patch.y <= 100
     press(ed, glfw.MOUSE_BUTTON_LEFT, 0, 200, 150, action=glfw.RELEASE)
@@ -161,8 +161,8 @@ def test_symmetric_painting_paints_each_dab_and_its_mirror(ed):
 
 def test_the_select_menus_shortcuts_are_the_keymaps_keys():
     pytest.importorskip("imgui_bundle")
-    from splatedit.app.gui_menus import _SELECT_ENTRIES
-    from splatedit.app.keymap import KEYMAP
+    from splatedit.app.ui.menus import _SELECT_ENTRIES
+    from splatedit.app.ui.keymap import KEYMAP
 
     names = {"equal": "=", "minus": "-"}
 
@@ -177,7 +177,7 @@ def test_the_select_menus_shortcuts_are_the_keymaps_keys():
 
 
 def test_armed_tools_and_toggles_say_so_in_the_panel(ed):
-    from splatedit.app.panel import panel_lines
+    from splatedit.app.ui.panel import panel_lines
     ed.viewport.last_info = None
 
     def text():

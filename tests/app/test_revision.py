@@ -4,7 +4,7 @@ from __future__ import annotations
 
 import gc
 
-from splatedit.app import revision
+from splatedit.app.document import revision
 import numpy as np
 
 from splatedit.model.cloud import SplatCloud

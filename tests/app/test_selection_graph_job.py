@@ -10,9 +10,9 @@ import time
 import pytest
 
 import splatedit.select.graph as graph_mod
-from splatedit.app import selection_tools as seltools
-from splatedit.app.bench import bunny_surface_cloud
-from splatedit.app.jobs import Cancelled, Job
+from splatedit.app.document import selection as seltools
+from splatedit.bench.editor import bunny_surface_cloud
+from splatedit.app.document.jobs import Cancelled, Job
 from splatedit.model.tiles import tiled_knn
 from splatedit.select.graph import NeighbourGraph
 

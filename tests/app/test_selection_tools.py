@@ -7,11 +7,11 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app import selection_tools as tools
-from splatedit.app.brush import BrushPicker, picker_for_view
+from splatedit.app.document import selection as tools
+from splatedit.app.tools.pick_brush import BrushPicker, picker_for_view
 from splatedit.select.closure import close_selection
 from splatedit.select.selection import HANDLE, SUPPORT, Selection
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 
 W, H = 640, 400
 
@@ -168,7 +168,7 @@ def test_closure_fills_a_painted_hole_and_reports_it(bunny):
 
 
 def test_tool_with_closure_is_one_undo_step(bunny):
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     cloud, graph = bunny
     s = Session(cloud, fit_sync=True)
     t = tools.SelectionTools()
@@ -202,7 +202,7 @@ def test_an_erase_stroke_stays_erased_and_never_grows_the_support(bunny, within)
     it does not fill the notch either (outside the strokes' reach), with or
     without cutting it to the selection before the stroke (the tester saw
     the hole refilled and the support grow: 9158 -> 9209)."""
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     cloud, graph = bunny
     p = cloud.positions
     s = Session(cloud, fit_sync=True)
@@ -227,7 +227,7 @@ def test_an_erase_stroke_stays_erased_and_never_grows_the_support(bunny, within)
 
 
 def test_an_erase_stroke_at_the_edge_stays_erased(bunny):
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     cloud, graph = bunny
     p = cloud.positions
     s = Session(cloud, fit_sync=True)
@@ -250,7 +250,7 @@ def test_an_erase_stroke_at_the_edge_stays_erased(bunny):
 def test_a_dab_covers_every_splat_under_its_circle_at_any_depth(bunny):
     """The brush's reach: the visible splats under the circle and the ones
     hidden behind them (the far side of the ear), nothing outside the circle."""
-    from splatedit.app.brush import BrushPicker
+    from splatedit.app.tools.pick_brush import BrushPicker
     cloud, graph = bunny
     p = cloud.positions
     w = h = 200

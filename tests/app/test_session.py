@@ -7,7 +7,7 @@ import numpy as np
 import pytest
 
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.session import GRAB, ROTATE, SCALE, Manipulation, Session, ViewInfo
+from splatedit.app.document.session import GRAB, ROTATE, SCALE, Manipulation, Session, ViewInfo
 from splatedit.model import SplatCloud
 from tests.app.sessions import plane_cloud, view
 

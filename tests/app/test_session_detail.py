@@ -5,7 +5,7 @@ bumps, the commit is recorded with its mode and replays bitwise, undo/redo."""
 import numpy as np
 import pytest
 
-from splatedit.app.session import ROTATE, Session
+from splatedit.app.document.session import ROTATE, Session
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.detail import DetailBasis
 from splatedit.deform.modes import DeformationMode as Mode

@@ -9,7 +9,7 @@ import pytest
 from splatedit.deform.modes import DeformationMode
 
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.session import Session, ViewInfo, GRAB
+from splatedit.app.document.session import Session, ViewInfo, GRAB
 from splatedit.errors import SplatEditError
 from splatedit.model import SplatCloud
 from splatedit.script import load_script, run_script

@@ -7,7 +7,7 @@ Root cause of the bug: a committed cloud is a shallow copy of its base
 (``copy.copy`` in ``DeformationBasis.apply``) and carried its revision
 number along, so the fit key of the restored base equalled the deformed
 cloud's and the basis fitted on the deformed cloud (controls moved by the
-undone move) was kept for the next edit (see :mod:`splatedit.app.revision`).
+undone move) was kept for the next edit (see :mod:`splatedit.app.document.revision`).
 
 The replay goes through the command line's own entry (``splatedit.cli.main
 deform``), the saved file through the writer the editor's Ctrl+S uses.
@@ -22,7 +22,7 @@ import numpy as np
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 
-from splatedit.app.session import GRAB, ROTATE, SCALE, Session
+from splatedit.app.document.session import GRAB, ROTATE, SCALE, Session
 from splatedit.cli import main
 from splatedit.io import read, write
 from splatedit.select.selection import HANDLE, SUPPORT

@@ -8,7 +8,7 @@ from __future__ import annotations
 import numpy as np
 import pytest
 
-from splatedit.app.transform_fields import TargetKind, TransformInput, apply_position, apply_transform, field_target
+from splatedit.app.ui.transform_fields import TargetKind, TransformInput, apply_position, apply_transform, field_target
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.test_editor_routing import ed, key  # noqa: F401 (fixture)
 

@@ -3,8 +3,8 @@
 import numpy as np
 import pytest
 
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.bench import bunny_surface_cloud, support_and_handle
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.bench.editor import bunny_surface_cloud, support_and_handle
 from splatedit.model.lod import LodPyramid
 
 pytestmark = pytest.mark.gpu
@@ -12,7 +12,7 @@ pytestmark = pytest.mark.gpu
 
 @pytest.fixture(scope="module")
 def scene():
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     cloud = bunny_surface_cloud(30000)
     vp = Viewport(budget_ms=100.0)
     vp.set_cloud(cloud)
@@ -76,7 +76,7 @@ def test_detail_mode_draws_the_cpu_commit_in_full_and_lod(scene):
     (n_b, lambda) rows; a level takes its representatives' rows) draws what
     the CPU commit gives: the same foreground as the committed cloud drawn
     without a basis."""
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     from splatedit.deform import transform as tf
     from splatedit.deform.detail import DetailBasis
     vp, cloud, cam = scene
@@ -126,8 +126,8 @@ def test_brush_paints_only_visible_splats_as_a_solid_patch(n):
     """The brush on the real pick pass: a disc on the bunny selects the front
     surface under it (no back-facing or hidden splats) without holes, also
     when splats are much smaller than a pixel."""
-    from splatedit.app.brush import picker_for_view
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.tools.pick_brush import picker_for_view
+    from splatedit.app.view.viewport import Viewport
     cloud = bunny_surface_cloud(n, seed=3)
     w, h = 320, 240
     cam = OrbitCamera(scene_radius=cloud.diagonal / 2)

@@ -7,10 +7,10 @@ same Gaussians drawn undeformed give the same image); still frames draw all."""
 import numpy as np
 import pytest
 
-from splatedit.app.bench import support_and_handle
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.gaussian_doc import gaussian_document
-from splatedit.app.viewport import render_camera
+from splatedit.bench.editor import support_and_handle
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.gaussian import gaussian_document
+from splatedit.app.view.viewport import render_camera
 from splatedit.data import gaussian_scene_path
 from splatedit.io import read_gaussians
 from splatedit.model.gaussian_lod import build_gaussian_lod, subset
@@ -40,7 +40,7 @@ def _sphere_scene(n):
 
 @pytest.mark.parametrize("which, share", [("bunny", 0.25), ("sphere100k", 0.1)])
 def test_lod_prefix_is_the_subset_and_close_to_the_full_frame(which, share):
-    from splatedit.render.gaussians import GaussianRenderer
+    from splatedit.render.gaussian.renderer import GaussianRenderer
     scene = read_gaussians(str(gaussian_scene_path())) if which == "bunny" else _sphere_scene(100_000)
     lod = build_gaussian_lod(scene)
     c = int(share * len(scene))
@@ -68,10 +68,10 @@ def test_lod_prefix_is_the_subset_and_close_to_the_full_frame(which, share):
 
 
 def test_viewport_draws_the_deformed_lod_while_moving_and_all_when_still():
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     from splatedit.deform.basis import DeformationBasis
     from splatedit.deform.gaussians import deform_with_evaluator
-    from splatedit.render.gaussians import GaussianRenderer
+    from splatedit.render.gaussian.renderer import GaussianRenderer
     scene = read_gaussians(str(gaussian_scene_path()))
     doc = gaussian_document(scene)
     cam = _camera(doc)
@@ -116,7 +116,7 @@ def test_gpu_sort_of_a_prefix_sorts_only_the_prefix_and_draws_the_same():
     """With the GPU's bitonic sort, a drawn prefix of 1,000 Gaussians out of
     the bunny's 5,000 is sorted at the prefix's power of two (1,024 keys, not
     8,192) and draws what the CPU sort draws."""
-    from splatedit.render.gaussians import GaussianRenderer
+    from splatedit.render.gaussian.renderer import GaussianRenderer
     scene = read_gaussians(str(gaussian_scene_path()))
     cam = render_camera(_camera(gaussian_document(scene)))
     images = {}

@@ -5,8 +5,8 @@ splat proxy whose selection and deformation basis apply row for row."""
 import numpy as np
 import pytest
 
-from splatedit.app.bench import support_and_handle
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.bench.editor import support_and_handle
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.data import default_model_path
 from splatedit.io import read
@@ -17,7 +17,7 @@ pytestmark = pytest.mark.gpu
 
 @pytest.fixture(scope="module")
 def scene():
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     cloud = read(default_model_path())
     sub = cloud.subset(np.random.default_rng(1).choice(cloud.n, 4000, replace=False))
     grow = np.sqrt(cloud.n / sub.n) * 0.8

@@ -5,8 +5,8 @@ exposes nothing else draws the same deformed, tinted frame and pick."""
 import numpy as np
 import pytest
 
-from splatedit.app.bench import support_and_handle, bunny_surface_cloud
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.bench.editor import support_and_handle, bunny_surface_cloud
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.render.scene import SceneRenderer
 
 pytestmark = pytest.mark.gpu
@@ -35,9 +35,9 @@ class InterfaceOnly:
 
 
 def test_viewport_drives_a_renderer_through_the_scene_interface_only():
-    from splatedit.app.viewport import Viewport
+    from splatedit.app.view.viewport import Viewport
     from splatedit.deform.basis import DeformationBasis
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     assert {"set_cloud", "set_basis", "render", "pick", "supports_detail"} <= MEMBERS
     cloud = bunny_surface_cloud(8000)
     sup, hnd = support_and_handle(cloud, 800)

@@ -11,7 +11,7 @@ import pytest
 
 from splatedit.cli import main
 from splatedit.data import default_model_path
-from splatedit.demo import DEMO_SCRIPT
+from splatedit.commands.demo import DEMO_SCRIPT
 from splatedit.io import read
 
 

@@ -272,7 +272,7 @@ def test_render_larger_than_available_memory_is_refused_before_reading(tmp_path,
     before the model is even read (the input here is a FIFO without writer:
     reading it would hang)."""
     import os
-    from splatedit.render import headless
+    from splatedit.render.splat import headless
     monkeypatch.setattr(headless, "available_memory", lambda: 2**30)
     fifo = tmp_path / "in.ply"
     os.mkfifo(fifo)

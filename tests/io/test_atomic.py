@@ -8,7 +8,7 @@ import stat
 import pytest
 
 from splatedit.errors import InputError
-from splatedit.io.atomic import atomic_open, atomic_write_text, check_writable_target
+from splatedit.atomic import atomic_open, atomic_write_text, check_writable_target
 
 
 def test_new_file_gets_umask_permissions_not_mkstemp_0600(tmp_path):

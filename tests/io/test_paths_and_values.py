@@ -7,7 +7,7 @@ import pytest
 
 from splatedit.errors import InputError
 from splatedit.io import convert, read, write
-from splatedit.io.atomic import atomic_write_text, check_writable_target
+from splatedit.atomic import atomic_write_text, check_writable_target
 from splatedit.model.estimate import estimate_splats
 
 

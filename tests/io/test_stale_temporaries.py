@@ -12,7 +12,7 @@ import numpy as np
 from splatedit.cli import main
 from splatedit.data import default_model_path
 from splatedit.io import read, write
-from splatedit.io.atomic import remove_stale_temporaries
+from splatedit.atomic import remove_stale_temporaries
 
 
 def test_sigterm_during_a_write_removes_the_temporary_and_keeps_the_target(tmp_path, monkeypatch, capsys):
@@ -38,7 +38,7 @@ def test_sigterm_during_a_write_removes_the_temporary_and_keeps_the_target(tmp_p
 
 def test_temporary_left_by_sigkill_is_removed_by_the_next_write(tmp_path):
     out = tmp_path / "out.ply"
-    code = ("import os, signal\nfrom splatedit.io.atomic import atomic_open\n"
+    code = ("import os, signal\nfrom splatedit.atomic import atomic_open\n"
             f"with atomic_open({str(out)!r}) as fh:\n"
             "    fh.write(b'half a file')\n    fh.flush()\n    os.kill(os.getpid(), signal.SIGKILL)\n")
     env = dict(os.environ, PYTHONPATH=os.getcwd())

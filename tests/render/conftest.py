@@ -22,7 +22,7 @@ REF_BAD_SHARE = 0.005
 
 @pytest.fixture(scope="session")
 def renderer():
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     r = Renderer()
     yield r
     r.close()

@@ -17,9 +17,9 @@ from splatedit.data import default_model_path
 from splatedit.deform.rotation import HandleRotation, RotationDisplacement
 from splatedit.io import read
 from splatedit.render.camera import Camera
-from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
+from splatedit.render.gaussian.renderer import GaussianRenderer, gaussian_bounds
 from splatedit.render.gpu_units import gpu_camera, pack_basis_rows, pack_deform_block
-from splatedit.render.gs_resources import pack_geometry
+from splatedit.render.gaussian.resources import pack_geometry
 from splatedit.render.uniforms import BASIS_GROUP, DEFORM_UBO, GS_FRAME_UBO, GS_GEOM, MAX_GROUPS
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, RENDER_TINT_HANDLE, RENDER_TINT_SUPPORT)
@@ -138,7 +138,7 @@ def test_gaussian_frame_block_bytes_equal_the_hand_packing(bunny_gaussians):
 
 
 def test_splat_geometry_and_detail_rows_bytes_equal_the_hand_packing(renderer, monkeypatch):
-    from splatedit.render import uploads
+    from splatedit.render.splat import uploads
     from splatedit.render.uniforms import DETAIL_ROW, SPLAT_GEOM
     cloud = read(default_model_path())
     monkeypatch.setattr(uploads, "RENDER_UPLOAD_CHUNK_SPLATS", 3000)    # several chunks, a partial last one

@@ -1,4 +1,4 @@
-"""The compute-shader rasterizer (splatedit.render.compute_raster) draws the
+"""The compute-shader rasterizer (splatedit.render.splat.compute_raster) draws the
 same frame as the raster path: images within the reference tolerance, the
 same covered pixels, the same accumulated weights; the path choice and the
 frame's pass lists."""
@@ -9,9 +9,9 @@ import numpy as np
 import pytest
 
 from splatedit.errors import ParameterError
-from splatedit.render.compute_raster import probe_key
+from splatedit.render.splat.compute_raster import probe_key
 from splatedit.render.camera import Camera
-from splatedit.render.frame_passes import ComputeAttributes, Frame, Prepass, pick_frame, splat_frame
+from splatedit.render.splat.passes import ComputeAttributes, Frame, Prepass, pick_frame, splat_frame
 from tests.render.conftest import REF_BAD_SHARE, REF_MEAN_TOL, REF_PIXEL_TOL
 from tests.render.deform_util import gaussian_basis
 from tests.render.scenes import sphere
@@ -119,7 +119,7 @@ def test_compute_path_matches_raster_in_prepass_windows(renderer, monkeypatch):
 
 
 def test_path_choice_follows_argument_env_and_device(renderer, monkeypatch):
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     renderer.set_cloud(sphere(2000))
     saved = renderer.raster_path
     try:
@@ -168,7 +168,7 @@ def test_compute_path_equals_raster_with_float32_accumulators(renderer):
     """With RGBA32F accumulators (no half-float blending) the two paths give
     the same image and weights and depths within float32 summation order."""
     _needs_compute(renderer)
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     cloud = sphere(5000)
     with Renderer(device=renderer.dev, accum_format="rgba32f") as r:
         r.set_cloud(cloud)

@@ -7,7 +7,7 @@ import pytest
 
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
-from splatedit.render.frame_passes import EyeDomeResolve, Resolve, splat_frame
+from splatedit.render.splat.passes import EyeDomeResolve, Resolve, splat_frame
 from tests.render.scenes import plane
 
 pytestmark = pytest.mark.gpu

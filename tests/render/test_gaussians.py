@@ -15,8 +15,8 @@ from splatedit.errors import ParameterError
 from splatedit.io import read
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render.camera import Camera
-from splatedit.render.gaussians import GaussianRenderer, gaussian_bounds
-from splatedit.render.gaussians_reference import render_reference
+from splatedit.render.gaussian.renderer import GaussianRenderer, gaussian_bounds
+from splatedit.render.gaussian.reference import render_reference
 from splatedit.tolerances import GS_PICK_MIN_OPACITY, GS_REF_BAD_SHARE, GS_REF_MEAN_TOL, GS_REF_PIXEL_TOL
 
 W, H = 96, 72

@@ -1,4 +1,4 @@
-"""The GPU radix sort (splatedit.render.gpu_sort) equals numpy's stable
+"""The GPU radix sort (splatedit.render.gaussian.gpu_sort) equals numpy's stable
 argsort exactly -- keys and values -- on random keys, heavy duplicates, n not
 a multiple of the workgroup or block, n = 0 and 1, and 1M pairs, in both
 scatter variants; it sorts the count it reads from the GPU buffer (clamped to
@@ -12,7 +12,7 @@ import pytest
 
 from splatedit.errors import ParameterError
 from splatedit.render import vk as V
-from splatedit.render.gpu_sort import (RADIX_BLOCK, BitonicSort, RadixSort, sortable_float_keys,
+from splatedit.render.gaussian.gpu_sort import (RADIX_BLOCK, BitonicSort, RadixSort, sortable_float_keys,
                                        subgroup_scatter_supported)
 
 

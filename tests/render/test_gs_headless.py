@@ -19,7 +19,7 @@ from splatedit.data import default_model_path
 from splatedit.io import read_gaussians
 from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
-from splatedit.render import gs_headless
+from splatedit.render.gaussian import headless as gs_headless
 from splatedit.script import fit_edit, load_script
 from splatedit.tolerances import GAUSSIAN_PROXY_SIGMAS
 

@@ -1,4 +1,4 @@
-"""The Gaussian full frame drawn in chunks (splatedit.render.gs_progressive):
+"""The Gaussian full frame drawn in chunks (splatedit.render.gaussian.progressive):
 consecutive chunks of the sorted order blended front to back give the
 one-shot frame; until done it shows the frame under it; a pick between the
 steps (it rewrites the pre-pass records) makes it sort again."""
@@ -9,14 +9,14 @@ import pytest
 from splatedit.data import gaussian_scene_path
 from splatedit.io import read_gaussians
 from splatedit.render.camera import Camera
-from splatedit.render.gs_resources import gaussian_bounds
+from splatedit.render.gaussian.resources import gaussian_bounds
 
 pytestmark = pytest.mark.gpu
 
 
 def test_chunks_give_the_one_shot_frame_and_show_the_under_frame_meanwhile():
-    from splatedit.render.gaussians import GaussianRenderer
-    from splatedit.render.gs_progressive import GaussianProgressiveFrame
+    from splatedit.render.gaussian.renderer import GaussianRenderer
+    from splatedit.render.gaussian.progressive import GaussianProgressiveFrame
     scene = read_gaussians(str(gaussian_scene_path()))
     lo, hi = gaussian_bounds(scene)
     cam = Camera.frame(lo, hi, aspect=4 / 3, direction=(0.3, 0.4, 1.0))

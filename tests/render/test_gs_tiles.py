@@ -1,4 +1,4 @@
-"""The compute tile rasterizer of the Gaussian renderer (splatedit.render.gs_tiles)
+"""The compute tile rasterizer of the Gaussian renderer (splatedit.render.gaussian.tiles)
 draws the quad raster path's image within GS_TILE_MEAN_TOL / GS_TILE_MAX_TOL
 (the bundled bunny scene and random anisotropic Gaussians, several views, an
 image size that is not a multiple of the tile, both accumulator formats, a
@@ -17,7 +17,7 @@ from splatedit.io import read_gaussians
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.gaussians import (CPU_DEVICE_PATH, CPU_DEVICE_SORT, GaussianRenderer, choose_path,
+from splatedit.render.gaussian.renderer import (CPU_DEVICE_PATH, CPU_DEVICE_SORT, GaussianRenderer, choose_path,
                                         choose_sort, gaussian_bounds)
 from splatedit.tolerances import GS_TILE_MAX_TOL, GS_TILE_MEAN_TOL
 

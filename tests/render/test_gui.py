@@ -1,4 +1,4 @@
-"""Dear ImGui drawn by our Vulkan GUI pipeline (splatedit.render.gui), headless on lavapipe.
+"""Dear ImGui drawn by our Vulkan GUI pipeline (splatedit.render.gui.gui), headless on lavapipe.
 
 A frame with a window, text, a button, a slider and a clipped fill is drawn
 over a known background in an offscreen RGBA8 target and read back: flat
@@ -16,7 +16,7 @@ imgui = pytest.importorskip("imgui_bundle").imgui
 
 from splatedit import tolerances as tol  # noqa: E402
 from splatedit.render import vk as V  # noqa: E402
-from splatedit.render.gui import Gui  # noqa: E402
+from splatedit.render.gui.gui import Gui  # noqa: E402
 from splatedit.render.vk.resources import Buffer, readback_array  # noqa: E402
 from splatedit.render.vk.window import InputEvent  # noqa: E402
 
@@ -255,7 +255,7 @@ def test_input_events_click_button_and_type(target):
 
 
 def test_key_table_covers_editor_keys():
-    from splatedit.render.gui_input import imgui_key
+    from splatedit.render.gui.input import imgui_key
     K = imgui.Key
     assert imgui_key(65) == K.a and imgui_key(90) == K.z and imgui_key(48) == K._0
     assert imgui_key(256) == K.escape and imgui_key(257) == K.enter and imgui_key(335) == K.keypad_enter

@@ -10,7 +10,7 @@ from PIL import Image
 
 from splatedit.errors import InputError
 from splatedit.render.camera import Camera
-from splatedit.render.headless import render_to_png
+from splatedit.render.splat.headless import render_to_png
 from tests.render.deform_util import gaussian_basis
 from tests.render.scenes import sphere
 
@@ -56,7 +56,7 @@ def test_render_to_png(tmp_path):
 
 
 def _no_renderer(monkeypatch):
-    import splatedit.render.headless as headless
+    import splatedit.render.splat.headless as headless
 
     def refuse(*a, **k):
         raise AssertionError("rendered before checking the output")
@@ -81,7 +81,7 @@ def test_render_to_png_output_under_a_regular_file(tmp_path, monkeypatch):
 def test_render_to_png_write_error_is_an_input_error(tmp_path, monkeypatch):
     import errno
     import contextlib
-    import splatedit.render.headless as headless
+    import splatedit.render.splat.headless as headless
 
     @contextlib.contextmanager
     def full_disk(path, mode="wb"):

@@ -1,4 +1,4 @@
-"""Progressive full-quality frames (splatedit.render.progressive)."""
+"""Progressive full-quality frames (splatedit.render.splat.progressive)."""
 
 from __future__ import annotations
 
@@ -8,7 +8,7 @@ import pytest
 from splatedit.data import default_model_path
 from splatedit.io import read
 from splatedit.render.camera import Camera
-from splatedit.render.progressive import ProgressiveFrame, composite
+from splatedit.render.splat.progressive import ProgressiveFrame, composite
 
 W, H = 120, 90
 
@@ -96,7 +96,7 @@ def test_under_a_half_size_device_image_is_pixel_doubled(renderer):
     """A level-of-detail frame left on the device by another renderer of the
     same device at half size is blitted (pixel-doubled) under the chunks:
     uncovered pixels show it as the CPU path's np.repeat would."""
-    from splatedit.render.renderer import Renderer
+    from splatedit.render.splat.renderer import Renderer
     r = renderer
     bunny = read(default_model_path())
     r.set_cloud(bunny)

@@ -114,7 +114,7 @@ def test_uploaded_pixels_then_gui_pass_over_them(renderer):
     over them; no validation message, the pixels outside the GUI unchanged."""
     from imgui_bundle import imgui
 
-    from splatedit.render.gui import Gui
+    from splatedit.render.gui.gui import Gui
     from splatedit.render.vk.swapchain import SwapchainPresenter
 
     dev = renderer.dev

@@ -10,9 +10,9 @@ from splatedit.data import gaussian_scene_path
 from splatedit.io import read_gaussians
 from splatedit.render.camera import Camera
 from splatedit.render.frame import Frame, Resolve
-from splatedit.render.gs_passes import (GsPick, GsPrepare, GsQuads, GsSort, GsTiles, draw_frame, pick_frame,
+from splatedit.render.gaussian.passes import (GsPick, GsPrepare, GsQuads, GsSort, GsTiles, draw_frame, pick_frame,
                                        prepare_frame)
-from splatedit.render.gs_resources import gaussian_bounds
+from splatedit.render.gaussian.resources import gaussian_bounds
 from splatedit.render.scene import SceneRenderer
 from tests.render.scenes import sphere
 
@@ -25,7 +25,7 @@ def scene():
 
 
 def test_both_renderers_satisfy_the_scene_renderer_protocol(renderer, scene):
-    from splatedit.render.gaussians import GaussianRenderer
+    from splatedit.render.gaussian.renderer import GaussianRenderer
     renderer.set_cloud(sphere(500))
     assert isinstance(renderer, SceneRenderer) and renderer.supports_detail and renderer.resident_frames
     with GaussianRenderer(device=renderer.dev) as g:
@@ -51,7 +51,7 @@ def test_gaussian_frames_are_ordered_pass_lists():
 
 @pytest.mark.parametrize("path", ["raster", "compute"])
 def test_gaussian_resident_frame_is_the_read_back_frame(scene, path):
-    from splatedit.render.gaussians import GaussianRenderer
+    from splatedit.render.gaussian.renderer import GaussianRenderer
     lo, hi = gaussian_bounds(scene)
     cam = Camera.frame(lo, hi, aspect=4 / 3, direction=(0.3, 0.4, 1.0))
     with GaussianRenderer(path=path, sort="cpu") as g:

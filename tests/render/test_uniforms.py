@@ -141,7 +141,7 @@ def test_std140_offsets_follow_the_glsl_rules():
 
 
 def test_renderer_buffer_size_is_the_dtype_size():
-    from splatedit.render import renderer
+    from splatedit.render.splat import renderer
     assert renderer.UBO_BYTES == FRAME_UBO.itemsize
 
 

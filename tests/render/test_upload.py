@@ -14,7 +14,7 @@ def test_upload_in_many_chunks_gives_the_same_gpu_data_and_image(renderer, monke
     """The bundled bunny (with colours) uploaded in chunks of 1000 splats, the
     last one partial: the device buffers hold exactly the float32 geometry and
     the colours of a one-chunk upload, and the frames agree."""
-    import splatedit.render.uploads as umod
+    import splatedit.render.splat.uploads as umod
     bunny = read(default_model_path())
     rng = np.random.default_rng(4)
     colors = rng.integers(0, 256, (bunny.n, 4), dtype=np.uint8)

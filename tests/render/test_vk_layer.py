@@ -8,7 +8,7 @@ import pytest
 from splatedit.errors import SplatEditError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
-from splatedit.render.renderer import Renderer
+from splatedit.render.splat.renderer import Renderer
 from tests.render.scenes import sphere
 
 

@@ -137,7 +137,7 @@ def test_an_erased_thigh_stays_erased_and_does_not_move_when_the_arm_lifts(limbs
     the hand painted as the handle.  Closure keeps the thigh out (without
     the erase memory the same masks close over it again: back sides, gaps
     and the hand's margin), and lifting the arm leaves the thigh untouched."""
-    from splatedit.app import selection_tools as tools
+    from splatedit.app.document import selection as tools
     cloud, arm, thigh, graph = limbs
     p = cloud.positions
     hand = p[arm][np.argmin(p[arm][:, 1])]
@@ -162,7 +162,7 @@ def test_an_erased_thigh_stays_erased_and_does_not_move_when_the_arm_lifts(limbs
 
 
 def test_erase_memory_survives_undo_and_redo(limbs):
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     cloud, arm, thigh, _ = limbs
     s = Session(cloud, fit_sync=True)
     s.paint(np.flatnonzero(arm | thigh))
@@ -178,7 +178,7 @@ def test_erase_memory_survives_undo_and_redo(limbs):
 
 
 def test_a_shrink_counts_as_erasing_and_a_grow_as_painting(limbs):
-    from splatedit.app import selection_tools as tools
+    from splatedit.app.document import selection as tools
     cloud, arm, _, graph = limbs
     sel = Selection(cloud.n)
     sel.paint(np.flatnonzero(arm & (cloud.positions[:, 1] < -2)), SUPPORT)

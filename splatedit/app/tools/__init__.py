@@ -16,7 +16,7 @@ the editor itself (they come first in press order), the others register themselv
 of this package that sets ``TOOL = SomeTool`` is found by
 :func:`protocol_tools`, and the editor makes one, reachable as
 ``editor.<SomeTool.name>``.  A new tool is that file plus its keymap rows
-(:mod:`splatedit.app.keymap`):
+(:mod:`splatedit.app.ui.keymap`):
 
 * :class:`~splatedit.app.tools.region.RegionSelectTool`: box and lasso selection;
 * :class:`~splatedit.app.tools.mirror.MirrorTool`: mirror selection, symmetric painting;

@@ -8,7 +8,7 @@ from typing import Callable
 
 import numpy as np
 
-from splatedit.app.keymap import KEYMAP, Action, Binding, Section
+from splatedit.app.ui.keymap import KEYMAP, Action, Binding, Section
 from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION
 
 
@@ -58,9 +58,9 @@ class Tool:
     :meth:`press_modal` first, then to :meth:`press` in its tool order; the
     first to return a :class:`DragMode` owns the drag (:meth:`drag` on each
     move, :meth:`release` at the end).  Keys: :meth:`actions` maps keymap
-    :class:`~splatedit.app.keymap.Action` values to handlers.  Drawing:
+    :class:`~splatedit.app.ui.keymap.Action` values to handlers.  Drawing:
     :meth:`shapes` returns backend-neutral shapes
-    (:mod:`splatedit.app.shapes`) that one painter draws on the GPU path and
+    (:mod:`splatedit.app.tools.shapes`) that one painter draws on the GPU path and
     on the CPU fallback alike.
     """
     #: the help section of this tool's keymap rows
@@ -97,7 +97,7 @@ class Tool:
         return None
 
     def shapes(self, w: int, h: int) -> list:
-        """Overlay shapes (:mod:`splatedit.app.shapes`) drawn this frame in a
+        """Overlay shapes (:mod:`splatedit.app.tools.shapes`) drawn this frame in a
         ``w`` x ``h`` pixel window."""
         return []
 
@@ -121,13 +121,13 @@ class ToolContext:
     # ---- document and selection
     @property
     def document(self):
-        """The :class:`~splatedit.app.session.Session` (None: no model open)."""
+        """The :class:`~splatedit.app.document.session.Session` (None: no model open)."""
         return self._ed.session
 
     @property
     def selection_edit(self):
         """The document's selection edit API
-        (:class:`~splatedit.app.selection_edit.SelectionEdit`)."""
+        (:class:`~splatedit.app.document.selection_edit.SelectionEdit`)."""
         return self._ed.session.selection_edit
 
     @property
@@ -148,7 +148,7 @@ class ToolContext:
     @property
     def graphs(self):
         """The neighbour graphs and closure bookkeeping
-        (:class:`~splatedit.app.selection_tools.SelectionTools`: the 3D /
+        (:class:`~splatedit.app.document.selection.SelectionTools`: the 3D /
         visible brush mode, the last closure's highlight)."""
         return self._ed.selection_tools
 
@@ -163,7 +163,7 @@ class ToolContext:
     # ---- view
     @property
     def camera(self):
-        """The :class:`~splatedit.app.camera_control.OrbitCamera`."""
+        """The :class:`~splatedit.app.view.camera_control.OrbitCamera`."""
         return self._ed.cam
 
     @property
@@ -172,7 +172,7 @@ class ToolContext:
         return self._ed.size
 
     def visible(self):
-        """The :class:`~splatedit.app.brush.BrushPicker` of the current view
+        """The :class:`~splatedit.app.tools.pick_brush.BrushPicker` of the current view
         (which splat is visible at each pixel)."""
         return self._ed.picking.get()
 
@@ -198,7 +198,7 @@ class ToolContext:
     @property
     def through(self) -> bool:
         """The brush mode (V): True for 3D / through, False for visible only."""
-        from splatedit.app.selection_tools import BRUSH_3D
+        from splatedit.app.document.selection import BRUSH_3D
         return self._ed.selection_tools.mode == BRUSH_3D
 
     def erasing(self, mods: int | None = None) -> bool:

@@ -8,7 +8,7 @@ their window cannot be driven reliably by xdotool under Xvfb, and the editor
 would block on (or poll) another process.  A list of our own works wherever
 the editor works, is tested through real key presses, and needs no package.
 
-The list: the recent files first (:mod:`splatedit.app.recent`), then the
+The list: the recent files first (:mod:`splatedit.app.ui.recent`), then the
 folder's parent (``..``), its sub-folders and the files whose extension
 :func:`splatedit.io.read` knows (:data:`splatedit.io.READ_EXTENSIONS`);
 hidden entries are left out.  Up / Down / PageUp / PageDown / Home / End
@@ -25,8 +25,8 @@ import os
 from dataclasses import dataclass
 from pathlib import Path
 
-from splatedit.app import overlay as ov
-from splatedit.app.keymap import Action, Section
+from splatedit.app.ui import overlay as ov
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import Tool
 
 BROWSER_FONT = 14

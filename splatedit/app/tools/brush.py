@@ -2,18 +2,18 @@
 selection tools (grow, shrink, connected, invert); draws the brush cursor
 and the last closure's highlight.  The selection editing itself (the
 target's rules, strokes and the closure that ends them) is the document's
-(:mod:`splatedit.app.selection_edit`), called through the tool context."""
+(:mod:`splatedit.app.document.selection_edit`), called through the tool context."""
 
 from __future__ import annotations
 
 import numpy as np
 
-from splatedit.app import overlay as ov
-from splatedit.app import selection_tools as seltools
-from splatedit.app.brush import stroke_points
-from splatedit.app.shapes import Circle, Label, Points
+from splatedit.app.ui import overlay as ov
+from splatedit.app.document import selection as seltools
+from splatedit.app.tools.pick_brush import stroke_points
+from splatedit.app.tools.shapes import Circle, Label, Points
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.keymap import Action, Section
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.tolerances import (EDITOR_BRUSH_KEY_STEP, EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX,
                                   EDITOR_BRUSH_WHEEL_STEP)

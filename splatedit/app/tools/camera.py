@@ -6,8 +6,8 @@ from __future__ import annotations
 import math
 
 
-from splatedit.app import revision
-from splatedit.app.keymap import Action, Section
+from splatedit.app.document import revision
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool, free_area  # noqa: F401 (free_area: API)
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent

@@ -5,8 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.app.keymap import Action, Section
-from splatedit.app.shapes import Dot, Polyline
+from splatedit.app.ui.keymap import Action, Section
+from splatedit.app.tools.shapes import Dot, Polyline
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.tolerances import EDITOR_CURVE_DOT_PICK_PX
 

@@ -9,7 +9,7 @@ A tool on the narrow protocol (:attr:`Tool.ctx` only).
 
 from __future__ import annotations
 
-from splatedit.app.keymap import Action, Section
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import Tool
 
 

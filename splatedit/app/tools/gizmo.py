@@ -9,11 +9,11 @@ import math
 
 import numpy as np
 
-from splatedit.app import overlay as ov
-from splatedit.app import revision
-from splatedit.app.keymap import Action, Section, typed_char
-from splatedit.app.session import GRAB, ROTATE, SCALE, ViewInfo
-from splatedit.app.shapes import TOP, Circle, Cross, Dot, Label, Polyline
+from splatedit.app.ui import overlay as ov
+from splatedit.app.document import revision
+from splatedit.app.ui.keymap import Action, Section, typed_char
+from splatedit.app.document.session import GRAB, ROTATE, SCALE, ViewInfo
+from splatedit.app.tools.shapes import TOP, Circle, Cross, Dot, Label, Polyline
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX,

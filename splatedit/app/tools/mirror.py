@@ -12,7 +12,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.app.keymap import Action, Section
+from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import Tool
 from splatedit.select.mirror import AXES, mirror_indices
 

@@ -27,8 +27,8 @@ import math
 
 import numpy as np
 
-from splatedit.app.keymap import Action, Section
-from splatedit.app.shapes import Polyline
+from splatedit.app.ui.keymap import Action, Section
+from splatedit.app.tools.shapes import Polyline
 from splatedit.app.tools.base import DragMode, Tool
 
 HANDLE_CENTRE, SUPPORT_RIM, CURSOR, VIEW_CENTRE = "handle centre", "support rim", "3D cursor", "view centre"
@@ -133,7 +133,7 @@ class PivotTool(Tool):
     def place_cursor(self, x: float, y: float) -> bool:
         """Put the 3D cursor on the front surface under pixel (x, y); False
         over the background."""
-        from splatedit.app.selection_tools import surface_under
+        from splatedit.app.document.selection import surface_under
         c = self.ctx
         p = c.visible()
         hit = surface_under(p.pick, p.pick_depth, p.depths, x, y, CURSOR_PICK_PX)
@@ -162,7 +162,7 @@ class PivotTool(Tool):
             return np.asarray(c.camera.target, float).copy()
         if self.mode == SUPPORT_RIM:
             doc = c.document
-            from splatedit.app import revision
+            from splatedit.app.document import revision
             key = (revision.of(doc.cloud), doc.selection.key()[1])
             if self._rim[0] != key:
                 g = c.neighbour_graph()
@@ -184,7 +184,7 @@ class PivotTool(Tool):
             if not sel.handle.any():
                 return np.eye(3)
             k = sel.active
-            from splatedit.app import revision
+            from splatedit.app.document import revision
             key = (revision.of(doc.cloud), doc.version, k)
             if self._local[0] != key:       # the handle's principal axes, once per document change
                 self._local = (key, principal_frame(doc.cloud.positions[sel.handle]))

@@ -17,8 +17,8 @@ import math
 
 import numpy as np
 
-from splatedit.app.keymap import Action, Section
-from splatedit.app.shapes import Polyline
+from splatedit.app.ui.keymap import Action, Section
+from splatedit.app.tools.shapes import Polyline
 from splatedit.app.tools.base import DragMode, Tool
 
 BOX, LASSO = "box", "lasso"

@@ -1,6 +1,6 @@
 """Device capabilities beyond VkPhysicalDeviceProperties: the subgroup
 properties (Vulkan 1.1 core, ``VkPhysicalDeviceSubgroupProperties``) that
-decide which variant of a compute shader runs (:mod:`splatedit.render.gpu_sort`)."""
+decide which variant of a compute shader runs (:mod:`splatedit.render.gaussian.gpu_sort`)."""
 
 from __future__ import annotations
 

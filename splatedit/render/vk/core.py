@@ -79,6 +79,7 @@ _LIVE_LOCK = threading.Lock()
 
 
 def track(kind: str, delta: int) -> None:
+    """Count ``delta`` live Vulkan handles of ``kind`` (the leak tests read the counts)."""
     with _LIVE_LOCK:
         _LIVE[kind] += delta
         if _LIVE[kind] == 0:
@@ -132,6 +133,7 @@ _MSG_LOCK = threading.Lock()
 
 
 def validation_enabled() -> bool:
+    """True when ``SPLATEDIT_VALIDATION`` asks for the Khronos validation layer."""
     return os.environ.get("SPLATEDIT_VALIDATION", "0") not in ("", "0", "false", "no")
 
 
@@ -294,7 +296,7 @@ class Device:
             shaderFloat64=0, vertexPipelineStoresAndAtomics=avail.vertexPipelineStoresAndAtomics,
             shaderInt64=1 if atomics else 0)
         self.features = feats
-        #: the device runs the compute splat rasterizer (splatedit.render.compute_raster):
+        #: the device runs the compute splat rasterizer (splatedit.render.splat.compute_raster):
         #: 64-bit buffer atomics (atomicMin of depth << 32 | id) and float32 buffer
         #: atomicAdd (VK_EXT_shader_atomic_float), both enabled at creation
         self.compute_raster = atomics

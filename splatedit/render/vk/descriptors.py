@@ -35,6 +35,8 @@ def shader_stages(names: str) -> int:
 
 @dataclass(frozen=True)
 class Binding:
+    """One descriptor binding: its number, type (``uniform``, ``storage``, ``sampled``, ``storage_image``)
+    and the shader stages that see it (e.g. ``"vert|frag"``)."""
     binding: int
     type: str       # "uniform" | "storage" | "sampled" | "storage_image"
     stages: str     # "vert|frag"
@@ -42,12 +44,15 @@ class Binding:
 
 @dataclass(frozen=True)
 class LayoutDesc:
+    """A pipeline layout by description: descriptor sets (tuples of :class:`Binding`), push-constant
+    bytes and stages; pipelines and layouts are cached by this value."""
     sets: tuple[tuple[Binding, ...], ...] = ()
     push_bytes: int = 0
     push_stages: str = "vert"
 
 
 class SetLayout:
+    """A VkDescriptorSetLayout for ``bindings`` on ``device``."""
     def __init__(self, device: Device, bindings: tuple[Binding, ...]):
         self.dev = device
         self.bindings = bindings
@@ -63,6 +68,7 @@ class SetLayout:
 
 
 class PipelineLayout:
+    """A VkPipelineLayout made from a :class:`LayoutDesc` and its set layouts."""
     def __init__(self, device: Device, desc: LayoutDesc, set_layouts: list[SetLayout]):
         self.dev = device
         self.desc = desc

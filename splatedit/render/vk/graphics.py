@@ -39,6 +39,7 @@ _COMPARE = {
 
 @dataclass(frozen=True)
 class VertexBinding:
+    """A vertex buffer binding: number, stride (bytes) and whether it advances per instance."""
     binding: int
     stride: int
     per_instance: bool = True
@@ -46,6 +47,7 @@ class VertexBinding:
 
 @dataclass(frozen=True)
 class VertexAttribute:
+    """A vertex attribute: shader location, binding, format name and byte offset in the record."""
     location: int
     binding: int
     format: str     # key of _VERTEX_FORMATS
@@ -54,6 +56,8 @@ class VertexAttribute:
 
 @dataclass(frozen=True)
 class GraphicsDesc:
+    """A graphics pipeline by description (shaders by SPIR-V name, render pass, layout, vertex input,
+    fixed-function state); the pipeline cache keys on this value."""
     vert: str                                   # spirv name, e.g. "splat.vert"
     frag: str
     render_pass: RenderPassDesc

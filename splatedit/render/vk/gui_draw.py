@@ -2,7 +2,7 @@
 scissor per draw, drawn into an existing colour target.
 
 :class:`GuiPainter` knows nothing about Dear ImGui (that is
-:mod:`splatedit.render.gui`); it draws indexed triangles whose vertices have
+:mod:`splatedit.render.gui.gui`); it draws indexed triangles whose vertices have
 ImGui's ``ImDrawVert`` layout (:data:`~splatedit.render.uniforms.GUI_VERTEX`,
 20 bytes: ``pos`` 2 x float32 in framebuffer pixels, ``uv`` 2 x float32,
 ``col`` RGBA8 unorm) and 16- or 32-bit indices

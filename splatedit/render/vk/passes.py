@@ -17,6 +17,7 @@ _LOAD_OPS = {"clear": vk.VK_ATTACHMENT_LOAD_OP_CLEAR, "load": vk.VK_ATTACHMENT_L
 
 @dataclass(frozen=True)
 class Attachment:
+    """One render-pass attachment: format name, load op, initial and final layout names, store."""
     format: str                     # key of resources.FORMATS
     load: str = "clear"             # "clear" | "load" | "dont_care"
     initial: str = "undefined"      # layout name (commands.IMAGE_LAYOUTS) when load == "load"
@@ -26,6 +27,7 @@ class Attachment:
 
 @dataclass(frozen=True)
 class RenderPassDesc:
+    """A render pass by description: colour attachments, an optional depth attachment (read-only or not)."""
     colors: tuple[Attachment, ...] = ()
     depth: Attachment | None = None
     depth_read_only: bool = False
@@ -61,6 +63,7 @@ def _dependencies() -> list:
 
 
 class RenderPass:
+    """A VkRenderPass made from a :class:`RenderPassDesc` (one subpass, full dependencies before and after)."""
     def __init__(self, device: Device, desc: RenderPassDesc):
         self.dev = device
         self.desc = desc
@@ -98,6 +101,7 @@ class RenderPass:
 
 
 class Framebuffer:
+    """A VkFramebuffer of ``attachments`` (objects with ``.view`` and ``.layout``) for a render pass, in pixels."""
     def __init__(self, device: Device, render_pass: RenderPass, attachments, width: int, height: int):
         """``attachments``: objects with ``.view`` and ``.layout`` (Image or a swapchain image wrapper)."""
         self.dev = device

@@ -24,6 +24,8 @@ from splatedit.render.vk.shaders import ShaderModule, specialization, stage_info
 
 @dataclass(frozen=True)
 class ComputeDesc:
+    """A compute pipeline by description: shader by SPIR-V name, layout and specialisation constants
+    ((constant_id, int32 value) pairs)."""
     comp: str                                   # spirv name, e.g. "gs_sort.comp"
     layout: LayoutDesc
     spec: tuple[tuple[int, int], ...] = ()      # (constant_id, int32 value)

@@ -28,6 +28,7 @@ def spirv_path(name: str) -> Path:
 
 
 class ShaderModule:
+    """A VkShaderModule loaded from the packaged SPIR-V file ``name`` (e.g. ``"splat.vert"``)."""
     def __init__(self, device: Device, name: str):
         self.dev = device
         self.name = name

@@ -36,7 +36,7 @@ def test_home_keeps_the_model_out_of_the_panel_column_and_uses_the_window_withou
 
     import numpy as np
 
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     from tests.app.test_editor_routing import StubEditor
     from tests.app.sessions import plane_cloud
 
@@ -68,7 +68,7 @@ def test_home_keeps_the_model_out_of_the_panel_column_and_uses_the_window_withou
 
 
 def _session_of(cloud):
-    from splatedit.app.session import Session
+    from splatedit.app.document.session import Session
     return Session(cloud, fit_sync=True)
 
 
@@ -120,7 +120,7 @@ def test_home_on_the_clean_bunny_frames_its_full_bounding_sphere():
     bounding sphere, as before the main-body extent."""
     import numpy as np
 
-    from splatedit.app.camera_control import OrbitCamera
+    from splatedit.app.view.camera_control import OrbitCamera
     from splatedit.data import default_model_path
     from splatedit.io import read
     from tests.app.test_editor_routing import StubEditor

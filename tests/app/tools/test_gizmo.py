@@ -12,10 +12,10 @@ import numpy as np
 import pytest
 
 from splatedit.select.selection import HANDLE, SUPPORT
-from splatedit.app.camera_control import OrbitCamera
+from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor
 from splatedit.app.tools.base import DragMode
-from splatedit.app.session import GRAB, ROTATE, SCALE, Session
+from splatedit.app.document.session import GRAB, ROTATE, SCALE, Session
 from splatedit.tolerances import EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_SCALE_PX
 from tests.app.sessions import plane_cloud
 
@@ -117,7 +117,7 @@ def test_all_parts_are_shown_and_picked_in_priority_order(editor):
     assert n_crossings > 0
     assert ed.gizmo.pick(5, 5) is None
     # the overlay draws grip, rings and arrows (shapes: one list for both painters)
-    from splatedit.app.shapes import Circle, Dot, Polyline, to_patches
+    from splatedit.app.tools.shapes import Circle, Dot, Polyline, to_patches
     shapes = ed.gizmo.shapes(W, H)
     kinds = [type(s) for s in shapes]
     assert kinds.count(Circle) == 1 and kinds.count(Polyline) >= 3 + 3 and kinds.count(Dot) == 3

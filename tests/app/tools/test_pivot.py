@@ -12,13 +12,13 @@ import types
 import numpy as np
 import pytest
 
-from splatedit.app.brush import BrushPicker
-from splatedit.app.manipulation import GRAB, SCALE, Manipulation
+from splatedit.app.tools.pick_brush import BrushPicker
+from splatedit.app.document.manipulation import GRAB, SCALE, Manipulation
 from splatedit.app.tools.pivot import (CURSOR, LOCAL, SUPPORT_RIM, VIEW, VIEW_CENTRE, principal_frame,
                                        rim_centroid)
 from splatedit.select.graph import NeighbourGraph
-from splatedit.app.camera_control import OrbitCamera
-from splatedit.app.session import Session
+from splatedit.app.view.camera_control import OrbitCamera
+from splatedit.app.document.session import Session
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.sessions import plane_cloud, view
 from tests.app.test_editor_routing import H, W, StubEditor

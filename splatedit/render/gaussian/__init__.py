@@ -1,0 +1,1 @@
+"""The 3D Gaussian Splatting renderer: resources, passes, compute tiles, GPU sort, progressive frames, numpy reference."""

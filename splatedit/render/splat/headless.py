@@ -1,0 +1,139 @@
+"""One-shot offscreen rendering to a PNG (what the CLI calls)."""
+
+from __future__ import annotations
+
+import os
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+from splatedit.errors import InputError, ParameterError
+from splatedit.atomic import atomic_open, check_writable_target
+from splatedit.model.cloud import SplatCloud
+from splatedit.render.camera import Camera
+from splatedit.render.splat.renderer import Renderer
+from splatedit.tolerances import RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL
+
+
+def available_memory() -> int | None:
+    """Bytes of memory the system can give without swapping (Linux
+    ``MemAvailable``), or None where that is unknown."""
+    try:
+        with open("/proc/meminfo", encoding="ascii") as fh:
+            for line in fh:
+                if line.startswith("MemAvailable:"):
+                    return int(line.split()[1]) * 1024
+    except (OSError, ValueError, IndexError):
+        pass
+    return None
+
+
+def check_render_memory(size, buffers: bool = False) -> None:
+    """Refuse, before allocating anything, an image that would not fit in the
+    available memory (RENDER_BYTES_PER_PIXEL, RENDER_BUFFERS_BYTES_PER_PIXEL).
+
+    Raises:
+        ParameterError: naming ``--size`` with the estimate and what is free.
+    """
+    w, h = (int(s) for s in size)
+    need = w * h * (RENDER_BUFFERS_BYTES_PER_PIXEL if buffers else RENDER_BYTES_PER_PIXEL)
+    free = available_memory()
+    if free is not None and need > free:
+        what = " with --buffers" if buffers else ""
+        raise ParameterError("--size", f"{w}x{h}{what} needs about {need / 2**30:.1f} GiB of memory, "
+                                       f"only {free / 2**30:.1f} GiB is available; render a smaller image")
+
+
+def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
+                  basis=None, dC=None, selection=None, buffers_path=None,
+                  device_name: str | None = None, raster_path: str | None = None, edl: bool = False) -> Path:
+    """Render ``cloud`` offscreen and save an RGBA PNG (atomically: temp file + rename).
+
+    Args:
+        size: (width, height) in pixels.
+        camera: default the editor's first view (:func:`splatedit.render.framing.default_view`:
+            the main body from the front about the detected up axis).
+        basis: optional ``(indices, B, Bx, By, Bz)`` deformation basis rows
+            (see :meth:`Renderer.set_basis`), plus ``detail`` (N, 4) for the
+            detail mode (:meth:`Renderer.set_detail`); applied on the GPU with ``dC``
+            ((K, 3) control-frame displacement, default zeros).  Chained edits
+            are committed on the CPU by the caller: pass the final cloud and
+            the last edit's basis.
+        selection: optional ``(support_mask, handle_mask)`` to tint.
+        buffers_path: also save the float buffers (depth, normal, weight,
+            colour; see :meth:`Renderer.render_buffers`) to this ``.npz``.
+        raster_path: ``"auto"`` / ``"raster"`` / ``"compute"`` (the
+            renderer's argument; default env var ``SPLATEDIT_RASTER`` or auto).
+        edl: eye-dome lighting (:attr:`Renderer.edl`, default strength and radius).
+    Returns the PNG path.
+
+    Raises:
+        InputError: naming the path, when an output cannot be written (its
+            directory cannot be created or written, it is a directory, the
+            disk is full, ...); the directories are checked (and created)
+            before rendering.
+    """
+    w, h = size_and_basis(size, basis, dC)
+    check_render_memory((w, h), buffers_path is not None)
+    out_png = Path(out_png)
+    outputs = [out_png] + ([Path(buffers_path)] if buffers_path is not None else [])
+    for out in outputs:
+        prepare_output(out)
+    if camera is None:
+        from splatedit.render.framing import default_view
+        camera = default_view(cloud, (w, h), path=cloud.source).camera
+    with Renderer(device_name=device_name, raster_path=raster_path) as r:
+        r.set_cloud(cloud)
+        r.edl = bool(edl)
+        if selection is not None:
+            r.set_selection(*selection)
+        if basis is not None:
+            idx, B, Bx, By, Bz = basis[:5]
+            r.set_basis(idx, B, Bx, By, Bz)
+            if len(basis) == 6:       # the detail mode's (n_b, lambda) rows
+                r.set_detail(idx, basis[5])
+            r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
+        img = r.render(camera, w, h)
+        bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None
+    write_image(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
+    if bufs is not None:
+        write_image(Path(buffers_path), lambda fh: np.savez_compressed(fh, **bufs))
+    return out_png
+
+
+def size_and_basis(size, basis, dC) -> tuple[int, int]:
+    """(width, height) of a headless render's ``size``; ParameterError for a
+    bad size or a ``dC`` without a ``basis``."""
+    try:
+        w, h = (int(s) for s in size)
+    except (TypeError, ValueError):
+        raise ParameterError("size", f"must be (width, height), got {size!r}") from None
+    if dC is not None and basis is None:
+        raise ParameterError("dC", "given without a basis")
+    return w, h
+
+
+def prepare_output(path: Path) -> None:
+    """Before rendering: create ``path``'s directory and check that a file can
+    be written there (the CLI has already refused existing files unless
+    --force, so an existing file is fine here)."""
+    parent = path.parent if str(path.parent) else Path(".")
+    try:
+        parent.mkdir(parents=True, exist_ok=True)
+    except OSError as e:
+        raise InputError(f"cannot create its directory {str(parent)!r}: {e.strerror or e}", path=str(path)) from None
+    check_writable_target(path, overwrite=True)
+    if not os.access(parent, os.W_OK | os.X_OK):
+        raise InputError(f"directory {str(parent)!r} is not writable", path=str(path))
+
+
+def write_image(path: Path, save) -> None:
+    """Write a rendered image to ``path`` atomically: ``save(fh)`` writes the
+    bytes to a temporary file that replaces ``path`` when done; an OS error
+    is an :class:`~splatedit.errors.InputError` naming the path."""
+    try:
+        with atomic_open(path, "wb") as fh:
+            save(fh)
+    except OSError as e:
+        raise InputError(f"cannot write: {e.strerror or e}", path=str(path)) from None
