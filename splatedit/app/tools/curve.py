@@ -91,7 +91,7 @@ class CurveTool(Tool):
         out = []
         poly = s.curve_polyline()
         if poly is not None:
-            out.append(Polyline(self._project(poly, w, h), CURVE_RGB, 3.0))
+            out.append(Polyline(self._project(poly, w, h), CURVE_RGB, 3.0, halo=False))
         active = s.manip_target[1] if (s.manip_target and s.manip_target[0] == "curve") else None
         chosen = s.active_curve_point() if s.curve_mode else None     # the transform fields' point: ringed
         for j, q in enumerate(self.dots(w, h)):

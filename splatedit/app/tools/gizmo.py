@@ -388,9 +388,9 @@ class GizmoTool(Tool):
         cur = m[:3, :3] @ piv + m[:3, 3]
         grip = self.scale_circle(w, h)
         if grip is not None:
-            out.append(Circle(grip[0], grip[1], (225, 225, 225), 1.0))
+            out.append(Circle(grip[0], grip[1], (225, 225, 225), 1.0, halo=False))
         for k, px in self.rings(w, h):
-            out.append(Polyline(px, ov.AXIS_RGB[k], 2.0))
+            out.append(Polyline(px, ov.AXIS_RGB[k], 2.0, halo=False))
         for k, p0, p1 in self.axes(w, h):
             out += [Polyline(np.array([p0, p1]), ov.AXIS_RGB[k], 3.0, halo=False),
                     Dot(p1, ov.AXIS_RGB[k], 4.0, rim=False)]

@@ -54,11 +54,12 @@ class Polyline:
 @dataclass(frozen=True)
 class Circle:
     """A circle outline of ``radius`` pixels about ``centre`` (2,), ``width``
-    pixels, over a dark halo."""
+    pixels; ``halo``: over a dark ring (contrast on any background)."""
     centre: tuple
     radius: float
     rgb: tuple
     width: float = 2.0
+    halo: bool = True
     layer: int = OVER
 
 
@@ -133,7 +134,7 @@ def to_patches(shapes, size: tuple[int, int]) -> list:
             p = ov.polyline_patch(s.strip(), s.rgb, width=max(int(round(s.width)), 1), halo=s.halo)
         elif isinstance(s, Circle):
             if drawable(s.centre):
-                img = ov.ring(int(round(s.radius)), s.rgb, max(int(round(s.width)), 1))
+                img = ov.ring(int(round(s.radius)), s.rgb, max(int(round(s.width)), 1), halo=s.halo)
                 p = ov.Patch(int(round(s.centre[0])) - img.shape[1] // 2,
                              int(round(s.centre[1])) - img.shape[0] // 2, img)
         elif isinstance(s, Dot):

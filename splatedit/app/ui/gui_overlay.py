@@ -123,8 +123,11 @@ def draw_shapes(shapes, w: int, h: int, under=None, top=None) -> None:
         elif isinstance(s, Circle):
             if _ok(s.centre):
                 c, r = _v(s.centre), float(s.radius)
-                dl.add_circle(c, r + 1.0, col((0, 0, 0), 150), 0, s.width + 2.0)
-                dl.add_circle(c, r, col(s.rgb, 230), 0, float(s.width))
+                if s.halo:
+                    dl.add_circle(c, r + 1.0, col((0, 0, 0), 150), 0, s.width + 2.0)
+                    dl.add_circle(c, r, col(s.rgb, 230), 0, float(s.width))
+                else:
+                    dl.add_circle(c, r, col(s.rgb), 0, float(s.width))
         elif isinstance(s, Dot):
             if _ok(s.centre):
                 if s.rim:

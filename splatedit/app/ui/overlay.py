@@ -93,14 +93,15 @@ def text_panel(lines: tuple, size: int = 14, bg=(20, 22, 28, 200), fg=(235, 235,
 
 
 @functools.lru_cache(maxsize=32)
-def ring(radius: int, rgb=(255, 255, 255), width: int = 2) -> np.ndarray:
-    """An RGBA image of a circle outline (with a dark halo for contrast)."""
+def ring(radius: int, rgb=(255, 255, 255), width: int = 2, halo: bool = True) -> np.ndarray:
+    """An RGBA image of a circle outline (with a dark halo for contrast unless ``halo`` is False)."""
     r = int(radius)
     s = 2 * r + 2 * width + 4
     img = Image.new("RGBA", (s, s), (0, 0, 0, 0))
     d = ImageDraw.Draw(img)
     c = s / 2
-    d.ellipse((c - r - 1, c - r - 1, c + r + 1, c + r + 1), outline=(0, 0, 0, 150), width=width + 2)
+    if halo:
+        d.ellipse((c - r - 1, c - r - 1, c + r + 1, c + r + 1), outline=(0, 0, 0, 150), width=width + 2)
     d.ellipse((c - r, c - r, c + r, c + r), outline=tuple(rgb) + (230,), width=width)
     return np.asarray(img)
 
