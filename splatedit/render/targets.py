@@ -209,21 +209,20 @@ def create_frame_objects(r, ubo_bytes: int) -> None:
     r.dC_ubo.view(np.float32)[:] = 0.0
 
 
-def targets_for(r, width: int, height: int, make):
-    """``r._targets`` for this image size, replaced by ``make(r, width, height)``
-    (after the device is idle) when the size changed.  Raises ParameterError
-    for a size outside 1..MAX_SIZE."""
+def reusable_targets(r, current, width: int, height: int):
+    """``current`` (renderer ``r``'s per-size targets, or None) when it has
+    this image size; else None, after destroying ``current`` (once the device
+    is idle): the caller makes new ones.  Raises ParameterError for a size
+    outside 1..MAX_SIZE (``current`` is then kept)."""
     for name, v in (("width", width), ("height", height)):
         if not isinstance(v, (int, np.integer)) or not 1 <= v <= MAX_SIZE:
             raise ParameterError(name, f"must be an integer in 1..{MAX_SIZE}, got {v!r}")
-    t = r._targets
-    if t is None or (t.width, t.height) != (width, height):
-        if t is not None:
-            r.dev.wait_idle()
-            t.destroy()
-            r._targets = None
-        r._targets = make(r, int(width), int(height))
-    return r._targets
+    if current is not None and (current.width, current.height) == (width, height):
+        return current
+    if current is not None:
+        r.dev.wait_idle()
+        current.destroy()
+    return None
 
 
 def clip_rect(rect, width: int, height: int) -> tuple[int, int, int, int]:

@@ -48,7 +48,7 @@ from splatedit.render.gpu_units import gpu_camera
 from splatedit.render.splat.prepass import Prepass, PrepObjects
 from splatedit.render.splat.layout import (GEOM_STRIDE, PREP_MAX_SIZE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
                                            UBO_BYTES, rp_attr, rp_window, splat_desc)
-from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
+from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, reusable_targets
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.splat.uploads import SceneUploads
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_EDL_RADIUS_PX,
@@ -403,7 +403,11 @@ class Renderer:
 
     # ------------------------------------------------------------- frames
     def targets_for(self, width: int, height: int) -> SplatTargets:
-        return targets_for(self, width, height, SplatTargets)
+        t = reusable_targets(self, self._targets, width, height)
+        if t is None:
+            self._targets = None                # a failure below leaves no destroyed targets behind
+            t = self._targets = SplatTargets(self, int(width), int(height))
+        return t
 
     def write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         # everything on the GPU is in model units relative to origin, divided
