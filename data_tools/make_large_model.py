@@ -10,7 +10,14 @@ normals; splat sizes come from the neighbour spacing
 splatedit.io.write (not committed; give it a path outside the repository or
 one that is git-ignored).
 
+With ``--normals-radius`` the file is what scanner pipelines write instead
+(issue 23's 10M file): x y z nx ny nz radius as float32 (28 bytes a point,
+280 MB at 10M), the radius from the sample density (the spacing of a
+hexagonal sampling of the same area, times SPLAT_RADIUS_FACTOR), written
+in chunks without estimating anything.
+
 Usage: python data_tools/make_large_model.py OUT.ply [--points N] [--input MESH] [--seed S]
+                                             [--normals-radius]
        (default: 1,000,000 points sampled from the default bunny)
 """
 
@@ -60,6 +67,30 @@ def sample_surface(vertices, faces, n_points: int, seed: int = 0):
     return pts, nrm
 
 
+def write_normals_radius_ply(path: Path, vertices, faces, n_points: int, seed: int = 0,
+                             chunk: int = 1_000_000) -> int:
+    """Write ``n_points`` area-uniform samples as a binary little-endian PLY
+    of float32 x y z nx ny nz radius, ``chunk`` points at a time.  Returns
+    the file size in bytes."""
+    from splatedit.tolerances import SPLAT_RADIUS_FACTOR
+    V = np.asarray(vertices, dtype=np.float64)
+    F = np.asarray(faces, dtype=np.int64)
+    area = 0.5 * np.linalg.norm(np.cross(V[F[:, 1]] - V[F[:, 0]], V[F[:, 2]] - V[F[:, 0]]), axis=1).sum()
+    radius = SPLAT_RADIUS_FACTOR * np.sqrt(2.0 * area / (np.sqrt(3.0) * n_points))
+    names = ("x", "y", "z", "nx", "ny", "nz", "radius")
+    head = ["ply", "format binary_little_endian 1.0", f"element vertex {n_points}"]
+    head += [f"property float {p}" for p in names] + ["end_header", ""]
+    with open(path, "wb") as fh:
+        fh.write("\n".join(head).encode("ascii"))
+        for i, lo in enumerate(range(0, n_points, chunk)):
+            m = min(chunk, n_points - lo)
+            pts, nrm = sample_surface(V, F, m, seed * 100_003 + i)
+            arr = np.empty((m, 7), dtype="<f4")
+            arr[:, :3], arr[:, 3:6], arr[:, 6] = pts, nrm, radius
+            fh.write(arr.tobytes())
+    return path.stat().st_size
+
+
 def main(argv=None) -> int:
     ap = argparse.ArgumentParser(description="area-uniform splat sampling of a mesh")
     ap.add_argument("output", type=Path)
@@ -67,11 +98,19 @@ def main(argv=None) -> int:
     ap.add_argument("--input", type=Path, default=None, help="mesh (default: the bunny)")
     ap.add_argument("--seed", type=int, default=0)
     ap.add_argument("--overwrite", action="store_true")
+    ap.add_argument("--normals-radius", action="store_true",
+                    help="write float32 x y z nx ny nz radius (no splat axes, no estimation)")
     args = ap.parse_args(argv)
     t0 = time.perf_counter()
     mesh = read(args.input or default_model_path())
     if mesh.faces is None or not len(mesh.faces):
         raise SystemExit(f"{args.input}: not a mesh (no faces)")
+    if args.normals_radius:
+        if args.output.exists() and not args.overwrite:
+            raise SystemExit(f"{args.output}: exists (--overwrite)")
+        size = write_normals_radius_ply(args.output, mesh.positions, mesh.faces, args.points, args.seed)
+        print(f"{args.output}: {args.points} points, {size} bytes, {time.perf_counter() - t0:.1f} s")
+        return 0
     pts, nrm = sample_surface(mesh.positions, mesh.faces, args.points, args.seed)
     u, v = splat_axes(pts, nrm)
     cloud = SplatCloud(pts, u, v, name=f"{mesh.name} x{args.points}")

@@ -252,6 +252,9 @@ def build_parser() -> argparse.ArgumentParser:
                    help="draw path: raster passes or compute shaders (splats: default env var SPLATEDIT_RASTER, "
                         "else auto: the faster, measured; Gaussian scenes: quads or the compute tile "
                         "rasterizer, default the device's, see docs/PERFORMANCE.md)")
+    s.add_argument("--full", action="store_true",
+                   help="draw every splat (default: where many splats fall in one pixel, a level of "
+                        "detail whose splats are about a pixel wide, see docs/commands.md)")
     s.add_argument("-f", "--force", action="store_true", help="overwrite outputs")
     s.set_defaults(func=cmd_render)
 
@@ -271,7 +274,9 @@ def build_parser() -> argparse.ArgumentParser:
                         "support splats of basis and of solve's grab cases (on a cloud 2.5x as large) "
                         "(e.g. --splats 1000000 10000000)")
     s.add_argument("--large", action="store_true",
-                   help="io: also the 10M-splat PLY read (writes an 840 MB file to the temp folder)")
+                   help="io: also the 10M-splat PLY read (writes an 840 MB file to the temp folder) and "
+                        "whole 'info' and 'render' processes of a 10M normals + radius PLY (280 MB) "
+                        "beside Open3D's read (SPLATEDIT_OPEN3D_PYTHON: its interpreter)")
     s.add_argument("--size", type=parse_size, default=None,
                    help="render, gaussian-render: image WxH (default 1280x720, 640x360 with --quick)")
     s.add_argument("--path", choices=("raster", "compute"), default=None,

@@ -258,6 +258,7 @@ class Editor:
         t.update({
             Action.OPEN: fa.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
+            Action.EDL: self.toggle_edl, Action.TWO_SIDED: self.toggle_two_sided,
             Action.DEFORMATION_MODE: self.cycle_deformation,
             Action.SPLATS_SMALLER: lambda: self.scale_splats(1.0 / EDITOR_SPLAT_SCALE_STEP),
             Action.SPLATS_LARGER: lambda: self.scale_splats(EDITOR_SPLAT_SCALE_STEP),
@@ -289,6 +290,28 @@ class Editor:
         vp.grey = not vp.grey
         grey = "uniform grey shading" if getattr(vp, "gaussians", None) is None else "grey (luminance)"
         self.say(f"colours: {grey}" if vp.grey else "colours: the file's colours")
+
+    def toggle_edl(self) -> None:
+        """Shift+E: eye-dome lighting on / off (splat models; a Gaussian scene says it has none)."""
+        vp = self.viewport
+        if getattr(vp, "gaussians", None) is not None:
+            vp.edl = False
+            self.say("eye-dome lighting is for point-splat models, not Gaussian splat scenes")
+            return
+        vp.edl = not vp.edl
+        self.say("eye-dome lighting " + ("on: depth edges and creases darkened (Shift+E: off)"
+                                         if vp.edl else "off"))
+
+    def toggle_two_sided(self) -> None:
+        """T: draw the splats seen from behind too (back-face culling off) / not."""
+        vp = self.viewport
+        if getattr(vp, "gaussians", None) is not None:
+            vp.two_sided = False
+            self.say("a Gaussian scene draws every Gaussian from both sides already")
+            return
+        vp.two_sided = not vp.two_sided
+        self.say("two-sided splats: " + ("on, splats seen from behind are drawn too (T: off)" if vp.two_sided
+                                         else "off, splats facing away are not drawn"))
 
     def scale_splats(self, factor: float) -> None:
         """Shift+[ / Shift+]: draw every splat's axes this much larger (display only)."""

@@ -9,7 +9,8 @@ Cases (one dict each, printed as a JSON line by the CLI):
   in a fresh Python process so its peak memory is its own: ``splatedit``
   (:func:`splatedit.io.read`, the whole SplatCloud), ``plyfile`` (its plain
   ``PlyData.read``, the structured vertex array only) and ``open3d``
-  (``read_point_cloud``; skipped with a note when Open3D is not installed).
+  (``read_point_cloud``, in ``SPLATEDIT_OPEN3D_PYTHON`` when set; skipped
+  with a note when Open3D is not installed).
   Keys: ``seconds`` (the read alone), ``peak_rss_mb`` (the child's peak
   resident memory), ``base_rss_mb`` (the child's memory after its imports,
   before reading), ``kept_mb`` (bytes of the arrays the reader returns) and
@@ -20,6 +21,17 @@ Cases (one dict each, printed as a JSON line by the CLI):
   laspy's own read (``laspy.read``) in the same run.  LAS has no normals:
   our read includes normal estimation, orientation and sizing of the raw
   points (``splatedit.model.estimate``), which is most of its time.
+
+* ``info_file`` / ``render_file`` (``--large`` only): issue 23's file, a
+  binary PLY of float32 x y z nx ny nz radius (28 bytes a point, 280 MB at
+  10M; a Fibonacci sphere), through the whole ``splatedit -q info`` and
+  ``splatedit -q render`` processes (1280x720; the render draws its level
+  of detail unless ``--full``), each beside Open3D's ``read_point_cloud`` of
+  the same file in a fresh process of the same run: ``seconds`` and
+  ``peak_rss_mb`` of each process (wall time, ``wait4``'s peak resident
+  memory), ``open3d_s``, ``open3d_peak_rss_mb`` and ``ratio_to_open3d``.
+  Open3D's interpreter: ``SPLATEDIT_OPEN3D_PYTHON`` if set (a separate
+  environment), else this one; skipped with a note when it has no Open3D.
 
 Sizes: 1M by default (``--quick``: 200k PLY, 20k LAS); 10M only with ``--large``.
 """
@@ -103,7 +115,8 @@ def write_sphere_ply(path: Path, n: int) -> int:
 def _child(kind: str, path: Path) -> dict:
     env = dict(os.environ)
     env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")     # as the CLI runs (see splatedit.cli)
-    proc = subprocess.run([sys.executable, "-c", _CHILD, kind, str(path)], capture_output=True,
+    exe = _open3d_python() if kind == "open3d" else sys.executable
+    proc = subprocess.run([exe, "-c", _CHILD, kind, str(path)], capture_output=True,
                           text=True, env=env)
     if proc.returncode != 0:
         last = (proc.stderr.strip().splitlines() or ["failed"])[-1]
@@ -111,9 +124,15 @@ def _child(kind: str, path: Path) -> dict:
     return json.loads(proc.stdout.strip().splitlines()[-1])
 
 
+def _open3d_python() -> str:
+    """The interpreter of the Open3D reads: ``SPLATEDIT_OPEN3D_PYTHON`` (an
+    environment of its own: Open3D pins its own numpy) or this one."""
+    return os.environ.get("SPLATEDIT_OPEN3D_PYTHON") or sys.executable
+
+
 def _has_open3d() -> bool:
     import importlib.util
-    return importlib.util.find_spec("open3d") is not None
+    return bool(os.environ.get("SPLATEDIT_OPEN3D_PYTHON")) or importlib.util.find_spec("open3d") is not None
 
 
 def bench_ply_read(counts, tmp: Path) -> Iterator[dict]:
@@ -133,6 +152,69 @@ def bench_ply_read(counts, tmp: Path) -> Iterator[dict]:
                 out["generate_s"] = round(gen, 2)
             yield out
         path.unlink()
+
+
+def write_normals_radius_ply(path: Path, n: int) -> int:
+    """Write ``n`` points of a unit Fibonacci sphere as float32 x y z nx ny nz
+    radius (the radius: 1.5x the spacing of a hexagonal sampling of the
+    sphere), ``_CHUNK`` at a time.  Returns the file size in bytes."""
+    names = ("x", "y", "z", "nx", "ny", "nz", "radius")
+    head = ["ply", "format binary_little_endian 1.0", f"element vertex {n}"]
+    head += [f"property float {p}" for p in names] + ["end_header", ""]
+    radius = 1.5 * np.sqrt(2.0 * 4.0 * np.pi / (np.sqrt(3.0) * n))
+    with open(path, "wb") as fh:
+        fh.write("\n".join(head).encode("ascii"))
+        for lo in range(0, n, _CHUNK):
+            nrm, _, _ = fibonacci_sphere(n, lo, min(n, lo + _CHUNK))
+            arr = np.empty((len(nrm), 7), dtype="<f4")
+            arr[:, :3], arr[:, 3:6], arr[:, 6] = nrm, nrm, radius
+            fh.write(arr.tobytes())
+    return path.stat().st_size
+
+
+def _process(cmd) -> dict:
+    """Run ``cmd``; its wall seconds and peak resident memory (``wait4``), or
+    ``skipped`` with its last stderr line when it fails."""
+    env = dict(os.environ)
+    env.setdefault("NUMPY_MADVISE_HUGEPAGE", "0")
+    t0 = time.perf_counter()
+    try:
+        proc = subprocess.Popen([str(c) for c in cmd], stdout=subprocess.DEVNULL,
+                                stderr=subprocess.PIPE, env=env)
+    except OSError as exc:                       # no such interpreter
+        return {"skipped": str(exc)[:200]}
+    _, status, usage = os.wait4(proc.pid, 0)
+    dt = time.perf_counter() - t0
+    err = proc.stderr.read().decode(errors="replace")
+    proc.stderr.close()
+    proc.returncode = os.waitstatus_to_exitcode(status)
+    if proc.returncode != 0:
+        return {"skipped": ((err.strip().splitlines() or ["failed"])[-1])[:200]}
+    return {"seconds": round(dt, 2), "peak_rss_mb": round(usage.ru_maxrss / 1024)}
+
+
+def bench_large_file(n: int, tmp: Path) -> Iterator[dict]:
+    """``info`` and ``render`` of a normals + radius PLY as whole processes,
+    each beside Open3D's read of the same file (module docstring)."""
+    path = tmp / f"scan{n}.ply"
+    size = write_normals_radius_ply(path, n)
+    o3d_python = _open3d_python()
+    o3d_code = "import sys, open3d as o3d; print(len(o3d.io.read_point_cloud(sys.argv[1]).points))"
+    cli = [sys.executable, "-m", "splatedit.cli", "-q"]
+    for case, cmd in (("info_file", cli + ["info", path]),
+                      ("render_file", cli + ["render", path, "-o", tmp / "render.png", "-f"])):
+        out = {"bench": "io", "case": case, "splats": n, "file_mb": round(size / 2**20)}
+        out.update(_process(cmd))
+        o3d = _process([o3d_python, "-c", o3d_code, path])
+        if "skipped" in o3d:
+            out["open3d"] = "not available: " + o3d["skipped"] + " (set SPLATEDIT_OPEN3D_PYTHON)"
+        else:
+            out["open3d_s"], out["open3d_peak_rss_mb"] = o3d["seconds"], o3d["peak_rss_mb"]
+            if "seconds" in out:
+                out["ratio_to_open3d"] = round(out["seconds"] / o3d["seconds"], 2)
+        out["load"] = round(os.getloadavg()[0], 1)
+        yield out
+    path.unlink()
 
 
 def scan_cloud(n: int, seed: int = 0):
@@ -186,4 +268,6 @@ def bench_io(*, quick: bool = False, large: bool = False, counts=None, las_point
     counts = counts or ((200_000,) if quick else ((1_000_000, 10_000_000) if large else (1_000_000,)))
     with tempfile.TemporaryDirectory(prefix="splatedit-bench-io-") as tmp:
         yield from bench_ply_read(counts, Path(tmp))
+        if large:
+            yield from bench_large_file(max(counts), Path(tmp))
         yield from bench_las(las_points or (20_000 if quick else 1_000_000), Path(tmp))

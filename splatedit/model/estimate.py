@@ -30,7 +30,7 @@ from splatedit.model.orient import orient_normals
 from splatedit.model.outliers import detect_outliers
 from splatedit.model.pca import morton_codes, neighbourhood_covariances, smallest_eigenvectors
 from splatedit.model.sizing import (boundary_points, limit_outlier_radii, limit_radii,
-                                    neighbour_indices, neighbour_median)
+                                    neighbour_indices, neighbour_median, settle_radii)
 from splatedit.model.neighbours import as_points as _points
 from splatedit.model.neighbours import knn  # noqa: F401  (part of this module's API)
 from splatedit.model.spacing import nearest_neighbour_distances
@@ -147,8 +147,10 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it, and the radius of an outlier
     (:func:`splatedit.model.outliers.detect_outliers`) at
     ``OUTLIER_RADIUS_REL_MEDIAN`` times the median radius of its neighbours
-    that are not outliers
-    (see :mod:`splatedit.model.sizing`).
+    that are not outliers; finally the first cap is applied again against
+    these radii (:func:`splatedit.model.sizing.settle_radii`), so a splat
+    next to shrunk ones is at most ``SIZE_CAP_REL_NEIGHBOURS`` times their
+    median too (see :mod:`splatedit.model.sizing`).
 
     Args:
         points: (n, 3) float64 positions; normals: (n, 3) float64 unit normals.
@@ -174,8 +176,10 @@ def robust_splat_radii(points, normals, *, tree: cKDTree | None = None, distance
     for lo in range(0, len(test), ESTIMATE_CHUNK_POINTS):     # its (m, k, 3) gathers in chunks
         part = test[lo:lo + ESTIMATE_CHUNK_POINTS]
         boundary[part] = boundary_points(pts, normals, nb, query=part)
+    first = r
     r = limit_radii(r, nb, boundary, local=local)
-    return limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
+    r = limit_outlier_radii(r, detect_outliers(pts, tree=tree, distances=distances).mask, nb)
+    return settle_radii(r, nb, r < first)
 
 
 def splat_axes(points, normals, *, radius=None, tree: cKDTree | None = None,

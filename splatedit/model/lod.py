@@ -302,3 +302,48 @@ def _preview_level(cloud: SplatCloud, budget: int) -> LodLevel:
                             None if cloud.colors is None else cloud.colors[idx], cloud.name)
     lvl = level_for_budget(sample, budget)
     return LodLevel(lvl.cloud, idx[lvl.rep], None, lvl.cell, lvl.scale)
+
+
+def thinned_level(cloud: SplatCloud, keep, *, margin: float = 1.0, seed: int = 0,
+                  chunk: int = 1 << 20) -> LodLevel:
+    """A level that keeps splat ``i`` with probability ``keep[i]`` and
+    enlarges the axes of a kept splat by ``1 / sqrt(keep[i])``.
+
+    Why it keeps the surface closed: where splats of area ``a`` lie with
+    density ``rho`` (a point of the surface is covered by ``rho a`` splats on
+    average), keeping each with probability ``p`` and scaling its area by
+    ``1 / p`` keeps ``rho a`` (the random thinning of a point process; the
+    enlarged splats stay as many per covered point).  This is the cheap level
+    of detail of a single view (:func:`splatedit.render.splat.headless.pixel_level`
+    chooses ``keep`` so the kept splats are about a pixel wide): one pass, no
+    sort, against ~1 s per million splats for the voxel levels of
+    :func:`build_level`, whose enlarged representatives cover their members
+    exactly.  Seeded: the same cloud and ``keep`` give the same level.
+
+    Args:
+        cloud: the full cloud (n splats).
+        keep: (n,) float keep probabilities in (0, 1] (smaller values are
+            raised to ``1 / MAX_ENLARGE**2``).
+        margin: a kept splat's area is further multiplied by
+            ``1 + (margin**2 - 1) (1 - keep)`` (1 where nothing is thinned,
+            ``margin**2`` where almost everything is): fewer Poisson gaps.
+        seed: of the random draws.
+        chunk: splats drawn per step (bounds the temporaries).
+    Returns:
+        :class:`LodLevel` whose ``cluster`` is None (the dropped splats are
+        assigned to no level splat) and ``cell`` is 0.
+    """
+    n = cloud.n
+    p = np.asarray(keep, dtype=np.float64)
+    rng = np.random.default_rng(seed)
+    parts = []
+    for lo in range(0, n, chunk):
+        pp = p[lo:lo + chunk]
+        parts.append(np.flatnonzero(rng.random(len(pp), dtype=np.float32) < pp) + lo)
+    rep = np.concatenate(parts) if parts else np.zeros(0, np.int64)
+    pr = np.clip(p[rep], 1.0 / MAX_ENLARGE ** 2, 1.0)
+    scale = np.sqrt((1.0 + (margin * margin - 1.0) * (1.0 - pr)) / pr)
+    colors = None if cloud.colors is None else cloud.colors[rep]
+    lvl = _derived_cloud(cloud.positions[rep], cloud.u[rep] * scale[:, None],
+                         cloud.v[rep] * scale[:, None], colors, cloud.name)
+    return LodLevel(lvl, rep.astype(np.int64), None, 0.0, scale)

@@ -18,7 +18,11 @@ stray neighbour does not move a median) and a boundary splat at
 ``BOUNDARY_CAP_REL_NEIGHBOURS`` times it; :func:`limit_outlier_radii` keeps
 outliers (:mod:`splatedit.model.outliers`), which may sit in clusters whose
 neighbours are strays too, at most ``OUTLIER_RADIUS_REL_MEDIAN`` times the
-median radius of their neighbours that are not outliers.  Boundary points of a point cloud
+median radius of their neighbours that are not outliers; :func:`settle_radii`
+then applies the neighbour cap again against the radii those caps left (a
+splat next to shrunk ones is capped at their new median), so that no splat
+ends more than ``SIZE_CAP_REL_NEIGHBOURS`` times its neighbours as drawn.
+Boundary points of a point cloud
 are found by :func:`boundary_points` (angular gap of the neighbours projected
 into the tangent plane, as PCL's BoundaryEstimation does), those of a mesh by
 :func:`mesh_border_ring` (vertices of the faces that touch an edge used by a
@@ -32,7 +36,8 @@ from scipy.spatial import cKDTree
 
 from splatedit.tolerances import (BOUNDARY_CAP_REL_NEIGHBOURS, BOUNDARY_GAP_DEG,
                                   ESTIMATE_CHUNK_POINTS, OUTLIER_RADIUS_REL_MEDIAN,
-                                  SIZE_CAP_REL_NEIGHBOURS, SIZE_NEIGHBOURS)
+                                  SIZE_CAP_REL_NEIGHBOURS, SIZE_NEIGHBOURS,
+                                  SIZE_SETTLE_ROUNDS)
 
 
 def neighbour_indices(points, k: int = SIZE_NEIGHBOURS, *, tree: cKDTree | None = None,
@@ -210,6 +215,54 @@ def limit_radii(radii, neighbours, boundary=None, *, cap: float = SIZE_CAP_REL_N
     if boundary is not None:
         limit = np.where(boundary, np.minimum(limit, boundary_cap * local), limit)
     return np.minimum(r, limit)
+
+
+def settle_radii(radii, neighbours, changed, *, cap: float = SIZE_CAP_REL_NEIGHBOURS,
+                 rounds: int = SIZE_SETTLE_ROUNDS) -> np.ndarray:
+    """Make the neighbour cap hold against the final sizes.
+
+    :func:`limit_radii` caps a radius relative to its neighbours' radii as
+    the spacing rule gave them; the caps then shrink some of those neighbours
+    (strays, boundary splats, outliers), so a splat that kept its size can
+    end many times larger than the neighbours as drawn (a rotating sensor's
+    multipath ghosts and near-sensor dust: up to 13.6x, where only some of a
+    cluster are flagged as outliers).  Here every splat next to one that
+    shrank is capped again at ``cap`` times the median of its neighbours'
+    current radii, round after round while any shrinks (each round only looks
+    at the neighbours of the splats that shrank in the one before).  Radii
+    only go down, and only where a splat is more than ``cap`` times its
+    neighbours' median, which a well-sampled surface never is (see
+    ``SIZE_CAP_REL_NEIGHBOURS``).
+
+    Args:
+        radii: (n,) float64 radii after the caps (model units).
+        neighbours: (n, m) integer indices of other points (m >= 1).
+        changed: (n,) bool, the splats whose radius the caps reduced.
+        cap: multiple of the neighbours' median radius.
+        rounds: at most this many rounds.
+    Returns:
+        (n,) float64 radii, never larger than ``radii``.
+    """
+    r = np.array(radii, dtype=np.float64)
+    changed = np.asarray(changed, dtype=bool)
+    n = len(r)
+    if n < 2 or neighbours.shape[1] == 0:
+        return r
+    step = 8 * ESTIMATE_CHUNK_POINTS
+    for _ in range(rounds):
+        if not changed.any():
+            break
+        near = np.concatenate([np.flatnonzero(changed[neighbours[lo:lo + step]].any(axis=1)) + lo
+                               for lo in range(0, n, step)])
+        local = np.empty(len(near))
+        for lo in range(0, len(near), ESTIMATE_CHUNK_POINTS):
+            local[lo:lo + ESTIMATE_CHUNK_POINTS] = _row_median(
+                r[neighbours[near[lo:lo + ESTIMATE_CHUNK_POINTS]]])
+        over = r[near] > cap * local
+        changed = np.zeros(n, dtype=bool)
+        changed[near[over]] = True
+        r[near[over]] = cap * local[over]
+    return r
 
 
 def limit_outlier_radii(radii, outliers, neighbours,

@@ -35,6 +35,9 @@ class SceneRenderer(Protocol):
             (splats: yes; Gaussians: no).
         resident_frames: :meth:`render_resident` returns an image the
             presenter may blit (splats); False: the viewport reads pixels back.
+        edl, supports_edl: eye-dome lighting on / off, where the renderer
+            has it (splats: :class:`~splatedit.render.frame_passes.EyeDomeResolve`;
+            Gaussians: no, ``edl`` stays False).
     """
 
     dev: Any
@@ -45,6 +48,8 @@ class SceneRenderer(Protocol):
     last_timings_ms: dict
     supports_detail: bool
     resident_frames: bool
+    supports_edl: bool
+    edl: bool
 
     def set_cloud(self, cloud) -> None:
         """Upload a scene (a SplatCloud or a GaussianCloud, as the renderer draws)."""

@@ -197,6 +197,10 @@ EDITOR_GUI_MAX_HIGHLIGHT_DOTS = 20_000
 #: row, the three "move" fields with their label, measures 252 px, plus the
 #: window padding and the scroll bar; a 960 px window keeps 640 px of view
 EDITOR_GUI_PANEL_WIDTH = 310
+#: width of the panel's sliders (brush radius, splat size; pixels): their value
+#: and label are written beside them ("300 px  brush radius" measures 140 px in
+#: the default font), 120 + 8 spacing + 140 fits the panel's 282 px content
+EDITOR_GUI_SLIDER_WIDTH = 120
 #: the help window goes beside the panel when that space is at least this wide
 #: (px), else over the whole window (the panel steps aside until it closes);
 #: the longest help line measures 763 px in the default font, narrower help
@@ -322,3 +326,24 @@ GS_LOD_GUESS_MS_PER_GAUSSIAN = 0.004
 #: 25% 3.43 (4.76 uncompensated), 100k sphere 10% 5.20 (7.57); the editor
 #: bench at 1280x720 (16k of 1M at half resolution): 4.92
 GS_LOD_TEST_MEAN_DIFF = 6.5
+
+
+# ---------------------------------------------------------------------------
+# The status line's hint for a view that draws (almost) nothing (app/view/coverage.py)
+# ---------------------------------------------------------------------------
+#: hint when the bound of the drawn share of the view is below this ...
+EDITOR_COVERAGE_HINT_SHARE = 0.005
+#: ... while at least this many splat centres are in view
+EDITOR_COVERAGE_HINT_MIN_IN_VIEW = 500
+#: splats looked at by the estimate (a fixed stride of the cloud)
+EDITOR_COVERAGE_SAMPLE = 16_384
+
+
+# ---------------------------------------------------------------------------
+# The live G / R / S readout next to the cursor (app/tools/gizmo.py readout_box)
+# ---------------------------------------------------------------------------
+#: its box keeps at least this far from the window's edges (pixels): a tester
+#: found it touching the right edge with the cursor there
+EDITOR_READOUT_MARGIN_PX = 8
+#: its box's top-left corner from the cursor (pixels), right and down
+EDITOR_READOUT_OFFSET_PX = 18

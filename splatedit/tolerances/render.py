@@ -32,6 +32,33 @@ RENDER_CLIP_MIN_RADIUS_REL = 1e-12
 RENDER_FRAME_MARGIN = 1.05
 #: default vertical field of view, degrees
 RENDER_FOV_DEG = 40.0
+#: `splatedit render` draws a level of detail when many splats fall in one
+#: pixel: splats thinned at random and enlarged to about this radius in
+#: pixels (splatedit.render.splat.headless.pixel_level; --full draws every one).
+#: Against the full render (lavapipe, raster path), a 2M-splat bunny surface
+#: (float32 normals + radius, data_tools/make_large_model.py --normals-radius)
+#: at 640x360, RGB levels: min radius 0.5 px keeps 53 % of the splats, mean
+#: |difference| 0.054, 0.040 % of the pixels off by more than 8 levels;
+#: 0.75 px: 24 %, 0.120, 0.19 %; 1 px: 13 %, 0.161, 0.33 % (0.169, 0.38 %
+#: with the margin below); 1.5 px: 6 %, 0.23, 0.52 %; 2 px: 3 %, 0.28,
+#: 0.62 %.  The 10M-splat file at 1280x720: 11 % kept, 0.089, 0.095 %
+#: (the whole `splatedit render` 38.4 s -> 8.2 s, see docs/PERFORMANCE.md)
+RENDER_LOD_MIN_RADIUS_PX = 1.0
+#: ... only when the level keeps at most this share of the splats
+RENDER_LOD_MAX_KEPT_SHARE = 0.5
+#: the thinned splats' linear size is multiplied by up to this margin (1 for
+#: kept-with-certainty splats, this for the strongly thinned ones): random
+#: thinning leaves Poisson gaps; with 1.0 the 2M bunny at 640x360 had 3
+#: pinholes (background pixels inside the silhouette; the full render 0) and
+#: the 10M at 1280x720 14; with 1.2 none (1.4: none, 0.424 % of the pixels
+#: off by more than 8 levels against 0.375 %)
+RENDER_LOD_MARGIN = 1.2
+#: the draw path of `splatedit render`'s level of detail (one frame: the
+#: "auto" path would draw two more to measure both).  The 10M file's level
+#: (1.06M splats about a pixel wide, 1280x720, lavapipe, load 5): compute
+#: 0.61 s of GPU time, raster 1.31 s; "auto" 3.8 s for its probe and frame.
+#: Where the device cannot run the compute path the raster path draws it
+RENDER_LOD_PATH = "compute"
 #: gamma applied by the shading pass (sRGB-like output)
 RENDER_GAMMA = 2.2
 #: headlight Phong: ambient, diffuse, specular, shininess

@@ -46,3 +46,24 @@ def test_default_save_path_keeps_scanner_formats(tmp_path):
         src = tmp_path / name
         src.write_bytes(b"")
         assert _default_save_path(src, name, bundled=False) == tmp_path / expected
+
+
+def test_a_model_opened_by_a_path_inside_the_package_is_saved_in_the_users_folder(tmp_path, monkeypatch):
+    """``splatedit edit .../splatedit/data/bunny.ply`` (a path, so not "the
+    bundled model"): the proposed save is in the current directory, never
+    beside the shipped file; from a current directory inside the package it
+    is the home folder; an explicit save into the package is refused."""
+    from splatedit.app.document.files import inside_package, package_folder, save_refusal
+    from splatedit.data import default_model_path
+    src = default_model_path()
+    assert inside_package(src) and not inside_package(tmp_path)
+    monkeypatch.chdir(tmp_path)
+    assert _default_save_path(src, src.name, bundled=False) == tmp_path / "bunny-edited.ply"
+    monkeypatch.chdir(package_folder() / "data")
+    home = tmp_path / "home"
+    home.mkdir()
+    monkeypatch.setenv("HOME", str(home))
+    assert _default_save_path(src, src.name, bundled=False) == home / "bunny-edited.ply"
+    into = package_folder() / "data" / "bunny-edited.ply"
+    assert "inside the installed splatedit package" in save_refusal(into, src)
+    assert save_refusal(tmp_path / "bunny-edited.ply", src) is None

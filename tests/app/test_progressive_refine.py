@@ -41,6 +41,7 @@ def _editor(n=60000, cloud=None, budgets=(8000, 2000), **session):
         session=Session(cloud, **session), viewport=vp, cam=cam, size=(W, H), drag=DragMode.NONE, gui=None,
         presenter=_Presenter(), said=[], overlay_patches=lambda w, h: [], wake=lambda: None,
         window=types.SimpleNamespace(iconified=lambda: False),
+        camera=types.SimpleNamespace(view_hint=lambda: None),      # the still view's edge-on hint
         selection_tools=types.SimpleNamespace(prepare=lambda c: None),
         picking=types.SimpleNamespace(invalidate=lambda: None, key=lambda: None))
     ed.say = ed.said.append

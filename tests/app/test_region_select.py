@@ -134,12 +134,21 @@ def test_the_region_outline_is_a_closed_shape_while_dragging(ed):
     assert ed.region.shapes(640, 480) == []
 
 
+def land_jobs(ed) -> None:
+    """Wait for the editor's background jobs and collect them (as its loop does)."""
+    for job in list(ed.jobs.values()):
+        assert job.wait(60)
+    ed.file_actions.poll_jobs()
+
+
 def test_mirror_adds_the_mirror_image_across_the_middle_plane(ed):
     s = ed.session
     p = s.cloud.positions
     right = (p[:, 0] > 0.5) & (p[:, 1] > 0)
     s.set_selection(right, np.zeros(s.cloud.n, bool))
     key(ed, glfw.KEY_M, glfw.MOD_CONTROL)
+    assert "mirror" in ed.jobs                      # a background job (the window keeps drawing)
+    land_jobs(ed)
     left = (p[:, 0] < -0.5) & (p[:, 1] > 0)
     assert (s.selection.support == (right | left)).all()
     assert s.history.labels[-1] == "mirror support"
@@ -216,3 +225,39 @@ def test_every_view_tool_is_on_the_protocol_and_draws_only_shapes(ed):
         assert "self.ed" not in src and "self.session" not in src, type(tool).__name__
         assert not hasattr(tool, "overlay") and not hasattr(tool, "underlay"), type(tool).__name__
     assert not hasattr(Tool, "overlay") and not hasattr(Tool, "ed")
+
+
+def test_a_mirror_whose_selection_changed_while_it_ran_changes_nothing(ed):
+    """The mirror job works on a copy of the selection: when the selection
+    changes before it lands (a stroke, an undo), its result is dropped and
+    the status line says so; the selection is the changed one."""
+    s = ed.session
+    p = s.cloud.positions
+    right = (p[:, 0] > 0.5) & (p[:, 1] > 0)
+    s.set_selection(right, np.zeros(s.cloud.n, bool))
+    key(ed, glfw.KEY_M, glfw.MOD_CONTROL)
+    other = p[:, 1] < -0.5
+    s.set_selection(other, np.zeros(s.cloud.n, bool))      # meanwhile
+    positions = s.history.position
+    land_jobs(ed)
+    assert (s.selection.support == other).all() and s.history.position == positions
+    assert "selection changed while it ran" in ed.messages[-1]
+
+
+def test_a_mirror_landing_after_another_model_was_opened_touches_neither(ed):
+    """The mirror job of the previous model lands after another model was
+    opened: the new document's selection and history stay as they are, and
+    nothing is recorded in the closed one."""
+    s = ed.session
+    p = s.cloud.positions
+    s.set_selection((p[:, 0] > 0.5) & (p[:, 1] > 0), np.zeros(s.cloud.n, bool))
+    old_len = len(s.history)
+    key(ed, glfw.KEY_M, glfw.MOD_CONTROL)
+    new = Session(plane_cloud(12), fit_sync=True)
+    try:
+        ed.session = new
+        land_jobs(ed)
+        assert not new.selection.support.any() and len(new.history) == 1
+        assert len(s.history) == old_len
+    finally:
+        new.close()

@@ -259,3 +259,25 @@ def test_pick_map_in_chunks_equals_the_single_pick(vertex_path):
     assert np.array_equal(got_idx, idx)
     assert np.array_equal(np.isnan(got_depth), np.isnan(depth))
     assert np.allclose(got_depth[idx >= 0], depth[idx >= 0], rtol=1e-6)
+
+
+def test_progressive_frame_with_eye_dome_lighting_ends_equal_to_the_edl_frame(vertex_path):
+    """With ``Renderer.edl`` (the editor's Shift+E) the progressive frame's
+    last image is the one-submit eye-dome frame bit for bit, and differs from
+    the frame without it (a large model refined in the editor keeps EDL)."""
+    r = vertex_path
+    bunny = read(default_model_path())
+    r.set_cloud(bunny)
+    cam = Camera.frame(*bunny.bounds(), aspect=W / H, direction=(0.3, 0.4, 1.0))
+    plain = r.render(cam, W, H)
+    r.edl = True
+    try:
+        full = r.render(cam, W, H)
+        with ProgressiveFrame(r, cam, W, H, 10000) as pf:
+            img = None
+            while not pf.done:
+                img = pf.step()
+        assert np.array_equal(img[..., :3], full[..., :3])
+        assert not np.array_equal(full[..., :3], plain[..., :3])
+    finally:
+        r.edl = False

@@ -26,15 +26,46 @@ from splatedit.tolerances import EDITOR_GUESS_MS_PER_SPLAT, EDITOR_LOD_BUDGETS, 
 KEEP_FORMAT_SUFFIXES = extensions(keep_on_save=True)
 
 
+def package_folder() -> Path:
+    """The folder of the installed ``splatedit`` package (resolved): the
+    parent of its ``data`` folder (the shipped models)."""
+    from splatedit.data import default_model_path
+    return default_model_path().resolve().parent.parent
+
+
+def inside_package(path) -> bool:
+    """True when ``path`` is in the installed splatedit package's folder
+    (its shipped models, ``splatedit/data/...``): files the editor opens but
+    never writes beside (an upgrade would delete them, and the folder may be
+    read-only or shared by every user of the installation)."""
+    try:
+        return Path(path).expanduser().resolve().is_relative_to(package_folder())
+    except (OSError, RuntimeError):
+        return False
+
+
+def user_folder() -> Path:
+    """Where a save of a bundled model goes, as other editors do with
+    read-only or bundled files: the current directory, else (it is in the
+    package, or not writable) the home folder."""
+    cwd = Path.cwd()
+    if not inside_package(cwd) and os.access(cwd, os.W_OK):
+        return cwd
+    return Path.home()
+
+
 def default_save_path(src: Path | None, name: str, bundled: bool) -> Path:
     """``<stem>-edited.ply`` (``.las`` / ``.laz`` / ``.e57`` for such inputs)
-    next to the input (the current directory for the bundled model or an
-    unwritable folder), never an existing file."""
+    next to the input, never an existing file.  A model of the installed
+    package (the bundled one, or any file opened from ``splatedit/data/...``,
+    :func:`inside_package`) or one in an unwritable folder is saved in the
+    user's folder instead (:func:`user_folder`): never into the package."""
     stem = Path(name).stem if name else (src.stem if src else "model")
     suffix = Path(name).suffix.lower() if name else (src.suffix.lower() if src else "")
     ext = suffix if suffix in KEEP_FORMAT_SUFFIXES else ".ply"
-    folder = Path.cwd()
-    if src is not None and not bundled and os.access(src.parent, os.W_OK):
+    folder = user_folder()
+    if (src is not None and not bundled and not inside_package(src)
+            and os.access(src.parent, os.W_OK)):
         folder = src.parent
     p = folder / f"{stem}-edited{ext}"
     k = 2
@@ -58,7 +89,11 @@ def _same_file(a, b) -> bool:
 def save_refusal(target, model) -> str | None:
     """Why the editor refuses to save to ``target`` (None when it may): saves
     never replace the opened model (a user's file or the bundled one), nor
-    does the edit script written beside the save."""
+    does the edit script written beside the save, and nothing is written into
+    the installed package's folder (:func:`inside_package`)."""
+    if inside_package(target):
+        return (f"not saved: {target} is inside the installed splatedit package ({package_folder()}); "
+                "Ctrl+Shift+S: save in a folder of yours")
     if model is None:
         return None
     for path in (target, script_path_for(Path(target))):
@@ -291,6 +326,10 @@ def poll_jobs(ed) -> None:
         if not job.done:
             continue
         del ed.jobs[name]
+        land = getattr(job, "land", None)
+        if land is not None:          # a tool's job (ToolContext.start_job) lands itself
+            land(job)
+            continue
         if job.error is not None:
             err = job.error
             if name == "graph":

@@ -9,6 +9,7 @@ which abandons a stale job.
 
 from __future__ import annotations
 
+import os
 import threading
 import time
 import traceback
@@ -46,6 +47,10 @@ class Job:
         self.error: BaseException | None = None
         self.started = time.perf_counter()
         self.cancel = threading.Event()
+        #: ``land(job)``: run by the editor on its main thread when it collects the
+        #: finished job (a tool's job, :meth:`ToolContext.start_job`); None: the
+        #: editor's own handling by name
+        self.land = None
         self.thread: threading.Thread | None = None
         self._done = threading.Event()
         self._wake = wake
@@ -63,6 +68,7 @@ class Job:
             if self.cancel.is_set():   # cancelled while still queued: do not start
                 raise Cancelled()
             self.result = fn(self.progress)
+            _test_hold(self.name)
         except BaseException as exc:  # noqa: BLE001 - reported by whoever polls the job
             self.error = exc
             if not isinstance(exc, (SplatEditError, Cancelled)):
@@ -84,3 +90,16 @@ class Job:
     def wait(self, timeout: float | None = None) -> bool:
         """Block until done (at most ``timeout`` s); True when done."""
         return self._done.wait(timeout)
+
+
+def _test_hold(name: str) -> None:
+    """Test hook (window tests watch the editor while a job runs): with
+    ``SPLATEDIT_TEST_HOLD_JOB`` set to a prefix of the job's name and
+    ``SPLATEDIT_TEST_HOLD_FILE`` to a path, a job whose work is done waits
+    while that file exists (at most 120 s) before it reports done."""
+    prefix, path = os.environ.get("SPLATEDIT_TEST_HOLD_JOB"), os.environ.get("SPLATEDIT_TEST_HOLD_FILE")
+    if not prefix or not path or not name.startswith(prefix):
+        return
+    t0 = time.monotonic()
+    while os.path.exists(path) and time.monotonic() - t0 < 120.0:
+        time.sleep(0.02)

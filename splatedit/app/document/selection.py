@@ -393,6 +393,14 @@ class SelectionTools:
             for before, now in zip(last[2], sel.handles):
                 changed |= before ^ now
         added = apply_closure(sel, session.cloud, g, changed, within)
+        self._closed(session, added)
+        return self.last_added
+
+    def _closed(self, session, added: np.ndarray) -> None:
+        """Bookkeeping after the session's selection was closed (``added``:
+        the (n,) bool splats closure added): the next closure's starting
+        point, the highlight."""
+        sel = session.selection
         self._last_closed = (session.cloud, sel.support.copy(), [h.copy() for h in sel.handles])
         self.closure_pending = False
         self.last_added = int(added.sum())
@@ -401,7 +409,6 @@ class SelectionTools:
             self.highlight_cloud = session.cloud
             self.highlight_until = time.perf_counter() + EDITOR_CLOSURE_HIGHLIGHT_S
             session.version += 1
-        return self.last_added
 
     def highlighted(self, cloud) -> np.ndarray | None:
         """(n,) bool of the splats to highlight now, or None."""
@@ -411,6 +418,32 @@ class SelectionTools:
         return self.highlight
 
     # ---------------------------------------------------------- tools
+    def background_apply(self, session) -> "BackgroundApply | None":
+        """A :class:`BackgroundApply` of the session's brush target (the
+        selection copied now), or None while the neighbour graph is built."""
+        g = self.graph(session.cloud)
+        if g is None:
+            return None
+        last = self._last_closed
+        if last is not None and (last[0] is not session.cloud or len(last[2]) != len(session.selection.handles)):
+            last = None
+        return BackgroundApply(session, session.brush_target, g, last)
+
+    def install(self, job: "BackgroundApply", label: str) -> bool:
+        """Make ``job``'s closed selection the session's (one undo step,
+        ``label``); False (nothing changed) when the session, its cloud or
+        its selection changed since the job copied it, a move runs, or the
+        job changed nothing."""
+        s = job.session
+        if job.result is None or s.manip is not None or job.key != BackgroundApply.key_of(s):
+            return False
+        sel, work = s.selection, job.result
+        for attr in ("support", "handles", "active", "reach", "erased", "handle_reach", "handle_erased"):
+            setattr(sel, attr, getattr(work, attr))
+        self._closed(s, job.added)
+        s.push(label)
+        return True
+
     def apply(self, session, target: str, mask: np.ndarray, label: str) -> bool:
         """Make the target's mask ``mask`` (see :func:`set_target`), close the
         selection and record both as one undo step; False when nothing changed
@@ -421,4 +454,51 @@ class SelectionTools:
             return False
         self.close(session)
         session.push(label)
+        return True
+
+
+class BackgroundApply:
+    """A selection tool's change made off the main thread (a long one: the
+    mirror of half a 1M-splat model): the session's selection is copied
+    when it starts (:meth:`SelectionTools.background_apply`), the worker
+    sets the brush target's mask on the copy with the brush rules and
+    closes it (:meth:`compute`), and the editor installs the result when
+    the job lands (:meth:`SelectionTools.install`) unless the selection
+    changed meanwhile."""
+
+    def __init__(self, session, target: str, graph, last_closed):
+        self.session, self.target, self.graph = session, target, graph
+        self.cloud = session.cloud
+        self.key = self.key_of(session)
+        self.sel = session.selection.copy()
+        # what the last closure left (copies: the worker compares against it)
+        self._last = None if last_closed is None else (last_closed[1].copy(), [h.copy() for h in last_closed[2]])
+        #: the closed selection (None: the mask changed nothing) and what closure added
+        self.result: Selection | None = None
+        self.added: np.ndarray | None = None
+
+    @staticmethod
+    def key_of(session) -> tuple:
+        """What must not change between the copy and the install."""
+        sel = session.selection
+        return (id(session.cloud), revision.of(session.cloud), sel.key(), sel.active, len(sel.handles),
+                session.history.position, len(session.history))
+
+    def target_mask(self) -> np.ndarray:
+        """(n,) bool: the brush target's mask in the copied selection."""
+        return target_mask(self.sel, self.target)
+
+    def compute(self, mask: np.ndarray) -> bool:
+        """Worker side: make the copy's target ``mask`` and close it; False
+        when ``mask`` changes nothing."""
+        sel = self.sel
+        if not set_target(sel, self.target, mask):
+            return False
+        changed = None
+        if self._last is not None and len(self._last[1]) == len(sel.handles):
+            changed = self._last[0] ^ sel.support
+            for before, now in zip(self._last[1], sel.handles):
+                changed |= before ^ now
+        self.added = apply_closure(sel, self.cloud, self.graph, changed)
+        self.result = sel
         return True

@@ -156,9 +156,34 @@ class ToolContext:
         """The document cloud's neighbour graph, or None while it is built."""
         return self._ed.selection_tools.graph(self._ed.session.cloud)
 
-    def start_job(self, name: str, fn):
-        """Run ``fn(progress)`` in a background job (the editor polls it)."""
-        return self._ed.start_graph_job(name, fn)
+    def background_select(self):
+        """A :class:`~splatedit.app.document.selection.BackgroundApply` of the
+        brush target (the selection copied now, closed by its worker), or
+        None while the neighbour graph is built."""
+        return self._ed.selection_tools.background_apply(self._ed.session)
+
+    def install(self, job, label: str) -> bool:
+        """Make a finished BackgroundApply's selection the document's (one
+        undo step); False when the selection changed since it started, or
+        another model was opened meanwhile."""
+        if job.session is not self._ed.session:
+            return False
+        return self._ed.selection_tools.install(job, label)
+
+    # ---- background work
+    def start_job(self, key: str, name: str, fn, land) -> None:
+        """Run ``fn(progress)`` as an editor job (:mod:`splatedit.app.document.jobs`:
+        a worker thread, a progress bar named ``name``, the window keeps
+        drawing); when it is done, ``land(job)`` runs on the main thread
+        (its ``result`` or ``error``)."""
+        from splatedit.app.document.jobs import Job
+        job = Job(name, fn, self._ed.wake)
+        job.land = land        # set before the editor can collect it (it polls on this thread)
+        self._ed.jobs[key] = job
+
+    def job_running(self, key: str) -> bool:
+        """A job started under ``key`` has not landed yet."""
+        return key in self._ed.jobs
 
     # ---- view
     @property
@@ -187,6 +212,13 @@ class ToolContext:
     def displaced(self) -> bool:
         """The view draws a displacement (a move in progress or pending)."""
         return self._ed.picking.displaced()
+
+    @property
+    def viewport(self):
+        """The view's display settings and drawn state, read only
+        (:class:`~splatedit.app.view.viewport.Viewport`: ``cloud`` drawn,
+        ``splat_scale``, ``two_sided``, ``gaussians``)."""
+        return self._ed.viewport
 
     def view_area(self) -> tuple[float, float, float, float]:
         """The part of the window no GUI covers, (x0, y0, x1, y1) fractions
@@ -249,6 +281,11 @@ class ToolContext:
     def say(self, text: str) -> None:
         """A message on the status line."""
         self._ed.say(text)
+
+    @property
+    def message(self) -> str:
+        """The status line's current message."""
+        return self._ed.message
 
     def show_error(self, text: str) -> None:
         """An error box (until dismissed)."""

@@ -222,6 +222,6 @@ class BrushTool(Tool):
         (mx, my), r = c.mouse, float(self.radius)
         out.append(Circle((mx, my), r, rgb, 2.0))
         k = r * 0.7071
-        out.append(Label((mx + k + 4, my + k + 4), "3D" if self.mode == seltools.BRUSH_3D else "VIS",
+        out.append(Label((mx + k + 1, my + k + 2), "3D" if self.mode == seltools.BRUSH_3D else "VIS",
                          rgb, size=11, bg_alpha=150))
         return out

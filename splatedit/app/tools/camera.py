@@ -9,6 +9,8 @@ import math
 from splatedit.app.document import revision
 from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool, free_area  # noqa: F401 (free_area: API)
+from splatedit.app.view.coverage import coverage_estimate
+from splatedit.app.view.coverage import hint as coverage_hint
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, next_up
@@ -22,6 +24,7 @@ class CameraTool(Tool):
         self.zoom_anchor = None          # (x, y, world point) kept while the cursor stays put
         self.up = UpAxis(1, 1)
         self._extent = None              # (cloud revision, FramingExtent)
+        self._hint_key = None            # the view whose drawn coverage was last estimated
 
     @property
     def cam(self):
@@ -30,12 +33,12 @@ class CameraTool(Tool):
     def actions(self):
         top = math.radians(89.0)
         return {Action.FRAME_ALL: self.frame_all, Action.FRAME_SELECTION: self.frame_selection,
-                Action.VIEW_FRONT: lambda: self.view_preset(0.0, 0.0),
-                Action.VIEW_RIGHT: lambda: self.view_preset(math.pi / 2, 0.0),
-                Action.VIEW_TOP: lambda: self.view_preset(0.0, top),
-                Action.VIEW_BACK: lambda: self.view_preset(math.pi, 0.0),
-                Action.VIEW_LEFT: lambda: self.view_preset(-math.pi / 2, 0.0),
-                Action.VIEW_BOTTOM: lambda: self.view_preset(0.0, -top),
+                Action.VIEW_FRONT: lambda: self.view_preset(0.0, 0.0, "front"),
+                Action.VIEW_RIGHT: lambda: self.view_preset(math.pi / 2, 0.0, "right"),
+                Action.VIEW_TOP: lambda: self.view_preset(0.0, top, "top"),
+                Action.VIEW_BACK: lambda: self.view_preset(math.pi, 0.0, "back"),
+                Action.VIEW_LEFT: lambda: self.view_preset(-math.pi / 2, 0.0, "left"),
+                Action.VIEW_BOTTOM: lambda: self.view_preset(0.0, -top, "bottom"),
                 Action.CYCLE_UP_AXIS: self.cycle_up_axis}
 
     # ----------------------------------------------------------- up axis
@@ -89,8 +92,9 @@ class CameraTool(Tool):
         w, h = self.ctx.size
         self.cam.frame(ext.center, ext.radius, w / max(h, 1), area=self.view_area())
         self.ctx.redraw()
-        if say and ext.note():
-            self.ctx.say(f"left out of the view: {ext.note()}")
+        if say:     # a view change replaces the previous status message with the view's name
+            note = ext.note()
+            self.ctx.say("view: the whole model" + (f"; left out of the view: {note}" if note else ""))
 
     def frame_selection(self) -> None:
         """F: the active handle (else the support) fills the free part of the window."""
@@ -104,11 +108,54 @@ class CameraTool(Tool):
         w, h = self.ctx.size
         self.cam.frame_points(s.cloud.positions[m], w / max(h, 1), area=self.view_area())
         self.ctx.redraw()
+        self.ctx.say(f"view: the {'active handle' if s.selection.handle.any() else 'support'}")
 
-    def view_preset(self, yaw: float, pitch: float) -> None:
-        """A numpad view: turn about the pivot (the framed model stays where it is on screen)."""
+    def view_preset(self, yaw: float, pitch: float, name: str | None = None) -> None:
+        """A numpad view: turn about the pivot (the framed model stays where it
+        is on screen); ``name`` ("front", "top", ...): the status line says it
+        (replacing whatever the previous message was)."""
         self.cam.turn_to(yaw, pitch)
         self.ctx.redraw()
+        if name is not None:
+            self.ctx.say(f"view: {name} (about the up axis {self.up.label})")
+            self._hint_key = None       # the view's name replaced any hint: estimate it again
+
+    def _drawn_cloud(self):
+        cloud = getattr(self.ctx.viewport, "cloud", None)
+        return self.ctx.document.cloud if cloud is None else cloud
+
+    def _view_key(self) -> tuple:
+        vp = self.ctx.viewport
+        return (self.cam.state(), tuple(self.ctx.size), revision.of(self._drawn_cloud()),
+                float(vp.splat_scale), bool(getattr(vp, "two_sided", False)))
+
+    def hint_checked(self) -> bool:
+        """The current view's coverage was estimated (:meth:`view_hint` ran for it)."""
+        return self.ctx.document is not None and self._hint_key == self._view_key()
+
+    def view_hint(self) -> None:
+        """A still view that draws (almost) nothing although many splats are
+        in it (a raw scan's estimated normals seen edge-on or from behind,
+        :mod:`splatedit.app.view.coverage`): say so on the status line, after
+        the view's name when that is the message.  Estimated once per view."""
+        c = self.ctx
+        vp = c.viewport
+        if c.document is None or getattr(vp, "gaussians", None) is not None:
+            return
+        key = self._view_key()
+        if key == self._hint_key:
+            return
+        cloud = self._drawn_cloud()
+        self._hint_key = key
+        w, h = c.size
+        culled = not getattr(vp, "two_sided", False)
+        cov = coverage_estimate(cloud.positions, cloud.u, cloud.v, self.cam, w, h, self.view_area(),
+                                float(vp.splat_scale), culling=culled)
+        if cov.tiny:
+            text = coverage_hint(cov, "Shift+1 / Shift+3 or a middle drag")
+            if culled and cov.front < 0.5 * cov.in_view:
+                text += ", or T: draw the splats seen from behind too"
+            c.say(f"{c.message}; {text}" if c.message.startswith("view:") else text)
 
     # -------------------------------------------------------------- mouse
     def press(self, e):

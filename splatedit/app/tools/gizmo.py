@@ -13,14 +13,24 @@ from splatedit.app.ui import overlay as ov
 from splatedit.app.document import revision
 from splatedit.app.ui.keymap import Action, Section, typed_char
 from splatedit.app.document.session import GRAB, ROTATE, SCALE, ViewInfo
-from splatedit.app.tools.shapes import TOP, Circle, Cross, Dot, Label, Polyline
+from splatedit.app.tools.shapes import TOP, Circle, Cross, Dot, Label, Polyline, place_inside
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX,
                                   EDITOR_GIZMO_RING_MIN_COS, EDITOR_GIZMO_RING_PX, EDITOR_GIZMO_RING_SEGMENTS,
-                                  EDITOR_GIZMO_SCALE_PX)
+                                  EDITOR_GIZMO_SCALE_PX, EDITOR_READOUT_MARGIN_PX, EDITOR_READOUT_OFFSET_PX)
 
 READOUT_RGB = (255, 230, 120)
+
+
+def readout_box(mouse, box_w: float, box_h: float, w: int, h: int) -> tuple[float, float]:
+    """Top-left (x, y) pixels of the live readout's box (``box_w`` x
+    ``box_h`` pixels, its padding included) in a ``w`` x ``h`` window:
+    EDITOR_READOUT_OFFSET_PX right of and below the cursor ``mouse``, moved
+    so that the whole box keeps EDITOR_READOUT_MARGIN_PX from every window
+    edge (a box wider than the window starts at the left margin)."""
+    off = EDITOR_READOUT_OFFSET_PX
+    return place_inside(float(mouse[0]) + off, float(mouse[1]) + off, box_w, box_h, w, h, EDITOR_READOUT_MARGIN_PX)
 
 
 class GizmoTool(Tool):
@@ -417,4 +427,6 @@ class GizmoTool(Tool):
         if text is None:
             return []
         mx, my = self.ctx.mouse
-        return [Label((mx + 18, my + 18), text, READOUT_RGB, size=13, keep_inside=True, layer=TOP)]
+        off = EDITOR_READOUT_OFFSET_PX       # placed by the painter (its text size): readout_box's rule
+        return [Label((mx + off, my + off), text, READOUT_RGB, size=13, keep_inside=True,
+                      margin=EDITOR_READOUT_MARGIN_PX, name="readout", layer=TOP)]

@@ -85,16 +85,20 @@ class Cross:
 
 @dataclass(frozen=True)
 class Label:
-    """One line of ``text`` on a dark box (alpha ``bg_alpha``) whose top-left
-    is ``corner`` (2,); ``size``: the font size in pixels (the GPU path
-    uses the GUI's font); ``keep_inside``: moved into the window when it
-    would stick out."""
+    """One line of ``text`` on a dark box (alpha ``bg_alpha``, its padding
+    included) whose top-left is ``corner`` (2,); ``size``: the font size in
+    pixels (the GPU path uses the GUI's font); ``keep_inside``: the box is
+    moved to keep ``margin`` pixels from every window edge
+    (:func:`place_inside`); ``name``: the painter reports where the box went
+    under this name (the GUI's ``gui_rects``)."""
     corner: tuple
     text: str
     rgb: tuple
     size: int = 13
     bg_alpha: int = 200
     keep_inside: bool = False
+    margin: float = 0.0
+    name: str = ""
     layer: int = OVER
 
 
@@ -111,6 +115,16 @@ class Points:
 SHAPES = (Polyline, Circle, Dot, Cross, Label, Points)
 
 
+def place_inside(x: float, y: float, box_w: float, box_h: float, w: int, h: int,
+                 margin: float = 0.0) -> tuple[float, float]:
+    """Top-left (x, y) of a ``box_w`` x ``box_h`` pixel box wanted at (x, y),
+    moved so that it keeps ``margin`` pixels from every edge of a ``w`` x
+    ``h`` window (a box wider than the window starts at the left margin)."""
+    x = min(float(x), w - margin - box_w)
+    y = min(float(y), h - margin - box_h)
+    return max(x, margin), max(y, margin)
+
+
 def in_draw_order(shapes) -> list:
     """``shapes`` sorted back to front by layer (stable); an object that is
     not a shape is an error."""
@@ -121,9 +135,10 @@ def in_draw_order(shapes) -> list:
     return sorted(shapes, key=lambda s: s.layer)
 
 
-def to_patches(shapes, size: tuple[int, int]) -> list:
+def to_patches(shapes, size: tuple[int, int], record=None) -> list:
     """The CPU painter: overlay patches (:class:`splatedit.app.ui.overlay.Patch`)
-    of ``shapes`` in draw order, for a ``size`` (w, h) pixel window."""
+    of ``shapes`` in draw order, for a ``size`` (w, h) pixel window;
+    ``record(name, (x, y, w, h))`` is told where named labels went."""
     from splatedit.app.ui import overlay as ov
     from splatedit.app.document.selection import points_patch
     w, h = size
@@ -148,9 +163,10 @@ def to_patches(shapes, size: tuple[int, int]) -> list:
                                 bg=LABEL_BG + (s.bg_alpha,))
             x, y = float(s.corner[0]), float(s.corner[1])
             if s.keep_inside:
-                x = min(max(x, 0), max(w - img.shape[1], 0))
-                y = min(max(y, 0), max(h - img.shape[0], 0))
+                x, y = place_inside(x, y, img.shape[1], img.shape[0], w, h, s.margin)
             p = ov.Patch(int(x), int(y), img)
+            if s.name and record is not None:
+                record(s.name, (int(x), int(y), img.shape[1], img.shape[0]))
         elif isinstance(s, Points):
             p = points_patch(s.points, (w, h), s.rgb, s.alpha)
         if p is not None:

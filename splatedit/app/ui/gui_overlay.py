@@ -17,7 +17,9 @@ import numpy as np
 from imgui_bundle import imgui
 
 from splatedit.app.document import selection as seltools
-from splatedit.app.tools.shapes import FAR_PX, TOP, Circle, Cross, Dot, Label, Points, Polyline, in_draw_order
+from splatedit.app.tools.shapes import (FAR_PX, TOP, Circle, Cross, Dot, Label, Points, Polyline, in_draw_order,
+                                        place_inside)
+from splatedit.app.ui.panel import Box
 from splatedit.tolerances import EDITOR_GUI_MAX_HIGHLIGHT_DOTS
 
 _SHADOW = (0, 0, 0, 160)
@@ -103,12 +105,13 @@ def dots(dl, px, size: tuple[int, int], rgb=seltools.CLOSURE_RGB, alpha: int = 2
 
 
 # ------------------------------------------------------------------ tools
-def draw_shapes(shapes, w: int, h: int, under=None, top=None) -> None:
+def draw_shapes(shapes, w: int, h: int, under=None, top=None, record=None) -> None:
     """The GPU painter: backend-neutral overlay shapes
     (:mod:`splatedit.app.tools.shapes`) as ImGui draw-list primitives, in draw
     order; layers UNDER and OVER into ``under`` (default: the background
     draw list, under the GUI's windows), TOP into ``top`` (default: the
-    foreground list, over the panels)."""
+    foreground list, over the panels); ``record(name, (x, y, w, h))`` is
+    told where named labels went."""
     if under is None:
         under = imgui.get_background_draw_list()
     if top is None:
@@ -136,19 +139,25 @@ def draw_shapes(shapes, w: int, h: int, under=None, top=None) -> None:
         elif isinstance(s, Cross):
             cross(dl, s.centre, s.rgb, float(s.size))
         elif isinstance(s, Label):
+            size = imgui.calc_text_size(s.text)
+            bw, bh = size.x + 6, size.y + 4              # label()'s box: 3 / 2 pixels around the text
             x, y = float(s.corner[0]), float(s.corner[1])
             if s.keep_inside:
-                size = imgui.calc_text_size(s.text)
-                x = min(max(x, 3), max(w - size.x - 3, 3))
-                y = min(max(y, 2), max(h - size.y - 2, 2))
-            label(dl, (x, y), s.text, s.rgb, s.bg_alpha)
+                x, y = place_inside(x, y, bw, bh, w, h, s.margin)
+            label(dl, (x + 3, y + 2), s.text, s.rgb, s.bg_alpha)
+            if s.name and record is not None:
+                record(s.name, (int(x), int(y), int(round(bw)), int(round(bh))))
         elif isinstance(s, Points):
             dots(dl, s.points, (w, h), s.rgb, s.alpha)
 
 
 def draw_tools(ed, w: int, h: int) -> None:
-    """Every tool's overlay shapes of the frame (:meth:`Editor.overlay_shapes`)."""
-    draw_shapes(ed.overlay_shapes(w, h), w, h)
+    """Every tool's overlay shapes of the frame (:meth:`Editor.overlay_shapes`);
+    where named labels went (the readout) is recorded in the GUI's rects
+    (the status file's ``gui_rects``)."""
+    gui = getattr(ed, "gui", None)
+    record = None if gui is None else (lambda name, b: gui.rects.__setitem__(name, Box(*b)))
+    draw_shapes(ed.overlay_shapes(w, h), w, h, record=record)
 
 
 def text_box(dl, lines, w: int, h: int, *, top: float | None = None, pad: int = 8,

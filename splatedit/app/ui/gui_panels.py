@@ -47,7 +47,7 @@ from splatedit.app.ui.gui_transform import TransformSection
 from splatedit.deform.modes import DeformationMode
 from splatedit.select.selection import SUPPORT
 from splatedit.tolerances import (EDITOR_GUI_FOOTER_MESSAGE_LINES, EDITOR_GUI_LAYOUT_SLACK_PX,
-                                  EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES,
+                                  EDITOR_GUI_PANEL_WIDTH, EDITOR_GUI_SETTLE_FRAMES, EDITOR_GUI_SLIDER_WIDTH,
                                   EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN)
 
 YELLOW = imgui.ImVec4(1.0, 0.9, 0.47, 1.0)
@@ -320,6 +320,20 @@ class EditorGui:
         if imgui.collapsing_header("Display", open_):
             self._display()
 
+    def _slider(self, label: str, name: str, value: float, lo: float, hi: float, fmt: str):
+        """A logarithmic slider with its value and ``label`` written beside
+        it, not in it: ImGui centres a slider's value text in its frame, where
+        the moving grab box covers it (a tester found "24 px" under the
+        brush radius's grab).  Rects ``<name>_slider`` and ``<name>_value``;
+        returns ImGui's (changed, value)."""
+        imgui.set_next_item_width(EDITOR_GUI_SLIDER_WIDTH)
+        changed, v = imgui.slider_float(f"##{name}", value, lo, hi, "", imgui.SliderFlags_.logarithmic.value)
+        self._rect(f"{name}_slider")
+        imgui.same_line()
+        imgui.text(f"{fmt % v}  {label}")
+        self._rect(f"{name}_value")
+        return changed, v
+
     def _tool_button(self, label: str, name: str, action: Action, on: bool) -> None:
         if on:
             imgui.push_style_color(imgui.Col_.button.value, ACTIVE_BUTTON)
@@ -348,18 +362,21 @@ class EditorGui:
         imgui.same_line()
         self._tool_button("3D" if b.mode == seltools.BRUSH_3D else "Visible", "tool_brush_mode",
                           Action.BRUSH_MODE, False)
-        imgui.set_next_item_width(150)
-        changed, r = imgui.slider_float("brush radius", float(b.radius), 2.0, 300.0, "%.0f px",
-                                        imgui.SliderFlags_.logarithmic.value)
+        changed, r = self._slider("brush radius", "brush_radius", float(b.radius), 2.0, 300.0, "%.0f px")
         if changed:
             b.set_radius(r)
+        # state lines wrap at the panel's edge (an armed box select's line was cut there)
+        imgui.push_text_wrap_pos(0.0)
         note = b.mode_note()
         if note:
             imgui.text_colored(YELLOW, note)
+            self._rect("brush_note")
         for tool in self.ed.tools:      # the protocol tools' state lines
             line = tool.status()
             if line:
                 imgui.text_colored(YELLOW, line)
+                self._rect(f"tool_status_{getattr(tool, 'name', type(tool).__name__)}")
+        imgui.pop_text_wrap_pos()
 
     def _stats(self, st) -> None:
         s = self.ed.session
@@ -435,9 +452,12 @@ class EditorGui:
             self.rect(f"display_{name.split()[0]}")
             if k < 2:
                 imgui.same_line()
-        imgui.set_next_item_width(150)
-        ch, v = imgui.slider_float("splat size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
-                                   EDITOR_SPLAT_SCALE_MAX, "%.2fx", imgui.SliderFlags_.logarithmic.value)
+        if getattr(vp, "gaussians", None) is None:      # eye-dome lighting: a splat pass
+            if imgui.checkbox("eye-dome lighting (Shift+E)", bool(vp.edl))[0]:
+                ed.run_action(Action.EDL)
+            self._rect("display_edl")
+        ch, v = self._slider("splat size", "splat_size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
+                             EDITOR_SPLAT_SCALE_MAX, "%.2fx")
         if ch:
             vp.splat_scale = float(v)
         imgui.set_next_item_width(150)

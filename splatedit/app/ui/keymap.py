@@ -119,6 +119,8 @@ class Action(enum.Enum):
     COLOUR_MODE = "colour_mode"
     SPLATS_SMALLER = "splats_smaller"
     SPLATS_LARGER = "splats_larger"
+    EDL = "edl"
+    TWO_SIDED = "two_sided"
     PANEL = "panel"
     HELP = "help"
     HELP_DOWN = "help_down"
@@ -336,6 +338,11 @@ KEYMAP: tuple[Binding, ...] = (
     Binding(S.DISPLAY, "Shift+[ / Shift+]", "splat size: smaller / larger (x0.8 / x1.25, 0.25x .. 4x)",
             Action.SPLATS_SMALLER, ("shift+left_bracket",)),
     Binding(S.DISPLAY, "", "", Action.SPLATS_LARGER, ("shift+right_bracket",)),
+    Binding(S.DISPLAY, "Shift+E", "eye-dome lighting on / off: depth edges and creases darkened (reads raw\n"
+            "scans without normals; also in the View menu)", Action.EDL, ("shift+e",)),
+    Binding(S.DISPLAY, "T", "two-sided splats on / off: draw the splats seen from behind too (a raw scan's\n"
+            "estimated normals facing away: a post or a wall from above; also in the View menu)",
+            Action.TWO_SIDED, ("t",)),
     Binding(S.DISPLAY, "P", "hide / show the panel", Action.PANEL, ("p",), C.ANY),
     Binding(S.DISPLAY, "F1  or  H", "show / hide this help (PageDown / PageUp, arrows or the wheel scroll it)",
             Action.HELP, ("f1", "h"), C.ANY),

@@ -49,7 +49,8 @@ def status_dict(ed) -> dict:
                      "pivot": [round(float(x), 6) for x in cam.pivot()]},
           "frame_area": [round(float(x), 6) for x in ed.camera.view_area()],
           "up_axis": ed.camera.up.label, "up_source": ed.camera.up.source.value,
-          "grey": bool(vp.grey), "splat_scale": round(float(vp.splat_scale), 4),
+          "grey": bool(vp.grey), "edl": bool(getattr(vp, "edl", False)),
+          "two_sided": bool(getattr(vp, "two_sided", False)), "splat_scale": round(float(vp.splat_scale), 4),
           "moving_frame_ms_median": (round(float(np.median(ed.moving_frame_ms)), 1)
                                      if ed.moving_frame_ms else None),
           "interactive_frames": len(vp.interactive_frames_ms),
@@ -96,6 +97,7 @@ def status_dict(ed) -> dict:
               history_label=s.history.labels[s.history.position],
               region_armed=ed.region.armed, region_points=len(ed.region.points),
               mirror_painting=ed.mirror.painting, mirror_axis="XYZ"[ed.mirror.axis],
+              view_hint_checked=ed.camera.hint_checked(),
               pivot=ed.pivot.mode, axes=ed.pivot.orientation,
               cursor=None if ed.pivot.cursor is None else [round(float(x), 9) for x in ed.pivot.cursor],
               manip_pivot=None if s.manip is None else [round(float(x), 9) for x in s.manip.pivot])

@@ -68,7 +68,7 @@ class SceneKey:
     sel_version: int
     basis_rev: int
     dc: bytes | None
-    display: tuple          # heat map, grey shading, splat scale, background
+    display: tuple          # heat map, grey shading, splat scale, background, eye-dome lighting, two-sided
 
 
 class FrameScheduler:
@@ -149,7 +149,8 @@ class FrameScheduler:
         ed, s, vp = self.ed, self.ed.session, self.ed.viewport
         dc = None if vp.dc is None else vp.dc.tobytes()
         return SceneKey(ed.cam.state(), ed.size, revision.of(s.cloud), s.version, revision.of(s.basis), dc,
-                        (vp.distortion_map, vp.grey, vp.splat_scale, vp.background))
+                        (vp.distortion_map, vp.grey, vp.splat_scale, vp.background, vp.edl,
+                         vp.two_sided))
 
     def async_refine(self) -> bool:
         """True when full-quality frames are slow enough to be refined progressively."""
@@ -182,6 +183,9 @@ class FrameScheduler:
         if w == 0 or h == 0 or ed.window.iconified():
             return
         t0 = time.perf_counter()
+        if (ed.session is not None and ed.drag is DragMode.NONE and not self.scene_interactive
+                and self.scene_key is not None and self.scene_key == self.state()):
+            ed.camera.view_hint()       # a still view drawn: does it show (almost) nothing?
         if self.gpu:
             self._draw_gpu(w, h)
         else:

@@ -53,6 +53,9 @@ def sync_slot(vp, slot: Slot, source, upload, level=None) -> bool:
     r.distortion_map = vp.distortion_map
     r.grey_shading = vp.grey
     r.splat_scale = vp.splat_scale
+    r.edl = bool(vp.edl) and r.supports_edl
+    if getattr(r, "backface_culling", None) is not None:     # splat renderers (Gaussians are never culled)
+        r.backface_culling = not vp.two_sided
     bg = tuple(float(x) for x in vp.background[:3])
     if tuple(r.background[:3]) != bg:       # only a change (GUI colour picker)
         r.background = (*bg, *tuple(r.background)[3:])

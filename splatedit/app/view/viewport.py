@@ -76,6 +76,10 @@ class Viewport:
         #: display options (Renderer.grey_shading, Renderer.splat_scale)
         self.grey = False
         self.splat_scale = 1.0
+        #: eye-dome lighting (Renderer.edl: depth edges darkened; raw scans without normals)
+        self.edl = False
+        #: draw back-facing splats too (Renderer.backface_culling off; splat scenes)
+        self.two_sided = False
         #: background colour (linear RGB 0..1, Renderer.background)
         from splatedit.tolerances import RENDER_BACKGROUND
         self.background = tuple(float(x) for x in RENDER_BACKGROUND[:3])

@@ -426,6 +426,9 @@ class GaussianRenderer:
     #: mode rows; the viewport reads Gaussian frames back (no resident presentation yet)
     supports_detail = False
     resident_frames = False
+    #: eye-dome lighting is a splat pass (render --edl): never drawn for Gaussians
+    supports_edl = False
+    edl = False
 
     # ------------------------------------------------ pieces the passes record
     #: the resolve pass's shader and descriptor-set layout (frame.Resolve)

@@ -13,7 +13,9 @@ from splatedit.atomic import atomic_open, check_writable_target
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.splat.renderer import Renderer
-from splatedit.tolerances import RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL
+from splatedit.tolerances import (RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL,
+                                  RENDER_LOD_MARGIN, RENDER_LOD_MAX_KEPT_SHARE,
+                                  RENDER_LOD_MIN_RADIUS_PX)
 
 
 def available_memory() -> int | None:
@@ -43,6 +45,64 @@ def check_render_memory(size, buffers: bool = False) -> None:
         what = " with --buffers" if buffers else ""
         raise ParameterError("--size", f"{w}x{h}{what} needs about {need / 2**30:.1f} GiB of memory, "
                                        f"only {free / 2**30:.1f} GiB is available; render a smaller image")
+
+
+def keep_for_pixels(cloud: SplatCloud, camera: Camera, height: int,
+                    min_radius_px: float = RENDER_LOD_MIN_RADIUS_PX, chunk: int = 1 << 20) -> np.ndarray:
+    """Keep probabilities of a single view's level of detail.
+
+    A splat of radius ``r`` (the geometric mean of its axis lengths) at depth
+    ``z`` along the view axis is ``r * f / z`` pixels wide (``f = height /
+    (2 tan(fov / 2))``); one below ``min_radius_px`` is kept with probability
+    ``(r_px / min_radius_px)^2`` and enlarged to that radius by
+    :func:`splatedit.model.lod.thinned_level`, so many splats in one pixel
+    become about one that covers it, as point-cloud viewers draw a level
+    chosen per output size.  Splats at or behind the eye keep 1.
+
+    Args:
+        cloud: n splats; camera: the view; height: image height in pixels.
+    Returns:
+        (n,) float64 probabilities in (0, 1].
+    """
+    eye = np.asarray(camera.eye, dtype=np.float64)
+    fwd = -camera.view_matrix()[2, :3]
+    f = height / (2.0 * np.tan(np.radians(camera.fov_deg) / 2.0))
+    out = np.empty(cloud.n)
+    scale = (f / min_radius_px) ** 2
+    z0 = float(eye @ fwd)
+    for lo in range(0, cloud.n, chunk):
+        u, v = cloud.u[lo:lo + chunk], cloud.v[lo:lo + chunk]
+        k = np.einsum("ij,ij->i", u, u)
+        k *= np.einsum("ij,ij->i", v, v)
+        np.sqrt(k, out=k)                                    # r^2 = |u| |v|
+        z = cloud.positions[lo:lo + chunk] @ fwd
+        z -= z0                                              # depth along the view axis
+        ahead = z > 0
+        z *= z
+        with np.errstate(divide="ignore", invalid="ignore", over="ignore"):
+            k *= scale
+            k /= z                                           # (r f / (z m))^2
+        k[~ahead | ~(k < 1.0)] = 1.0                         # behind the eye, NaN, or wide enough
+        out[lo:lo + chunk] = k
+    return out
+
+
+def pixel_level(cloud: SplatCloud, camera: Camera, height: int, *,
+                min_radius_px: float = RENDER_LOD_MIN_RADIUS_PX,
+                max_kept_share: float = RENDER_LOD_MAX_KEPT_SHARE):
+    """The level of detail ``splatedit render`` draws for this view: splats
+    thinned and enlarged to about ``min_radius_px`` (:func:`keep_for_pixels`,
+    :func:`splatedit.model.lod.thinned_level` with ``RENDER_LOD_MARGIN``), or None when it would keep
+    more than ``max_kept_share`` of them (the full cloud is drawn then).
+
+    Returns:
+        :class:`splatedit.model.lod.LodLevel` or None.
+    """
+    from splatedit.model.lod import thinned_level
+    keep = keep_for_pixels(cloud, camera, height, min_radius_px)
+    if keep.sum() > max_kept_share * cloud.n:
+        return None
+    return thinned_level(cloud, keep, margin=RENDER_LOD_MARGIN)
 
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,

@@ -54,7 +54,7 @@ from splatedit.errors import ParameterError
 from splatedit.render import vk as V
 from splatedit.render.camera import Camera
 from splatedit.render.splat.renderer import Renderer
-from splatedit.render.splat.passes import FrameContext, RasterSplats, Resolve
+from splatedit.render.splat.passes import EyeDomeResolve, FrameContext, RasterSplats, Resolve
 from splatedit.render.splat.layout import RESOLVE_SET, WORKGROUP
 from splatedit.tolerances import PROGRESSIVE_SHADE_PAD_PX
 
@@ -69,6 +69,14 @@ _BOX_BLOCK = 4096
 _RP_OVER = V.RenderPassDesc(colors=(V.Attachment("rgba8", "load", initial="transfer_src", final="transfer_src"),))
 _OVER_DESC = V.GraphicsDesc("fullscreen.vert", "resolve.frag", _RP_OVER, V.LayoutDesc(sets=(RESOLVE_SET,)),
                             topology="triangle_list", blend_alpha=True)
+#: the same with eye-dome lighting (Renderer.edl): the shown image is shaded as the one-submit frame is
+_OVER_EDL_DESC = V.GraphicsDesc("fullscreen.vert", "resolve_edl.frag", _RP_OVER, V.LayoutDesc(sets=(RESOLVE_SET,)),
+                                topology="triangle_list", blend_alpha=True)
+
+
+def _resolve(r: Renderer) -> Resolve:
+    """The renderer's shading pass (:class:`EyeDomeResolve` with ``r.edl``)."""
+    return EyeDomeResolve() if r.edl else Resolve()
 
 
 def _union(a, b):
@@ -185,7 +193,7 @@ class ProgressiveFrame:
                 def rec(cb):
                     draw(cb, "attr")
                     if readback:
-                        Resolve().record(cb, ctx)
+                        _resolve(r).record(cb, ctx)
                         cb.copy_image_to_buffer(t.out, self._rb)
                         cb.host_read_barrier()
                 r.dev.submit(rec)
@@ -287,7 +295,7 @@ class ProgressiveFrame:
                 self.write_ubo(r.background_alpha)
 
                 def rec(cb):
-                    Resolve().record(cb, FrameContext(r, t, t.offscreen))
+                    _resolve(r).record(cb, FrameContext(r, t, t.offscreen))
                 r.dev.submit(rec)
                 self._unshown, self._final = False, True
             return self._read(t.out) if readback else t.out
@@ -326,7 +334,7 @@ class ProgressiveFrame:
                     cb.image_barrier(img, "transfer_src", "transfer", "transfer_write",
                                      "color_output", "color_read|color_write")
                 if shade:
-                    pipe = r.cache.pipeline(_OVER_DESC)
+                    pipe = r.cache.pipeline(_OVER_EDL_DESC if r.edl else _OVER_DESC)
                     cb.begin_render_pass(r.cache.render_pass(_RP_OVER), self._fb_over, [None])
                     cb.set_scissor(*rect)
                     cb.bind_pipeline(pipe)

@@ -482,6 +482,7 @@ class Renderer:
     #: mode's rows (set_detail) and frames the presenter blits (render_resident)
     supports_detail = True
     resident_frames = True
+    supports_edl = True
 
     @property
     def targets(self):

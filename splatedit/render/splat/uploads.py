@@ -13,7 +13,6 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.rotation import split_displacement
 from splatedit.errors import ParameterError
 from splatedit.model.cloud import SplatCloud
 from splatedit.render import vk as V
@@ -324,6 +323,9 @@ class SceneUploads:
         planes are chosen from the model bounds grown by the largest possible
         splat displacement (``Renderer.clip_bounds``), so geometry moved outside
         the undeformed model is not clipped."""
+        # imported here: the deform package (scipy.linalg) costs a one-shot
+        # `splatedit render` 0.4-0.9 s of start-up it does not need undeformed
+        from splatedit.deform.rotation import split_displacement
         a, rot = split_displacement(dC)
         if rot is not None and len(rot.rotations) > MAX_GROUPS:
             raise ParameterError("dC", f"the renderer blends at most {MAX_GROUPS} handle rotations")

@@ -98,7 +98,7 @@ def test_home_frames_the_main_body_of_a_cloud_with_far_clumps_and_says_so():
             px, depth = ed.cam.project(plane.positions, w, h)
             boxes.append((px.min(0), px.max(0)))
             if c is cloud:
-                assert ed.messages[-1] == ("left out of the view: 9 points far outside the main body "
+                assert ed.messages[-1] == ("view: the whole model; left out of the view: 9 points far outside the main body "
                                            "(outliers?): `splatedit convert --remove-outliers`")
                 strays, d = ed.cam.project(far, w, h)
                 off = (d <= 0) | (strays[:, 0] < 0) | (strays[:, 0] > w) | (strays[:, 1] < 0) | (strays[:, 1] > h)
@@ -109,7 +109,7 @@ def test_home_frames_the_main_body_of_a_cloud_with_far_clumps_and_says_so():
                 after = ed.camera.extent()
                 assert after is not before and np.isclose(after.radius, 2 * before.radius)
             else:
-                assert ed.messages == []
+                assert ed.messages == ["view: the whole model"]      # no far points to name
         finally:
             s.close()
     assert np.allclose(boxes[0][0], boxes[1][0]) and np.allclose(boxes[0][1], boxes[1][1])
@@ -135,6 +135,33 @@ def test_home_on_the_clean_bunny_frames_its_full_bounding_sphere():
         ref = OrbitCamera(yaw=ed.cam.yaw, pitch=ed.cam.pitch, up_axis=ed.cam.up_axis)
         ref.frame((lo + hi) / 2, float(np.linalg.norm(hi - lo)) / 2, w / h, area=ed.camera.view_area())
         assert np.allclose(ref.target, ed.cam.target, rtol=0, atol=1e-12) and ref.distance == ed.cam.distance
-        assert ed.messages == []
+        assert ed.messages == ["view: the whole model"]
+    finally:
+        s.close()
+
+
+@pytest.mark.parametrize("keys,name", [
+    (("KEY_1", "MOD_SHIFT"), "view: front"), (("KEY_3", "MOD_SHIFT"), "view: right"),
+    (("KEY_7", "MOD_SHIFT"), "view: top"), (("KEY_KP_7", 0), "view: top"),
+    (("KEY_KP_1", "MOD_CONTROL"), "view: back"), (("KEY_7", "MOD_CONTROL|MOD_SHIFT"), "view: bottom"),
+    (("KEY_HOME", 0), "view: the whole model"), (("KEY_F", 0), "view: the support"),
+])
+def test_a_view_key_replaces_the_previous_status_message_with_the_views_name(keys, name):
+    """Shift+1/3/7, the numpad and Home / F: the status line names the new
+    view instead of keeping the message of whatever was done before."""
+    import glfw
+
+    from splatedit.app.document.session import Session
+    from tests.app.sessions import plane_cloud
+    from tests.app.test_editor_routing import StubEditor, key
+
+    s = Session(plane_cloud(), fit_sync=True)
+    try:
+        ed = StubEditor(s)
+        s.set_selection(s.cloud.positions[:, 0] > 0, None)
+        ed.say("splat size 1.25x (display only; saves are unchanged)")     # an older message
+        mods = 0 if keys[1] == 0 else eval("|".join(f"glfw.{m}" for m in keys[1].split("|")))
+        key(ed, getattr(glfw, keys[0]), mods)
+        assert ed.messages[-1].startswith(name), ed.messages
     finally:
         s.close()

@@ -192,3 +192,15 @@ def test_gizmo_is_hidden_when_the_handle_is_far_off_screen(editor):
     editor.cam.target = np.array([40.0, 0.0, 0.0])
     assert not editor.gizmo.rings(W, H) and not editor.gizmo.axes(W, H)
     assert editor.gizmo.scale_circle(W, H) is None
+
+
+def test_readout_box_keeps_the_margin_on_every_side():
+    """The live readout's box follows the cursor (down and right of it) and
+    is moved to stay EDITOR_READOUT_MARGIN_PX inside the window."""
+    from splatedit.app.tools.gizmo import readout_box
+    from splatedit.tolerances import EDITOR_READOUT_MARGIN_PX as M, EDITOR_READOUT_OFFSET_PX as O
+    assert readout_box((100, 100), 200, 17, 960, 600) == (100 + O, 100 + O)
+    x, y = readout_box((955, 595), 200, 17, 960, 600)
+    assert (x + 200, y + 17) == (960 - M, 600 - M)
+    assert readout_box((-50, -50), 200, 17, 960, 600) == (M, M)
+    assert readout_box((500, 300), 2000, 17, 960, 600)[0] == M       # wider than the window: from the left
