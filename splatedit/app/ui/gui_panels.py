@@ -328,10 +328,10 @@ class EditorGui:
         returns ImGui's (changed, value)."""
         imgui.set_next_item_width(EDITOR_GUI_SLIDER_WIDTH)
         changed, v = imgui.slider_float(f"##{name}", value, lo, hi, "", imgui.SliderFlags_.logarithmic.value)
-        self._rect(f"{name}_slider")
+        self.rect(f"{name}_slider")
         imgui.same_line()
         imgui.text(f"{fmt % v}  {label}")
-        self._rect(f"{name}_value")
+        self.rect(f"{name}_value")
         return changed, v
 
     def _tool_button(self, label: str, name: str, action: Action, on: bool) -> None:
@@ -370,12 +370,12 @@ class EditorGui:
         note = b.mode_note()
         if note:
             imgui.text_colored(YELLOW, note)
-            self._rect("brush_note")
+            self.rect("brush_note")
         for tool in self.ed.tools:      # the protocol tools' state lines
             line = tool.status()
             if line:
                 imgui.text_colored(YELLOW, line)
-                self._rect(f"tool_status_{getattr(tool, 'name', type(tool).__name__)}")
+                self.rect(f"tool_status_{getattr(tool, 'name', type(tool).__name__)}")
         imgui.pop_text_wrap_pos()
 
     def _stats(self, st) -> None:
@@ -455,7 +455,7 @@ class EditorGui:
         if getattr(vp, "gaussians", None) is None:      # eye-dome lighting: a splat pass
             if imgui.checkbox("eye-dome lighting (Shift+E)", bool(vp.edl))[0]:
                 ed.run_action(Action.EDL)
-            self._rect("display_edl")
+            self.rect("display_edl")
         ch, v = self._slider("splat size", "splat_size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
                              EDITOR_SPLAT_SCALE_MAX, "%.2fx")
         if ch:
