@@ -7,7 +7,10 @@ An owned part of :class:`~splatedit.app.document.session.Session`
 the closure that ends them: :mod:`splatedit.select.closure`, bounded by the
 selection before an erase stroke), and whole-mask edits (a region, a
 mirror image, grow / shrink ...: the target's new mask, closed and recorded
-as one undo step).  Closure needs the cloud's neighbour graph; the
+as one undo step; on a large cloud a copy of the selection is changed and
+closed by a worker and installed when it lands, unless the selection changed
+meanwhile: :meth:`SelectionEdit.background_select`,
+:meth:`SelectionEdit.install`).  Closure needs the cloud's neighbour graph; the
 :class:`~splatedit.app.document.selection.SelectionTools` that builds it in the
 background is given by the editor (``graphs``); without one (a session in a
 test) strokes and edits are recorded unclosed.
@@ -70,6 +73,23 @@ class SelectionEdit:
         s.version += 1
         s.push(label)
         return True
+
+    def background_select(self):
+        """A :class:`~splatedit.app.document.selection.BackgroundApply` of the
+        brush target (the selection copied now, to be changed and closed by a
+        worker), or None while the neighbour graph is built (or without a
+        graph service)."""
+        return None if self.graphs is None else self.graphs.background_apply(self._s)
+
+    def install(self, job, label: str) -> bool:
+        """Make a finished background edit's selection this document's (one
+        undo step, ``label``); False when it belongs to another document, the
+        selection changed since it started, a move runs, or it changed nothing."""
+        if self.graphs is None or job.session is not self._s:
+            return False
+        ok = self.graphs.install(job, label)
+        self.last_added = self.graphs.last_added if ok else 0
+        return ok
 
     # ------------------------------------------------------------ strokes
     def begin_stroke(self, erase: bool) -> None:

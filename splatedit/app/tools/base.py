@@ -160,15 +160,13 @@ class ToolContext:
         """A :class:`~splatedit.app.document.selection.BackgroundApply` of the
         brush target (the selection copied now, closed by its worker), or
         None while the neighbour graph is built."""
-        return self._ed.selection_tools.background_apply(self._ed.session)
+        return self._ed.session.selection_edit.background_select()
 
     def install(self, job, label: str) -> bool:
         """Make a finished BackgroundApply's selection the document's (one
         undo step); False when the selection changed since it started, or
         another model was opened meanwhile."""
-        if job.session is not self._ed.session:
-            return False
-        return self._ed.selection_tools.install(job, label)
+        return self._ed.session.selection_edit.install(job, label)
 
     # ---- background work
     def start_job(self, key: str, name: str, fn, land) -> None:
