@@ -175,6 +175,20 @@ class Editor:
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()
 
+    # ------------------------------------------------------------- document
+    @property
+    def session(self):
+        """The open document (:class:`~splatedit.app.document.session.Session`), or None."""
+        return self.__dict__.get("_session")
+
+    @session.setter
+    def session(self, s) -> None:
+        # the document's selection edits close through the editor's neighbour graphs
+        edit = getattr(s, "selection_edit", None)
+        if edit is not None and edit.graphs is None:
+            edit.graphs = self.selection_tools
+        self.__dict__["_session"] = s
+
     # ---------------------------------------------------------------- utils
     def wake(self) -> None:
         try:
