@@ -97,8 +97,8 @@ def measure(spec: str, size, frames: int, folder: Path, profile: bool, panel: bo
     ed = Editor(path, size=size, vsync=False, max_seconds=600)
     st = Stages()
     fr = ed.frames
-    st.wrap(ed, "handle_events", "events")
-    st.wrap(ed, "poll_jobs", "jobs")
+    st.wrap(ed.routing, "handle_events", "events")
+    st.wrap(ed.file_actions, "poll_jobs", "jobs")
     st.wrap(fr, "sync_document", "sync")
     st.wrap(ed.viewport, "render", "render")
     st.wrap(fr, "_progressive_step", "refine")

@@ -2,7 +2,7 @@
 
 An object the :class:`~splatedit.app.editor.Editor` owns (``editor.crash_guard``).  The loop
 dispatches work in a few places -- each window event
-(:meth:`~splatedit.app.ui.routing.EventRouting.handle_events`), the landing of
+(:meth:`~splatedit.app.ui.routing.EventRouter.handle_events`), the landing of
 finished jobs (load, save, levels of detail, graph), the session's poll
 (fits and background commits landing), each frame (scene, GUI and its
 buttons' actions, present) and the status file -- and each runs inside
@@ -32,7 +32,8 @@ import sys
 import traceback
 from pathlib import Path
 
-from splatedit.app.document import recovery, revision
+from splatedit.app.document import recovery
+from splatedit.app.document import revision
 from splatedit.app.tools.base import DragMode
 from splatedit.errors import SplatEditError
 
@@ -163,7 +164,7 @@ class CrashGuard:
             recovery.discard(entry)
             self.ed.say(f"recovery copy of {entry.name} discarded")
             return
-        if self.ed.open_path(entry.model, confirmed=True):
+        if self.ed.file_actions.open_path(entry.model, confirmed=True):
             self.restoring = entry
 
     def on_restored(self) -> None:

@@ -17,9 +17,9 @@ up in the one keymap (:mod:`splatedit.app.ui.keymap`, which also generates the
 help and the manual's controls list) and run the bound action; each tool draws
 its overlay.  Files (:mod:`splatedit.app.document.files`): Ctrl+O shows the file
 browser (:class:`~splatedit.app.tools.browser.FileBrowserTool`), a file
-dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) :meth:`Editor.open_dialog`,
-:meth:`Editor.open_path` and :meth:`Editor.recent_files` are the API a GUI
-File menu calls; load / save errors stay in an error box until dismissed.
+dropped on the window opens the same way, and (:mod:`splatedit.app.file_actions`) ``open_dialog``,
+``open_path`` and ``recent_files`` are the API a GUI
+File menu calls (on :attr:`Editor.file_actions`); load / save errors stay in an error box until dismissed.
 Entry point: :func:`run_editor`.
 """
 
@@ -33,6 +33,7 @@ import threading
 import time
 from pathlib import Path
 
+from splatedit.app.tools.pick_brush import ViewPicking
 from splatedit.app.crash_guard import CrashGuard
 from splatedit.app.document.files import check_model_file, save_refusal, script_path_for  # noqa: F401 (API)
 from splatedit.app.document.files import default_save_path as _default_save_path  # noqa: F401 (API)
@@ -42,12 +43,13 @@ from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.document.jobs import Job
 from splatedit.app.ui.keymap import Action
 from splatedit.app.ui.options import CONTROLS, add_arguments, options_from_args  # noqa: F401 (re-exported)
-from splatedit.app.ui.panel import HelpView, compose_overlay
+from splatedit.app.ui.panel import PANEL_MARGIN, HelpView, compose_overlay
+from splatedit.app.document.selection import SelectionTools
 from splatedit.app.document.session import Session
 from splatedit.app.ui.status import StatusWriter
 from splatedit.app.ui.recent import RecentFiles
-from splatedit.app.ui.routing import HELP_WHEEL_LINES, EventRouting  # noqa: F401 (API)
-from splatedit.app.tools.base import DragMode
+from splatedit.app.ui.routing import HELP_WHEEL_LINES, EventRouter  # noqa: F401 (API)
+from splatedit.app.tools.base import DragMode, free_area
 from splatedit.app.tools.browser import FileBrowserTool
 from splatedit.app.tools.brush import BrushTool
 from splatedit.app.tools.camera import CameraTool
@@ -55,11 +57,22 @@ from splatedit.app.tools.curve import CurveTool
 from splatedit.app.tools.gizmo import GizmoTool
 from splatedit.app.tools import protocol_tools
 from splatedit.errors import ParameterError, SplatEditError
-from splatedit.tolerances import (EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN, EDITOR_SPLAT_SCALE_STEP,
+from splatedit.tolerances import (EDITOR_GUI_PANEL_WIDTH, EDITOR_SPLAT_SCALE_MAX, EDITOR_SPLAT_SCALE_MIN,
+                                  EDITOR_SPLAT_SCALE_STEP,
                                   IQR_DEFAULT_TOL)
 
 
-class Editor(EventRouting, FileActions):
+class Editor:
+    """The editor window's loop and the state its parts share.
+
+    It owns its parts and delegates to them: :attr:`routing` (window events
+    to the GUI, the questions and the tools; keys through the keymap,
+    :class:`~splatedit.app.ui.routing.EventRouter`), :attr:`file_actions`
+    (load / open / save / export / quit,
+    :class:`~splatedit.app.file_actions.FileActions`), the tools
+    (:mod:`splatedit.app.tools`), the frame scheduler and the crash guard.
+    """
+
     def __init__(self, path=None, *, size=(1280, 720), save_as=None, method="auto",
                  tol=IQR_DEFAULT_TOL, max_centers=None, vsync=True, status_file=None,
                  budget_ms=100.0, lod=True, bundled=False, max_seconds=None, offer_recent=False,
@@ -110,6 +123,10 @@ class Editor(EventRouting, FileActions):
         #: the central exception guard, recovery copies and the restore question
         #: (:class:`~splatedit.app.crash_guard.CrashGuard`)
         self.crash_guard = CrashGuard(self)
+        #: window events and key actions (:class:`~splatedit.app.ui.routing.EventRouter`)
+        self.routing = EventRouter(self)
+        #: the File menu API (:class:`~splatedit.app.file_actions.FileActions`)
+        self.file_actions = FileActions(self)
         self.cloud_name = self.path.name if self.path else "model"
         self.jobs: dict[str, Job] = {}
         self.running = True
@@ -143,6 +160,11 @@ class Editor(EventRouting, FileActions):
         if not hasattr(self, "frames"):
             self.frames = FrameScheduler(self, 100.0)
         self.debug_enabled = os.environ.get("SPLATEDIT_EDITOR_DEBUG", "") not in ("", "0")
+        #: the neighbour graphs of the document's clouds (built in the background) and
+        #: the closure of selection edits (:class:`~splatedit.app.document.selection.SelectionTools`)
+        self.selection_tools = SelectionTools(self.start_graph_job)
+        #: the pick map of the current view (:class:`~splatedit.app.tools.pick_brush.ViewPicking`)
+        self.picking = ViewPicking(self)
         # tools: press order (after every tool's press_modal)
         self.camera = CameraTool(self)
         self.brush = BrushTool(self)
@@ -157,6 +179,20 @@ class Editor(EventRouting, FileActions):
         self.browser = FileBrowserTool(self)
         self.actions = self._action_table()
         self.manip_actions = self.gizmo.manip_actions()
+
+    # ------------------------------------------------------------- document
+    @property
+    def session(self):
+        """The open document (:class:`~splatedit.app.document.session.Session`), or None."""
+        return self.__dict__.get("_session")
+
+    @session.setter
+    def session(self, s) -> None:
+        # the document's selection edits close through the editor's neighbour graphs
+        edit = getattr(s, "selection_edit", None)
+        if edit is not None and edit.graphs is None:
+            edit.graphs = self.selection_tools
+        self.__dict__["_session"] = s
 
     # ---------------------------------------------------------------- utils
     def wake(self) -> None:
@@ -187,6 +223,19 @@ class Editor(EventRouting, FileActions):
     @property
     def size(self) -> tuple[int, int]:
         return self.window.framebuffer_size()
+
+    def view_area(self) -> tuple[float, float, float, float]:
+        """The part of the window framing fills, (x0, y0, x1, y1) fractions
+        (:func:`~splatedit.app.tools.base.free_area`): beside the side panel
+        when it is shown, below the GUI's menu bar."""
+        w, h = self.size
+        box = self.panel_box if self.panel_visible else None
+        if box is not None and tuple(box) == (0, 0, 0, 0):
+            # no frame laid out yet (a model opened before the first GUI frame): the GUI
+            # panel's first place, at the left; the CPU text panel's size is not known
+            box = (PANEL_MARGIN, 0, EDITOR_GUI_PANEL_WIDTH, 0) if self.gui is not None else None
+        top = self.gui.menu_height if self.gui is not None else 0.0
+        return free_area(w, h, box, top)
 
     def motion(self) -> None:
         self.frames.motion()
@@ -224,8 +273,9 @@ class Editor(EventRouting, FileActions):
             t.update(tool.actions())
         s = lambda: self.session  # noqa: E731
         t.update(self.browser.actions())
+        fa = self.file_actions
         t.update({
-            Action.OPEN: self.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
+            Action.OPEN: fa.open_dialog, Action.DISMISS_ERROR: self.dismiss_error,
             Action.DISTORTION_MAP: self.toggle_distortion_map, Action.COLOUR_MODE: self.toggle_colours,
             Action.EDL: self.toggle_edl, Action.TWO_SIDED: self.toggle_two_sided,
             Action.DEFORMATION_MODE: self.cycle_deformation,
@@ -236,8 +286,8 @@ class Editor(EventRouting, FileActions):
             Action.HELP_CLOSE: self.help.toggle,
             Action.UNDO: lambda: self.say("undo" if s().undo() else "undo: nothing to do"),
             Action.REDO: lambda: self.say("redo" if s().redo() else "redo: nothing to do"),
-            Action.SAVE: self.save_edits, Action.SAVE_AS: self.ask_save_as,
-            Action.EXPORT_SCRIPT: self.export_script, Action.QUIT: self.request_quit})
+            Action.SAVE: fa.save_edits, Action.SAVE_AS: fa.ask_save_as,
+            Action.EXPORT_SCRIPT: fa.export_script, Action.QUIT: fa.request_quit})
         return t
 
     def cycle_deformation(self) -> None:
@@ -291,6 +341,11 @@ class Editor(EventRouting, FileActions):
     def toggle_panel(self) -> None:
         self.panel_visible = not self.panel_visible
 
+    def run_action(self, action: Action) -> None:
+        """Run the handler bound to ``action`` (keys and GUI buttons share it;
+        :meth:`~splatedit.app.ui.routing.EventRouter.run_action`)."""
+        self.routing.run_action(action)
+
     def finish_manip(self) -> None:
         self.gizmo.finish_manip()
 
@@ -298,6 +353,14 @@ class Editor(EventRouting, FileActions):
         self.gizmo.commit_pose()
 
     # -------------------------------------------------------------- overlay
+    def overlay_shapes(self, w: int, h: int) -> list:
+        """Every tool's overlay shapes of a ``w`` x ``h`` frame
+        (:mod:`splatedit.app.tools.shapes`), in tool order (none without a model);
+        the GPU path and the CPU fallback paint this one list."""
+        if self.session is None:
+            return []
+        return [shape for tool in self.tools for shape in tool.shapes(w, h)]
+
     def overlay_patches(self, w: int, h: int) -> list:
         return compose_overlay(self, w, h)
 
@@ -325,10 +388,11 @@ class Editor(EventRouting, FileActions):
         (KeyboardInterrupt), after writing a recovery copy of unsaved edits."""
         if self.path is None:
             raise SplatEditError("no model to open")
-        self.start_load()
+        fa = self.file_actions
+        fa.start_load()
         guard = self.crash_guard
-        if not guard.offer_recovery() and self.offer_recent and self.recent_files():
-            self.open_dialog(Path.cwd())
+        if not guard.offer_recovery() and self.offer_recent and fa.recent_files():
+            fa.open_dialog(Path.cwd())
         restore_sigterm = _sigterm_as_interrupt()
         try:
             self._loop()
@@ -357,9 +421,9 @@ class Editor(EventRouting, FileActions):
                 if w == 0 or h == 0 or self.window.iconified():
                     pending = False          # minimized: nothing to draw, do not spin
                 events = self.window.poll(0.0 if pending else (0.05 if busy else 0.5))
-                self.handle_events(events)          # each event guarded on its own
+                self.routing.handle_events(events)          # each event guarded on its own
                 with guarded("collecting a finished job"):
-                    self.poll_jobs()
+                    self.file_actions.poll_jobs()
                 if self.ooc is not None:
                     with guarded("refining the out-of-core view"):
                         self.ooc.poll(self)
@@ -406,7 +470,7 @@ class Editor(EventRouting, FileActions):
         for j in list(self.jobs.values()):
             if j.name == "saving":
                 j.wait()     # never leave a half-written file behind
-        self.brush.tools.cancel()   # a graph build stops at its next tile (its pool would hold up the exit)
+        self.selection_tools.cancel()   # a graph build stops at its next tile (its pool would hold up the exit)
         self.frames.close()
         if self.gui is not None:
             if self.presenter is not None:

@@ -22,7 +22,7 @@ import time
 import numpy as np
 
 from splatedit.bench.solve import (
-    _bundled_model,
+    bundled_model,
     ball_selection,
     sample_transform,
     wavy_plane_cloud,
@@ -42,7 +42,7 @@ def accuracy_cases(large: bool = False):
     wavy plane with one and two handles at growing resolution (m about 1,000
     to 6,000), and with ``large`` square supports with two big handles
     (m about 8,500, 14,000 and 20,000)."""
-    bunny = _bundled_model()
+    bunny = bundled_model()
     if bunny is not None:
         top = bunny.positions[np.argmax(bunny.positions[:, 1])]
         r = 0.25 * bunny.diagonal

@@ -59,7 +59,7 @@ def bunny_surface_cloud(n: int, seed: int = 0, overlap: float = 2.0) -> SplatClo
     return SplatCloud(p, t1 * r, t2 * r, None, name=f"bunny{n}")
 
 
-def _support_and_handle(cloud: SplatCloud, support_splats: int = 20000):
+def support_and_handle(cloud: SplatCloud, support_splats: int = 20000):
     """A ball support of about ``support_splats`` splats around a surface point
     and a handle ball of a quarter of its radius."""
     p = cloud.positions
@@ -126,7 +126,7 @@ def bench_editor_frames(counts=(100_000, 1_000_000, 2_000_000), size=(1280, 720)
             vp.set_cloud(cloud)
             vp.set_pyramid(pyr)
             vp.assume_cost(None, 1)
-            sup, hnd = _support_and_handle(cloud)
+            sup, hnd = support_and_handle(cloud)
             vp.set_selection(sup, hnd, n)
             cam = OrbitCamera(scene_radius=cloud.diagonal / 2, yaw=0.3, pitch=0.2)
             lo, hi = cloud.bounds()

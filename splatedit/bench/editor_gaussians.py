@@ -44,7 +44,7 @@ def _diff(a: np.ndarray, b: np.ndarray) -> tuple[float, float]:
 
 def bench_gaussian_editor_frames(counts=(100_000, 1_000_000), size=(1280, 720), frames: int = 8,
                                  budget_ms: float = 100.0) -> Iterator[dict]:
-    from splatedit.bench.editor import _support_and_handle
+    from splatedit.bench.editor import support_and_handle
     from splatedit.app.view.camera_control import OrbitCamera
     from splatedit.app.document.gaussian import gaussian_document
     from splatedit.app.view.viewport import Viewport
@@ -62,7 +62,7 @@ def bench_gaussian_editor_frames(counts=(100_000, 1_000_000), size=(1280, 720), 
         vp = Viewport(budget_ms=budget_ms, renderer=Renderer(validation=False))
         try:
             vp.set_cloud(doc)
-            sup, hnd = _support_and_handle(doc)
+            sup, hnd = support_and_handle(doc)
             vp.set_selection(sup, hnd, 1)
             from splatedit.select.closure import closed_masks
             sup, hs, _ = closed_masks(doc, sup, [hnd])

@@ -20,7 +20,7 @@ import numpy as np
 
 from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.errors import ParameterError
-from splatedit.bench.render import _basis, _loadavg, _rotation_displacement, sphere_cloud
+from splatedit.bench.render import smooth_basis, load_average, turned_handle_displacement, sphere_cloud
 from splatedit.render.camera import Camera
 from splatedit.render.gaussian.renderer import GaussianRenderer, gaussian_bounds
 
@@ -103,7 +103,7 @@ def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int 
                 out["frame_over_first"] = round(m["total"] / first["total"], 3)
                 out["wall_over_first"] = round(m["wall"] / first["wall"], 3)
                 if deform and first is m:
-                    B = _basis(g.positions)
+                    B = smooth_basis(g.positions)
                     dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]]) * 0.2
                     r.set_basis(np.arange(n), *B)
                     r.set_displacement(dC)
@@ -114,10 +114,10 @@ def bench_gaussians(counts=(100_000, 1_000_000), size=(1280, 720), repeats: int 
                     out["deformed_frame_over_plain"] = round(d["total"] / m["total"], 3)
                     # the editor's default mode: every Gaussian through the rotation-aware branch
                     # (bench render's 120-degree handle with tiny frame offsets: same culling)
-                    r.set_displacement(_rotation_displacement(dC, *g.bounds()))
+                    r.set_displacement(turned_handle_displacement(dC, *g.bounds()))
                     q = _frames(r, cam, w, h, repeats)
                     out["ms_prepass_rotation"] = round(q["prepass"], 2)
                     out["rotation_prepass_over_linear"] = round(q["prepass"] / d["prepass"], 3)
-            out["loadavg_1min"] = _loadavg()
+            out["loadavg_1min"] = load_average()
             out["wall_s"] = round(time.perf_counter() - t0, 1)
             yield out

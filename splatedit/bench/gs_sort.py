@@ -18,7 +18,7 @@ from typing import Iterator
 
 import numpy as np
 
-from splatedit.bench.render import _loadavg
+from splatedit.bench.render import load_average
 from splatedit.render import vk as V
 from splatedit.render.gaussian.gpu_sort import BitonicSort, RadixSort, default_scatter, subgroup_scatter_supported
 
@@ -104,6 +104,6 @@ def bench_gpu_sort(counts=(100_000, 1_000_000, 4_000_000), repeats: int = 3, dev
                 for ln in lines:
                     yield {"bench": "gpu_sort", "device": dev.name, "pairs": n, **ln, "ms": round(ln["ms"], 3),
                            "pairs_per_s": round(n / max(ln["ms"] * 1e-3, 1e-12)),
-                           "over_radix": round(ln["ms"] / max(base, 1e-9), 3), "loadavg_1min": _loadavg()}
+                           "over_radix": round(ln["ms"] / max(base, 1e-9), 3), "loadavg_1min": load_average()}
         finally:
             cache.destroy()

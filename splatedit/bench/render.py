@@ -44,7 +44,7 @@ def sphere_cloud(n: int, overlap: float = 1.0) -> SplatCloud:
     return SplatCloud(nrm, t1 * s, t2 * s, None, name=f"sphere{n}")
 
 
-def _basis(points: np.ndarray):
+def smooth_basis(points: np.ndarray):
     """A smooth 4-column basis with analytic gradient (Gaussian bumps)."""
     q = np.array([[0.5, 0.5, 0.5], [-0.5, 0.3, 0.2], [0.1, -0.6, 0.4], [0.0, 0.0, -0.7]])
     diff = points[:, None, :] - q[None]
@@ -53,7 +53,7 @@ def _basis(points: np.ndarray):
     return B, g[..., 0], g[..., 1], g[..., 2]
 
 
-def _rotation_displacement(dC, lo, hi):
+def turned_handle_displacement(dC, lo, hi):
     """``dC`` as the residual of one handle turned by 120 degrees about a tilted
     axis: every splat takes the rotation branch of the pre-pass (all its
     math, closed forms), while the frame offsets are small (1e-3 of the model)
@@ -155,7 +155,7 @@ def _case(r: Renderer, cloud: SplatCloud, model: str, w: int, h: int, repeats: i
     }
     if deform:
         out.update(_deformed(r, cloud, cam, w, h, repeats, plain, plain_best))
-    out["loadavg_1min"] = _loadavg()
+    out["loadavg_1min"] = load_average()
     out["wall_s"] = round(time.perf_counter() - t0, 1)
     return out
 
@@ -164,7 +164,7 @@ def _deformed(r: Renderer, cloud: SplatCloud, cam, w: int, h: int, repeats: int,
     """The deformation cases of :func:`bench_render` (default path)."""
     n = cloud.n
     lo, hi = cloud.bounds()
-    B = _basis((cloud.positions - 0.5 * (lo + hi)) / max(float(np.max(hi - lo)) / 2.0, 1e-12))
+    B = smooth_basis((cloud.positions - 0.5 * (lo + hi)) / max(float(np.max(hi - lo)) / 2.0, 1e-12))
     dC = np.array([[0.1, 0.2, 0.0], [0.0, -0.1, 0.1], [0.05, 0.0, 0.1], [-0.1, 0.0, 0.0]])
     dC = dC * 0.1 * float(np.max(hi - lo))
     r.set_basis(np.arange(n), *B)
@@ -176,7 +176,7 @@ def _deformed(r: Renderer, cloud: SplatCloud, cam, w: int, h: int, repeats: int,
     finally:
         r.distortion_map = False
     # the same basis as one rotation-aware handle turned 120 degrees (rotation.glsl)
-    r.set_displacement(_rotation_displacement(dC, lo, hi))
+    r.set_displacement(turned_handle_displacement(dC, lo, hi))
     rot, rot_best = _frames(r, cam, w, h, repeats)
     # a contiguous support region: the 10% of the splats nearest to one point
     d2 = np.sum((cloud.positions - cloud.positions[0]) ** 2, axis=1)
@@ -203,7 +203,8 @@ def _deformed(r: Renderer, cloud: SplatCloud, cam, w: int, h: int, repeats: int,
     }
 
 
-def _loadavg() -> float:
+def load_average() -> float:
+    """The 1-minute load average (/proc/loadavg), NaN where it cannot be read."""
     try:
         with open("/proc/loadavg") as f:
             return float(f.read().split()[0])

@@ -272,7 +272,9 @@ def bench_groups(cloud: SplatCloud | None = None, *, quick: bool = False, method
 
 
 # ------------------------------------------------------------ standard cases
-def _bundled_model():
+def bundled_model():
+    """The bundled bunny model (:class:`~splatedit.model.SplatCloud`), or None
+    when it is missing or cannot be read."""
     path = Path(__file__).resolve().parent.parent / "data" / "bunny.ply"
     if not path.is_file():
         return None
@@ -295,7 +297,7 @@ def standard_cases(large: bool = True):
     * ``plane-1M-support`` (``large``): 1.21M splats, 1.0M support splats,
       IQR only (m ~ 13000) -- the per-frame apply target.
     """
-    bunny = _bundled_model()
+    bunny = bundled_model()
     if bunny is not None:
         top = bunny.positions[np.argmax(bunny.positions[:, 1])]
         r = 0.25 * bunny.diagonal

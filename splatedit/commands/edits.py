@@ -93,7 +93,7 @@ def _faces_note(cloud, output) -> str:
             f"write {' or '.join(FACE_EXTENSIONS)} to keep them)")
 
 
-def _print_edit(args, rep) -> None:
+def print_edit(args, rep) -> None:
     """One edit's report line, its distortion figures and (stderr) warnings:
     conflicting constraints, splats stretched beyond DISTORTION_WARN_STRETCH."""
     args.progress.close()
@@ -130,7 +130,7 @@ def _run_edits(args, cloud, script_path):
     script = load_script(script_path)
     return run_script(cloud, script, method=getattr(args, "method", None), tol=getattr(args, "tol", None),
                       source=str(script_path), progress=args.progress,
-                      on_edit=lambda rep: _print_edit(args, rep))
+                      on_edit=lambda rep: print_edit(args, rep))
 
 
 def cmd_deform(args) -> int:
@@ -145,7 +145,7 @@ def cmd_deform(args) -> int:
     from splatedit.io.formats import suffix_of
     if suffix_of(args.output) == ".copc.laz" and is_copc_path(args.input):
         # out of core: the regions' nodes read, the rest copied compressed
-        return deform_copc(args, lambda rep: _print_edit(args, rep))
+        return deform_copc(args, lambda rep: print_edit(args, rep))
     cloud = read(args.input, progress=args.progress)
     t0 = time.perf_counter()
     out, reports = _run_edits(args, cloud, args.edit)
@@ -167,7 +167,7 @@ def _deform_gaussians(args) -> int:
     t0 = time.perf_counter()
     out, reports = run_script_gaussians(g, script, method=args.method, tol=args.tol,
                                         source=str(args.edit), progress=args.progress,
-                                        on_edit=lambda rep: _print_edit(args, rep))
+                                        on_edit=lambda rep: print_edit(args, rep))
     write_gaussians(args.output, out, overwrite=args.force, up_axis=_kept_up(args.input))
     print(f"wrote {args.output}: {len(out)} Gaussians, {len(reports)} edit(s) in "
           f"{time.perf_counter() - t0:.2f} s")

@@ -8,7 +8,7 @@ import os
 import sys
 from pathlib import Path
 
-from splatedit.commands.edits import _print_edit
+from splatedit.commands.edits import print_edit
 from splatedit.errors import ParameterError
 from splatedit.tolerances import RENDER_LOD_PATH
 
@@ -218,12 +218,12 @@ def _gpu_edit(args, cloud, on_gpu=None):
     from splatedit.script import Removal
     if isinstance(script.edits[-1], Removal):      # ends with a delete / crop: all of it on the CPU
         cloud, _ = run_script(cloud, script, source=source, progress=args.progress,
-                              on_edit=lambda rep: _print_edit(args, rep))
+                              on_edit=lambda rep: print_edit(args, rep))
         return cloud, None, None
     if len(script.edits) > 1:
         head = dataclasses.replace(script, edits=script.edits[:-1])
         cloud, _ = run_script(cloud, head, source=source, progress=args.progress,
-                              on_edit=lambda rep: _print_edit(args, rep))
+                              on_edit=lambda rep: print_edit(args, rep))
     resolved, basis, d_c = fit_edit(cloud, script.edits[-1], script.solver, source=source,
                                     progress=args.progress)
     args.progress.close()

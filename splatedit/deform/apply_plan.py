@@ -6,8 +6,8 @@ Per frame a support splat needs only linear combinations of ``dC``:
 ``Wu = u_x Bx + u_y By + u_z Bz`` (the tangent-axis basis) and likewise for
 ``v``.  :func:`build_hot_path` builds these three (N, K + 3) float64 arrays
 once per base cloud, stored in the order of a run plan of the support indices
-(:func:`_run_plan`: long runs of consecutive splat indices are written with a
-slice, the rest gathered into chunks and scattered; :func:`_fill_small_gaps`
+(:func:`run_plan`: long runs of consecutive splat indices are written with a
+slice, the rest gathered into chunks and scattered; :func:`fill_small_gaps`
 computes through short gaps of fixed splats so that many short runs become a
 few long GEMMs); :func:`apply_hot_path` then runs three chunked GEMMs per
 frame straight into the output arrays and copies the splats outside the
@@ -48,7 +48,7 @@ _GAP_FILL_REL = 0.25
 _RUN_MIN = 512
 
 
-def _fill_small_gaps(index: np.ndarray, rel: float = _GAP_FILL_REL, run_min: int | None = None):
+def fill_small_gaps(index: np.ndarray, rel: float = _GAP_FILL_REL, run_min: int | None = None):
     """Sorted splat indices plus the rows of the small gaps between their runs.
 
     Returns ``(span, member)``: ``span`` (M,) sorted indices (``index`` and
@@ -82,7 +82,7 @@ def _fill_small_gaps(index: np.ndarray, rel: float = _GAP_FILL_REL, run_min: int
     return span[order], member[order]
 
 
-def _run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
+def run_plan(index: np.ndarray, run_min: int = _RUN_MIN, chunk: int = _APPLY_CHUNK):
     """Split sorted splat indices into segments ``(order_lo, order_hi, dest)``.
 
     ``order`` (returned) permutes positions of ``index`` so that every segment
@@ -144,8 +144,8 @@ def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:
     """
     # computing through small gaps of fixed splats (restored afterwards) turns
     # many short runs into a few long GEMMs
-    span, member = _fill_small_gaps(indices)
-    order, segments = _run_plan(span)
+    span, member = fill_small_gaps(indices)
+    order, segments = run_plan(span)
     rank = np.cumsum(member) - 1                      # plan position -> row in pack
     k = pack.shape[2]
     srcs = (cloud.positions, cloud.u, cloud.v)
@@ -172,7 +172,7 @@ def build_hot_path(pack: np.ndarray, indices: np.ndarray, cloud) -> dict:
     if 2 * len(span) > n_all:
         comp = np.ones(n_all, dtype=bool)
         comp[span] = False
-        comp_segments = [d for _, _, d in _run_plan(np.flatnonzero(comp), chunk=1 << 30)[1]]
+        comp_segments = [d for _, _, d in run_plan(np.flatnonzero(comp), chunk=1 << 30)[1]]
     return dict(positions=cloud.positions, u=cloud.u, v=cloud.v, arrays=arrays,
                 segments=segments, comp_segments=comp_segments, filler=filler)
 

@@ -64,7 +64,7 @@ def _spatial_chunks(rows: np.ndarray, points: np.ndarray) -> np.ndarray:
     return rows[np.argsort((g[:, 0] * 16 + g[:, 1]) * 16 + g[:, 2], kind="stable")]
 
 
-def _wrap(cloud, arrays, validate: bool, progress=None):
+def deformed_copy(cloud, arrays, validate: bool, progress=None):
     """A copy of ``cloud`` with the deformed ``(positions, u, v)`` arrays
     (no ``__init__``: skips the O(n) validation on the hot path), checked
     when ``validate``."""
@@ -460,7 +460,7 @@ class DeformationBasis:
         name shared with ``cloud``).  ``validate=True`` re-checks the splat
         invariants (an extreme deformation can flatten splats).  ``progress``:
         see :meth:`apply_arrays` (then ``CHECK_STAGE`` before the check)."""
-        return _wrap(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
+        return deformed_copy(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
 
     def commit(self, cloud, dC, *, validate: bool = True, progress=None):
         """Apply ``dC`` and return the deformed cloud as the new base for the

@@ -394,8 +394,8 @@ class DetailBasis:
 
     def apply(self, cloud, dC, *, validate: bool = False, progress=None):
         """The deformed cloud (see :meth:`DeformationBasis.apply`)."""
-        from splatedit.deform.basis import _wrap
-        return _wrap(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
+        from splatedit.deform.basis import deformed_copy
+        return deformed_copy(cloud, self.apply_arrays(cloud, dC, progress=progress), validate, progress)
 
     def commit(self, cloud, dC, *, validate: bool = True, progress=None):
         """Apply ``dC`` and return the validated deformed cloud."""

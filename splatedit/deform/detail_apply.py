@@ -31,9 +31,9 @@ from __future__ import annotations
 
 import numpy as np
 
-from splatedit.deform.apply_plan import APPLY_STAGE, _fill_small_gaps, _run_plan
+from splatedit.deform.apply_plan import APPLY_STAGE, fill_small_gaps, run_plan
 from splatedit.deform.rotation import arc_coefficients, handle_blocks
-from splatedit.deform.rotation_apply import _skew
+from splatedit.deform.rotation_apply import skew
 from splatedit.progress import report
 from splatedit.tolerances import DETAIL_APPLY_CHUNK
 
@@ -50,8 +50,8 @@ class DetailHotPath:
     def __init__(self, basis, n_points: int):
         bb, lay = basis.base_basis, basis.layer
         idx = basis.indices
-        span, member = _fill_small_gaps(idx)
-        order, self.segments = _run_plan(span)
+        span, member = fill_small_gaps(idx)
+        order, self.segments = run_plan(span)
         sel = member[order]                               # plan columns that are support splats
         prow = (np.cumsum(member) - 1)[order][sel]        # their rows in the basis / layer
         m, k = len(order), bb.n_columns
@@ -88,7 +88,7 @@ class DetailHotPath:
         self.comp_segments = None
         if 2 * len(span) > n_points:      # the support is most of the cloud: copy only the rest
             comp = np.setdiff1d(np.arange(n_points), span, assume_unique=True)
-            self.comp_segments = [d for _, _, d in _run_plan(comp, chunk=1 << 30)[1]]
+            self.comp_segments = [d for _, _, d in run_plan(comp, chunk=1 << 30)[1]]
         self.n_columns = k
 
     # ------------------------------------------------------------ per frame
@@ -102,7 +102,7 @@ class DetailHotPath:
         x[k:, :3] = np.eye(3)
         for i, h in enumerate(turning):
             r = rot.rotations[h]
-            km = _skew(r.w / r.angle)
+            km = skew(r.w / r.angle)
             cols = self.blocks[h]
             x[cols, 3 + 6 * i:6 + 6 * i] = r.offsets @ km.T
             x[cols, 6 + 6 * i:9 + 6 * i] = r.offsets @ (km @ km).T

@@ -36,9 +36,9 @@ from splatedit.deform.rbf_fit import (
     METHODS,
     PROGRESS_STAGE,
     FitSolution,
-    _as_float_array,
-    _FitInfo,
-    _relative_residuals,
+    as_float_array,
+    FitInfo,
+    relative_residuals,
     solve_constraints,
 )
 from splatedit.blas import single_blas_thread
@@ -96,7 +96,7 @@ class TriharmonicRBF:
     """
 
     def __init__(self, *, centers_n, weights, poly_coeffs, shift, scale,
-                 center_indices, info: _FitInfo):
+                 center_indices, info: FitInfo):
         self._centers_n = np.ascontiguousarray(centers_n, dtype=np.float64)
         self.weights = np.ascontiguousarray(weights, dtype=np.float64)
         self.poly_coeffs = None if poly_coeffs is None else np.ascontiguousarray(poly_coeffs)
@@ -274,7 +274,7 @@ class TriharmonicRBF:
 
     # -- evaluation --------------------------------------------------------
     def _normalise_query(self, x) -> np.ndarray:
-        xa = _as_float_array("x", x)
+        xa = as_float_array("x", x)
         if xa.ndim != 2 or xa.shape[1] != 3:
             raise ParameterError("x", f"expected shape (N, 3), got {xa.shape}")
         return (xa - self.shift) / self.scale
@@ -383,7 +383,7 @@ def achieved_residuals(f: "TriharmonicRBF", points: np.ndarray, values: np.ndarr
     for s in range(0, len(points), step):
         d = f(points[s:s + step]) - values[s:s + step]
         res_sq += np.einsum("ij,ij->j", d, d)
-    return _relative_residuals(np.sqrt(res_sq), values)
+    return relative_residuals(np.sqrt(res_sq), values)
 
 
 def field_roughness(f: "TriharmonicRBF", points: np.ndarray) -> float:
@@ -405,7 +405,7 @@ def _checked_choice(f: "TriharmonicRBF", g: "TriharmonicRBF", points: np.ndarray
     ``g`` when ``f`` is POLY_CHECK_FACTOR times steeper (:func:`field_roughness`
     at the constraints and the ``probe`` points) and ``g`` meets its
     constraints as well (achieved residual within its note limit or ``f``'s)."""
-    pts = points if probe is None else np.vstack([points, _as_float_array("probe", probe).reshape(-1, 3)])
+    pts = points if probe is None else np.vstack([points, as_float_array("probe", probe).reshape(-1, 3)])
     rf, rg = field_roughness(f, pts), field_roughness(g, pts)
     ok = g.residual <= max(f.residual, g._residual_limit())
     weak = f.poly_rank - g.poly_rank

@@ -51,7 +51,9 @@ PROGRESS_STAGE = "fitting deformation"
 # input validation and preprocessing
 # ---------------------------------------------------------------------------
 
-def _as_float_array(name: str, value) -> np.ndarray:
+def as_float_array(name: str, value) -> np.ndarray:
+    """``value`` as a float64 array; not numeric: a
+    :class:`~splatedit.errors.ParameterError` naming the parameter ``name``."""
     try:
         arr = np.asarray(value, dtype=np.float64)
     except (TypeError, ValueError) as exc:
@@ -60,7 +62,7 @@ def _as_float_array(name: str, value) -> np.ndarray:
 
 
 def _validate(points, values, method, tol, max_centers, progress):
-    pts = _as_float_array("points", points)
+    pts = as_float_array("points", points)
     if pts.ndim != 2 or pts.shape[1] != 3:
         raise ParameterError("points", f"expected shape (m, 3), got {pts.shape}")
     m = pts.shape[0]
@@ -69,7 +71,7 @@ def _validate(points, values, method, tol, max_centers, progress):
     if not np.all(np.isfinite(pts)):
         bad = int(np.flatnonzero(~np.all(np.isfinite(pts), axis=1))[0])
         raise ParameterError("points", f"row {bad} is not finite")
-    vals = _as_float_array("values", values)
+    vals = as_float_array("values", values)
     if vals.ndim != 2:
         raise ParameterError(
             "values", f"expected shape (m, k), got {vals.shape} (use values[:, None] for one column)")
@@ -134,7 +136,10 @@ def _merge_duplicates(pts_n: np.ndarray, vals: np.ndarray, radius: float):
 
 
 @dataclass
-class _FitInfo:
+class FitInfo:
+    """How an RBF fit went: the solver ``method``, whether a ``polynomial``
+    part was fitted, the relative ``residuals`` per column, the iterative
+    solver's ``residual_history`` (None for direct solves) and ``notes``."""
     method: str
     polynomial: bool
     residuals: np.ndarray
@@ -164,7 +169,7 @@ class FitSolution:
         poly_coeffs: (10, k) float64 monomial coefficients, or None (dropped).
         shift: (3,) float64, scale: float (model units) the normalisation.
         center_indices: (n,) indices of the centres into ``points``.
-        info: the solver's :class:`_FitInfo`.
+        info: the solver's :class:`FitInfo`.
     """
 
     points: np.ndarray
@@ -175,7 +180,7 @@ class FitSolution:
     shift: np.ndarray
     scale: float
     center_indices: np.ndarray
-    info: _FitInfo
+    info: FitInfo
 
 
 def coordinate_precision(pts: np.ndarray) -> float:
@@ -436,7 +441,7 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
     notes = head + notes
     report(progress, PROGRESS_STAGE, 1.0)
 
-    info = _FitInfo(method=used, polynomial=use_poly, residuals=residuals,
+    info = FitInfo(method=used, polynomial=use_poly, residuals=residuals,
                     residual_history=history, notes=notes, n_constraints=m,
                     n_input_constraints=m_in, tol=tol, rcond=rcond,
                     poly_rank=poly.rank if use_poly else 0,
@@ -451,7 +456,7 @@ def solve_constraints(points, values, method: str = "auto", tol: float = IQR_DEF
 # the two solvers (normalised coordinates)
 # ---------------------------------------------------------------------------
 
-def _relative_residuals(res_norm: np.ndarray, b: np.ndarray) -> np.ndarray:
+def relative_residuals(res_norm: np.ndarray, b: np.ndarray) -> np.ndarray:
     """Scale-free ``res_norm / ||b||`` per column (both 2-norms over the m
     constraints, so a uniform error e on values of RMS size s gives e / s
     whatever m); the absolute ``res_norm`` where ``b`` is identically 0."""
@@ -486,7 +491,7 @@ def _fit_lu(pts_n, vals, poly):
                                   "use method='iqr' or remove near-duplicate constraints")
     x, info = lapack.dgetrs(lu, piv, rhs)
     res = np.linalg.norm(a @ x - rhs, axis=0)
-    residuals = _relative_residuals(res, vals)
+    residuals = relative_residuals(res, vals)
     w = x[:m]
     q = poly.coeffs @ x[m:] if use_poly else None
     return w, q, np.arange(m), residuals, float(rcond)

@@ -41,7 +41,7 @@ from splatedit.deform.rotation import series_fill
 from splatedit.tolerances import BLAS_SINGLE_THREAD_MNK, ROTATION_APPLY_CHUNK, ROTATION_APPLY_MIN_CHUNK
 
 
-def _skew(k: np.ndarray) -> np.ndarray:
+def skew(k: np.ndarray) -> np.ndarray:
     """(3, 3) matrix of ``k x``."""
     return np.array([[0.0, -k[2], k[1]], [k[2], 0.0, -k[0]], [-k[1], k[0], 0.0]])
 
@@ -67,7 +67,7 @@ def frame_matrix(d: np.ndarray, rot, blocks) -> tuple[np.ndarray, list[float]]:
     angles = []
     for i, h in enumerate(turning):
         r = rot.rotations[h]
-        km = _skew(r.w / r.angle)
+        km = skew(r.w / r.angle)
         cols, c0 = blocks[h], 3 + 7 * i
         x[cols, c0:c0 + 3] = r.offsets @ km.T
         x[cols, c0 + 3:c0 + 6] = r.offsets @ (km @ km).T

@@ -18,10 +18,13 @@ from splatedit.model.cloud import SplatCloud, column_bounds
 from splatedit.progress import report
 from splatedit.tolerances import MAX_COORDINATE_ABS, PLY_READ_CHUNK_BYTES
 
-_NORMALS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
-_COLORS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
+#: the property names of a normal, per naming convention (first match wins)
+NORMAL_FIELDS = (("nx", "ny", "nz"), ("normal_x", "normal_y", "normal_z"))
+#: the property names of a colour (RGB + alpha), per naming convention
+COLOR_FIELDS = (("red", "green", "blue", "alpha"), ("diffuse_red", "diffuse_green", "diffuse_blue",
                                                "diffuse_alpha"), ("r", "g", "b", "a"))
-_AXES = ("ux", "uy", "uz", "vx", "vy", "vz")
+#: the property names of a splat's two tangent axes (splatedit's splat PLY)
+AXIS_FIELDS = ("ux", "uy", "uz", "vx", "vy", "vz")
 
 # --------------------------------------------------- scan attributes
 
@@ -52,7 +55,7 @@ def _shift_row(exc: InputError, lo: int) -> InputError:
                       prop=exc.prop)
 
 
-def _columns_view(buf, dtype, names, rows: int):
+def columns_view(buf, dtype, names, rows: int):
     """(rows, k) view of ``k`` consecutive fields of one type in the record
     buffer (one strided copy instead of k), or None when they are not
     laid out that way."""
@@ -119,7 +122,7 @@ def in_range(arr) -> bool:
     return bool(arr.max() <= MAX_COORDINATE_ABS and arr.min() >= -MAX_COORDINATE_ABS)
 
 
-def _grow_bounds(blk, lo_b, hi_b) -> bool:
+def grow_bounds(blk, lo_b, hi_b) -> bool:
     """Widen the running bounds ``lo_b``/``hi_b`` (3,) by the (m, 3) block;
     True when the block is :func:`in_range`."""
     bmin, bmax = column_bounds(blk)
@@ -162,12 +165,12 @@ def vertex_columns(layout, src: str) -> VertexColumns:
                              element="vertex", prop=p)
     if n == 0:
         raise InputError("zero vertices: the file holds no points", path=src, element="vertex")
-    nn = next((t for t in _NORMALS if set(t) <= names), None)
-    have_axes = set(_AXES) <= names
-    cn = next((t for t in _COLORS if set(t[:3]) <= names), None)
+    nn = next((t for t in NORMAL_FIELDS if set(t) <= names), None)
+    have_axes = set(AXIS_FIELDS) <= names
+    cn = next((t for t in COLOR_FIELDS if set(t[:3]) <= names), None)
     use_c = [p for p in cn if p in names] if cn else []
     checked = ["x", "y", "z"] + list(nn or ()) + (["radius"] if "radius" in names else []) \
-        + (list(_AXES) if have_axes else [])
+        + (list(AXIS_FIELDS) if have_axes else [])
     return VertexColumns(names, nn, have_axes, use_c, all(dtype[p].kind in "iu" for p in use_c),
                          checked)
 
@@ -186,8 +189,8 @@ def read_binary_chunked(path, layout, progress, stored_origin=None) -> SplatClou
     names, nn, have_axes, use_c = spec.names, spec.normals, spec.axes, spec.colors
     out = {"positions": (np.empty((n, 3)), ("x", "y", "z"))}
     if have_axes:
-        out["u"] = (np.empty((n, 3)), _AXES[:3])
-        out["v"] = (np.empty((n, 3)), _AXES[3:])
+        out["u"] = (np.empty((n, 3)), AXIS_FIELDS[:3])
+        out["v"] = (np.empty((n, 3)), AXIS_FIELDS[3:])
     elif nn:
         out["normals"] = (np.empty((n, 3)), nn)
     if "radius" in names and not have_axes:
@@ -204,7 +207,7 @@ def read_binary_chunked(path, layout, progress, stored_origin=None) -> SplatClou
         rec = np.frombuffer(buf, dtype=dtype, count=hi - lo)
         ok = True
         for key, (arr, cols) in out.items():
-            view = _columns_view(buf, dtype, cols, hi - lo)
+            view = columns_view(buf, dtype, cols, hi - lo)
             blk = arr[lo:hi]
             if view is not None:
                 blk[...] = view
@@ -212,7 +215,7 @@ def read_binary_chunked(path, layout, progress, stored_origin=None) -> SplatClou
                 for j, p in enumerate(cols):
                     blk[:, j] = rec[p]
             if key == "positions":        # per column: the bounds come with the test
-                ok = _grow_bounds(blk, lo_b, hi_b) and ok
+                ok = grow_bounds(blk, lo_b, hi_b) and ok
             else:
                 ok = ok and in_range(blk)
         if have_axes and nn:        # normals not kept, still checked

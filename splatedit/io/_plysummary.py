@@ -10,7 +10,7 @@ import numpy as np
 
 from splatedit.errors import InputError
 from splatedit.io._build import check_extent, colors_from_columns, local_origin, rebase
-from splatedit.io._plybinary import (_AXES, _columns_view, _grow_bounds, body_chunks, in_range,
+from splatedit.io._plybinary import (AXIS_FIELDS, columns_view, grow_bounds, body_chunks, in_range,
                                      vertex_columns)
 from splatedit.model.summary import CloudSummary
 from splatedit.progress import report
@@ -20,7 +20,7 @@ from splatedit.tolerances import MAX_COORDINATE_ABS, MIN_AXIS_LENGTH_REL, MIN_AX
 def _triple(buf, rec, dtype, names, m) -> np.ndarray:
     """(m, k) float64 of k properties of the chunk (a strided view where
     the file lays them out consecutively as doubles, else a copy)."""
-    view = _columns_view(buf, dtype, names, m)
+    view = columns_view(buf, dtype, names, m)
     if view is not None and view.dtype == np.float64:
         return view
     return np.column_stack([rec[p] for p in names]).astype(np.float64, copy=False)
@@ -48,7 +48,7 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
     # x y z, the axes and the normals are checked through their bounds and
     # squared lengths (a NaN or a value beyond MAX_COORDINATE_ABS makes a
     # squared length NaN or above MAX_COORDINATE_ABS^2); the rest column by column
-    vectors = ("x", "y", "z") + _AXES + (spec.normals or ())
+    vectors = ("x", "y", "z") + AXIS_FIELDS + (spec.normals or ())
     others = [p for p in spec.checked if p not in vectors]
     others += [p for p in ("intensity", "classification") if p in spec.names and dtype[p].kind == "f"]
     limit2 = MAX_COORDINATE_ABS ** 2
@@ -67,13 +67,13 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
         # one aligned copy of the axes (the file's 84-byte records leave
         # doubles unaligned: numpy's reductions on them ran 1.7x slower)
         axes = axes_buf[:m]
-        axes[...] = _triple(buf, rec, dtype, _AXES, m)
+        axes[...] = _triple(buf, rec, dtype, AXIS_FIELDS, m)
         u, v = axes[:, :3], axes[:, 3:]
         uu = np.einsum("ij,ij->i", u, u)
         vv = np.einsum("ij,ij->i", v, v)
-        ok = _grow_bounds(blk, lo_b, hi_b) and uu.max() <= limit2 and vv.max() <= limit2
+        ok = grow_bounds(blk, lo_b, hi_b) and uu.max() <= limit2 and vv.max() <= limit2
         if ok and spec.normals:
-            nrm = _columns_view(buf, dtype, spec.normals, m)
+            nrm = columns_view(buf, dtype, spec.normals, m)
             nrm = np.column_stack([rec[p] for p in spec.normals]) if nrm is None else nrm
             ok = bool(np.einsum("ij,ij->i", nrm, nrm).max() <= limit2)
         if not (ok and all(in_range(rec[p]) for p in others)):
@@ -97,8 +97,8 @@ def read_ply_summary(path, layout, progress=None, stored_origin=None) -> CloudSu
         del rec
         report(progress, "reading", hi / n)
     def normals_of(rec) -> np.ndarray:
-        u = np.column_stack([rec[p] for p in _AXES[:3]]).astype(np.float64)
-        v = np.column_stack([rec[p] for p in _AXES[3:]]).astype(np.float64)
+        u = np.column_stack([rec[p] for p in AXIS_FIELDS[:3]]).astype(np.float64)
+        v = np.column_stack([rec[p] for p in AXIS_FIELDS[3:]]).astype(np.float64)
         return np.cross(u, v)
 
     return _summary(path, layout, spec, positions, radii, (lo_b, hi_b), float(np.sqrt(shortest)),
@@ -159,7 +159,7 @@ def _normals_radius_summary(path, layout, spec, progress, stored_origin) -> Clou
         nrm = _triple(buf, rec, dtype, spec.normals, m)
         nn = np.einsum("ij,ij->i", nrm, nrm)
         # NaN fails every comparison below, so a NaN anywhere returns None
-        ok = (_grow_bounds(blk, lo_b, hi_b) and (nn > 0).all() and (nn <= limit2).all()
+        ok = (grow_bounds(blk, lo_b, hi_b) and (nn > 0).all() and (nn <= limit2).all()
               and (r > 0).all() and (r <= MAX_COORDINATE_ABS).all())
         if not (ok and all(in_range(rec[p]) for p in others)):
             return None

@@ -100,11 +100,11 @@ def read_gaussian_ply(path, *, progress=None) -> GaussianCloud:
     Raises:
         InputError: naming the file and the property (and row) at fault.
     """
-    from splatedit.io.ply import _load
+    from splatedit.io.ply import read_ply_data
     from splatedit.progress import report
     report(progress, "reading", 0.0)
     check_declared_sizes(path)
-    ply = _load(path)
+    ply = read_ply_data(path)
     if "vertex" not in ply:
         raise InputError("no 'vertex' element", path=str(path))
     el = ply["vertex"]

@@ -34,7 +34,7 @@ import plyfile
 
 from splatedit.errors import InputError
 from splatedit.io._build import build_cloud, check_finite, colors_from_columns, triangulate
-from splatedit.io._plybinary import _AXES, _COLORS, _NORMALS, read_binary_chunked, scan_columns
+from splatedit.io._plybinary import AXIS_FIELDS, COLOR_FIELDS, NORMAL_FIELDS, read_binary_chunked, scan_columns
 from splatedit.io._plycheck import TYPES as _TYPES
 from splatedit.io._plycheck import (binary_layout, check_declared_sizes, check_trailing, origin_comment,
                                    stored_origin, warn_trailing)
@@ -65,7 +65,10 @@ def _wrap(exc: Exception, path) -> InputError:
     return InputError(f"malformed PLY file: {exc}", path=str(path))
 
 
-def _load(path) -> plyfile.PlyData:
+def read_ply_data(path) -> plyfile.PlyData:
+    """The whole PLY file at ``path`` as :class:`plyfile.PlyData` (face lists
+    read as triangles); a malformed or unreadable file is an
+    :class:`~splatedit.errors.InputError` naming it."""
     known = {"face": {name: 3 for name in _FACE_LISTS}}
     errors = (plyfile.PlyParseError, ValueError, TypeError, UnicodeDecodeError, IndexError,
               EOFError, OSError, MemoryError, OverflowError)
@@ -261,7 +264,7 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     if fast is not None:
         data, face_lists = fast
     else:
-        ply = _load(path)
+        ply = read_ply_data(path)
         if "vertex" not in ply:
             raise InputError("no 'vertex' element", path=str(path))
         check_trailing(path, ply)
@@ -278,14 +281,14 @@ def read_ply(path, *, progress=None) -> SplatCloud:
                          element="vertex")
     cols = {p: _column(data, p, path) for p in ("x", "y", "z")}
     normals = radius = u = v = colors = None
-    nn = next((t for t in _NORMALS if set(t) <= names), None)
+    nn = next((t for t in NORMAL_FIELDS if set(t) <= names), None)
     if nn:
         cols.update({p: _column(data, p, path) for p in nn})
     if "radius" in names:
         cols["radius"] = _column(data, "radius", path)
-    have_axes = set(_AXES) <= names
+    have_axes = set(AXIS_FIELDS) <= names
     if have_axes:
-        cols.update({p: _column(data, p, path) for p in _AXES})
+        cols.update({p: _column(data, p, path) for p in AXIS_FIELDS})
     check_finite(cols, str(path))
     f64 = {k: np.asarray(c, dtype=np.float64) for k, c in cols.items()}
     positions = np.column_stack([f64["x"], f64["y"], f64["z"]])
@@ -294,9 +297,9 @@ def read_ply(path, *, progress=None) -> SplatCloud:
     if "radius" in f64:
         radius = f64["radius"]
     if have_axes:
-        u = np.column_stack([f64[p] for p in _AXES[:3]])
-        v = np.column_stack([f64[p] for p in _AXES[3:]])
-    cn = next((t for t in _COLORS if set(t[:3]) <= names), None)
+        u = np.column_stack([f64[p] for p in AXIS_FIELDS[:3]])
+        v = np.column_stack([f64[p] for p in AXIS_FIELDS[3:]])
+    cn = next((t for t in COLOR_FIELDS if set(t[:3]) <= names), None)
     if cn:
         use = [p for p in cn if p in names]
         colors = colors_from_columns([_column(data, p, path) for p in use], use, str(path))
@@ -314,7 +317,7 @@ def _vertex_dtype(cloud: SplatCloud, axes: bool, byte_order: str) -> np.dtype:
     fields = [(p, e + "f8") for p in ("x", "y", "z")]
     if axes:
         fields += [(p, e + "f4") for p in ("nx", "ny", "nz")]
-        fields += [(p, e + "f8") for p in _AXES]
+        fields += [(p, e + "f8") for p in AXIS_FIELDS]
     if cloud.colors is not None:
         fields += [(p, "u1") for p in ("red", "green", "blue", "alpha")]
     if cloud.intensity is not None:
@@ -341,9 +344,9 @@ def _vertex_array(cloud: SplatCloud, dtype: np.dtype, rows: slice = slice(None))
         nrm /= np.linalg.norm(nrm, axis=1, keepdims=True)
         for j, p in enumerate(("nx", "ny", "nz")):
             arr[p] = nrm[:, j]
-        for j, p in enumerate(_AXES[:3]):
+        for j, p in enumerate(AXIS_FIELDS[:3]):
             arr[p] = u[:, j]
-        for j, p in enumerate(_AXES[3:]):
+        for j, p in enumerate(AXIS_FIELDS[3:]):
             arr[p] = v[:, j]
     if cloud.colors is not None:
         for j, p in enumerate(("red", "green", "blue", "alpha")):

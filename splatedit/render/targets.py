@@ -80,19 +80,19 @@ class SizedTargets:
     def _create(self, r) -> None:
         raise NotImplementedError
 
-    def _add(self, obj):
+    def add(self, obj):
         self.objects.append(obj)
         return obj
 
-    def _fb(self, rp, atts):
+    def framebuffer(self, rp, atts):
         """A framebuffer of this size on render pass ``rp`` with attachments ``atts``."""
-        return self._add(V.Framebuffer(self._r.dev, rp, atts, self.width, self.height))
+        return self.add(V.Framebuffer(self._r.dev, rp, atts, self.width, self.height))
 
     def target_fb(self, target: RenderTarget):
         """The (cached) framebuffer of :func:`rp_resolve` writing ``target``."""
         hit = self.target_fbs.get(target.serial)
         if hit is None:
-            fb = self._fb(self._r.cache.render_pass(rp_resolve(target)), [target.attachment])
+            fb = self.framebuffer(self._r.cache.render_pass(rp_resolve(target)), [target.attachment])
             hit = self.target_fbs[target.serial] = (target, fb)
         return hit[1]
 
@@ -113,11 +113,11 @@ class SizedTargets:
             dev = self._r.dev
             first = len(self.objects)
             try:
-                self.pick_index = self._add(V.Image(dev, self.width, self.height, "r32ui",
+                self.pick_index = self.add(V.Image(dev, self.width, self.height, "r32ui",
                                                     ("color", "transfer_src")))
-                self.pick_depth = self._add(V.Image(dev, self.width, self.height, "d32f",
+                self.pick_depth = self.add(V.Image(dev, self.width, self.height, "d32f",
                                                     ("depth", "transfer_src")))
-                self.fb_pick = self._fb(self._r.cache.render_pass(RP_PICK), [self.pick_index, self.pick_depth])
+                self.fb_pick = self.framebuffer(self._r.cache.render_pass(RP_PICK), [self.pick_index, self.pick_depth])
             except BaseException:
                 for o in reversed(self.objects[first:]):
                     o.destroy()
@@ -179,7 +179,7 @@ class SplatTargets(SizedTargets):
         width, height = self.width, self.height
 
         def img(fmt, usage):
-            return self._add(V.Image(dev, width, height, fmt, usage))
+            return self.add(V.Image(dev, width, height, fmt, usage))
 
         self.depth = img("d32f", ("depth", "transfer_src"))
         # storage: the compute rasterizer's copy pass writes them (splatedit.render.splat.compute_raster)
@@ -190,9 +190,9 @@ class SplatTargets(SizedTargets):
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
         rp_depth = r.cache.render_pass(RP_DEPTH)
         rp_attr_pass = r.cache.render_pass(rp_attr(r.accum_format, "shader_read"))
-        self.fb_depth = self._fb(rp_depth, [self.depth])
-        self.fb_attr = self._fb(rp_attr_pass, [self.accum_color, self.accum_normal, self.depth])
-        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(RESOLVE_SET)))
+        self.fb_depth = self.framebuffer(rp_depth, [self.depth])
+        self.fb_attr = self.framebuffer(rp_attr_pass, [self.accum_color, self.accum_normal, self.depth])
+        self.resolve_set = self.add(V.DescriptorSet(dev, r.cache.set_layout(RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 1: (self.accum_color, r.sampler), 2: (self.accum_normal, r.sampler)})
 
 
@@ -209,21 +209,20 @@ def create_frame_objects(r, ubo_bytes: int) -> None:
     r.dC_ubo.view(np.float32)[:] = 0.0
 
 
-def targets_for(r, width: int, height: int, make):
-    """``r._targets`` for this image size, replaced by ``make(r, width, height)``
-    (after the device is idle) when the size changed.  Raises ParameterError
-    for a size outside 1..MAX_SIZE."""
+def reusable_targets(r, current, width: int, height: int):
+    """``current`` (renderer ``r``'s per-size targets, or None) when it has
+    this image size; else None, after destroying ``current`` (once the device
+    is idle): the caller makes new ones.  Raises ParameterError for a size
+    outside 1..MAX_SIZE (``current`` is then kept)."""
     for name, v in (("width", width), ("height", height)):
         if not isinstance(v, (int, np.integer)) or not 1 <= v <= MAX_SIZE:
             raise ParameterError(name, f"must be an integer in 1..{MAX_SIZE}, got {v!r}")
-    t = r._targets
-    if t is None or (t.width, t.height) != (width, height):
-        if t is not None:
-            r.dev.wait_idle()
-            t.destroy()
-            r._targets = None
-        r._targets = make(r, int(width), int(height))
-    return r._targets
+    if current is not None and (current.width, current.height) == (width, height):
+        return current
+    if current is not None:
+        r.dev.wait_idle()
+        current.destroy()
+    return None
 
 
 def clip_rect(rect, width: int, height: int) -> tuple[int, int, int, int]:

@@ -20,7 +20,10 @@ from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import AFFINE_MIN_SINGULAR_REL, IQR_DEFAULT_TOL, MAX_COORDINATE_ABS, MAX_SCRIPT_BYTES
 
 
-class _Ctx:
+class ParseContext:
+    """Where an edit script being parsed came from (``source``: its path, or
+    None): :meth:`fail` makes the error for a bad value at a JSON path."""
+
     def __init__(self, source: str | None):
         self.source = source
 
@@ -84,7 +87,7 @@ def _kind(value) -> str:
     return "an object"
 
 
-def _region(ctx: _Ctx, value, jp: str, flags: tuple[str, ...] = ()) -> Region:
+def _region(ctx: ParseContext, value, jp: str, flags: tuple[str, ...] = ()) -> Region:
     """One region of ``value``: a sphere, box or index list; ``flags`` are
     further keys the caller reads itself (an edit's support: ``fill_holes``),
     accepted and dropped here so that an unknown key's message lists them."""
@@ -116,7 +119,7 @@ def _region(ctx: _Ctx, value, jp: str, flags: tuple[str, ...] = ()) -> Region:
     return Indices(tuple(out))
 
 
-def _transform(ctx: _Ctx, value, jp: str) -> Transform:
+def _transform(ctx: ParseContext, value, jp: str) -> Transform:
     obj = ctx.obj(value, jp, allowed=("matrix", "translate", "rotate", "scale"))
     if not obj:
         raise ctx.fail(jp, "is empty: give 'matrix' or any of 'translate', 'rotate', 'scale'")
@@ -162,7 +165,7 @@ def _transform(ctx: _Ctx, value, jp: str) -> Transform:
     return TRS(translate, axis, degrees, rcenter, scale, scenter)
 
 
-def _curves(ctx: _Ctx, value, jp: str) -> tuple[Curve, ...]:
+def _curves(ctx: ParseContext, value, jp: str) -> tuple[Curve, ...]:
     from splatedit.deform.curves import first_coincident_point
     if not isinstance(value, list) or not value:
         raise ctx.fail(jp, f"must be a non-empty list of curves, got {_kind(value)}")
@@ -200,7 +203,7 @@ def parse_script(data: Any, source: str | None = None) -> EditScript:
     Raises:
         EditScriptError: naming the JSON path of the first bad value.
     """
-    ctx = _Ctx(source)
+    ctx = ParseContext(source)
     top = ctx.obj(data, "$", required=("version", "edits"), allowed=("version", "solver", "edits"))
     if top["version"] != SCRIPT_VERSION:
         raise ctx.fail("$.version", f"unsupported version {top['version']!r} (this splatedit reads {SCRIPT_VERSION})")

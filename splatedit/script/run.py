@@ -15,7 +15,7 @@ from splatedit.deform.modes import DeformationMode
 from splatedit.deform.refine import refine_committed
 from splatedit.errors import EditScriptError, InputError, SplatEditError
 from splatedit.script.model import Edit, EditScript, Removal, SolverSettings
-from splatedit.script.parse import _Ctx
+from splatedit.script.parse import ParseContext
 from splatedit.select.regions import Box, Indices, Region, Sphere
 from splatedit.tolerances import CLOSURE_ONE_SIDED_SHARE
 
@@ -103,7 +103,7 @@ def removal_mask(positions: np.ndarray, item: Removal, source: str | None = None
         EditScriptError: an index past the model, a region that selects no
             splat, or an item that would leave none (the item's JSON path).
     """
-    ctx = _Ctx(source)
+    ctx = ParseContext(source)
     n = len(positions)
     jp = f"{item.json_path}.{item.key}"
     r = item.region
@@ -133,7 +133,7 @@ def resolve_edit(cloud, edit: Edit, source: str | None = None):
     Raises:
         EditScriptError: a region selects nothing or indexes past the cloud.
     """
-    ctx = _Ctx(source)
+    ctx = ParseContext(source)
     n = cloud.n
 
     def mask(region: Region, jp: str) -> np.ndarray:

@@ -162,7 +162,7 @@ def test_an_exception_in_an_event_handler_outside_the_actions_is_caught(ed):
 
     def broken(e):
         raise ValueError("bad scroll")
-    ed.on_scroll = broken
+    ed.routing.on_scroll = broken
     ed.window.events = [types.SimpleNamespace(kind="scroll", dx=0.0, dy=1.0, mods=0, x=1.0, y=1.0),
                         key_event(glfw.KEY_2)]
     ed.loop_once()
@@ -231,7 +231,7 @@ def test_sigterm_or_ctrl_c_with_unsaved_edits_writes_a_recovery_copy(ed):
     def interrupted(timeout):
         raise KeyboardInterrupt
     ed.window.poll = interrupted
-    ed.start_load = lambda: None
+    ed.file_actions.start_load = lambda: None
     with pytest.raises(KeyboardInterrupt):
         ed.run()
     (e,) = recovery.entries()
@@ -253,13 +253,13 @@ def test_the_next_start_offers_the_copy_restore_adopts_its_edits_discard_removes
     try:
         assert other.crash_guard.offer_recovery() and other.crash_guard.confirm_restore == e and other.modal()
         # Esc: asked again next time (kept)
-        other.on_key(key_event(glfw.KEY_ESCAPE))
+        other.routing.on_key(key_event(glfw.KEY_ESCAPE))
         assert other.crash_guard.confirm_restore is None and recovery.entries() == [e]
         # Y: restore -- the recovered model opens (a load job), its edits become the document's
         opened = []
-        other.open_path = lambda p, confirmed=False: opened.append(p) or True
+        other.file_actions.open_path = lambda p, confirmed=False: opened.append(p) or True
         assert other.crash_guard.offer_recovery()
-        other.on_key(key_event(glfw.KEY_Y))
+        other.routing.on_key(key_event(glfw.KEY_Y))
         assert opened == [e.model] and other.crash_guard.restoring == e
         other.session = Session(read(str(e.model)), fit_sync=True)       # what the load job lands
         other.crash_guard.on_restored()
@@ -271,7 +271,7 @@ def test_the_next_start_offers_the_copy_restore_adopts_its_edits_discard_removes
         # N: discard
         e2 = ed.crash_guard.write_recovery("again") or recovery.write_recovery(s, ed.path)
         assert other.crash_guard.offer_recovery()
-        other.on_key(key_event(glfw.KEY_N))
+        other.routing.on_key(key_event(glfw.KEY_N))
         assert recovery.entries() == [] and not e2.model.exists()
     finally:
         other.session.close()

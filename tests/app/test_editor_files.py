@@ -56,11 +56,11 @@ class StubEditor(Editor):
         """Wait for the jobs (load, graph) and collect them."""
         for j in list(self.jobs.values()):
             assert j.wait(30)
-        self.poll_jobs()
+        self.file_actions.poll_jobs()
 
 
 def key(ed, k, mods=0):
-    ed.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
+    ed.routing.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
 
 
 @pytest.fixture
@@ -102,15 +102,15 @@ def test_ctrl_o_lists_only_models_and_folders_and_enter_opens_one(ed, models):
     assert ed.session is not old and ed.session.cloud.n == 12 * 12
     assert ed.path == models / "b_plane.ply" and ed.cloud_name == "b_plane.ply"
     assert ed.viewport.cloud is ed.session.cloud and ed.viewport.pyramid is None
-    assert ed.recent_files() == [models / "b_plane.ply"]
+    assert ed.file_actions.recent_files() == [models / "b_plane.ply"]
     assert ed.title.endswith("b_plane.ply")
 
 
 def test_typing_jumps_backspace_goes_up_and_enter_enters_folders(ed, models):
-    ed.open_dialog()
+    ed.file_actions.open_dialog()
     b = ed.browser
     for ch in "B_":
-        ed.on_char(types.SimpleNamespace(char=ch))
+        ed.routing.on_char(types.SimpleNamespace(char=ch))
     assert b.selected.name == "b_plane.ply" and b.typed == "B_"
     key(ed, glfw.KEY_BACKSPACE)
     key(ed, glfw.KEY_BACKSPACE)          # deletes the typed text first ...
@@ -120,7 +120,7 @@ def test_typing_jumps_backspace_goes_up_and_enter_enters_folders(ed, models):
     key(ed, glfw.KEY_ENTER)
     assert b.folder == models
     for ch in "sub":
-        ed.on_char(types.SimpleNamespace(char=ch))
+        ed.routing.on_char(types.SimpleNamespace(char=ch))
     key(ed, glfw.KEY_ENTER)
     assert b.folder == models / "sub" and [e.name for e in b.entries] == [".."]
     key(ed, glfw.KEY_ESCAPE)
@@ -128,14 +128,14 @@ def test_typing_jumps_backspace_goes_up_and_enter_enters_folders(ed, models):
 
 
 def test_a_click_on_a_row_picks_it(ed, models):
-    ed.open_dialog()
+    ed.file_actions.open_dialog()
     b = ed.browser
     b.overlay(W, H)                      # the layout of the drawn list
     i = [e.name for e in b.entries].index("b_plane.ply")
     x = b.box[0] + 20
     y = b.row0 + (i - b.top) * b.line_h + b.line_h / 2
     assert b.row_at(x, y) == i and b.row_at(b.box[0] - 5, y) is None
-    ed.on_button(types.SimpleNamespace(x=x, y=y, button=glfw.MOUSE_BUTTON_LEFT, mods=0, action=glfw.PRESS))
+    ed.routing.on_button(types.SimpleNamespace(x=x, y=y, button=glfw.MOUSE_BUTTON_LEFT, mods=0, action=glfw.PRESS))
     assert not b.shown and ed.jobs["load"].key == models / "b_plane.ply"
     ed.settle()
 
@@ -149,11 +149,11 @@ def test_unsaved_changes_ask_first(ed, models):
         s.manip.type_char(ch)
     assert s.commit() and s.dirty
     target = models / "b_plane.ply"
-    assert not ed.open_path(target)
+    assert not ed.file_actions.open_path(target)
     assert ed.confirm_open == target and "load" not in ed.jobs and ed.modal()
     key(ed, glfw.KEY_N)
     assert ed.confirm_open is None and ed.session is s and "load" not in ed.jobs
-    ed.open_path(target)
+    ed.file_actions.open_path(target)
     key(ed, glfw.KEY_Y)
     ed.settle()
     assert ed.session is not s and ed.session.cloud.n == 144
@@ -163,29 +163,29 @@ def test_unsaved_changes_ask_first(ed, models):
                                          ("notes.md", "unsupported file extension")])
 def test_an_unreadable_file_shows_an_error_box_and_keeps_the_model(ed, models, name, needle, capsys):
     s = ed.session
-    ed.open_path(models / name)
+    ed.file_actions.open_path(models / name)
     ed.settle()
     assert ed.session is s and ed.path == models / "a_plane.ply"
     assert ed.error_box is not None and needle in ed.error_box
     assert f"splatedit: error: " in capsys.readouterr().err
-    assert ed.recent_files() == []
+    assert ed.file_actions.recent_files() == []
     key(ed, glfw.KEY_ESCAPE)               # Esc closes the box first
     assert ed.error_box is None
 
 
 def test_a_dropped_file_opens_and_a_dropped_folder_is_browsed(ed, models):
-    ed.on_drop(types.SimpleNamespace(paths=(str(models / "sub"),)))
+    ed.routing.on_drop(types.SimpleNamespace(paths=(str(models / "sub"),)))
     assert ed.browser.shown and ed.browser.folder == models / "sub"
-    ed.on_drop(types.SimpleNamespace(paths=(str(models / "b_plane.ply"), str(models / "a_plane.ply"))))
+    ed.routing.on_drop(types.SimpleNamespace(paths=(str(models / "b_plane.ply"), str(models / "a_plane.ply"))))
     assert not ed.browser.shown
     ed.settle()
     assert ed.session.cloud.n == 144 and any("only b_plane.ply" in m for m in ed.messages)
 
 
 def test_recent_files_come_first_in_the_browser(ed, models):
-    ed.open_path(models / "b_plane.ply")
+    ed.file_actions.open_path(models / "b_plane.ply")
     ed.settle()
-    ed.open_dialog(models / "sub")
+    ed.file_actions.open_dialog(models / "sub")
     b = ed.browser
     assert [(e.kind.value, e.name) for e in b.entries[:2]] == [("recent", "b_plane.ply"), ("parent", "..")]
     key(ed, glfw.KEY_ENTER)              # the recent file is selected first
@@ -194,7 +194,7 @@ def test_recent_files_come_first_in_the_browser(ed, models):
 
 
 def test_a_failed_save_shows_an_error_box(ed, tmp_path, capsys):
-    ed.save(tmp_path / "no-such-folder" / "out.ply")
+    ed.file_actions.save(tmp_path / "no-such-folder" / "out.ply")
     ed.settle()
     assert ed.error_box is not None and "saving failed" in ed.error_box and "no-such-folder" in ed.error_box
     assert "splatedit: error: saving failed" in capsys.readouterr().err
@@ -203,7 +203,7 @@ def test_a_failed_save_shows_an_error_box(ed, tmp_path, capsys):
     (patch,) = error_box(ed, W, H, 8)          # drawn: a click inside it closes it
     assert ed.error_rect == patch.box
     x, y, bw, bh = ed.error_rect
-    ed.on_button(types.SimpleNamespace(x=x + bw / 2, y=y + bh / 2, button=glfw.MOUSE_BUTTON_LEFT, mods=0,
+    ed.routing.on_button(types.SimpleNamespace(x=x + bw / 2, y=y + bh / 2, button=glfw.MOUSE_BUTTON_LEFT, mods=0,
                                        action=glfw.PRESS))
     assert ed.error_box is None
 
@@ -217,16 +217,16 @@ def test_ctrl_o_during_a_move_cancels_the_move(ed):
 
 
 def test_a_typed_path_that_matches_no_entry_is_opened_as_typed(ed, models):
-    ed.open_dialog(models / "sub")
+    ed.file_actions.open_dialog(models / "sub")
     for ch in "../b_plane.ply":
-        ed.on_char(types.SimpleNamespace(char=ch))
+        ed.routing.on_char(types.SimpleNamespace(char=ch))
     key(ed, glfw.KEY_ENTER)
     assert not ed.browser.shown and ed.jobs["load"].key == models / "b_plane.ply"
     ed.settle()
     assert ed.session.cloud.n == 144
-    ed.open_dialog(models / "sub")
+    ed.file_actions.open_dialog(models / "sub")
     for ch in "../nothing.ply":
-        ed.on_char(types.SimpleNamespace(char=ch))
+        ed.routing.on_char(types.SimpleNamespace(char=ch))
     key(ed, glfw.KEY_KP_ENTER)
     assert "load" not in ed.jobs and "no such file" in ed.error_box
 
@@ -240,7 +240,7 @@ def test_a_newly_opened_model_gets_a_fresh_default_view_for_its_own_up_axis(ed, 
     # the plane is z = const: as a LAS (Z-up by format) it is a ground plane
     write(str(las), cloud)
     ed.cam.screen_offset = (0.3, -0.2)
-    ed.open_path(las)
+    ed.file_actions.open_path(las)
     ed.settle()
     assert ed.path == las and ed.camera.up.label.endswith("Z")
     cam = ed.cam
@@ -259,7 +259,7 @@ def _chars(ed, text):
     for ch in text:
         code = getattr(glfw, f"KEY_{ch.upper()}", glfw.KEY_SLASH if ch == "/" else glfw.KEY_PERIOD)
         key(ed, code)
-        ed.on_char(types.SimpleNamespace(char=ch))
+        ed.routing.on_char(types.SimpleNamespace(char=ch))
 
 
 def test_save_as_prompt_backspace_deletes_one_character_and_typing_appends(ed, models, tmp_path):

@@ -22,7 +22,7 @@ def test_opening_a_scan_with_far_clumps_frames_its_body_and_says_so(shared_data,
     ed = StubEditor(s, tmp_path / "plane.ply")
     try:
         ed.panel_visible = False
-        ed.open_path(shared_data / "poste_france.xyz")
+        ed.file_actions.open_path(shared_data / "poste_france.xyz")
         ed.settle()
         cloud = ed.session.cloud
         assert cloud.n == 9031

@@ -14,6 +14,7 @@ import pytest
 from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.editor import Editor, check_model_file, save_refusal
+from splatedit.app.file_actions import FileActions
 from splatedit.app.document.jobs import Cancelled, Job
 from splatedit.app.document.session import GRAB, SCALE, Manipulation, Session, ViewInfo
 from splatedit.errors import InputError, SplatEditError
@@ -56,7 +57,7 @@ def test_editor_save_refuses_the_input_and_writes_nothing(tmp_path):
     model.write_bytes(b"original")
     said = []
     stub = types.SimpleNamespace(session=object(), jobs={}, path=model, say=said.append)
-    Editor.save(stub, tmp_path / "." / "scan.ply")
+    FileActions(stub).save(tmp_path / "." / "scan.ply")
     assert stub.jobs == {} and len(said) == 1 and "not saved" in said[0]
     assert model.read_bytes() == b"original"
 

@@ -44,11 +44,11 @@ def ed():
 
 
 def key(ed, k, mods=0):
-    ed.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
+    ed.routing.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
 
 
 def press(ed, button, mods=0, x=100.0, y=100.0, action=None):
-    ed.on_button(types.SimpleNamespace(x=x, y=y, button=button, mods=mods,
+    ed.routing.on_button(types.SimpleNamespace(x=x, y=y, button=button, mods=mods,
                                        action=glfw.PRESS if action is None else action))
 
 
@@ -63,7 +63,7 @@ def test_camera_tool_takes_middle_and_alt_drags(ed, button, mods, mode):
     yaw, target = ed.cam.yaw, np.array(ed.cam.target, float)
     press(ed, button, mods)
     assert ed.drag is mode and ed.drag_tool is ed.camera
-    ed.on_move(types.SimpleNamespace(x=140.0, y=120.0))
+    ed.routing.on_move(types.SimpleNamespace(x=140.0, y=120.0))
     moved = ed.cam.yaw != yaw or not np.allclose(ed.cam.target, target) or ed.cam.distance != 4.0
     assert moved
     press(ed, button, mods, action=glfw.RELEASE)

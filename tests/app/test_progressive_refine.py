@@ -42,8 +42,8 @@ def _editor(n=60000, cloud=None, budgets=(8000, 2000), **session):
         presenter=_Presenter(), said=[], overlay_patches=lambda w, h: [], wake=lambda: None,
         window=types.SimpleNamespace(iconified=lambda: False),
         camera=types.SimpleNamespace(view_hint=lambda: None),      # the still view's edge-on hint
-        brush=types.SimpleNamespace(picker=None, tools=types.SimpleNamespace(prepare=lambda c: None),
-                                    pick_key=lambda: None))
+        selection_tools=types.SimpleNamespace(prepare=lambda c: None),
+        picking=types.SimpleNamespace(invalidate=lambda: None, key=lambda: None))
     ed.say = ed.said.append
     return ed
 
@@ -218,7 +218,7 @@ def test_the_brush_pick_map_is_drawn_in_chunks_after_the_refinement(ed):
     camera change drops a pick map under way."""
     fr, vp = ed.frames, ed.viewport
     key = ("view", 1)
-    ed.brush.pick_key = lambda: key
+    ed.picking.key = lambda: key
     _slow(ed)
     fr.motion()
     fr.draw()

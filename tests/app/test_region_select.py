@@ -29,7 +29,7 @@ def ed():
 def drag(ed, pts, mods=0):
     press(ed, glfw.MOUSE_BUTTON_LEFT, mods, *pts[0])
     for x, y in pts[1:]:
-        ed.on_move(types.SimpleNamespace(x=float(x), y=float(y)))
+        ed.routing.on_move(types.SimpleNamespace(x=float(x), y=float(y)))
     press(ed, glfw.MOUSE_BUTTON_LEFT, mods, *pts[-1], action=glfw.RELEASE)
 
 
@@ -124,11 +124,11 @@ def test_right_click_cancels_an_armed_box_and_the_brush_paints_again(ed):
 def test_the_region_outline_is_a_closed_shape_while_dragging(ed):
     key(ed, glfw.KEY_B, glfw.MOD_CONTROL)
     press(ed, glfw.MOUSE_BUTTON_LEFT, 0, 100, 100)
-    ed.on_move(types.SimpleNamespace(x=200.0, y=150.0))
+    ed.routing.on_move(types.SimpleNamespace(x=200.0, y=150.0))
     (shape,) = ed.region.shapes(640, 480)
     assert shape.closed and shape.strip().shape == (5, 2)
     from splatedit.app.tools.shapes import to_patches
-    (patch,) = to_patches([shape])
+    (patch,) = to_patches([shape], (640, 480))
     assert patch.rgba[..., 3].max() == 255 and patch.x <= 100 and patch.y <= 100
     press(ed, glfw.MOUSE_BUTTON_LEFT, 0, 200, 150, action=glfw.RELEASE)
     assert ed.region.shapes(640, 480) == []
@@ -138,7 +138,7 @@ def land_jobs(ed) -> None:
     """Wait for the editor's background jobs and collect them (as its loop does)."""
     for job in list(ed.jobs.values()):
         assert job.wait(60)
-    ed.poll_jobs()
+    ed.file_actions.poll_jobs()
 
 
 def test_mirror_adds_the_mirror_image_across_the_middle_plane(ed):
@@ -211,6 +211,20 @@ def test_protocol_tools_register_themselves_and_use_only_their_context(ed):
         src = inspect.getsource(inspect.getmodule(cls))
         # on the protocol: the narrow context, no reach into the editor or its other tools
         assert "self.ed." not in src and "self.session" not in src, cls.__name__
+
+
+def test_every_view_tool_is_on_the_protocol_and_draws_only_shapes(ed):
+    """The built-in tools too (camera, curve, gizmo, brush): only the tool
+    context (no ``ed.*`` reach-ins), and their overlays are shapes that one
+    painter draws on both paths (no separate ``overlay`` / ``underlay``)."""
+    import inspect
+
+    from splatedit.app.tools.base import Tool
+    for tool in ed.tools:
+        src = inspect.getsource(inspect.getmodule(type(tool)))
+        assert "self.ed" not in src and "self.session" not in src, type(tool).__name__
+        assert not hasattr(tool, "overlay") and not hasattr(tool, "underlay"), type(tool).__name__
+    assert not hasattr(Tool, "overlay") and not hasattr(Tool, "ed")
 
 
 def test_a_mirror_whose_selection_changed_while_it_ran_changes_nothing(ed):

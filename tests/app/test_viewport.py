@@ -4,7 +4,7 @@ import numpy as np
 import pytest
 
 from splatedit.app.view.camera_control import OrbitCamera
-from splatedit.bench.editor import bunny_surface_cloud, _support_and_handle
+from splatedit.bench.editor import bunny_surface_cloud, support_and_handle
 from splatedit.model.lod import LodPyramid
 
 pytestmark = pytest.mark.gpu
@@ -48,7 +48,7 @@ def test_idle_full_quality_and_interactive_lod(scene):
 def test_handle_moves_in_lod_and_full(scene):
     from splatedit.deform.basis import DeformationBasis
     vp, cloud, cam = scene
-    sup, hnd = _support_and_handle(cloud, 3000)
+    sup, hnd = support_and_handle(cloud, 3000)
     vp.set_selection(sup, hnd, 1)
     basis = DeformationBasis.fit(cloud, sup, [hnd])
     vp.set_basis(basis)
@@ -80,7 +80,7 @@ def test_detail_mode_draws_the_cpu_commit_in_full_and_lod(scene):
     from splatedit.deform import transform as tf
     from splatedit.deform.detail import DetailBasis
     vp, cloud, cam = scene
-    sup, hnd = _support_and_handle(cloud, 3000)
+    sup, hnd = support_and_handle(cloud, 3000)
     basis = DetailBasis.fit(cloud, sup, [hnd])
     c = cloud.positions[hnd].mean(axis=0)
     dc = basis.displacement([tf.rotate((0.0, 0.0, 1.0), 60.0, c)])

@@ -7,7 +7,7 @@ same Gaussians drawn undeformed give the same image); still frames draw all."""
 import numpy as np
 import pytest
 
-from splatedit.bench.editor import _support_and_handle
+from splatedit.bench.editor import support_and_handle
 from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.document.gaussian import gaussian_document
 from splatedit.app.view.viewport import render_camera
@@ -82,7 +82,7 @@ def test_viewport_draws_the_deformed_lod_while_moving_and_all_when_still():
         assert not vp.last_info.lod and vp.last_info.splats == len(scene)     # no ranking yet: all
         lod = build_gaussian_lod(scene)
         vp.set_gaussian_lod(lod)
-        sup, hnd = _support_and_handle(doc, 1500)
+        sup, hnd = support_and_handle(doc, 1500)
         basis = DeformationBasis.fit(doc, sup, [hnd])
         vp.set_basis(basis)
         m = np.eye(4)

@@ -5,7 +5,7 @@ splat proxy whose selection and deformation basis apply row for row."""
 import numpy as np
 import pytest
 
-from splatedit.bench.editor import _support_and_handle
+from splatedit.bench.editor import support_and_handle
 from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.bench.gs_scenes import gaussians_from_splats
 from splatedit.data import default_model_path
@@ -45,7 +45,7 @@ def test_gaussians_draw_pick_tint_and_deform_through_the_viewport(scene):
     idx, depth = vp.pick(cam, 160, 120)
     hit = idx >= 0
     assert hit.mean() > 0.05 and (g.opacities()[idx[hit]] >= GS_PICK_MIN_OPACITY).all()
-    sup, hnd = _support_and_handle(proxy, 800)
+    sup, hnd = support_and_handle(proxy, 800)
     vp.set_selection(sup, hnd, 1)
     tinted = vp.render(cam, 160, 120)
     assert np.abs(tinted.astype(int) - img).sum() > 1000

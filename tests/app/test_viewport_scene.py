@@ -5,7 +5,7 @@ exposes nothing else draws the same deformed, tinted frame and pick."""
 import numpy as np
 import pytest
 
-from splatedit.bench.editor import _support_and_handle, bunny_surface_cloud
+from splatedit.bench.editor import support_and_handle, bunny_surface_cloud
 from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.render.scene import SceneRenderer
 
@@ -40,7 +40,7 @@ def test_viewport_drives_a_renderer_through_the_scene_interface_only():
     from splatedit.render.splat.renderer import Renderer
     assert {"set_cloud", "set_basis", "render", "pick", "supports_detail"} <= MEMBERS
     cloud = bunny_surface_cloud(8000)
-    sup, hnd = _support_and_handle(cloud, 800)
+    sup, hnd = support_and_handle(cloud, 800)
     basis = DeformationBasis.fit(cloud, sup, [hnd])
     m = np.eye(4)
     m[:3, 3] = [0.0, 0.15, 0.0]

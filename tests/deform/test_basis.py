@@ -8,7 +8,7 @@ import pytest
 from scipy.interpolate import RBFInterpolator
 
 from splatedit.bench.solve import sample_transform, sphere_cloud, wavy_plane_cloud
-from splatedit.deform.apply_plan import _run_plan
+from splatedit.deform.apply_plan import run_plan
 from splatedit.deform.basis import DeformationBasis
 from splatedit.deform.rbf import TriharmonicRBF
 from splatedit.deform.transform import (
@@ -283,7 +283,7 @@ def test_scattered_indices_take_the_same_path_as_runs(one):
         np.testing.assert_allclose(getattr(s, name), getattr(a, name)[perm], atol=1e-10)
     idx = np.sort(np.random.default_rng(4).choice(10_000, 3000, replace=False))
     idx = np.concatenate([idx, np.arange(20_000, 26_000)])
-    order, segs = _run_plan(idx, run_min=100, chunk=1000)
+    order, segs = run_plan(idx, run_min=100, chunk=1000)
     assert np.array_equal(np.sort(order), np.arange(len(idx)))
     covered = np.concatenate([np.arange(d.start, d.stop) if isinstance(d, slice) else d
                               for _, _, d in segs])
@@ -388,7 +388,7 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
     runs of support splats (one long GEMM instead of a call per run) and then
     restores them: they must come out bitwise identical, -0.0 included."""
     import splatedit.deform.apply_plan as apply_plan
-    from splatedit.deform.apply_plan import _fill_small_gaps
+    from splatedit.deform.apply_plan import fill_small_gaps
     monkeypatch.setattr(apply_plan, "_RUN_MIN", 64)   # runs of 112 count as long here
     cloud = wavy_plane_cloud(120)
     p = cloud.positions.copy()
@@ -402,7 +402,7 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
     p[gap_rows, 0] = -0.0                # negative zeros must survive
     cloud = SplatCloud(p, cloud.u, cloud.v)
     handle = support & (np.linalg.norm(cloud.positions[:, :2], axis=1) < 0.2)
-    span, member = _fill_small_gaps(np.flatnonzero(support))
+    span, member = fill_small_gaps(np.flatnonzero(support))
     assert (~member).sum() > 0          # the plan really computes through gaps
     b = DeformationBasis.fit(cloud, support, [handle], method="iqr", fill_holes=False)
     out = b.apply(cloud, b.displacement([translate([0.0, 0.0, 0.1])]))
@@ -413,12 +413,12 @@ def test_fixed_splats_in_gaps_between_support_runs_stay_bitwise_even_negative_ze
 
 
 def test_gap_filling_leaves_scattered_indices_alone():
-    from splatedit.deform.apply_plan import _fill_small_gaps
+    from splatedit.deform.apply_plan import fill_small_gaps
     idx = np.sort(np.random.default_rng(0).choice(100_000, 30_000, replace=False))
-    span, member = _fill_small_gaps(idx)
+    span, member = fill_small_gaps(idx)
     assert member.all() and np.array_equal(span, idx)
     runs = np.concatenate([np.arange(0, 1000), np.arange(1100, 2100), np.arange(5000, 5010)])
-    span, member = _fill_small_gaps(runs)
+    span, member = fill_small_gaps(runs)
     assert np.array_equal(span[member], runs)
     assert np.array_equal(span[~member], np.arange(1000, 1100))   # 100 <= 0.25 * 1000; the 10-run is short
 

@@ -64,11 +64,11 @@ def test_no_leaks_after_teardown():
 
 
 def test_vulkan_error_mapping():
-    from splatedit.render.vk.core import _result_name
+    from splatedit.render.vk.core import result_name
     import vulkan
-    assert _result_name(vulkan.VkErrorOutOfDeviceMemory()) == "VK_ERROR_OUT_OF_DEVICE_MEMORY"
-    assert _result_name(vulkan.VkTimeout()) == "VK_TIMEOUT"
-    assert _result_name(vulkan.VkSuboptimalKhr()) == "VK_SUBOPTIMAL_KHR"
+    assert result_name(vulkan.VkErrorOutOfDeviceMemory()) == "VK_ERROR_OUT_OF_DEVICE_MEMORY"
+    assert result_name(vulkan.VkTimeout()) == "VK_TIMEOUT"
+    assert result_name(vulkan.VkSuboptimalKhr()) == "VK_SUBOPTIMAL_KHR"
     err = V.VulkanError("vkQueuePresentKHR", "VK_SUBOPTIMAL_KHR")
     assert isinstance(err, SplatEditError) and "VK_SUBOPTIMAL_KHR" in str(err)
 

@@ -198,7 +198,7 @@ def on_drop(ed, paths: list[Path]) -> None:
     if len(paths) > 1:
         ed.say(f"{len(paths)} files dropped: opening only {first.name}")
     if first.is_dir():
-        ed.open_dialog(first)
+        ed.file_actions.open_dialog(first)
     else:
         open_path(ed, first)
 
@@ -302,7 +302,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
     ed.cloud_name = cloud.name or ed.cloud_name
     from splatedit.app.document.session import Session
     ed.session = Session(cloud, method=ed.method, tol=ed.tol, max_centers=ed.max_centers,
-                           on_change=ed.wake)
+                           on_change=ed.wake, graphs=ed.selection_tools)
     ed.viewport.set_cloud(cloud)
     # the heat map shows an edit's stretch: a freshly opened model has none (it
     # would draw as a flat grey silhouette), so it opens shaded
@@ -328,7 +328,7 @@ def on_loaded(ed, cloud, path: Path | None = None) -> None:
             from splatedit.model.gaussian_lod import build_gaussian_lod
             return build_gaussian_lod(scene, progress=progress)
         ed.jobs["lod"] = Job("Gaussian level of detail", rank, ed.wake)
-    ed.brush.tools.prepare(cloud)
+    ed.selection_tools.prepare(cloud)
     guard = getattr(ed, "crash_guard", None)
     if guard is None or guard.restoring is None:      # a recovery file is not a recent model
         remember(ed, ed.path)
@@ -353,7 +353,7 @@ def poll_jobs(ed) -> None:
             if name == "graph":
                 if not isinstance(err, Cancelled):
                     ed.say(f"{job.name} failed: {err}")
-                ed.brush.tools.poll()
+                ed.selection_tools.poll()
                 continue
             if isinstance(err, Cancelled):
                 continue
@@ -380,14 +380,14 @@ def poll_jobs(ed) -> None:
             result = job.result
             if isinstance(result, tuple):       # (scan, cloud): out of core
                 scan, result = result
-                ed.on_loaded(result, job.key)
+                ed.file_actions.on_loaded(result, job.key)
                 ed.ooc = scan
                 ed.session.splats_fixed = "not for a scan opened out of core (every point stays in its file)"
                 ed.say(f"opened {ed.cloud_name} out of core: {scan.copc.point_count:,} points, "
                        f"{result.n:,} shown; the view refines where the camera looks")
             else:
                 ed.ooc = None
-                ed.on_loaded(result, job.key)
+                ed.file_actions.on_loaded(result, job.key)
             guard = getattr(ed, "crash_guard", None)
             entry = None if guard is None else guard.restoring
             if entry is not None and Path(job.key) == Path(os.path.abspath(entry.model)):
@@ -417,5 +417,8 @@ def poll_jobs(ed) -> None:
             ed.saved_script = job.result
             ed.say(f"edit script written to {job.result}")
         elif name == "graph":
-            if ed.brush.tools.poll() and ed.brush.tools.closure_pending and ed.session is not None:
-                ed.brush.close_pending_selection()
+            graphs = ed.selection_tools
+            if graphs.poll() and graphs.closure_pending and ed.session is not None:
+                added = ed.session.selection_edit.close_pending()    # the selection waiting for it
+                if added:
+                    ed.say(f"closure added {added:,} splats")

@@ -199,7 +199,7 @@ class Manipulation:
         ax = f" {self.axis_name()}" if self.axis is not None else ""
         if self.mode == GRAB:
             d = self._translation(typed)
-            return f"distance{ax} {_num(self._distance(d), '.4g')}   ({', '.join(_num(v) for v in d)}){src}"
+            return f"distance{ax} {format_number(self._distance(d), '.4g')}   ({', '.join(format_number(v) for v in d)}){src}"
         if self.mode == ROTATE:
             return f"angle{ax} {self._angle_deg(typed):+.1f} deg{src}"
         return f"factor{ax} {self._factor(typed):.3f}x{src}"
@@ -214,10 +214,10 @@ class Manipulation:
         typed = self._typed_ok()
         axis = self.axis_name() or None
         if self.mode == GRAB:
-            return f"Grab {_num(self._distance(self._translation(typed)))}" + (f" along {axis}" if axis else "")
+            return f"Grab {format_number(self._distance(self._translation(typed)))}" + (f" along {axis}" if axis else "")
         if self.mode == ROTATE:
-            return f"Rotate {_num(self._angle_deg(typed), '.3g')} deg about {axis or 'the view axis'}"
-        return f"Scale x{_num(self._factor(typed))}" + (f" along {axis}" if axis else "")
+            return f"Rotate {format_number(self._angle_deg(typed), '.3g')} deg about {axis or 'the view axis'}"
+        return f"Scale x{format_number(self._factor(typed))}" + (f" along {axis}" if axis else "")
 
     def describe(self) -> str:
         name = {GRAB: "Grab", ROTATE: "Rotate", SCALE: "Scale"}[self.mode]
@@ -230,7 +230,7 @@ class Manipulation:
         return f"{name}{ax}{val}   (Enter/click: apply, Esc/right click: cancel)"
 
 
-def _num(v: float, fmt: str = ".3g") -> str:
+def format_number(v: float, fmt: str = ".3g") -> str:
     """``v`` formatted with ``fmt``, never as "-0" (a component rounding to zero reads 0)."""
     text = format(float(v), fmt)
     return "0" if float(text) == 0 else text

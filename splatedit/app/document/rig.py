@@ -9,7 +9,8 @@ from dataclasses import dataclass, field
 import numpy as np
 
 
-def _matrix_tuple(m) -> tuple:
+def matrix_tuple(m) -> tuple:
+    """A (4, 4) matrix as a tuple of row tuples of floats (hashable, JSON-able)."""
     return tuple(tuple(float(x) for x in row) for row in np.asarray(m, float))
 
 
@@ -29,7 +30,7 @@ class Rig:
         """Hashable copy (for undo snapshots)."""
         return (tuple(tuple(float(x) for x in p) for p in self.curve_points),
                 tuple(tuple(float(x) for x in d) for d in self.curve_moves),
-                tuple(_matrix_tuple(m) for m in self.pose))
+                tuple(matrix_tuple(m) for m in self.pose))
 
     def restore(self, t: tuple | None) -> None:
         pts, moves, pose = t if t else ((), (), ())

@@ -46,6 +46,8 @@ key, so switching to or from detail refits); each committed edit records it.
 Parts kept in their own modules: the history (:mod:`splatedit.app.document.session_history`:
 snapshots, undo, redo; an owned object, ``session.history_part``), editing the rig
 (:mod:`splatedit.app.document.session_rig`: handles, curve points; owned, ``session.rig_part``),
+selection editing (:mod:`splatedit.app.document.selection_edit`: strokes, their closure, region
+edits; owned, ``session.selection_edit``),
 the pose and its manipulation (:mod:`splatedit.app.document.session_pose`: G/R/S, finish,
 commit; owned, ``session.pose_part``), the rig's pose and curve
 (:mod:`splatedit.app.document.rig`), the fit scheduling (:mod:`splatedit.app.document.fitting`),
@@ -69,6 +71,7 @@ from splatedit.app.document.gaussian import DETAIL_UNAVAILABLE, gaussians_of
 from splatedit.app.document.history import History
 from splatedit.app.document.manipulation import GRAB, ROTATE, SCALE, Manipulation, ViewInfo  # noqa: F401 (API)
 from splatedit.app.document.rig import Rig
+from splatedit.app.document.selection_edit import SelectionEdit
 from splatedit.app.document.session_history import SessionHistory
 from splatedit.app.document.session_pose import PoseEditing
 from splatedit.app.document.session_rig import HANDLE_COLUMNS, MAX_CURVE_POINTS, RigEditing, columns_needed  # noqa: F401 (API)
@@ -121,6 +124,9 @@ class Session:
         method, tol, max_centers: solver settings (also written to exported scripts).
         fit_sync: run fits on the calling thread (tests); commits then never
             run in the background either.
+        graphs: the neighbour-graph and closure service of the selection
+            edits (:class:`~splatedit.app.document.selection.SelectionTools`,
+            the editor's); None: selection edits are not closed.
 
     Commits (:meth:`commit`) estimated at ``commit_sync_ms`` or more run in
     the background (:mod:`splatedit.app.document.commit_job`); meanwhile
@@ -129,7 +135,7 @@ class Session:
     """
 
     def __init__(self, cloud, *, method: str = "auto", tol: float = IQR_DEFAULT_TOL,
-                 max_centers: int | None = None, fit_sync: bool = False, on_change=None):
+                 max_centers: int | None = None, fit_sync: bool = False, on_change=None, graphs=None):
         self.method, self.tol, self.max_centers = method, tol, max_centers
         #: deformation mode of new edits (the editor's B key; carried into exported scripts)
         self.deformation = DeformationMode.ROTATION
@@ -138,6 +144,9 @@ class Session:
         self.fit = FitScheduler(sync=fit_sync, on_change=self.on_change)
         self.cloud = cloud
         self.selection = Selection(cloud.n)
+        #: the selection edit API: brush target, strokes and their closure, region
+        #: edits (:class:`~splatedit.app.document.selection_edit.SelectionEdit`)
+        self.selection_edit = SelectionEdit(self, graphs)
         self.rig = Rig()
         #: handle and curve-point editing (:class:`~splatedit.app.document.session_rig.RigEditing`)
         self.rig_part = RigEditing(self)

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 from splatedit.app.document.manipulation import GRAB, Manipulation, ViewInfo
-from splatedit.app.document.rig import _matrix_tuple
+from splatedit.app.document.rig import matrix_tuple
 from splatedit.errors import SplatEditError
 
 
@@ -232,7 +232,7 @@ class PoseEditing:
         if curve is not None:
             curves = (Curve(tuple(tuple(float(x) for x in p) for p in self.s.curve_points),
                             tuple(tuple(float(x) for x in d) for d in moves), None),)
-        matrices = tuple(Matrix(_matrix_tuple(m)) for m in mats)
+        matrices = tuple(Matrix(matrix_tuple(m)) for m in mats)
         mode = self.s.deformation
 
         def make_edit():

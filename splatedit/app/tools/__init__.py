@@ -9,9 +9,10 @@ overlay drawing and its help entries (:class:`~splatedit.app.tools.base.Tool`).
   rings, scale grip) and G/R/S manipulations with their live readout;
 * :class:`~splatedit.app.tools.curve.CurveTool`: the control curve.
 
-Tools on the narrow protocol (:attr:`~splatedit.app.tools.base.Tool.ctx`,
+Every tool is on the narrow protocol (:attr:`~splatedit.app.tools.base.Tool.ctx`,
 :meth:`~splatedit.app.tools.base.Tool.shapes`,
-:meth:`~splatedit.app.tools.base.Tool.status`) register themselves: a module
+:meth:`~splatedit.app.tools.base.Tool.status`); the four above are made by
+the editor itself (they come first in press order), the others register themselves: a module
 of this package that sets ``TOOL = SomeTool`` is found by
 :func:`protocol_tools`, and the editor makes one, reachable as
 ``editor.<SomeTool.name>``.  A new tool is that file plus its keymap rows

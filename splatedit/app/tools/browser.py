@@ -112,12 +112,13 @@ def list_folder(folder: Path) -> tuple[list[Entry], str | None]:
 
 
 class FileBrowserTool(Tool):
-    """The Ctrl+O file browser (modal while shown).  ``ed.open_path(path)``
-    opens the picked file; ``ed.recent_files()`` gives the recent list."""
+    """The Ctrl+O file browser (modal while shown).  ``ed.file_actions.open_path(path)``
+    opens the picked file; ``ed.file_actions.recent_files()`` gives the recent list."""
     section = Section.BROWSER
 
     def __init__(self, ed):
         super().__init__(ed)
+        self.ed = ed                 # a modal dialog of the editor's files, not a view tool
         self.shown = False
         self.folder = Path.cwd()
         self.entries: list[Entry] = []
@@ -151,7 +152,7 @@ class FileBrowserTool(Tool):
         if self.error is not None and not listed:
             self.ed.say(self.error)
         self.folder = folder
-        recent = [Entry(p, EntryKind.RECENT) for p in self.ed.recent_files()]
+        recent = [Entry(p, EntryKind.RECENT) for p in self.ed.file_actions.recent_files()]
         self.entries = recent + listed
         self.typed = ""
         self.index = self.top = 0
@@ -227,7 +228,7 @@ class FileBrowserTool(Tool):
 
     def _open(self, path: Path) -> None:
         self.close()
-        self.ed.open_path(path)
+        self.ed.file_actions.open_path(path)
 
     def actions(self) -> dict:
         return {Action.BROWSE_UP: lambda: self.move(-1), Action.BROWSE_DOWN: lambda: self.move(1),

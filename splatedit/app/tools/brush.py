@@ -1,20 +1,22 @@
 """Brush tool: paints the support / the active handle, erases, and runs the
-selection tools (grow, shrink, connected, invert) with closure; owns the
-pick map of the current view and the brush cursor overlay."""
+selection tools (grow, shrink, connected, invert); draws the brush cursor
+and the last closure's highlight.  The selection editing itself (the
+target's rules, strokes and the closure that ends them) is the document's
+(:mod:`splatedit.app.document.selection_edit`), called through the tool context."""
 
 from __future__ import annotations
 
 import numpy as np
 
 from splatedit.app.ui import overlay as ov
-from splatedit.app.document import revision
 from splatedit.app.document import selection as seltools
-from splatedit.app.tools.pick_brush import BrushPicker, picker_for_view, stroke_points
+from splatedit.app.tools.pick_brush import stroke_points
+from splatedit.app.tools.shapes import Circle, Label, Points
 from splatedit.select.selection import HANDLE, SUPPORT
 from splatedit.app.ui.keymap import Action, Section
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.tolerances import (EDITOR_BRUSH_KEY_STEP, EDITOR_BRUSH_MAX_PX, EDITOR_BRUSH_MIN_PX,
-                                  EDITOR_BRUSH_WHEEL_STEP, EDITOR_PICK_TOL_PX)
+                                  EDITOR_BRUSH_WHEEL_STEP)
 
 ERASE_RGB = (230, 60, 60)
 
@@ -26,11 +28,6 @@ class BrushTool(Tool):
         super().__init__(ed)
         self.radius = 24.0               # pixels
         self.erase_toggle = False
-        self.stroke_changed = False
-        self.stroke_before = None      # the selection before an erase stroke (Selection)
-        self.picker: BrushPicker | None = None
-        self.picker_key = None
-        self.tools = seltools.SelectionTools(ed.start_graph_job)
         self._warned_no_graph = False
 
     def actions(self):
@@ -41,34 +38,36 @@ class BrushTool(Tool):
                 Action.NEW_HANDLE: self.new_handle, Action.REMOVE_HANDLE: self.remove_handle,
                 Action.BRUSH_SMALLER: lambda: self.set_radius(self.radius / EDITOR_BRUSH_KEY_STEP),
                 Action.BRUSH_LARGER: lambda: self.set_radius(self.radius * EDITOR_BRUSH_KEY_STEP),
-                Action.CLEAR_SELECTION: lambda: self.session.clear(None),
-                Action.CLEAR_HANDLES: lambda: self.session.clear(HANDLE),
+                Action.CLEAR_SELECTION: lambda: self.ctx.document.clear(None),
+                Action.CLEAR_HANDLES: lambda: self.ctx.document.clear(HANDLE),
                 Action.GROW: lambda: self.selection_tool("grow"),
                 Action.SHRINK: lambda: self.selection_tool("shrink"),
                 Action.INVERT: lambda: self.selection_tool("invert"),
                 Action.SELECT_ALL: lambda: self.selection_tool("all"),
-                Action.CONNECTED: lambda: self.selection_tool("connected", *self.ed.mouse),
-                Action.CONNECTED_ALL: lambda: self.selection_tool("connected", *self.ed.mouse, whole=True)}
+                Action.CONNECTED: lambda: self.selection_tool("connected", *self.ctx.mouse),
+                Action.CONNECTED_ALL: lambda: self.selection_tool("connected", *self.ctx.mouse, whole=True)}
 
     # ------------------------------------------------------------ settings
     @property
     def mode(self) -> str:
-        return self.tools.mode
+        """``BRUSH_3D`` (through) or ``BRUSH_VISIBLE`` (V toggles)."""
+        return self.ctx.graphs.mode
 
     def mode_note(self) -> str | None:
         """While the 3D brush waits for the neighbour graph: what it does
         meanwhile and how far the graph is (shown in the panel), else None."""
-        if self.tools.mode != seltools.BRUSH_3D or self.ed.session is None:
+        c = self.ctx
+        if c.graphs.mode != seltools.BRUSH_3D or c.document is None:
             return None
-        done = self.tools.building(self.session.cloud)
+        done = c.graphs.building(c.document.cloud)
         if done is None:
             return None
         return f"3D brush: visible-only until the neighbour graph is ready ({done * 100:.0f}%)"
 
     def toggle_mode(self) -> None:
-        mode = self.tools.toggle_mode()
-        self.ed.say("brush: 3D (everything inside the sphere, front and back)" if mode == seltools.BRUSH_3D
-                    else "brush: visible splats only")
+        mode = self.ctx.graphs.toggle_mode()
+        self.ctx.say("brush: 3D (everything inside the sphere, front and back)" if mode == seltools.BRUSH_3D
+                     else "brush: visible splats only")
 
     def toggle_erase(self) -> None:
         self.erase_toggle = not self.erase_toggle
@@ -81,10 +80,10 @@ class BrushTool(Tool):
         self.set_radius(self.radius * (EDITOR_BRUSH_WHEEL_STEP ** e.dy))
 
     def set_target(self, target: str) -> None:
-        self.session.brush_target = target
+        self.ctx.document.brush_target = target
 
     def next_handle(self, step: int) -> None:
-        s = self.session
+        s = self.ctx.document
         if len(s.selection.handles) > 1:
             s.cycle_handle(step)
             s.brush_target = HANDLE
@@ -92,88 +91,56 @@ class BrushTool(Tool):
             s.brush_target = HANDLE if s.brush_target == SUPPORT else SUPPORT
 
     def new_handle(self) -> None:
-        s = self.session
+        s = self.ctx.document
         if s.add_handle():
-            self.ed.say(f"handle {len(s.selection.handles)}: paint it with the handle brush")
+            self.ctx.say(f"handle {len(s.selection.handles)}: paint it with the handle brush")
         else:
-            self.ed.say("the active handle is empty: paint it with the handle brush")
+            self.ctx.say("the active handle is empty: paint it with the handle brush")
 
     def remove_handle(self) -> None:
-        s = self.session
+        s = self.ctx.document
         if s.remove_handle():
-            self.ed.say(f"handle removed ({len(s.selection.handles)} left)")
+            self.ctx.say(f"handle removed ({len(s.selection.handles)} left)")
 
     def erasing(self) -> bool:
-        return self.erase_toggle or bool(self.ed.window.mods() & self.ed.g.MOD_CONTROL)
+        """A stroke now erases (E on, or Ctrl held)."""
+        return self.ctx.erasing()
 
-    # ------------------------------------------------------------- picking
-    def pick_key(self) -> tuple:
-        """What the pick map depends on: camera, size, the cloud's and the
-        basis' revisions, the displacement drawn."""
-        ed, s = self.ed, self.session
-        w, h = ed.size
-        dc = ed.viewport.dc
-        return (ed.cam.state(), w, h, revision.of(s.cloud), revision.of(s.basis),
-                None if dc is None or not dc.any() else dc.tobytes())
-
-    def picker_current(self) -> bool:
-        return self.picker is not None and self.picker_key == self.pick_key()
-
-    def get_picker(self) -> BrushPicker:
-        ed, s = self.ed, self.session
-        w, h = ed.size
-        key = self.pick_key()
-        if self.picker is None or self.picker_key != key:
-            ready = ed.frames.take_pick(key)     # drawn in chunks after the view's refinement
-            idx, front = ready if ready is not None else ed.viewport.pick(ed.cam, w, h)
-            self.picker = picker_for_view(idx, front, ed.cam, s.cloud.positions, s.cloud.radii, EDITOR_PICK_TOL_PX)
-            self.picker_key = key
-        return self.picker
-
-    def splat_under(self, x: float, y: float) -> int:
-        p = self.get_picker().pick
-        ix, iy = int(x), int(y)
-        if 0 <= iy < p.shape[0] and 0 <= ix < p.shape[1]:
-            return int(p[iy, ix])
-        return -1
-
-    def _displaced(self) -> bool:
-        dc = self.ed.viewport.dc
-        return dc is not None and bool(dc.any())
-
+    # ------------------------------------------------------------ painting
     def paint_at(self, points) -> None:
-        ed, s = self.ed, self.session
+        c = self.ctx
+        s, edit = c.document, c.selection_edit
         erase = self.erasing()
-        picker = self.get_picker()
-        graph = self.tools.graph(s.cloud) if self.tools.mode == seltools.BRUSH_3D else None
-        if self.tools.mode == seltools.BRUSH_3D and graph is None and not self._warned_no_graph:
+        picker = c.visible()
+        three_d = c.graphs.mode == seltools.BRUSH_3D
+        graph = c.neighbour_graph() if three_d else None
+        if three_d and graph is None and not self._warned_no_graph:
             self._warned_no_graph = True
-            ed.say("3D brush: the neighbour graph is being built, painting visible splats meanwhile")
-        displaced = self._displaced()
+            c.say("3D brush: the neighbour graph is being built, painting visible splats meanwhile")
+        displaced = c.displaced()
+        mirror = c.tool("mirror")
         changed = False
         for x, y in points:
             if graph is not None:
-                sph = seltools.brush_sphere(picker, ed.cam, s.cloud.positions, x, y, self.radius, ed.size, displaced)
+                sph = seltools.brush_sphere(picker, c.camera, s.cloud.positions, x, y, self.radius, c.size, displaced)
                 idx = seltools.splats_in_sphere(graph.tree, sph) if sph is not None else np.zeros(0, np.int64)
             else:
                 idx = picker.query(x, y, self.radius)
             # the dab's 3D reach (its circle through the model): closure may add there only
             reach = None if erase else picker.covered(x, y, self.radius)
-            if ed.mirror.painting:             # symmetric painting: the dab's mirror image too
-                idx = ed.mirror.with_mirror(idx)
-                reach = None if reach is None else ed.mirror.with_mirror(reach)
-            changed |= s.paint(idx, erase=erase, reach=reach)
+            if mirror.painting:             # symmetric painting: the dab's mirror image too
+                idx = mirror.with_mirror(idx)
+                reach = None if reach is None else mirror.with_mirror(reach)
+            changed |= edit.dab(idx, erase=erase, reach=reach)
         if changed:
-            self.stroke_changed = True
-            ed.motion()
+            c.redraw()
 
     # ---------------------------------------------------------------- mouse
     def press(self, e):
-        if e.button != self.ed.g.MOUSE_BUTTON_LEFT:
+        if e.button != self.ctx.keys.MOUSE_BUTTON_LEFT:
             return None
-        self.stroke_changed = False
         # an erase stroke: the selection before it bounds what closure may give back
-        self.stroke_before = self.session.selection.copy() if self.erasing() else None
+        self.ctx.selection_edit.begin_stroke(self.erasing())
         self.paint_at([(e.x, e.y)])
         return DragMode.PAINT
 
@@ -184,45 +151,24 @@ class BrushTool(Tool):
     def release(self, mode):
         if mode is not DragMode.PAINT:
             return
-        s = self.session
-        before, self.stroke_before = self.stroke_before, None
-        if self.stroke_changed and before is not None:
-            target = lambda sel: sel.support if s.brush_target == SUPPORT else sel.handle  # noqa: E731
-            self.tools.close(s, within=before)
-            msg = seltools.erase_message(target(before), target(s.selection),
-                                         "support" if s.brush_target == SUPPORT else "handle")
-            if msg:
-                self.ed.say(msg)
-        elif self.stroke_changed:
-            added = self.tools.close(s)
-            if added:
-                self.ed.say(f"closure added {added:,} splats")
-        s.end_stroke(self.stroke_changed)
-        self.stroke_changed = False
+        msg = self.ctx.selection_edit.end_stroke()      # closure, one undo step
+        if msg:
+            self.ctx.say(msg)
 
     # ------------------------------------------------------ selection tools
-    def close_pending_selection(self) -> None:
-        """The neighbour graph arrived after a selection change: close it now (an undo step)."""
-        s = self.session
-        if s.manip is not None:
-            return
-        n = self.tools.close(s)
-        if n:
-            s.push("fill holes")
-            self.ed.say(f"closure added {n:,} splats")
-
     def selection_tool(self, tool: str, x: float | None = None, y: float | None = None,
                        whole: bool = False) -> None:
         """Run ``tool`` ("grow", "shrink", "connected", "invert", "all") on the brush
         target (support or active handle), close the selection: one undo step."""
-        ed, s = self.ed, self.session
+        c = self.ctx
+        s = c.document
         if s.manip is not None:
             return
         target = s.brush_target
         what = "support" if target == SUPPORT else "handle"
-        graph = self.tools.graph(s.cloud)
+        graph = c.neighbour_graph()
         if graph is None and tool not in ("invert", "all"):
-            ed.say("the neighbour graph is still being built: try again in a moment")
+            c.say("the neighbour graph is still being built: try again in a moment")
             return
         sel = s.selection
         if tool == "grow":
@@ -234,10 +180,10 @@ class BrushTool(Tool):
         elif tool == "all":
             mask = seltools.everything(sel, target)
         elif tool == "connected":
-            sph = seltools.brush_sphere(self.get_picker(), ed.cam, s.cloud.positions, x, y, self.radius, ed.size,
-                                        self._displaced())
+            sph = seltools.brush_sphere(c.visible(), c.camera, s.cloud.positions, x, y, self.radius, c.size,
+                                        c.displaced())
             if sph is None:
-                ed.say("select connected: put the cursor on the model")
+                c.say("select connected: put the cursor on the model")
                 return
             reach = None
             if not whole:
@@ -248,40 +194,34 @@ class BrushTool(Tool):
             raise ValueError(tool)
         i = 0 if target == SUPPORT else 1
         before = s.selection.counts[i]
-        if not self.tools.apply(s, target, mask, f"{tool} {what}"):
-            ed.say(f"{tool}: the {what} did not change")
+        if not c.select(mask, f"{tool} {what}"):
+            c.say(f"{tool}: the {what} did not change")
             return
         n = s.selection.counts[i] - before
-        added = self.tools.last_added
-        ed.say(f"{tool} {what}: {n:+,} splats" + (f", closure added {added:,}" if added else ""))
+        added = c.selection_edit.last_added
+        c.say(f"{tool} {what}: {n:+,} splats" + (f", closure added {added:,}" if added else ""))
 
     # -------------------------------------------------------------- drawing
     def cursor_colour(self) -> tuple:
         if self.erasing():
             return ERASE_RGB
-        return ov.SUPPORT_RGB if self.session.brush_target == SUPPORT else ov.HANDLE_RGB
+        return ov.SUPPORT_RGB if self.ctx.target == SUPPORT else ov.HANDLE_RGB
 
-    def underlay(self, w, h):
-        """What the last closure added (flashes yellow)."""
-        s, ed = self.session, self.ed
-        hl = self.tools.highlighted(s.cloud)
-        if hl is None:
-            return []
-        px, d = ed.cam.project(s.cloud.positions[hl], w, h)
-        p = seltools.points_patch(np.where((d > 0)[:, None], px, np.nan), (w, h))
-        return [] if p is None else [p]
-
-    def overlay(self, w, h):
-        """The brush circle and its mode tag at the cursor."""
-        ed, s = self.ed, self.session
-        if ed.drag.camera or s.manip is not None or ed.modal() or not ed.cursor_inside:
-            return []
-        col = self.cursor_colour()
-        img = ov.ring(int(round(self.radius)), col)
-        mx, my = ed.mouse
-        out = [ov.Patch(int(mx) - img.shape[1] // 2, int(my) - img.shape[0] // 2, img)]
-        tag = ov.text_panel(("3D" if self.tools.mode == seltools.BRUSH_3D else "VIS",), size=11,
-                            fg=tuple(col) + (255,), pad=2, bg=(20, 22, 28, 150))
-        r = int(round(self.radius * 0.7071))
-        out.append(ov.Patch(int(mx) + r + 2, int(my) + r + 2, tag))
+    def shapes(self, w, h):
+        """What the last closure added (flashes yellow, under everything) and,
+        over the model, the brush circle with its mode tag at the cursor."""
+        c = self.ctx
+        s, out = c.document, []
+        hl = c.graphs.highlighted(s.cloud)
+        if hl is not None:
+            px, d = c.camera.project(s.cloud.positions[hl], w, h)
+            out.append(Points(np.where((d > 0)[:, None], px, np.nan), seltools.CLOSURE_RGB))
+        if s.manip is not None or not c.pointer_free():
+            return out
+        rgb = self.cursor_colour()
+        (mx, my), r = c.mouse, float(self.radius)
+        out.append(Circle((mx, my), r, rgb, 2.0))
+        k = r * 0.7071
+        out.append(Label((mx + k + 1, my + k + 2), "3D" if self.mode == seltools.BRUSH_3D else "VIS",
+                         rgb, size=11, bg_alpha=150))
         return out

@@ -8,36 +8,12 @@ import math
 
 from splatedit.app.document import revision
 from splatedit.app.ui.keymap import Action, Section
-from splatedit.app.ui.panel import PANEL_MARGIN
-from splatedit.app.tools.base import DragMode, Tool
+from splatedit.app.tools.base import DragMode, Tool, free_area  # noqa: F401 (free_area: API)
 from splatedit.app.view.coverage import coverage_estimate
 from splatedit.app.view.coverage import hint as coverage_hint
 from splatedit.io.formats import is_z_up
 from splatedit.model.extent import FramingExtent, framing_extent
 from splatedit.model.orientation import UpAxis, detect_cloud_up_axis, next_up
-from splatedit.tolerances import EDITOR_FRAME_MIN_FREE_FRACTION, EDITOR_GUI_PANEL_WIDTH
-
-
-def free_area(w: int, h: int, panel_box, top: float = 0.0) -> tuple[float, float, float, float]:
-    """(x0, y0, x1, y1) fractions of a ``w`` x ``h`` pixel window (y down)
-    that no GUI covers: below a menu bar ``top`` pixels high and beside the
-    side panel's column (``panel_box`` (x, y, w, h) pixels or None): the
-    panel grows downwards as its sections open, so its whole column counts,
-    like Blender's side regions.  The whole window when what is left would be
-    narrower than ``EDITOR_FRAME_MIN_FREE_FRACTION`` of it."""
-    w, h = max(int(w), 1), max(int(h), 1)
-    x0, x1, y0 = 0.0, float(w), min(max(float(top), 0.0), float(h))
-    if panel_box is not None:
-        px, _, pw, _ = panel_box
-        if w - (px + pw) >= px:         # more room right of the panel
-            x0 = float(px + pw)
-        else:
-            x1 = float(px)
-    if x1 - x0 < EDITOR_FRAME_MIN_FREE_FRACTION * w:
-        x0, x1 = 0.0, float(w)
-    if h - y0 < EDITOR_FRAME_MIN_FREE_FRACTION * h:
-        y0 = 0.0
-    return x0 / w, y0 / h, x1 / w, 1.0
 
 
 class CameraTool(Tool):
@@ -52,7 +28,7 @@ class CameraTool(Tool):
 
     @property
     def cam(self):
-        return self.ed.cam
+        return self.ctx.camera
 
     def actions(self):
         top = math.radians(89.0)
@@ -83,31 +59,22 @@ class CameraTool(Tool):
     def set_up(self, up: UpAxis) -> None:
         self.up = up
         self.cam.up_axis = up.vector
-        self.ed.motion()
+        self.ctx.redraw()
 
     def cycle_up_axis(self) -> None:
         self.set_up(next_up(self.up))
         self.view_preset(self.cam.yaw, self.cam.pitch)
-        self.ed.say(f"up axis {self.up.label} (numpad 1 / 3 / 7 views turn about it)")
+        self.ctx.say(f"up axis {self.up.label} (numpad 1 / 3 / 7 views turn about it)")
 
     # ------------------------------------------------------------ framing
     def view_area(self) -> tuple[float, float, float, float]:
-        """The part of the window framing fills (:func:`free_area`): beside the
-        side panel when it is shown, below the GUI's menu bar."""
-        ed = self.ed
-        w, h = ed.size
-        box = ed.panel_box if ed.panel_visible else None
-        if box is not None and tuple(box) == (0, 0, 0, 0):
-            # no frame laid out yet (a model opened before the first GUI frame): the GUI
-            # panel's first place, at the left; the CPU text panel's size is not known
-            box = (PANEL_MARGIN, 0, EDITOR_GUI_PANEL_WIDTH, 0) if ed.gui is not None else None
-        top = ed.gui.menu_height if ed.gui is not None else 0.0
-        return free_area(w, h, box, top)
+        """The part of the window framing fills (:meth:`ToolContext.view_area`)."""
+        return self.ctx.view_area()
 
     def extent(self) -> FramingExtent | None:
         """The open model's :func:`~splatedit.model.extent.framing_extent`
         (its main body), computed once per cloud revision; None without a model."""
-        s = self.session
+        s = self.ctx.document
         if s is None:
             return None
         key = revision.of(s.cloud)
@@ -122,65 +89,65 @@ class CameraTool(Tool):
         ext = self.extent()
         if ext is None:
             return
-        w, h = self.ed.size
+        w, h = self.ctx.size
         self.cam.frame(ext.center, ext.radius, w / max(h, 1), area=self.view_area())
-        self.ed.motion()
+        self.ctx.redraw()
         if say:     # a view change replaces the previous status message with the view's name
             note = ext.note()
-            self.ed.say("view: the whole model" + (f"; left out of the view: {note}" if note else ""))
+            self.ctx.say("view: the whole model" + (f"; left out of the view: {note}" if note else ""))
 
     def frame_selection(self) -> None:
         """F: the active handle (else the support) fills the free part of the window."""
-        s = self.session
+        s = self.ctx.document
         if s is None:
             return
         m = s.selection.handle if s.selection.handle.any() else s.selection.support
         if not m.any():
             self.frame_all()
             return
-        w, h = self.ed.size
+        w, h = self.ctx.size
         self.cam.frame_points(s.cloud.positions[m], w / max(h, 1), area=self.view_area())
-        self.ed.motion()
-        self.ed.say(f"view: the {'active handle' if s.selection.handle.any() else 'support'}")
+        self.ctx.redraw()
+        self.ctx.say(f"view: the {'active handle' if s.selection.handle.any() else 'support'}")
 
     def view_preset(self, yaw: float, pitch: float, name: str | None = None) -> None:
         """A numpad view: turn about the pivot (the framed model stays where it
         is on screen); ``name`` ("front", "top", ...): the status line says it
         (replacing whatever the previous message was)."""
         self.cam.turn_to(yaw, pitch)
-        self.ed.motion()
+        self.ctx.redraw()
         if name is not None:
-            self.ed.say(f"view: {name} (about the up axis {self.up.label})")
+            self.ctx.say(f"view: {name} (about the up axis {self.up.label})")
             self._hint_key = None       # the view's name replaced any hint: estimate it again
 
     def _drawn_cloud(self):
-        cloud = getattr(self.ed.viewport, "cloud", None)
-        return self.session.cloud if cloud is None else cloud
+        cloud = getattr(self.ctx.viewport, "cloud", None)
+        return self.ctx.document.cloud if cloud is None else cloud
 
     def _view_key(self) -> tuple:
-        vp = self.ed.viewport
-        return (self.cam.state(), tuple(self.ed.size), revision.of(self._drawn_cloud()),
+        vp = self.ctx.viewport
+        return (self.cam.state(), tuple(self.ctx.size), revision.of(self._drawn_cloud()),
                 float(vp.splat_scale), bool(getattr(vp, "two_sided", False)))
 
     def hint_checked(self) -> bool:
         """The current view's coverage was estimated (:meth:`view_hint` ran for it)."""
-        return self.session is not None and self._hint_key == self._view_key()
+        return self.ctx.document is not None and self._hint_key == self._view_key()
 
     def view_hint(self) -> None:
         """A still view that draws (almost) nothing although many splats are
         in it (a raw scan's estimated normals seen edge-on or from behind,
         :mod:`splatedit.app.view.coverage`): say so on the status line, after
         the view's name when that is the message.  Estimated once per view."""
-        ed, s = self.ed, self.session
-        vp = ed.viewport
-        if s is None or getattr(vp, "gaussians", None) is not None:
+        c = self.ctx
+        vp = c.viewport
+        if c.document is None or getattr(vp, "gaussians", None) is not None:
             return
         key = self._view_key()
         if key == self._hint_key:
             return
         cloud = self._drawn_cloud()
         self._hint_key = key
-        w, h = ed.size
+        w, h = c.size
         culled = not getattr(vp, "two_sided", False)
         cov = coverage_estimate(cloud.positions, cloud.u, cloud.v, self.cam, w, h, self.view_area(),
                                 float(vp.splat_scale), culling=culled)
@@ -188,11 +155,11 @@ class CameraTool(Tool):
             text = coverage_hint(cov, "Shift+1 / Shift+3 or a middle drag")
             if culled and cov.front < 0.5 * cov.in_view:
                 text += ", or T: draw the splats seen from behind too"
-            ed.say(f"{ed.message}; {text}" if ed.message.startswith("view:") else text)
+            c.say(f"{c.message}; {text}" if c.message.startswith("view:") else text)
 
     # -------------------------------------------------------------- mouse
     def press(self, e):
-        g = self.ed.g
+        g = self.ctx.keys
         alt = bool(e.mods & g.MOD_ALT)
         if e.button == g.MOUSE_BUTTON_MIDDLE or (e.button == g.MOUSE_BUTTON_LEFT and alt):
             if e.mods & g.MOD_SHIFT:
@@ -204,29 +171,29 @@ class CameraTool(Tool):
         if mode is DragMode.ORBIT:
             self.cam.orbit(dx, dy)
         elif mode is DragMode.PAN:
-            self.cam.pan(dx, dy, self.ed.size[1])
+            self.cam.pan(dx, dy, self.ctx.size[1])
         elif mode is DragMode.DOLLY:
             self.cam.dolly(-dy / 20.0)
         else:
             return
-        self.ed.motion()
+        self.ctx.redraw()
 
     def scroll(self, e) -> None:
         """Wheel: zoom to the surface point under the cursor (picked once, when
         this view's pick map is at hand, then kept while the cursor stays put)."""
-        ed = self.ed
-        w, h = ed.size
+        c = self.ctx
+        w, h = c.size
         anchor = self.zoom_anchor
         if anchor is None or abs(anchor[0] - e.x) > 2 or abs(anchor[1] - e.y) > 2:
             point = None
-            if ed.brush.picker_current() and ed.drag is DragMode.NONE:
-                i = ed.brush.splat_under(e.x, e.y)
+            if c.pick_ready() and not c.dragging():
+                i = c.splat_under(e.x, e.y)
                 if i >= 0:
-                    point = self.session.cloud.positions[i].copy()
+                    point = c.document.cloud.positions[i].copy()
             if point is None:
                 point = self.cam.point_at_depth(e.x, e.y, w, h, self.cam.distance)
             anchor = self.zoom_anchor = (e.x, e.y, point)
         _, d = self.cam.project(anchor[2], w, h)
         depth = float(d[0]) if d[0] > 0 else None
         self.cam.dolly(e.dy, e.x, e.y, w, h, depth)
-        ed.motion()
+        c.redraw()

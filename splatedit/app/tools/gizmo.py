@@ -13,6 +13,7 @@ from splatedit.app.ui import overlay as ov
 from splatedit.app.document import revision
 from splatedit.app.ui.keymap import Action, Section, typed_char
 from splatedit.app.document.session import GRAB, ROTATE, SCALE, ViewInfo
+from splatedit.app.tools.shapes import TOP, Circle, Cross, Dot, Label, Polyline, place_inside
 from splatedit.app.tools.base import DragMode, Tool
 from splatedit.errors import SplatEditError
 from splatedit.tolerances import (EDITOR_GIZMO_HIT_PX, EDITOR_GIZMO_MIN_PX, EDITOR_GIZMO_PX,
@@ -28,10 +29,8 @@ def readout_box(mouse, box_w: float, box_h: float, w: int, h: int) -> tuple[floa
     EDITOR_READOUT_OFFSET_PX right of and below the cursor ``mouse``, moved
     so that the whole box keeps EDITOR_READOUT_MARGIN_PX from every window
     edge (a box wider than the window starts at the left margin)."""
-    m, off = EDITOR_READOUT_MARGIN_PX, EDITOR_READOUT_OFFSET_PX
-    x = min(float(mouse[0]) + off, w - m - box_w)
-    y = min(float(mouse[1]) + off, h - m - box_h)
-    return max(x, m), max(y, m)
+    off = EDITOR_READOUT_OFFSET_PX
+    return place_inside(float(mouse[0]) + off, float(mouse[1]) + off, box_w, box_h, w, h, EDITOR_READOUT_MARGIN_PX)
 
 
 class GizmoTool(Tool):
@@ -50,26 +49,26 @@ class GizmoTool(Tool):
     def manip_actions(self):
         """Actions while a manipulation runs (Context.MANIP)."""
         def mode(m):
-            self.session.manip.mode = m
-            self.session.manip.typed = ""
+            self.ctx.document.manip.mode = m
+            self.ctx.document.manip.typed = ""
         return {Action.GRAB: lambda: mode(GRAB), Action.ROTATE: lambda: mode(ROTATE),
                 Action.SCALE: lambda: mode(SCALE),
-                Action.AXIS_X: lambda: self.session.manip.set_axis(0),
-                Action.AXIS_Y: lambda: self.session.manip.set_axis(1),
-                Action.AXIS_Z: lambda: self.session.manip.set_axis(2),
-                Action.TYPE_BACKSPACE: lambda: self.session.manip.backspace(),
+                Action.AXIS_X: lambda: self.ctx.document.manip.set_axis(0),
+                Action.AXIS_Y: lambda: self.ctx.document.manip.set_axis(1),
+                Action.AXIS_Z: lambda: self.ctx.document.manip.set_axis(2),
+                Action.TYPE_BACKSPACE: lambda: self.ctx.document.manip.backspace(),
                 Action.MANIP_DONE: self.finish_manip, Action.MANIP_CANCEL: self.cancel_manip}
 
     def type_key(self, key: int) -> None:
         ch = typed_char(key)
         if ch is not None:
-            self.session.manip.type_char(ch)
+            self.ctx.document.manip.type_char(ch)
 
     # ------------------------------------------------------------ geometry
     def handle_centre(self) -> np.ndarray | None:
         """Posed centroid of the active handle (cached per document version,
         cloud revision and pose)."""
-        s = self.session
+        s = self.ctx.document
         k = s.selection.active
         key = (s.version, revision.of(s.cloud), k, s.pose[k].tobytes() if k < len(s.pose) else b"")
         if self._centre_key != key:
@@ -80,40 +79,40 @@ class GizmoTool(Tool):
     def pivot_point(self) -> np.ndarray | None:
         """The gizmo's centre: the chosen pivot (:mod:`splatedit.app.tools.pivot`),
         else the active handle's posed centroid (None without a handle)."""
-        p = self.ed.pivot.point()
+        p = self.ctx.tool("pivot").point()
         return p if p is not None else self.handle_centre()
 
     def frame(self) -> np.ndarray:
         """(3, 3) the gizmo's axes (columns X, Y, Z), :meth:`PivotTool.frame`."""
-        return self.ed.pivot.frame()
+        return self.ctx.tool("pivot").frame()
 
     def _begin(self, mode: str, mouse) -> bool:
         """Start ``mode`` about the chosen pivot with the chosen axes."""
-        pv = self.ed.pivot
+        pv = self.ctx.tool("pivot")
         piv = pv.point()
-        return self.session.begin(mode, self.view_info(piv), mouse, pivot=piv, frame=pv.frame(),
+        return self.ctx.document.begin(mode, self.view_info(piv), mouse, pivot=piv, frame=pv.frame(),
                                   frame_name=pv.frame_name())
 
     def view_info(self, pivot=None) -> ViewInfo:
-        ed = self.ed
-        w, h = ed.size
-        r, u, b = ed.cam.basis()
-        piv = self.session.handle_centroid() if pivot is None else np.asarray(pivot, float)
-        px, depth = ed.cam.project(piv, w, h)
+        c = self.ctx
+        w, h = c.size
+        r, u, b = c.camera.basis()
+        piv = c.document.handle_centroid() if pivot is None else np.asarray(pivot, float)
+        px, depth = c.camera.project(piv, w, h)
         return ViewInfo(r, u, b, (float(px[0, 0]), float(px[0, 1])),
-                        ed.cam.world_per_pixel(max(float(depth[0]), 1e-9), h))
+                        c.camera.world_per_pixel(max(float(depth[0]), 1e-9), h))
 
     def _base(self, w: int, h: int):
         """``(pivot, pivot_px, world_per_px)`` of the gizmo, or None when it is
         hidden (no fitted active handle, a manipulation running, the curve
         tool on, or the handle behind the eye / far off-screen)."""
-        s = self.session
+        s = self.ctx.document
         if not s.active_fitted() or s.manip is not None or s.curve_mode:
             return None
         if self.handle_centre() is None:
             return None
         piv = self.pivot_point()
-        cam = self.ed.cam
+        cam = self.ctx.camera
         px, d = cam.project(piv, w, h)
         if d[0] <= 0:
             return None
@@ -129,7 +128,7 @@ class GizmoTool(Tool):
         if base is None:
             return []
         piv, p0, wpp = base
-        ends, de = self.ed.cam.project(piv + self.frame().T * (wpp * EDITOR_GIZMO_PX), w, h)
+        ends, de = self.ctx.camera.project(piv + self.frame().T * (wpp * EDITOR_GIZMO_PX), w, h)
         return [(k, p0, ends[k]) for k in range(3)
                 if de[k] > 0 and float(np.hypot(*(ends[k] - p0))) > EDITOR_GIZMO_MIN_PX]
 
@@ -141,7 +140,7 @@ class GizmoTool(Tool):
         if base is None:
             return []
         piv, _, wpp = base
-        back = self.ed.cam.basis()[2]
+        back = self.ctx.camera.basis()[2]
         t = np.linspace(0.0, 2.0 * math.pi, EDITOR_GIZMO_RING_SEGMENTS + 1)
         t[-1] = 0.0
         out = []
@@ -151,7 +150,7 @@ class GizmoTool(Tool):
                 continue
             u, v = f[:, (k + 1) % 3], f[:, (k + 2) % 3]
             pts = piv + wpp * EDITOR_GIZMO_RING_PX * (np.cos(t)[:, None] * u + np.sin(t)[:, None] * v)
-            px, d = self.ed.cam.project(pts, w, h)
+            px, d = self.ctx.camera.project(pts, w, h)
             px = np.array(px, float)
             px[np.asarray(d) <= 0] = np.nan
             out.append((k, px))
@@ -175,12 +174,12 @@ class GizmoTool(Tool):
         """What the panel must not cover: the gizmo, or while a handle is being
         moved (gizmo hidden) the moved handle's centre and its surroundings."""
         box = self.box(w, h)
-        s = self.session
+        s = self.ctx.document
         if box is not None or s.manip is None or not s.selection.handle.any():
             return box
         piv = self.handle_centre()
         m = s.current_matrix()
-        px, d = self.ed.cam.project(m[:3, :3] @ piv + m[:3, 3], w, h)
+        px, d = self.ctx.camera.project(m[:3, :3] @ piv + m[:3, 3], w, h)
         if d[0] <= 0:
             return None
         r = float(EDITOR_GIZMO_PX)
@@ -189,7 +188,7 @@ class GizmoTool(Tool):
     # ---------------------------------------------------------- hit tests
     def arrow_hit(self, x: float, y: float) -> int | None:
         """The arrow under pixel (x, y) (outer three quarters, EDITOR_GIZMO_HIT_PX)."""
-        w, h = self.ed.size
+        w, h = self.ctx.size
         best, axis = EDITOR_GIZMO_HIT_PX, None
         q = np.array([x, y])
         for k, p0, p1 in self.axes(w, h):
@@ -202,7 +201,7 @@ class GizmoTool(Tool):
 
     def ring_hit(self, x: float, y: float) -> int | None:
         """The nearest rotate ring within EDITOR_GIZMO_HIT_PX of pixel (x, y)."""
-        w, h = self.ed.size
+        w, h = self.ctx.size
         best, axis = EDITOR_GIZMO_HIT_PX, None
         q = np.array([x, y], float)
         for k, px in self.rings(w, h):
@@ -220,7 +219,7 @@ class GizmoTool(Tool):
         return axis
 
     def scale_hit(self, x: float, y: float) -> bool:
-        w, h = self.ed.size
+        w, h = self.ctx.size
         c = self.scale_circle(w, h)
         return c is not None and abs(math.hypot(x - c[0][0], y - c[0][1]) - c[1]) <= EDITOR_GIZMO_HIT_PX
 
@@ -264,18 +263,19 @@ class GizmoTool(Tool):
     # --------------------------------------------------------------- mouse
     def press_modal(self, e):
         """While a manipulation runs: left click applies it, right click cancels."""
-        s, g = self.session, self.ed.g
+        s, g = self.ctx.document, self.ctx.keys
         if s.manip is None:
             return None
         if e.button == g.MOUSE_BUTTON_LEFT:
             self.finish_manip()
         elif e.button == g.MOUSE_BUTTON_RIGHT:
             s.cancel()
-            self.ed.motion()
+            self.ctx.redraw()
         return DragMode.NONE
 
     def press(self, e):
-        ed, s, g = self.ed, self.session, self.ed.g
+        c = self.ctx
+        s, g = c.document, c.keys
         if e.button != g.MOUSE_BUTTON_LEFT or s.basis is None or (e.mods & g.MOD_CONTROL):
             return None
         x, y = e.x, e.y
@@ -283,51 +283,51 @@ class GizmoTool(Tool):
         if hit is not None and self._begin(hit[0], (x, y)):
             if hit[1] is not None:
                 s.manip.set_axis(hit[1])
-            ed.motion()
+            c.redraw()
             return DragMode.MANIP
-        if ed.brush.erase_toggle:
+        if c.tool("brush").erase_toggle:
             return None
-        i = ed.brush.splat_under(x, y)
+        i = c.splat_under(x, y)
         k = s.selection.handle_of(i) if i >= 0 else -1
-        ed.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle {k}")
+        c.debug(f"left press at {x:.0f},{y:.0f}: splat {i}, handle {k}")
         if k >= 0:
             s.select_handle(k)
             if self._begin(GRAB, (x, y)):
-                ed.motion()
+                c.redraw()
                 return DragMode.MANIP
         return None
 
     def release(self, mode):
-        if mode is DragMode.MANIP and self.session.manip is not None:
+        if mode is DragMode.MANIP and self.ctx.document.manip is not None:
             self.finish_manip()
 
     # ------------------------------------------------------------- actions
     def begin_key(self, mode: str) -> None:
         """G / R / S: start moving the active handle with the mouse."""
-        s, ed = self.session, self.ed
+        s, c = self.ctx.document, self.ctx
         if not s.active_fitted():
-            ed.say("paint a support region and a handle first" if not s.selection.handle.any()
+            c.say("paint a support region and a handle first" if not s.selection.handle.any()
                    else "the deformation is still being fitted" if s.fitting
                    else f"cannot move the handle: {s.fit_error}" if s.fit_error
                    else "the active handle is not fitted yet")
             return
-        self._begin(mode, ed.mouse)
+        self._begin(mode, c.mouse)
 
     def cancel_manip(self) -> None:
-        self.session.cancel()
-        self.ed.drag = DragMode.NONE
+        self.ctx.document.cancel()
+        self.ctx.end_drag()
 
     def cancel_idle(self) -> None:
         """Esc with nothing moving: discard the pending moves, else leave the curve tool."""
-        s = self.session
+        s = self.ctx.document
         if s.pose_pending:
             s.reset_pose()
-            self.ed.say("pending moves discarded")
+            self.ctx.say("pending moves discarded")
         elif s.curve_mode:
             s.curve_mode = False
 
     def commit_pose(self) -> None:
-        if self.session.pose_pending:
+        if self.ctx.document.pose_pending:
             self._apply(lambda s: s.commit())
 
     def finish_manip(self) -> None:
@@ -337,94 +337,96 @@ class GizmoTool(Tool):
         self._apply(lambda s: s.finish() == "commit")
 
     def _apply(self, action) -> None:
-        ed, s = self.ed, self.session
-        ed.drag = DragMode.NONE
+        c, s = self.ctx, self.ctx.document
+        c.end_drag()
         bad = s.manip.problem() if s.manip is not None else None
         if bad:
-            ed.say(f"{bad}: type another value (Backspace), or Esc to cancel")
-            ed.motion()
+            c.say(f"{bad}: type another value (Backspace), or Esc to cancel")
+            c.redraw()
             return
         try:
             if action(s):
                 if s.committing:
-                    ed.say(f"applying edit {len(s.edits) + 1} in the background (the view stays live; "
+                    c.say(f"applying edit {len(s.edits) + 1} in the background (the view stays live; "
                            "editing waits until it lands)")
                 else:
-                    ed.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
+                    c.say(f"edit {len(s.edits)} applied in {s.last_commit_seconds * 1e3:.0f} ms")
         except SplatEditError as exc:
             s.cancel()
-            ed.say(f"edit not applied: {exc}")
-        ed.motion()
+            c.say(f"edit not applied: {exc}")
+        c.redraw()
 
     def report_commit(self) -> None:
         """Show how a background commit ended (once): a message, or the
         error box when a splat degenerated (the document is unchanged)."""
-        s, ed = self.session, self.ed
+        s, c = self.ctx.document, self.ctx
         out = s.commit_outcome
         if out is None:
             return
         s.commit_outcome = None
         if out.error is None:
-            ed.say(f"edit {out.edits} applied in {out.seconds:.1f} s")
+            c.say(f"edit {out.edits} applied in {out.seconds:.1f} s")
         else:
-            ed.show_error(f"edit not applied: {out.error}")
-        ed.motion()
+            c.show_error(f"edit not applied: {out.error}")
+        c.redraw()
 
     # ------------------------------------------------------------- drawing
-    def overlay(self, w, h):
-        s, cam = self.session, self.ed.cam
+    def shapes(self, w, h):
+        """Inactive handles' crosses, the active handle's axes, rotation
+        rings, scale circle, constraint axis, the pivot -> current line and
+        the live readout next to the cursor (over the panels)."""
+        c = self.ctx
+        s, cam = c.document, c.camera
         out = []
         if len(s.selection.handles) > 1:        # inactive handles: a dark green cross at their centre
             for k, hm in enumerate(s.selection.handles):
                 if k != s.selection.active and hm.any():
                     px, d = cam.project(s.handle_centroid(k), w, h)
                     if d[0] > 0:
-                        out.append(ov.cross_patch(px[0], (20, 90, 25), 6))
+                        out.append(Cross(px[0], (20, 90, 25), 6.0))
+        out += self._handle_shapes(w, h)
+        return out + self.readout_shapes()
+
+    def _handle_shapes(self, w: int, h: int) -> list:
+        c = self.ctx
+        s, cam = c.document, c.camera
         if not s.selection.handle.any() or (s.manip_target and s.manip_target[0] == "curve"):
-            return out + self.readout_patches()
+            return []
+        out = []
         piv = self.handle_centre()
         m = s.current_matrix()
         cur = m[:3, :3] @ piv + m[:3, 3]
         grip = self.scale_circle(w, h)
-        if grip is not None and np.isfinite(grip[0]).all() and np.abs(grip[0]).max() < 1e5:
-            img = ov.ring(int(round(grip[1])), (225, 225, 225), 1)
-            out.append(ov.Patch(int(round(grip[0][0])) - img.shape[1] // 2,
-                                int(round(grip[0][1])) - img.shape[0] // 2, img))
+        if grip is not None:
+            out.append(Circle(grip[0], grip[1], (225, 225, 225), 1.0, halo=False))
         for k, px in self.rings(w, h):
-            p = ov.polyline_patch(px, ov.AXIS_RGB[k], 2)
-            if p:
-                out.append(p)
+            out.append(Polyline(px, ov.AXIS_RGB[k], 2.0, halo=False))
         for k, p0, p1 in self.axes(w, h):
-            p = ov.line_patch(p0, p1, ov.AXIS_RGB[k], 3, dot=True)
-            if p:
-                out.append(p)
+            out += [Polyline(np.array([p0, p1]), ov.AXIS_RGB[k], 3.0, halo=False),
+                    Dot(p1, ov.AXIS_RGB[k], 4.0, rim=False)]
         px, depth = cam.project(np.vstack([piv, cur]), w, h)
         if depth.min() <= 0:
-            return out + self.readout_patches()
+            return out
         if s.manip is not None and s.manip.axis is not None:
             a = s.manip.axis_vector() * cam.scene_radius
             ends, d2 = cam.project(np.vstack([cur - a, cur + a]), w, h)
             if d2.min() > 0:
-                p = ov.line_patch(ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1)
-                if p:
-                    out.append(p)
+                out.append(Polyline(np.array(ends[:2]), ov.AXIS_RGB[s.manip.axis], 1.0, halo=False))
         if s.manip is not None:
-            p = ov.line_patch(px[0], px[1], (255, 255, 255), 1)
-            if p:
-                out.append(p)
-        out.append(ov.cross_patch(px[1], ov.HANDLE_RGB if s.active_fitted() else (200, 200, 200)))
-        return out + self.readout_patches()
+            out.append(Polyline(np.array(px[:2]), (255, 255, 255), 1.0, halo=False))
+        out.append(Cross(px[1], ov.HANDLE_RGB if s.active_fitted() else (200, 200, 200)))
+        return out
 
     def readout_text(self) -> str | None:
-        m = self.session.manip
+        m = self.ctx.document.manip
         return None if m is None else m.readout()
 
-    def readout_patches(self) -> list:
+    def readout_shapes(self) -> list:
         """The live distance / angle / factor, next to the cursor while moving."""
         text = self.readout_text()
         if text is None:
             return []
-        img = ov.text_panel((text,), size=13, fg=READOUT_RGB + (255,), pad=3, bg=(20, 22, 28, 200))
-        w, h = self.ed.size
-        x, y = readout_box(self.ed.mouse, img.shape[1], img.shape[0], w, h)
-        return [ov.Patch(int(x), int(y), img)]
+        mx, my = self.ctx.mouse
+        off = EDITOR_READOUT_OFFSET_PX       # placed by the painter (its text size): readout_box's rule
+        return [Label((mx + off, my + off), text, READOUT_RGB, size=13, keep_inside=True,
+                      margin=EDITOR_READOUT_MARGIN_PX, name="readout", layer=TOP)]

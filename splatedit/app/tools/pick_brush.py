@@ -186,3 +186,64 @@ def picker_for_view(pick: np.ndarray, front_depth: np.ndarray | None, camera, po
     footprint = np.abs(depth) * (camera.world_per_pixel(1.0, h) * tol_px)
     tol = np.maximum(2.0 * np.asarray(radii), footprint)
     return BrushPicker(pick, px, depth, tol, front_depth)
+
+
+class ViewPicking:
+    """The pick map of the editor's current view (an owned part of the
+    :class:`~splatedit.app.editor.Editor`, ``editor.picking``): which splat
+    is visible at each pixel, as a :class:`BrushPicker`, rebuilt when the
+    view or the drawn document changes (taken from the frame scheduler when
+    it drew it in chunks after the view's refinement, else picked now).
+    Used by the brush, the region tools, clicks on a handle or the support
+    and the zoom to the cursor."""
+
+    def __init__(self, ed):
+        self._ed = ed
+        self._picker: BrushPicker | None = None
+        self._key = None
+
+    def key(self) -> tuple:
+        """What the pick map depends on: camera, size, the cloud's and the
+        basis' revisions, the displacement drawn."""
+        from splatedit.app.document import revision
+        ed = self._ed
+        s = ed.session
+        w, h = ed.size
+        dc = ed.viewport.dc
+        return (ed.cam.state(), w, h, revision.of(s.cloud), revision.of(s.basis),
+                None if dc is None or not dc.any() else dc.tobytes())
+
+    def invalidate(self) -> None:
+        """Forget the pick map (the drawn cloud was replaced)."""
+        self._picker = None
+
+    def current(self) -> bool:
+        """The pick map of this view is at hand (no pick needed to use it)."""
+        return self._picker is not None and self._key == self.key()
+
+    def get(self) -> BrushPicker:
+        """The :class:`BrushPicker` of this view (picked when stale)."""
+        from splatedit.tolerances import EDITOR_PICK_TOL_PX
+        ed = self._ed
+        s = ed.session
+        w, h = ed.size
+        key = self.key()
+        if self._picker is None or self._key != key:
+            ready = ed.frames.take_pick(key)     # drawn in chunks after the view's refinement
+            idx, front = ready if ready is not None else ed.viewport.pick(ed.cam, w, h)
+            self._picker = picker_for_view(idx, front, ed.cam, s.cloud.positions, s.cloud.radii, EDITOR_PICK_TOL_PX)
+            self._key = key
+        return self._picker
+
+    def splat_under(self, x: float, y: float) -> int:
+        """The index of the splat visible at pixel (x, y), or -1."""
+        p = self.get().pick
+        ix, iy = int(x), int(y)
+        if 0 <= iy < p.shape[0] and 0 <= ix < p.shape[1]:
+            return int(p[iy, ix])
+        return -1
+
+    def displaced(self) -> bool:
+        """The view draws a displacement (a move in progress or pending)."""
+        dc = self._ed.viewport.dc
+        return dc is not None and bool(dc.any())

@@ -1,12 +1,14 @@
-"""The tools' overlays drawn on the GPU: ImGui draw-list shapes.
+"""The tools' overlays drawn on the GPU: ImGui draw-list primitives.
 
-The same geometry as the CPU overlay (:mod:`splatedit.app.ui.overlay`, the
-tools' ``overlay`` patches), taken from the tools (gizmo axes, rings and
-scale circle, curve polyline and dots, brush ring, the last closure's
-highlight, the live G/R/S readout), but emitted as lines, circles and text
-into ImGui's *background* draw list, which the GUI pass draws under its
-windows, on top of the scene frame in the swapchain image: no pixels are
-composited on the CPU.  Called between ``Gui.new_frame`` and ``Gui.render``.
+The GPU painter of the tool protocol (:func:`draw_shapes`): the tools'
+backend-neutral shapes (:mod:`splatedit.app.tools.shapes`; the CPU fallback
+paints the same list with :func:`splatedit.app.tools.shapes.to_patches`) are
+emitted as lines, circles and text into ImGui's *background* draw list,
+which the GUI pass draws under its windows, on top of the scene frame in
+the swapchain image (shapes of the TOP layer, the live G/R/S readout, go to
+the foreground list, over the panels): no pixels are composited on the CPU.
+Called between ``Gui.new_frame`` and ``Gui.render``.  Also the modal text
+boxes (file browser, error box).
 """
 
 from __future__ import annotations
@@ -14,17 +16,13 @@ from __future__ import annotations
 import numpy as np
 from imgui_bundle import imgui
 
-from splatedit.app.ui import overlay as ov
-from splatedit.app.tools.curve import CURVE_RGB
-from splatedit.app.tools.gizmo import READOUT_RGB, readout_box
 from splatedit.app.document import selection as seltools
-from splatedit.app.tools.shapes import Polyline
+from splatedit.app.tools.shapes import (FAR_PX, TOP, Circle, Cross, Dot, Label, Points, Polyline, in_draw_order,
+                                        place_inside)
 from splatedit.app.ui.panel import Box
 from splatedit.tolerances import EDITOR_GUI_MAX_HIGHLIGHT_DOTS
 
 _SHADOW = (0, 0, 0, 160)
-#: pixel coordinates beyond this are off any window (a point near the eye plane)
-_FAR_PX = 1e5
 
 
 def col(rgb, alpha: int = 255) -> int:
@@ -33,7 +31,7 @@ def col(rgb, alpha: int = 255) -> int:
 
 
 def _ok(*pts) -> bool:
-    return all(np.isfinite(p).all() and np.abs(p).max() < _FAR_PX for p in pts)
+    return all(np.isfinite(p).all() and np.abs(p).max() < FAR_PX for p in pts)
 
 
 def _v(p) -> imgui.ImVec2:
@@ -107,113 +105,59 @@ def dots(dl, px, size: tuple[int, int], rgb=seltools.CLOSURE_RGB, alpha: int = 2
 
 
 # ------------------------------------------------------------------ tools
-def draw_brush(ed, dl, w: int, h: int) -> None:
-    """The closure highlight (under everything) and the brush ring with its mode tag."""
-    s, b = ed.session, ed.brush
-    hl = b.tools.highlighted(s.cloud)
-    if hl is not None:
-        px, d = ed.cam.project(s.cloud.positions[hl], w, h)
-        dots(dl, np.where((d > 0)[:, None], px, np.nan), (w, h))
-    if ed.drag.camera or s.manip is not None or ed.modal() or not ed.cursor_inside:
-        return
-    if ed.gui is not None and ed.gui.wants_mouse:
-        return                      # the pointer is over a panel: no brush there
-    rgb = b.cursor_colour()
-    mx, my = ed.mouse
-    r = float(b.radius)
-    dl.add_circle(imgui.ImVec2(mx, my), r + 1.0, col((0, 0, 0), 150), 0, 4.0)
-    dl.add_circle(imgui.ImVec2(mx, my), r, col(rgb, 230), 0, 2.0)
-    tag = "3D" if b.tools.mode == seltools.BRUSH_3D else "VIS"
-    k = r * 0.7071
-    label(dl, (mx + k + 4, my + k + 4), tag, rgb, 150)
-
-
-def draw_curve(ed, dl, w: int, h: int) -> None:
-    s = ed.session
-    poly = s.curve_polyline()
-    if poly is not None:
-        px, d = ed.cam.project(poly, w, h)
-        px = np.array(px, float)
-        px[np.asarray(d) <= 0] = np.nan
-        polyline(dl, px, CURVE_RGB, 3.0)
-    active = s.manip_target[1] if (s.manip_target and s.manip_target[0] == "curve") else None
-    chosen = s.active_curve_point() if s.curve_mode else None     # the transform fields' point: ringed
-    for j, q in enumerate(ed.curve.dots(w, h)):
-        if j == chosen and j != active:
-            dot(dl, q, (255, 255, 255), 7.0)
-        dot(dl, q, (255, 255, 255) if j == active else CURVE_RGB, 7.0 if j == active else 5.0)
-
-
-def draw_gizmo(ed, dl, w: int, h: int) -> None:
-    """Inactive handles' crosses, the active handle's axes, rotation rings,
-    scale circle, constraint axis and the pivot -> current line."""
-    s, cam, gz = ed.session, ed.cam, ed.gizmo
-    if len(s.selection.handles) > 1:
-        for k, hm in enumerate(s.selection.handles):
-            if k != s.selection.active and hm.any():
-                px, d = cam.project(s.handle_centroid(k), w, h)
-                if d[0] > 0:
-                    cross(dl, px[0], (20, 90, 25), 6.0)
-    if not s.selection.handle.any() or (s.manip_target and s.manip_target[0] == "curve"):
-        return
-    piv = gz.handle_centre()
-    m = s.current_matrix()
-    cur = m[:3, :3] @ piv + m[:3, 3]
-    grip = gz.scale_circle(w, h)
-    if grip is not None and _ok(grip[0]):
-        dl.add_circle(_v(grip[0]), float(grip[1]), col((225, 225, 225)), 0, 1.0)
-    for k, px in gz.rings(w, h):
-        polyline(dl, px, ov.AXIS_RGB[k], 2.0)
-    for k, p0, p1 in gz.axes(w, h):
-        line(dl, p0, p1, ov.AXIS_RGB[k], 3.0, dot=True)
-    px, depth = cam.project(np.vstack([piv, cur]), w, h)
-    if depth.min() <= 0:
-        return
-    if s.manip is not None and s.manip.axis is not None:
-        a = s.manip.axis_vector() * cam.scene_radius
-        ends, d2 = cam.project(np.vstack([cur - a, cur + a]), w, h)
-        if d2.min() > 0:
-            line(dl, ends[0], ends[1], ov.AXIS_RGB[s.manip.axis], 1.0)
-    if s.manip is not None:
-        line(dl, px[0], px[1], (255, 255, 255), 1.0)
-    cross(dl, px[1], ov.HANDLE_RGB if s.active_fitted() else (200, 200, 200))
-
-
-def draw_readout(ed, dl, w: int, h: int) -> None:
-    """The live distance / angle / factor next to the cursor while moving."""
-    text = ed.gizmo.readout_text()
-    if text is None:
-        return
-    size = imgui.calc_text_size(text)
-    bw, bh = size.x + 6, size.y + 4              # label()'s box: 3 / 2 pixels around the text
-    bx, by = readout_box(ed.mouse, bw, bh, w, h)
-    label(dl, (bx + 3, by + 2), text, READOUT_RGB)
-    gui = getattr(ed, "gui", None)
-    if gui is not None:                          # where it is (the status file's gui_rects)
-        gui.rects["readout"] = Box(int(bx), int(by), int(round(bw)), int(round(bh)))
-
-
-def draw_shapes(dl, shapes) -> None:
-    """Backend-neutral overlay shapes (:mod:`splatedit.app.tools.shapes`) as draw-list lines."""
-    for s in shapes:
-        if not isinstance(s, Polyline):
-            raise TypeError(f"not an overlay shape: {s!r}")
-        strip = s.strip()
-        polyline(dl, strip, (0, 0, 0), s.width + 2.0)       # a dark halo, as the CPU path
-        polyline(dl, strip, s.rgb, s.width)
+def draw_shapes(shapes, w: int, h: int, under=None, top=None, record=None) -> None:
+    """The GPU painter: backend-neutral overlay shapes
+    (:mod:`splatedit.app.tools.shapes`) as ImGui draw-list primitives, in draw
+    order; layers UNDER and OVER into ``under`` (default: the background
+    draw list, under the GUI's windows), TOP into ``top`` (default: the
+    foreground list, over the panels); ``record(name, (x, y, w, h))`` is
+    told where named labels went."""
+    if under is None:
+        under = imgui.get_background_draw_list()
+    if top is None:
+        top = imgui.get_foreground_draw_list()
+    for s in in_draw_order(shapes):
+        dl = top if s.layer == TOP else under
+        if isinstance(s, Polyline):
+            strip = s.strip()
+            if s.halo:
+                polyline(dl, strip, (0, 0, 0), s.width + 2.0)       # a dark halo, as the CPU path
+            polyline(dl, strip, s.rgb, s.width)
+        elif isinstance(s, Circle):
+            if _ok(s.centre):
+                c, r = _v(s.centre), float(s.radius)
+                if s.halo:
+                    dl.add_circle(c, r + 1.0, col((0, 0, 0), 150), 0, s.width + 2.0)
+                    dl.add_circle(c, r, col(s.rgb, 230), 0, float(s.width))
+                else:
+                    dl.add_circle(c, r, col(s.rgb), 0, float(s.width))
+        elif isinstance(s, Dot):
+            if _ok(s.centre):
+                if s.rim:
+                    dl.add_circle_filled(_v(s.centre), s.radius + 1.0, col((0, 0, 0), 200))
+                dl.add_circle_filled(_v(s.centre), float(s.radius), col(s.rgb))
+        elif isinstance(s, Cross):
+            cross(dl, s.centre, s.rgb, float(s.size))
+        elif isinstance(s, Label):
+            size = imgui.calc_text_size(s.text)
+            bw, bh = size.x + 6, size.y + 4              # label()'s box: 3 / 2 pixels around the text
+            x, y = float(s.corner[0]), float(s.corner[1])
+            if s.keep_inside:
+                x, y = place_inside(x, y, bw, bh, w, h, s.margin)
+            label(dl, (x + 3, y + 2), s.text, s.rgb, s.bg_alpha)
+            if s.name and record is not None:
+                record(s.name, (int(x), int(y), int(round(bw)), int(round(bh))))
+        elif isinstance(s, Points):
+            dots(dl, s.points, (w, h), s.rgb, s.alpha)
 
 
 def draw_tools(ed, w: int, h: int) -> None:
-    """Every tool overlay of the frame into the background draw list."""
-    if ed.session is None:
-        return
-    dl = imgui.get_background_draw_list()
-    draw_brush(ed, dl, w, h)
-    draw_curve(ed, dl, w, h)
-    draw_gizmo(ed, dl, w, h)
-    for tool in ed.tools:               # the protocol's shapes, painted on the GPU
-        draw_shapes(dl, tool.shapes(w, h))
-    draw_readout(ed, imgui.get_foreground_draw_list(), w, h)      # over the panels
+    """Every tool's overlay shapes of the frame (:meth:`Editor.overlay_shapes`);
+    where named labels went (the readout) is recorded in the GUI's rects
+    (the status file's ``gui_rects``)."""
+    gui = getattr(ed, "gui", None)
+    record = None if gui is None else (lambda name, b: gui.rects.__setitem__(name, Box(*b)))
+    draw_shapes(ed.overlay_shapes(w, h), w, h, record=record)
 
 
 def text_box(dl, lines, w: int, h: int, *, top: float | None = None, pad: int = 8,

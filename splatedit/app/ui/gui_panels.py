@@ -5,7 +5,7 @@ presenter's Vulkan device.  Each presented frame it builds, between
 ``new_frame`` and ``render``:
 
 * the **menu bar** (:mod:`splatedit.app.ui.menus`): File
-  (:attr:`EditorGui.file_menu`, a list of :class:`MenuEntry` that other
+  (:attr:`EditorGui.menus.file_menu <splatedit.app.ui.menus.MenuBar.file_menu>`, a list of :class:`MenuEntry` that other
   parts of the editor extend: Open..., Open recent, Save ...), Edit (undo /
   redo), View (panels, help, frame all);
 * the **side panel** (collapsible sections; P hides it, as before; placed at
@@ -33,7 +33,10 @@ import time
 
 from imgui_bundle import imgui
 
-from splatedit.app.ui import help as gui_help, gui_overlay, questions as gui_questions
+from splatedit.app.ui import help as gui_help
+from splatedit.app.ui import gui_overlay
+from splatedit.app.ui import questions as gui_questions
+from splatedit.app.ui import overlay as ov
 from splatedit.app.document.gaussian import model_summary
 from splatedit.app.ui.menus import MenuBar, MenuEntry  # noqa: F401 (MenuEntry: the File menu's rows)
 from splatedit.app.document import selection as seltools
@@ -55,26 +58,19 @@ ACTIVE_BUTTON = imgui.IM_COL32(40, 110, 200, 255)
 MESSAGE_SECONDS = 8.0
 
 
-class EditorGui(MenuBar):
+class EditorGui:
     def __init__(self, ed, device):
         from splatedit.render.gui.gui import Gui
         self.ed = ed
         self.gui = Gui(device)
         imgui.get_io().config_flags &= ~imgui.ConfigFlags_.nav_enable_keyboard.value   # keys are the editor's
-        has = lambda: ed.session is not None  # noqa: E731
-        #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
-        self.file_menu: list[MenuEntry] = [
-            MenuEntry("Open...", lambda: ed.run_action(Action.OPEN), "Ctrl+O", name="menu_open"),
-            MenuEntry("Open recent", None, submenu=self._recent_menu, name="menu_recent"),
-            MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
-            MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
-            MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
-            MenuEntry("Quit", lambda: ed.run_action(Action.QUIT), "Q")]
+        #: the menu bar (an owned part, :class:`~splatedit.app.ui.menus.MenuBar`;
+        #: its ``file_menu`` rows may be extended)
+        self.menus = MenuBar(ed, self.rect)
         self.transform = TransformSection(ed)
         self.rects: dict[str, Box] = {}
         self.panel_box: Box | None = None
         self.help_box: Box | None = None
-        self.menu_height = 0.0
         self._panel_size = (EDITOR_GUI_PANEL_WIDTH, 200)
         self._sections_h = 400.0           # the panel's scrolling part / footer heights (last frame)
         self._footer_h = 60.0
@@ -86,7 +82,6 @@ class EditorGui(MenuBar):
         self._history_follow = 0                             # frames left that scroll to the current entry
         self._last = time.perf_counter()
         self.windows: list[Box] = []        # GUI windows of the last frame (mouse routing)
-        self._menu_open = False
         self._close_menus = False          # Esc was pressed with a menu open
         self._press_in_gui = False
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
@@ -106,18 +101,18 @@ class EditorGui(MenuBar):
         self.gui.feed(ev)
         self._frames_wanted = EDITOR_GUI_SETTLE_FRAMES
         kind = ev.kind
-        if kind == "key" and self._menu_open and ev.key == self.ed.g.KEY_ESCAPE:
+        if kind == "key" and self.menus.open and ev.key == self.ed.g.KEY_ESCAPE:
             # Esc closes an open menu (ImGui does not without keyboard navigation, and
             # the menu would then swallow the next click: the first stroke did nothing);
             # the key is the menu's, it cancels nothing else
             if ev.action == 1:
-                self._close_menus, self._menu_open = True, False
+                self._close_menus, self.menus.open = True, False
             return True
         if kind in ("key", "char"):
             return self.wants_keyboard
         if kind == "button":
             if ev.action == 1:                    # press
-                self._press_in_gui = self._menu_open or self.owns_point(ev.x, ev.y)
+                self._press_in_gui = self.menus.open or self.owns_point(ev.x, ev.y)
                 return self._press_in_gui
             taken, self._press_in_gui = self._press_in_gui, False
             return taken
@@ -154,7 +149,12 @@ class EditorGui(MenuBar):
     @property
     def menu_open(self) -> bool:
         """A menu of the menu bar was open in the last frame."""
-        return self._menu_open
+        return self.menus.open
+
+    @property
+    def menu_height(self) -> float:
+        """The menu bar's height in pixels (last frame)."""
+        return self.menus.height
 
     @property
     def wants_keyboard(self) -> bool:
@@ -163,7 +163,7 @@ class EditorGui(MenuBar):
         holds while a clicked window keeps the focus, which would swallow the
         editor's keys (Esc after a palette button) though ImGui does nothing
         with them (keyboard navigation is off)."""
-        self.gui._current()
+        self.gui.make_current()
         return bool(imgui.get_io().want_text_input)
 
     # ---------------------------------------------------------------- frame
@@ -175,12 +175,13 @@ class EditorGui(MenuBar):
         self._last = now
         self.rects = {}
         self.windows = []
-        self._menu_open = False
         if self._close_menus:
             imgui.internal.close_popups_except_modals()
             self._close_menus = False
         gui_overlay.draw_tools(self.ed, w, h)
-        self._menu_bar(w)
+        bar = self.menus.draw(w)
+        if bar is not None:
+            self.windows.append(bar)
         help_full = self.ed.help.shown and self._help_area(w, h)[1]
         if self.ed.panel_visible and not help_full:
             self._panel(w, h)
@@ -207,7 +208,7 @@ class EditorGui(MenuBar):
     def close(self) -> None:
         self.gui.close()
 
-    def _rect(self, name: str) -> None:
+    def rect(self, name: str) -> None:
         """Record the last widget's rectangle as ``name`` when it is wholly
         shown (one scrolled out of the panel's sections, or under the footer,
         is not: it cannot be clicked)."""
@@ -303,7 +304,7 @@ class EditorGui(MenuBar):
         if getattr(self.ed, "ooc", None) is not None:
             imgui.text_disabled(self.ed.ooc.summary(s))
         imgui.pop_text_wrap_pos()
-        self._rect("panel_summary")
+        self.rect("panel_summary")
         if s.manip is not None:               # the live readout of a running move
             imgui.text_colored(YELLOW, s.manip.readout())
             imgui.push_text_wrap_pos(0.0)
@@ -317,7 +318,7 @@ class EditorGui(MenuBar):
         if imgui.collapsing_header("Deformation", open_):
             self._deformation()
         if imgui.collapsing_header("Transform", open_):
-            self.transform.draw(self._rect)
+            self.transform.draw(self.rect)
         # History before Display: at 1280x720 the History section was always
         # below the fold (issue 19 item 8); the display options are set once
         if imgui.collapsing_header("History", open_):
@@ -333,10 +334,10 @@ class EditorGui(MenuBar):
         returns ImGui's (changed, value)."""
         imgui.set_next_item_width(EDITOR_GUI_SLIDER_WIDTH)
         changed, v = imgui.slider_float(f"##{name}", value, lo, hi, "", imgui.SliderFlags_.logarithmic.value)
-        self._rect(f"{name}_slider")
+        self.rect(f"{name}_slider")
         imgui.same_line()
         imgui.text(f"{fmt % v}  {label}")
-        self._rect(f"{name}_value")
+        self.rect(f"{name}_value")
         return changed, v
 
     def _tool_button(self, label: str, name: str, action: Action, on: bool) -> None:
@@ -346,7 +347,7 @@ class EditorGui(MenuBar):
             self.ed.run_action(action)
         if on:
             imgui.pop_style_color()
-        self._rect(name)
+        self.rect(name)
 
     def _palette(self) -> None:
         s = self.ed.session
@@ -375,12 +376,12 @@ class EditorGui(MenuBar):
         note = b.mode_note()
         if note:
             imgui.text_colored(YELLOW, note)
-            self._rect("brush_note")
+            self.rect("brush_note")
         for tool in self.ed.tools:      # the protocol tools' state lines
             line = tool.status()
             if line:
                 imgui.text_colored(YELLOW, line)
-                self._rect(f"tool_status_{getattr(tool, 'name', type(tool).__name__)}")
+                self.rect(f"tool_status_{getattr(tool, 'name', type(tool).__name__)}")
         imgui.pop_text_wrap_pos()
 
     def _stats(self, st) -> None:
@@ -411,12 +412,12 @@ class EditorGui(MenuBar):
         if d is not None:
             imgui.text_colored(RED if d.exceeds_warn else imgui.ImVec4(0.92, 0.92, 0.92, 1.0),
                                f"stretch max {d.max_stretch:.1f}x, {d.n_above_warn:,} > {d.warn:g}x")
-            source = gui_overlay.ov.distortion_source(s)
+            source = ov.distortion_source(s)
             if source:
                 imgui.push_text_wrap_pos(0.0)
                 imgui.text_disabled(source)
                 imgui.pop_text_wrap_pos()
-                self._rect("distortion_source")
+                self.rect("distortion_source")
 
     def _deformation(self) -> None:
         ed, s = self.ed, self.ed.session
@@ -427,7 +428,7 @@ class EditorGui(MenuBar):
             if imgui.radio_button(m.value, s.deformation is m) and s.deformation is not m:
                 s.set_deformation(m)
                 ed.say(f"deformation: {m.value}")
-            self._rect(f"mode_{m.value}")
+            self.rect(f"mode_{m.value}")
             if m is DeformationMode.DETAIL and not detail_ok:
                 imgui.end_disabled()
             imgui.same_line()
@@ -454,13 +455,13 @@ class EditorGui(MenuBar):
                     ed.run_action(Action.DISTORTION_MAP)
                 if k < 2 and vp.grey != (k == 1):
                     ed.run_action(Action.COLOUR_MODE)
-            self._rect(f"display_{name.split()[0]}")
+            self.rect(f"display_{name.split()[0]}")
             if k < 2:
                 imgui.same_line()
         if getattr(vp, "gaussians", None) is None:      # eye-dome lighting: a splat pass
             if imgui.checkbox("eye-dome lighting (Shift+E)", bool(vp.edl))[0]:
                 ed.run_action(Action.EDL)
-            self._rect("display_edl")
+            self.rect("display_edl")
         ch, v = self._slider("splat size", "splat_size", float(vp.splat_scale), EDITOR_SPLAT_SCALE_MIN,
                              EDITOR_SPLAT_SCALE_MAX, "%.2fx")
         if ch:
@@ -501,7 +502,7 @@ class EditorGui(MenuBar):
                     self._history_follow -= 1
                     self._frames_wanted = max(self._frames_wanted, 1)   # the frame that applies it
                 if imgui.is_item_visible():
-                    self._rect(f"history_{k}")
+                    self.rect(f"history_{k}")
         imgui.end_child()           # always (ImGui's rule for begin_child)
 
     def jump(self, k: int) -> None:

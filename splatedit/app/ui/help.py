@@ -53,7 +53,7 @@ def draw_help(g, w: int, h: int) -> None:
     # room for it below the rows, or it would hide the last row (the help's last line at the end)
     bar = imgui.get_style().scrollbar_size
     if g.help_width is None:
-        g.help_width = max(imgui.calc_text_size(text).x for text, _ in hv._lines)
+        g.help_width = max(imgui.calc_text_size(text).x for text, _ in hv.lines)
     wide = g.help_width > avail.x - bar          # (the vertical bar takes its width when paged)
     hv.rows = max(int((avail.y - foot - (bar if wide else 0.0)) // lh), 1)
     child_h = hv.rows * lh + (bar if wide else 0.0)
@@ -70,7 +70,7 @@ def draw_help(g, w: int, h: int) -> None:
     if abs(sy - target) > 0.5:
         imgui.set_scroll_y(target)
     g.help_scroll_set = target
-    for text, title in hv._lines:
+    for text, title in hv.lines:
         if title:
             imgui.text_colored(BLUE, text)
         else:

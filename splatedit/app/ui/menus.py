@@ -1,12 +1,14 @@
-"""The editor's menu bar (Dear ImGui): File (:attr:`EditorGui.file_menu`,
+"""The editor's menu bar (Dear ImGui): File (:attr:`MenuBar.file_menu`,
 rows of :class:`MenuEntry`, with Open... and the Open recent submenu), Edit
 (undo / redo), Select (all / none / invert, box / lasso, grow / shrink /
 connected, mirror and the selection toggles), Pivot (the centre and axes of
 R / S and the gizmo) and View (panels, help, frame all, the six views about the up axis).
 
-A part of :class:`~splatedit.app.ui.gui_panels.EditorGui` (mixed into it: it
-uses its ``ed``, ``windows``, ``rects`` and ``_rect``).  Esc closes an open
-menu (:meth:`~splatedit.app.ui.gui_panels.EditorGui.feed`)."""
+An owned part of :class:`~splatedit.app.ui.gui_panels.EditorGui`
+(``gui.menus``, a :class:`MenuBar`): it is given the editor and the GUI's
+function that records a widget's rectangle, and reports its height and
+whether a menu is open.  Esc closes an open menu
+(:meth:`~splatedit.app.ui.gui_panels.EditorGui.feed`)."""
 
 from __future__ import annotations
 
@@ -68,23 +70,44 @@ class MenuEntry:
 
 
 class MenuBar:
-    """The menu bar of the EditorGui."""
+    """The menu bar of the EditorGui: ``ed`` the editor, ``record(name)``
+    records the last widget's rectangle under ``name`` (the GUI's
+    ``gui_rects``)."""
 
-    # ------------------------------------------------------------ menu bar
-    def _menu_bar(self, w: int) -> None:
+    def __init__(self, ed, record: Callable[[str], None]):
+        self.ed = ed
+        self._rect = record
+        #: the File menu, top to bottom (append / insert MenuEntry rows to extend it)
+        has = lambda: ed.session is not None  # noqa: E731
+        self.file_menu: list[MenuEntry] = [
+            MenuEntry("Open...", lambda: ed.run_action(Action.OPEN), "Ctrl+O", name="menu_open"),
+            MenuEntry("Open recent", None, submenu=self._recent_menu, name="menu_recent"),
+            MenuEntry("Save", lambda: ed.run_action(Action.SAVE), "Ctrl+S", has),
+            MenuEntry("Save as...", lambda: ed.run_action(Action.SAVE_AS), "Ctrl+Shift+S", has),
+            MenuEntry("Export edit script", lambda: ed.run_action(Action.EXPORT_SCRIPT), "Ctrl+E", has),
+            MenuEntry("Quit", lambda: ed.run_action(Action.QUIT), "Q")]
+        #: the bar's height in pixels (last frame)
+        self.height = 0.0
+        #: a menu was open in the frame being laid out / the last frame
+        self.open = False
+
+    def draw(self, w: int) -> Box | None:
+        """Lay out the bar (a ``w`` pixels wide window); returns its box
+        (None when ImGui did not show it).  Resets :attr:`open` first."""
         ed = self.ed
+        self.open = False
         if not imgui.begin_main_menu_bar():
-            return
-        self.menu_height = imgui.get_window_size().y
-        self.windows.append(Box(0, 0, w, int(self.menu_height)))
+            return None
+        self.height = imgui.get_window_size().y
+        box = Box(0, 0, w, int(self.height))
         if imgui.begin_menu("File"):
-            self._menu_open = True
+            self.open = True
             self._menu_entries(self.file_menu)
             imgui.end_menu()
         self._rect("menu_file")
         s = ed.session
         if imgui.begin_menu("Edit", s is not None):
-            self._menu_open = True
+            self.open = True
             if imgui.menu_item("Undo", "Ctrl+Z", False, s.history.can_undo or s.manip is not None)[0]:
                 ed.run_action(Action.UNDO)
             if imgui.menu_item("Redo", "Ctrl+Shift+Z", False, s.history.can_redo)[0]:
@@ -92,17 +115,17 @@ class MenuBar:
             imgui.end_menu()
         self._rect("menu_edit")
         if imgui.begin_menu("Select", s is not None):
-            self._menu_open = True
+            self.open = True
             self._select_menu()
             imgui.end_menu()
         self._rect("menu_select")
         if imgui.begin_menu("Pivot", s is not None):
-            self._menu_open = True
+            self.open = True
             self._pivot_menu()
             imgui.end_menu()
         self._rect("menu_pivot")
         if imgui.begin_menu("View"):
-            self._menu_open = True
+            self.open = True
             if imgui.menu_item("Panels", "P", ed.panel_visible)[0]:
                 ed.run_action(Action.PANEL)
             if imgui.menu_item("Help", "F1", ed.help.shown)[0]:
@@ -124,6 +147,7 @@ class MenuBar:
             imgui.end_menu()
         self._rect("menu_view")
         imgui.end_main_menu_bar()
+        return box
 
     def _select_menu(self) -> None:
         """Select: all / none / invert, box / lasso, grow / shrink / connected,
@@ -195,9 +219,9 @@ class MenuBar:
         unsaved-changes question included), then "Clear recent files"."""
         from splatedit.app.ui.recent import menu_labels
         ed = self.ed
-        paths = ed.recent_files()
+        paths = ed.file_actions.recent_files()
         if not paths:
             return [MenuEntry("(no recent files)", lambda: None, enabled=lambda: False, name="recent_none")]
-        rows = [MenuEntry(label, lambda p=p: ed.open_path(p), name=f"recent_{i}")
+        rows = [MenuEntry(label, lambda p=p: ed.file_actions.open_path(p), name=f"recent_{i}")
                 for i, (label, p) in enumerate(zip(menu_labels(paths), paths))]
-        return rows + [MenuEntry("Clear recent files", ed.clear_recent, name="recent_clear")]
+        return rows + [MenuEntry("Clear recent files", ed.file_actions.clear_recent, name="recent_clear")]

@@ -93,14 +93,15 @@ def text_panel(lines: tuple, size: int = 14, bg=(20, 22, 28, 200), fg=(235, 235,
 
 
 @functools.lru_cache(maxsize=32)
-def ring(radius: int, rgb=(255, 255, 255), width: int = 2) -> np.ndarray:
-    """An RGBA image of a circle outline (with a dark halo for contrast)."""
+def ring(radius: int, rgb=(255, 255, 255), width: int = 2, halo: bool = True) -> np.ndarray:
+    """An RGBA image of a circle outline (with a dark halo for contrast unless ``halo`` is False)."""
     r = int(radius)
     s = 2 * r + 2 * width + 4
     img = Image.new("RGBA", (s, s), (0, 0, 0, 0))
     d = ImageDraw.Draw(img)
     c = s / 2
-    d.ellipse((c - r - 1, c - r - 1, c + r + 1, c + r + 1), outline=(0, 0, 0, 150), width=width + 2)
+    if halo:
+        d.ellipse((c - r - 1, c - r - 1, c + r + 1, c + r + 1), outline=(0, 0, 0, 150), width=width + 2)
     d.ellipse((c - r, c - r, c + r, c + r), outline=tuple(rgb) + (230,), width=width)
     return np.asarray(img)
 
@@ -151,9 +152,9 @@ def progress_bar(width: int, fraction: float, label: str, size: int = 14) -> np.
     return np.asarray(img)
 
 
-def polyline_patch(points, rgb, width: int = 3) -> Patch | None:
-    """A line strip through pixel ``points`` (m, 2) with a dark halo; NaN
-    points break the strip."""
+def polyline_patch(points, rgb, width: int = 3, halo: bool = True) -> Patch | None:
+    """A line strip through pixel ``points`` (m, 2), with a dark halo unless
+    ``halo`` is False; NaN points break the strip."""
     p = np.asarray(points, float)
     ok = np.isfinite(p).all(axis=1) & (np.abs(p) < 1e5).all(axis=1) if len(p) else np.zeros(0, bool)
     if ok.sum() < 2:
@@ -174,20 +175,22 @@ def polyline_patch(points, rgb, width: int = 3) -> Patch | None:
             cur = []
     if cur:
         runs.append(cur)
-    for col, wd in (((0, 0, 0, 140), width + 2), (tuple(rgb) + (255,), width)):
+    layers = (((0, 0, 0, 140), width + 2),) if halo else ()
+    for col, wd in layers + ((tuple(rgb) + (255,), width),):
         for r in runs:
             if len(r) >= 2:
                 d.line(r, fill=col, width=wd, joint="curve")
     return Patch(bx, by, np.asarray(img))
 
 
-def dot_patch(p, rgb, radius: int = 5) -> Patch:
-    """A filled dot with a dark outline at pixel ``p``."""
+def dot_patch(p, rgb, radius: int = 5, rim: bool = True) -> Patch:
+    """A filled dot at pixel ``p``, with a dark outline unless ``rim`` is False."""
     x, y = float(p[0]), float(p[1])
     s = radius + 3
     img = Image.new("RGBA", (2 * s + 1, 2 * s + 1), (0, 0, 0, 0))
     d = ImageDraw.Draw(img)
-    d.ellipse((s - radius - 1, s - radius - 1, s + radius + 1, s + radius + 1), fill=(0, 0, 0, 200))
+    if rim:
+        d.ellipse((s - radius - 1, s - radius - 1, s + radius + 1, s + radius + 1), fill=(0, 0, 0, 200))
     d.ellipse((s - radius, s - radius, s + radius, s + radius), fill=tuple(rgb) + (255,))
     return Patch(int(round(x)) - s, int(round(y)) - s, np.asarray(img))
 

@@ -138,12 +138,13 @@ class HelpView:
         self.rows = 0                # lines that fit (last layout)
         self.box: Box | None = None
         self.covers_panel = False    # the window is too small for both: the panel steps aside
-        self._lines = help_lines()
+        #: the help's rows, (text, rgb) (:func:`~splatedit.app.ui.keymap.help_lines`)
+        self.lines = help_lines()
         self._cache = None
 
     @property
     def total(self) -> int:
-        return len(self._lines)
+        return len(self.lines)
 
     def toggle(self) -> None:
         self.shown = not self.shown
@@ -158,7 +159,7 @@ class HelpView:
     def _measure(self, size: int) -> tuple[int, int]:
         f = ov.font(size)
         asc, desc = f.getmetrics()
-        width = max(int(f.getlength(t)) + 1 for t, _ in self._lines)
+        width = max(int(f.getlength(t)) + 1 for t, _ in self.lines)
         return width + 16, asc + desc + 2
 
     def layout(self, win: tuple[int, int], panel: Box | None) -> tuple[Box, int, int]:
@@ -194,7 +195,7 @@ class HelpView:
         self.scroll(0)                     # keep top in range after a resize
         key = (box, size, rows, self.top)
         if self._cache is None or self._cache[0] != key:
-            shown = self._lines[self.top:self.top + rows]
+            shown = self.lines[self.top:self.top + rows]
             lines = [(t, HELP_TITLE_RGB) if title else t for t, title in shown]
             end = self.top + len(shown)
             more = "PageDown / PageUp, arrows or wheel: scroll   " if rows < self.total else ""
@@ -268,11 +269,7 @@ def compose_overlay(ed, w: int, h: int) -> list:
     patches = []
     s = ed.session
     if s is not None:
-        patches += ed.brush.underlay(w, h)
-        for tool in (ed.curve, ed.gizmo, ed.brush):
-            patches += tool.overlay(w, h)
-        for tool in ed.tools:          # the protocol's shapes, painted on the CPU
-            patches += to_patches(tool.shapes(w, h))
+        patches += to_patches(ed.overlay_shapes(w, h), (w, h))   # the tools' shapes, painted on the CPU
     panel = ov.text_panel(tuple(panel_lines(ed))) if ed.panel_visible else None
     box = None
     if panel is not None:

@@ -28,15 +28,15 @@ def _buttons(ed) -> tuple | None:
                 ("Discard (N)", lambda: ed.crash_guard.answer_restore(False)))
     if ed.confirm_open is not None:
         name = ed.confirm_open.name
-        return (open_question(ed), (f"Open {name} without saving (Y)", lambda: ed.answer_open(True)),
-                ("Keep editing (N / Esc)", lambda: ed.answer_open(False)))
+        return (open_question(ed), (f"Open {name} without saving (Y)", lambda: ed.file_actions.answer_open(True)),
+                ("Keep editing (N / Esc)", lambda: ed.file_actions.answer_open(False)))
     if ed.confirm_quit:
         return (("Unsaved changes.", "Y / Q: quit without saving     N / Esc: keep editing", "(Ctrl+S saves)"),
-                ("Quit without saving (Y)", lambda: ed.answer_quit(True)),
-                ("Keep editing (N / Esc)", lambda: ed.answer_quit(False)))
+                ("Quit without saving (Y)", lambda: ed.file_actions.answer_quit(True)),
+                ("Keep editing (N / Esc)", lambda: ed.file_actions.answer_quit(False)))
     if ed.prompt is not None:
-        return (save_prompt_lines(ed), ("Save (Enter)", lambda: ed.prompt_key(g.KEY_ENTER)),
-                ("Cancel (Esc)", lambda: ed.prompt_key(g.KEY_ESCAPE)))
+        return (save_prompt_lines(ed), ("Save (Enter)", lambda: ed.file_actions.prompt_key(g.KEY_ENTER)),
+                ("Cancel (Esc)", lambda: ed.file_actions.prompt_key(g.KEY_ESCAPE)))
     return None
 
 
@@ -57,11 +57,11 @@ def draw_question(gui, w: int, h: int) -> None:
     clicked = None
     if imgui.button(yes[0]):
         clicked = yes[1]
-    gui._rect("question_yes")
+    gui.rect("question_yes")
     imgui.same_line()
     if imgui.button(no[0]):
         clicked = no[1]
-    gui._rect("question_no")
+    gui.rect("question_no")
     p, s = imgui.get_window_pos(), imgui.get_window_size()
     gui.windows.append(Box(int(p.x), int(p.y), int(s.x), int(s.y)))
     imgui.end()

@@ -81,7 +81,7 @@ def status_dict(ed) -> dict:
     if s is None:
         return st
     ss = s.stats()
-    tools = ed.brush.tools
+    tools = ed.selection_tools
     st.update(n=s.cloud.n, state=ss.state, support=ss.support, handle=ss.handle,
               edits=len(s.edits), dirty=s.dirty, undo_position=s.history.position,
               history=len(s.history), manip=None if s.manip is None else s.manip.mode,
@@ -129,7 +129,7 @@ def status_dict(ed) -> dict:
     st["last_refinement"] = None if last is None else last.timings()
     st["refinements"] = fr.refinements
     #: the brush's pick map of this view was drawn after its refinement (no pick on first use)
-    st["pick_map_ready"] = fr.take_pick(ed.brush.pick_key()) is not None
+    st["pick_map_ready"] = fr.take_pick(ed.picking.key()) is not None
     st["vulkan_devices_created"] = devices_created()
     w, h = ed.size
     gz = ed.gizmo

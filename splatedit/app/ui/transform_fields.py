@@ -73,14 +73,14 @@ class TransformInput:
 
     def label(self) -> str:
         """The edit's name in the history: ``Move (0.05, 0, 0), Rotate 30 deg, Scale x1.2``."""
-        from splatedit.app.document.manipulation import _num
+        from splatedit.app.document.manipulation import format_number
         parts = []
         if any(self.translate):
-            parts.append(f"Move ({', '.join(_num(v) for v in self.translate)})")
+            parts.append(f"Move ({', '.join(format_number(v) for v in self.translate)})")
         if self.degrees != 0:
-            parts.append(f"Rotate {_num(self.degrees)} deg")
+            parts.append(f"Rotate {format_number(self.degrees)} deg")
         if self.factor != 1.0:
-            parts.append(f"Scale x{_num(self.factor)}")
+            parts.append(f"Scale x{format_number(self.factor)}")
         return ", ".join(parts) or "Transform"
 
     def describe(self) -> str:

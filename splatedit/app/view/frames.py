@@ -136,8 +136,8 @@ class FrameScheduler:
         cloud, basis, dc = s.display_state(vp.distortion_map)   # the last edit's, for its heat map
         if vp.cloud is not cloud:
             vp.set_cloud(cloud)
-            ed.brush.picker = None
-        ed.brush.tools.prepare(s.cloud)
+            ed.picking.invalidate()
+        ed.selection_tools.prepare(s.cloud)
         if self._sel_version_seen != s.version:
             vp.set_selection(s.selection.support, s.selection.handle, s.version, s.selection.others())
             self._sel_version_seen = s.version
@@ -318,7 +318,7 @@ class FrameScheduler:
             self.last_progressive = p
             self.refinements += 1
             self.progressive = None
-            pick_key = ed.brush.pick_key()
+            pick_key = ed.picking.key()
             if (pick_key is not None and getattr(p.frame, "chunked_pick", True)
                     and (self._pick_ready is None or self._pick_ready[0] != pick_key)):
                 self.picking = (p, pick_key)     # the brush's pick map next, while the view is still
@@ -330,7 +330,7 @@ class FrameScheduler:
         """One chunk of the still view's pick map (started when its refinement
         ended), dropped on any change; kept for the brush when complete."""
         p, pick_key = self.picking
-        if moving or p.key != key or self.ed.brush.pick_key() != pick_key:
+        if moving or p.key != key or self.ed.picking.key() != pick_key:
             self.drop_picking()
             return
         f = p.frame

@@ -14,7 +14,7 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.model.gaussians import GaussianCloud
 from splatedit.render.camera import Camera
 from splatedit.render.gaussian.renderer import GaussianRenderer, gaussian_bounds
-from splatedit.render.splat.headless import _prepare_output, _size_and_basis, _write, check_render_memory
+from splatedit.render.splat.headless import prepare_output, size_and_basis, write_image, check_render_memory
 
 
 def splat_proxy(cloud: GaussianCloud) -> SplatCloud:
@@ -47,10 +47,10 @@ def render_gaussians_to_png(cloud: GaussianCloud, out_png, *, size=(512, 512), c
     """
     if not isinstance(cloud, GaussianCloud):
         raise ParameterError("cloud", f"must be a GaussianCloud, got {type(cloud).__name__}")
-    w, h = _size_and_basis(size, basis, dC)
+    w, h = size_and_basis(size, basis, dC)
     check_render_memory((w, h))
     out_png = Path(out_png)
-    _prepare_output(out_png)
+    prepare_output(out_png)
     camera = default_camera(cloud, w, h) if camera is None else camera
     with GaussianRenderer(sort=sort, path=path, device_name=device_name) as r:
         r.set_gaussians(cloud)
@@ -59,5 +59,5 @@ def render_gaussians_to_png(cloud: GaussianCloud, out_png, *, size=(512, 512), c
             r.set_basis(idx, B, Bx, By, Bz)
             r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
         img = r.render(camera, w, h)
-    _write(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
+    write_image(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
     return out_png

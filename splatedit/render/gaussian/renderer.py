@@ -60,7 +60,7 @@ from splatedit.render.gaussian.resources import (GS_PREP_WG, GS_REC_BYTES, GS_RE
                                            NO_BASIS_ROW, PATHS, SORTS, GaussianTargets, gaussian_bounds,
                                            pack_geometry, rp_accum)
 from splatedit.render.gaussian.tiles import TileRasterizer
-from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, targets_for
+from splatedit.render.targets import RP_PICK, RenderTarget, create_frame_objects, reusable_targets
 from splatedit.render.uniforms import GS_FRAME_UBO, GS_PREP_PUSH
 from splatedit.tolerances import (GS_ALPHA_MAX, GS_ALPHA_MIN, GS_FRUSTUM_CLAMP, GS_LOWPASS_PX2, GS_NEAR_CULL_REL,
                                   GS_PICK_MIN_OPACITY, GS_PICK_SIGMAS, GS_POLAR_ITERATIONS, GS_TILE_PAIRS_PER_GAUSSIAN,
@@ -385,7 +385,11 @@ class GaussianRenderer:
     # -------------------------------------------------------------- frame
     def targets_for(self, width: int, height: int) -> GaussianTargets:
         """The per-size images for width x height (re-created when the size changes)."""
-        return targets_for(self, width, height, GaussianTargets)
+        t = reusable_targets(self, self._targets, width, height)
+        if t is None:
+            self._targets = None                # a failure below leaves no destroyed targets behind
+            t = self._targets = GaussianTargets(self, int(width), int(height))
+        return t
 
     def write_ubo(self, camera: Camera, width: int, height: int, srgb_target: bool = False):
         o, sc = self.origin, self.scale

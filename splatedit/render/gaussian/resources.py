@@ -55,11 +55,11 @@ class GaussianTargets(SizedTargets):
     def _create(self, r):       # r: the GaussianRenderer
         dev = r.dev
         # storage: the compute tile rasterizer (gaussian/tiles.py) writes it instead of the quad draw
-        self.accum = self._add(V.Image(dev, self.width, self.height, r.accum_format, ("color", "sampled", "storage")))
-        self.fb_accum = self._fb(r.cache.render_pass(rp_accum(r.accum_format)), [self.accum])
-        self.out = self._add(V.Image(dev, self.width, self.height, "rgba8", ("color", "transfer_src")))
+        self.accum = self.add(V.Image(dev, self.width, self.height, r.accum_format, ("color", "sampled", "storage")))
+        self.fb_accum = self.framebuffer(r.cache.render_pass(rp_accum(r.accum_format)), [self.accum])
+        self.out = self.add(V.Image(dev, self.width, self.height, "rgba8", ("color", "transfer_src")))
         self.offscreen = RenderTarget(self.out, "rgba8", "transfer_src")
-        self.resolve_set = self._add(V.DescriptorSet(dev, r.cache.set_layout(GS_RESOLVE_SET)))
+        self.resolve_set = self.add(V.DescriptorSet(dev, r.cache.set_layout(GS_RESOLVE_SET)))
         self.resolve_set.write({0: r.ubo, 10: (self.accum, r.sampler)})
 
 

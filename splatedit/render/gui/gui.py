@@ -96,7 +96,9 @@ class Gui:
         self.last_stats = GuiFrameStats(0, 0, 0, 0, 0, 0)
 
     # ---------------------------------------------------------------- input
-    def _current(self):
+    def make_current(self):
+        """Make this GUI's ImGui context the current one (several GUIs may
+        exist); returns its ImGui IO."""
         if self._closed:
             raise RuntimeError("the GUI has been closed")
         imgui.set_current_context(self.ctx)
@@ -104,24 +106,24 @@ class Gui:
 
     def feed(self, ev) -> bool:
         """Give ImGui one window event; True when ImGui claims it (see :mod:`gui_input`)."""
-        io = self._current()
+        io = self.make_current()
         gui_input.feed_event(io, ev)
         return gui_input.wants_event(io, ev)
 
     @property
     def wants_mouse(self) -> bool:
         """The pointer is over a GUI window or ImGui is dragging: mouse events are ImGui's."""
-        return bool(self._current().want_capture_mouse)
+        return bool(self.make_current().want_capture_mouse)
 
     @property
     def wants_keyboard(self) -> bool:
         """A GUI widget has keyboard focus (e.g. a text field): keys are ImGui's."""
-        return bool(self._current().want_capture_keyboard)
+        return bool(self.make_current().want_capture_keyboard)
 
     # ---------------------------------------------------------------- frame
     def new_frame(self, width: int, height: int, dt: float) -> None:
         """Start a frame for a ``width`` x ``height`` pixel target; ``dt`` seconds since the last."""
-        io = self._current()
+        io = self.make_current()
         if self._in_frame:
             self.discard_frame()
         io.display_size = (float(width), float(height))
@@ -131,7 +133,7 @@ class Gui:
 
     def discard_frame(self) -> None:
         """End a frame that will not be drawn (e.g. the window is minimized)."""
-        self._current()
+        self.make_current()
         if self._in_frame:
             imgui.end_frame()
             self._in_frame = False
@@ -141,7 +143,7 @@ class Gui:
         layout (a window's ``begin`` without ``end``): ImGui's own error
         recovery closes what was left open (logged, not asserted), so the
         next :meth:`new_frame` starts clean."""
-        io = self._current()
+        io = self.make_current()
         if not self._in_frame:
             return
         assert_on = io.config_error_recovery_enable_assert
@@ -159,7 +161,7 @@ class Gui:
         """End the frame (``imgui.render``), apply ImGui's texture requests,
         upload the geometry and record the GUI pass into ``cmd`` (see
         :meth:`GuiPainter.record` for ``clear``/``final``)."""
-        self._current()
+        self.make_current()
         if not self._in_frame:
             raise RuntimeError("Gui.render() without Gui.new_frame()")
         imgui.render()

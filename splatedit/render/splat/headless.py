@@ -134,12 +134,12 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             disk is full, ...); the directories are checked (and created)
             before rendering.
     """
-    w, h = _size_and_basis(size, basis, dC)
+    w, h = size_and_basis(size, basis, dC)
     check_render_memory((w, h), buffers_path is not None)
     out_png = Path(out_png)
     outputs = [out_png] + ([Path(buffers_path)] if buffers_path is not None else [])
     for out in outputs:
-        _prepare_output(out)
+        prepare_output(out)
     if camera is None:
         from splatedit.render.framing import default_view
         camera = default_view(cloud, (w, h), path=cloud.source).camera
@@ -156,13 +156,13 @@ def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera
             r.set_displacement(np.zeros((np.asarray(B).shape[1], 3)) if dC is None else dC)
         img = r.render(camera, w, h)
         bufs = r.render_buffers(camera, w, h) if buffers_path is not None else None
-    _write(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
+    write_image(out_png, lambda fh: Image.fromarray(img, "RGBA").save(fh, format="PNG"))
     if bufs is not None:
-        _write(Path(buffers_path), lambda fh: np.savez_compressed(fh, **bufs))
+        write_image(Path(buffers_path), lambda fh: np.savez_compressed(fh, **bufs))
     return out_png
 
 
-def _size_and_basis(size, basis, dC) -> tuple[int, int]:
+def size_and_basis(size, basis, dC) -> tuple[int, int]:
     """(width, height) of a headless render's ``size``; ParameterError for a
     bad size or a ``dC`` without a ``basis``."""
     try:
@@ -174,7 +174,7 @@ def _size_and_basis(size, basis, dC) -> tuple[int, int]:
     return w, h
 
 
-def _prepare_output(path: Path) -> None:
+def prepare_output(path: Path) -> None:
     """Before rendering: create ``path``'s directory and check that a file can
     be written there (the CLI has already refused existing files unless
     --force, so an existing file is fine here)."""
@@ -188,7 +188,10 @@ def _prepare_output(path: Path) -> None:
         raise InputError(f"directory {str(parent)!r} is not writable", path=str(path))
 
 
-def _write(path: Path, save) -> None:
+def write_image(path: Path, save) -> None:
+    """Write a rendered image to ``path`` atomically: ``save(fh)`` writes the
+    bytes to a temporary file that replaces ``path`` when done; an OS error
+    is an :class:`~splatedit.errors.InputError` naming the path."""
     try:
         with atomic_open(path, "wb") as fh:
             save(fh)

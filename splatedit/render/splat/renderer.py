@@ -48,7 +48,7 @@ from splatedit.render.gpu_units import gpu_camera
 from splatedit.render.splat.prepass import Prepass, PrepObjects
 from splatedit.render.splat.layout import (GEOM_STRIDE, PREP_MAX_SIZE, RESOLVE_SET, RP_POINTS, SPLAT_SET,
                                            UBO_BYTES, rp_attr, rp_window, splat_desc)
-from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, targets_for
+from splatedit.render.targets import RenderTarget, SplatTargets, create_frame_objects, resolve_desc, reusable_targets
 from splatedit.render.uniforms import FRAME_UBO, PREPARED_PUSH, SPLAT_GEOM
 from splatedit.render.splat.uploads import SceneUploads
 from splatedit.tolerances import (RENDER_BACKGROUND, RENDER_GAMMA, RENDER_EDL_RADIUS_PX,
@@ -403,7 +403,11 @@ class Renderer:
 
     # ------------------------------------------------------------- frames
     def targets_for(self, width: int, height: int) -> SplatTargets:
-        return targets_for(self, width, height, SplatTargets)
+        t = reusable_targets(self, self._targets, width, height)
+        if t is None:
+            self._targets = None                # a failure below leaves no destroyed targets behind
+            t = self._targets = SplatTargets(self, int(width), int(height))
+        return t
 
     def write_ubo(self, camera: Camera, width: int, height: int, apply_gamma: bool = True):
         # everything on the GPU is in model units relative to origin, divided
@@ -470,7 +474,7 @@ class Renderer:
     def fb_attr_readback(self, t: SplatTargets):
         if getattr(t, "fb_attr_rb", None) is None:
             rp = self.cache.render_pass(rp_attr(self.accum_format, "transfer_src"))
-            t.fb_attr_rb = t._fb(rp, [t.accum_color, t.accum_normal, t.depth])
+            t.fb_attr_rb = t.framebuffer(rp, [t.accum_color, t.accum_normal, t.depth])
         return t.fb_attr_rb
 
     # ------------------------------------------------- frames as pass lists
@@ -631,9 +635,9 @@ class Renderer:
         self.require_cloud()
         t = self.targets_for(width, height)
         if getattr(t, "fb_points", None) is None:
-            t.points_color = t._add(V.Image(self.dev, width, height, "rgba8", ("color",)))
-            t.points_depth = t._add(V.Image(self.dev, width, height, "d32f", ("depth",)))
-            t.fb_points = t._fb(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
+            t.points_color = t.add(V.Image(self.dev, width, height, "rgba8", ("color",)))
+            t.points_depth = t.add(V.Image(self.dev, width, height, "d32f", ("depth",)))
+            t.fb_points = t.framebuffer(self.cache.render_pass(RP_POINTS), [t.points_color, t.points_depth])
         desc = V.GraphicsDesc("points.vert", "points.frag", RP_POINTS, V.LayoutDesc(sets=(SPLAT_SET,)),
                               topology="point_list", bindings=(V.VertexBinding(0, GEOM_STRIDE, per_instance=False),),
                               attributes=(V.VertexAttribute(0, 0, "vec3", SPLAT_GEOM.fields["center"][1]),),

@@ -4,6 +4,7 @@ decide which variant of a compute shader runs (:mod:`splatedit.render.gaussian.g
 
 from __future__ import annotations
 
+import weakref
 from dataclasses import dataclass
 
 import vulkan as vk
@@ -22,10 +23,14 @@ class SubgroupProperties:
     arithmetic: bool
 
 
+#: the subgroup properties asked so far, per device (forgotten with the device)
+_SUBGROUP_PROPS: "weakref.WeakKeyDictionary[Device, SubgroupProperties]" = weakref.WeakKeyDictionary()
+
+
 def subgroup_properties(dev: Device) -> SubgroupProperties:
     """The device's subgroup properties (lavapipe 22.3 on AVX2: size 8,
     compute and fragment stages, basic/vote/arithmetic/ballot/shuffle/quad)."""
-    cached = getattr(dev, "_subgroup_props", None)
+    cached = _SUBGROUP_PROPS.get(dev)
     if cached is not None:
         return cached
     sp = vk.VkPhysicalDeviceSubgroupProperties()
@@ -36,7 +41,7 @@ def subgroup_properties(dev: Device) -> SubgroupProperties:
         compute=bool(sp.supportedStages & vk.VK_SHADER_STAGE_COMPUTE_BIT),
         ballot=bool(sp.supportedOperations & vk.VK_SUBGROUP_FEATURE_BALLOT_BIT),
         arithmetic=bool(sp.supportedOperations & vk.VK_SUBGROUP_FEATURE_ARITHMETIC_BIT))
-    dev._subgroup_props = out
+    _SUBGROUP_PROPS[dev] = out
     return out
 
 

@@ -7,7 +7,8 @@ import vulkan as vk
 
 from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
 
-_LAYOUTS = {
+#: image layouts by the short names the recording helpers and passes take
+IMAGE_LAYOUTS = {
     "undefined": vk.VK_IMAGE_LAYOUT_UNDEFINED,
     "general": vk.VK_IMAGE_LAYOUT_GENERAL,
     "color": vk.VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL,
@@ -38,7 +39,7 @@ class CommandBuffer:
             self.handle = handle
             return
         d = device.device
-        info = vk.VkCommandBufferAllocateInfo(commandPool=device._pool,
+        info = vk.VkCommandBufferAllocateInfo(commandPool=device.command_pool,
                                               level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
                                               commandBufferCount=1)
         self.handle = call(vk.vkAllocateCommandBuffers, d, info)[0]
@@ -76,7 +77,7 @@ class CommandBuffer:
             track("fence", -1)
             self._fence = None
         if self.handle is not None:
-            vk.vkFreeCommandBuffers(d, self.dev._pool, 1, [self.handle])
+            vk.vkFreeCommandBuffers(d, self.dev.command_pool, 1, [self.handle])
             track("command_buffer", -1)
             self.handle = None
 
@@ -133,7 +134,7 @@ class CommandBuffer:
     def image_barrier(self, image, new_layout: str, src_stage: str, src_access: str,
                       dst_stage: str, dst_access: str):
         """Transition ``image`` from its recorded layout to ``new_layout``."""
-        new = _LAYOUTS[new_layout]
+        new = IMAGE_LAYOUTS[new_layout]
         sub = vk.VkImageSubresourceRange(aspectMask=image.aspect, baseMipLevel=0, levelCount=1,
                                          baseArrayLayer=0, layerCount=1)
         ib = vk.VkImageMemoryBarrier(srcAccessMask=_access(src_access), dstAccessMask=_access(dst_access),

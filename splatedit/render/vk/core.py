@@ -48,7 +48,9 @@ class DeviceNotFoundError(VulkanError):
         self.result = "VK_ERROR_INITIALIZATION_FAILED"
 
 
-def _result_name(exc: BaseException) -> str:
+def result_name(exc: BaseException) -> str:
+    """The Vulkan result code name of a python-vulkan exception
+    (``VkErrorOutOfDeviceMemory`` -> ``VK_ERROR_OUT_OF_DEVICE_MEMORY``)."""
     name = type(exc).__name__  # e.g. VkErrorOutOfDeviceMemory, VkTimeout
     out = ["VK"]
     word = ""
@@ -68,7 +70,7 @@ def call(fn, *args, name: str | None = None):
     try:
         return fn(*args)
     except (vk.VkError, vk.VkException) as exc:
-        raise VulkanError(name or getattr(fn, "__name__", "vulkan call"), _result_name(exc)) from None
+        raise VulkanError(name or getattr(fn, "__name__", "vulkan call"), result_name(exc)) from None
 
 
 # ---------------------------------------------------------- live handles
@@ -194,7 +196,8 @@ class Device:
         self.instance = None
         self.device = None
         self._messenger = None
-        self._pool = None
+        #: the device's command pool (command buffers are allocated from it)
+        self.command_pool = None
         self._closed = False
         if validation is None:
             validation = validation_enabled()
@@ -233,7 +236,7 @@ class Device:
         try:
             self.instance = vk.vkCreateInstance(info, None)
         except (vk.VkError, vk.VkException, OSError) as exc:
-            name = _result_name(exc) if isinstance(exc, (vk.VkError, vk.VkException)) else str(exc)
+            name = result_name(exc) if isinstance(exc, (vk.VkError, vk.VkException)) else str(exc)
             if "INCOMPATIBLE_DRIVER" in name:
                 raise DeviceNotFoundError(
                     "no Vulkan driver is installed (vkCreateInstance: VK_ERROR_INCOMPATIBLE_DRIVER); "
@@ -314,7 +317,7 @@ class Device:
         pinfo = vk.VkCommandPoolCreateInfo(
             flags=vk.VK_COMMAND_POOL_CREATE_RESET_COMMAND_BUFFER_BIT,
             queueFamilyIndex=self.queue_family)
-        self._pool = call(vk.vkCreateCommandPool, self.device, pinfo, None)
+        self.command_pool = call(vk.vkCreateCommandPool, self.device, pinfo, None)
         track("command_pool", 1)
 
     def _atomic_features(self) -> bool:
@@ -385,10 +388,10 @@ class Device:
                 vk.vkDeviceWaitIdle(self.device)
             except Exception:
                 pass
-            if self._pool is not None:
-                vk.vkDestroyCommandPool(self.device, self._pool, None)
+            if self.command_pool is not None:
+                vk.vkDestroyCommandPool(self.device, self.command_pool, None)
                 track("command_pool", -1)
-                self._pool = None
+                self.command_pool = None
             vk.vkDestroyDevice(self.device, None)
             track("device", -1)
             self.device = None

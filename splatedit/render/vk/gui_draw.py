@@ -39,7 +39,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from splatedit.render.uniforms import GUI_PUSH, GUI_VERTEX
-from splatedit.render.vk.commands import _LAYOUTS, CommandBuffer
+from splatedit.render.vk.commands import IMAGE_LAYOUTS, CommandBuffer
 from splatedit.render.vk.core import Device
 from splatedit.render.vk.descriptors import Binding, DescriptorSet, LayoutDesc
 from splatedit.render.vk.graphics import GraphicsDesc, VertexAttribute, VertexBinding
@@ -58,7 +58,7 @@ _VERTEX_BINDINGS = (VertexBinding(0, VERTEX_BYTES, per_instance=False),)
 _VERTEX_ATTRIBUTES = tuple(VertexAttribute(location, 0, fmt, GUI_VERTEX.fields[name][1])
                            for location, (name, fmt) in enumerate((("pos", "vec2"), ("uv", "vec2"),
                                                                    ("col", "unorm8x4"))))
-_LAYOUT_NAMES = {v: k for k, v in _LAYOUTS.items()}
+_LAYOUT_NAMES = {v: k for k, v in IMAGE_LAYOUTS.items()}
 
 
 @dataclass(frozen=True)
@@ -256,7 +256,7 @@ class GuiPainter:
         ``final``.  ``scale``/``translate``: pixel -> clip transform (2 floats
         each).  Returns the number of draw calls issued."""
         target = framebuffer.attachments[0]
-        if clear is None and target.layout == _LAYOUTS["undefined"]:
+        if clear is None and target.layout == IMAGE_LAYOUTS["undefined"]:
             # nothing to load: transition so the "load" pass finds the layout it names
             cmd.image_barrier(target, "color", "top", "none", "color_output", "color_write")
         initial = "undefined" if clear is not None else _LAYOUT_NAMES.get(target.layout)

@@ -7,7 +7,7 @@ from dataclasses import dataclass
 
 import vulkan as vk
 
-from splatedit.render.vk.commands import _LAYOUTS
+from splatedit.render.vk.commands import IMAGE_LAYOUTS
 from splatedit.render.vk.core import Device, call, release, track
 from splatedit.render.vk.resources import FORMATS
 
@@ -20,7 +20,7 @@ class Attachment:
     """One render-pass attachment: format name, load op, initial and final layout names, store."""
     format: str                     # key of resources.FORMATS
     load: str = "clear"             # "clear" | "load" | "dont_care"
-    initial: str = "undefined"      # layout name (commands._LAYOUTS) when load == "load"
+    initial: str = "undefined"      # layout name (commands.IMAGE_LAYOUTS) when load == "load"
     final: str = "color"            # layout after the pass
     store: bool = True
 
@@ -75,9 +75,9 @@ class RenderPass:
                 storeOp=vk.VK_ATTACHMENT_STORE_OP_STORE if a.store else vk.VK_ATTACHMENT_STORE_OP_DONT_CARE,
                 stencilLoadOp=vk.VK_ATTACHMENT_LOAD_OP_DONT_CARE,
                 stencilStoreOp=vk.VK_ATTACHMENT_STORE_OP_DONT_CARE,
-                initialLayout=_LAYOUTS[a.initial if a.load == "load" else "undefined"],
-                finalLayout=_LAYOUTS[a.final]))
-            self.final_layouts.append(_LAYOUTS[a.final])
+                initialLayout=IMAGE_LAYOUTS[a.initial if a.load == "load" else "undefined"],
+                finalLayout=IMAGE_LAYOUTS[a.final]))
+            self.final_layouts.append(IMAGE_LAYOUTS[a.final])
         color_refs = [vk.VkAttachmentReference(attachment=i, layout=vk.VK_IMAGE_LAYOUT_COLOR_ATTACHMENT_OPTIMAL)
                       for i in range(len(desc.colors))]
         depth_ref = None

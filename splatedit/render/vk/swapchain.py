@@ -36,7 +36,7 @@ import numpy as np
 import vulkan as vk
 
 from splatedit.errors import SplatEditError
-from splatedit.render.vk.core import Device, VulkanError, _result_name, call, track
+from splatedit.render.vk.core import Device, VulkanError, result_name, call, track
 from splatedit.render.vk.resources import Buffer
 from splatedit.render.vk.swapchain_target import SwapchainTarget
 
@@ -148,7 +148,7 @@ class SwapchainPresenter:
     def _create_sync(self) -> None:
         d = self.device
         self._cmd = call(vk.vkAllocateCommandBuffers, d, vk.VkCommandBufferAllocateInfo(
-            commandPool=self.dev._pool, level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
+            commandPool=self.dev.command_pool, level=vk.VK_COMMAND_BUFFER_LEVEL_PRIMARY,
             commandBufferCount=1))[0]
         track("command_buffer", 1)
         self._fence = call(vk.vkCreateFence, d,
@@ -299,7 +299,7 @@ class SwapchainPresenter:
             # the image *was* acquired (suboptimal is a success code): use it, recreate after
             self.needs_recreate = True
         except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkAcquireNextImageKHR", _result_name(exc)) from None
+            raise VulkanError("vkAcquireNextImageKHR", result_name(exc)) from None
         return int(idx_ptr[0])
 
     def _begin_commands(self):
@@ -327,7 +327,7 @@ class SwapchainPresenter:
         except (vk.VkErrorOutOfDateKhr, vk.VkSuboptimalKhr):
             self.needs_recreate = True
         except (vk.VkError, vk.VkException) as exc:
-            raise VulkanError("vkQueuePresentKHR", _result_name(exc)) from None
+            raise VulkanError("vkQueuePresentKHR", result_name(exc)) from None
         self.frames_presented += 1
 
     def render_frame(self, record) -> bool:
@@ -490,7 +490,7 @@ class SwapchainPresenter:
                 track("fence", -1)
                 self._fence = None
             if self._cmd is not None:
-                vk.vkFreeCommandBuffers(d, dev._pool, 1, [self._cmd])
+                vk.vkFreeCommandBuffers(d, dev.command_pool, 1, [self._cmd])
                 track("command_buffer", -1)
                 self._cmd = None
             if self.swapchain is not None:

@@ -41,14 +41,14 @@ class StubEditor(Editor):
 
 
 def button(ed, x, y, action):
-    ed.on_button(types.SimpleNamespace(x=x, y=y, action=action, button=G.MOUSE_BUTTON_LEFT, mods=0))
+    ed.routing.on_button(types.SimpleNamespace(x=x, y=y, action=action, button=G.MOUSE_BUTTON_LEFT, mods=0))
 
 
 def drag(ed, points):
     """Left press at points[0], moves through the rest, release at the last."""
     button(ed, *points[0], G.PRESS)
     for x, y in points[1:]:
-        ed.on_move(types.SimpleNamespace(x=x, y=y))
+        ed.routing.on_move(types.SimpleNamespace(x=x, y=y))
     m = None if ed.session.manip is None else ed.session.manip.matrix()
     button(ed, *points[-1], G.RELEASE)
     return m
@@ -116,8 +116,12 @@ def test_all_parts_are_shown_and_picked_in_priority_order(editor):
         assert ed.gizmo.pick(*(c + d * (rad + EDITOR_GIZMO_HIT_PX + 2))) is None
     assert n_crossings > 0
     assert ed.gizmo.pick(5, 5) is None
-    # the overlay draws grip, rings and arrows
-    assert len(ed.gizmo.overlay(W, H)) >= 1 + 3 + 3
+    # the overlay draws grip, rings and arrows (shapes: one list for both painters)
+    from splatedit.app.tools.shapes import Circle, Dot, Polyline, to_patches
+    shapes = ed.gizmo.shapes(W, H)
+    kinds = [type(s) for s in shapes]
+    assert kinds.count(Circle) == 1 and kinds.count(Polyline) >= 3 + 3 and kinds.count(Dot) == 3
+    assert len(to_patches(shapes, (W, H))) == len(shapes)
 
 
 def test_edge_on_rings_are_hidden_and_nothing_shows_while_moving(editor):

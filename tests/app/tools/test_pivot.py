@@ -44,7 +44,7 @@ def editor():
 
 
 def key(ed, k, mods=0):
-    ed.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
+    ed.routing.on_key(types.SimpleNamespace(key=k, mods=mods, action=glfw.PRESS))
 
 
 def test_rim_centroid_is_where_the_support_meets_the_fixed_part():
@@ -91,7 +91,7 @@ def test_rotate_about_the_support_rim_keeps_the_rim_fixed_and_the_gizmo_sits_on_
     key(ed, glfw.KEY_PERIOD)
     assert ed.pivot.mode == SUPPORT_RIM
     rim = ed.pivot.point()
-    g = ed.brush.tools.graph(s.cloud)
+    g = ed.selection_tools.graph(s.cloud)
     assert np.allclose(rim, rim_centroid(s.cloud.positions, s.selection.support, g))
     assert np.linalg.norm(rim - s.handle_centroid()) > 0.2
     px, _ = ed.cam.project(rim, W, H)
@@ -130,7 +130,7 @@ def test_shift_right_click_places_the_cursor_on_the_surface_and_it_can_be_the_pi
     _, depth = ed.cam.project(hit, W, H)
     pick = np.zeros((H, W), np.int64)
     ed.pivot.ctx.visible = lambda: BrushPicker(pick, pick_depth=np.full((H, W), float(depth[0])))
-    ed.on_button(types.SimpleNamespace(x=x, y=y, action=glfw.PRESS, button=glfw.MOUSE_BUTTON_RIGHT,
+    ed.routing.on_button(types.SimpleNamespace(x=x, y=y, action=glfw.PRESS, button=glfw.MOUSE_BUTTON_RIGHT,
                                        mods=glfw.MOD_SHIFT))
     assert ed.drag_tool is None
     assert np.allclose(ed.pivot.cursor, hit, atol=1e-9)
