@@ -17,7 +17,7 @@ import vulkan as vk
 from splatedit.render import vk as V
 from splatedit.render.uniforms import GUI_PUSH, GUI_VERTEX
 from splatedit.render.vk.commands import CommandBuffer
-from splatedit.render.vk.gui_draw import _VERTEX_ATTRIBUTES, VERTEX_BYTES, GuiDraw, GuiPainter, gui_push
+from splatedit.render.gui.painter import _VERTEX_ATTRIBUTES, VERTEX_BYTES, GuiDraw, GuiPainter, gui_push
 from splatedit.render.vk.shaders import specialization
 
 pytestmark = pytest.mark.gpu

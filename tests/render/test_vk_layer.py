@@ -64,7 +64,7 @@ def test_no_leaks_after_teardown():
 
 
 def test_vulkan_error_mapping():
-    from splatedit.render.vk.core import result_name
+    from splatedit.render.vk.handles import result_name
     import vulkan
     assert result_name(vulkan.VkErrorOutOfDeviceMemory()) == "VK_ERROR_OUT_OF_DEVICE_MEMORY"
     assert result_name(vulkan.VkTimeout()) == "VK_TIMEOUT"

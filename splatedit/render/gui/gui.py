@@ -21,7 +21,7 @@ its own Vulkan device.  The API we rely on (imgui-bundle 1.93, Dear ImGui 1.92):
   are used) through ``draw_data.textures[i]`` (``status``, ``width``,
   ``height``, ``format``, ``get_pixels_array()``, ``updates``,
   ``unused_frames``, ``set_tex_id``, ``set_status``).  Those requests are
-  carried out here on a :class:`~splatedit.render.vk.gui_draw.GuiPainter`
+  carried out here on a :class:`~splatedit.render.gui.painter.GuiPainter`
   before the frame's draws are recorded; ``renderer_has_vtx_offset`` lets a
   frame exceed 65536 vertices with 16-bit indices.
 
@@ -51,7 +51,7 @@ import numpy as np
 from imgui_bundle import imgui
 
 from splatedit.render.gui import input as gui_input
-from splatedit.render.vk.gui_draw import GuiDraw, GuiPainter
+from splatedit.render.gui.painter import GuiDraw, GuiPainter
 
 
 @dataclass(frozen=True)

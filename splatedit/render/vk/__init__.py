@@ -18,9 +18,8 @@ Raw ``vk*`` calls live only in this package.  It provides
   tests; :func:`devices_created` - devices created so far in this process.  Everything is destroyed explicitly, in reverse order of creation.
 """
 
-from splatedit.render.vk.core import (WHOLE_SIZE, Device, DeviceNotFoundError, VulkanError, devices_created,
-                                      drain_validation_messages, list_devices, live_handles,
-                                      validation_enabled)
+from splatedit.render.vk.core import WHOLE_SIZE, Device, drain_validation_messages, list_devices, validation_enabled
+from splatedit.render.vk.handles import DeviceNotFoundError, VulkanError, devices_created, live_handles
 from splatedit.render.vk.resources import Buffer, Image, Sampler, readback_array
 from splatedit.render.vk.commands import CommandBuffer, QueryPool
 from splatedit.render.vk.descriptors import Binding, DescriptorSet, LayoutDesc

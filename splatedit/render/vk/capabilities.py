@@ -9,7 +9,8 @@ from dataclasses import dataclass
 
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, call
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call
 
 
 @dataclass(frozen=True)

@@ -5,7 +5,7 @@ from __future__ import annotations
 import numpy as np
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
+from splatedit.render.vk.handles import VulkanError, call, flag_bits, release, track
 
 #: image layouts by the short names the recording helpers and passes take
 IMAGE_LAYOUTS = {
@@ -26,9 +26,10 @@ _FENCE_TIMEOUT_NS = 600 * 10**9
 class CommandBuffer:
     """A primary command buffer for one submission; :meth:`submit_and_wait` blocks on a fence."""
 
-    def __init__(self, device: Device, handle=None):
-        """``handle``: record into an existing command buffer that its owner
-        allocated, submits and frees (e.g. the swapchain presenter's); the
+    def __init__(self, device, handle=None):
+        """``device``: the :class:`~splatedit.render.vk.core.Device` whose
+        command pool and queue it uses.  ``handle``: record into an existing
+        command buffer that its owner allocated, submits and frees (e.g. the swapchain presenter's); the
         object then owns nothing and :meth:`submit_and_wait` is unavailable."""
         self.dev = device
         self.handle = None
@@ -281,7 +282,8 @@ def _texel_region(image, rect, buf_offset: int):
 class QueryPool:
     """A timestamp query pool; :meth:`results_ns` returns times relative to its first query read."""
 
-    def __init__(self, device: Device, count: int):
+    def __init__(self, device, count: int):
+        """``count`` timestamp queries on ``device`` (a :class:`~splatedit.render.vk.core.Device`)."""
         self.dev = device
         self.count = count
         info = vk.VkQueryPoolCreateInfo(queryType=vk.VK_QUERY_TYPE_TIMESTAMP, queryCount=count)

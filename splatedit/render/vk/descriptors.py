@@ -12,7 +12,8 @@ from dataclasses import dataclass
 
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, call, flag_bits, release, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call, flag_bits, release, track
 
 _STAGE_BITS = {
     "vert": vk.VK_SHADER_STAGE_VERTEX_BIT,

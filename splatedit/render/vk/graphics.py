@@ -10,7 +10,8 @@ from dataclasses import dataclass
 
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, call
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call
 from splatedit.render.vk.descriptors import LayoutDesc, PipelineLayout
 from splatedit.render.vk.passes import RenderPass, RenderPassDesc
 from splatedit.render.vk.shaders import ShaderModule, specialization, stage_info

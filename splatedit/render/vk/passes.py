@@ -8,7 +8,8 @@ from dataclasses import dataclass
 import vulkan as vk
 
 from splatedit.render.vk.commands import IMAGE_LAYOUTS
-from splatedit.render.vk.core import Device, call, release, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call, release, track
 from splatedit.render.vk.resources import FORMATS
 
 _LOAD_OPS = {"clear": vk.VK_ATTACHMENT_LOAD_OP_CLEAR, "load": vk.VK_ATTACHMENT_LOAD_OP_LOAD,

@@ -15,7 +15,8 @@ from dataclasses import dataclass
 
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, call, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call, track
 from splatedit.render.vk.descriptors import Binding, LayoutDesc, PipelineLayout, SetLayout
 from splatedit.render.vk.graphics import GraphicsDesc, create_graphics_pipeline
 from splatedit.render.vk.passes import RenderPass, RenderPassDesc

@@ -5,7 +5,8 @@ from __future__ import annotations
 import numpy as np
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, VulkanError, call, flag_bits, release, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import VulkanError, call, flag_bits, release, track
 
 _BUFFER_USAGE = {
     "vertex": vk.VK_BUFFER_USAGE_VERTEX_BUFFER_BIT,

@@ -8,7 +8,8 @@ from pathlib import Path
 import numpy as np
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, VulkanError, call, release, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import VulkanError, call, release, track
 
 #: where compiled shaders are looked up, in order: the package copy (package
 #: data, present in an installed wheel) and the repository's top-level spirv/

@@ -27,7 +27,7 @@ the default present mode; ``vsync=False`` asks for MAILBOX, then IMMEDIATE.
 Validation: as for every :class:`~splatedit.render.vk.core.Device`
 (``SPLATEDIT_VALIDATION=1``); messages are collected by
 :func:`splatedit.render.vk.core.drain_validation_messages`.  Every handle is
-counted in :func:`splatedit.render.vk.core.live_handles`.
+counted in :func:`splatedit.render.vk.handles.live_handles`.
 """
 
 from __future__ import annotations
@@ -36,7 +36,8 @@ import numpy as np
 import vulkan as vk
 
 from splatedit.errors import SplatEditError
-from splatedit.render.vk.core import Device, VulkanError, result_name, call, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import VulkanError, result_name, call, track
 from splatedit.render.vk.resources import Buffer
 from splatedit.render.vk.swapchain_target import SwapchainTarget
 

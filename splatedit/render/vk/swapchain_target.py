@@ -13,7 +13,8 @@ from __future__ import annotations
 
 import vulkan as vk
 
-from splatedit.render.vk.core import Device, call, track
+from splatedit.render.vk.core import Device
+from splatedit.render.vk.handles import call, track
 from splatedit.render.vk.passes import Framebuffer
 
 #: swapchain VkFormat -> name in resources.FORMATS

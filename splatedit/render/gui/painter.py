@@ -1,4 +1,4 @@
-"""Raw Vulkan side of the GUI: textured, alpha-blended 2D triangles with a
+"""The GUI's draw pass: textured, alpha-blended 2D triangles with a
 scissor per draw, drawn into an existing colour target.
 
 :class:`GuiPainter` knows nothing about Dear ImGui (that is
