@@ -37,20 +37,9 @@ import sys
 import time
 from pathlib import Path
 
+from xvfb_display import start_xvfb
 
-def _xvfb():
-    r, w = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, pass_fds=(w,))
-    os.close(w)
-    text = b""
-    with os.fdopen(r, "rb") as pipe:
-        while not text.endswith(b"\n"):
-            c = pipe.read(1)
-            if not c:
-                break
-            text += c
-    return proc, f":{int(text)}"
+
 
 
 def _model(spec: str, folder: Path) -> Path:
@@ -235,7 +224,7 @@ def main() -> None:
     size = tuple(int(x) for x in a.size.split("x"))
     proc = None
     if not os.environ.get("SPLATEDIT_BENCH_KEEP_DISPLAY"):
-        proc, disp = _xvfb()
+        proc, disp = start_xvfb("1600x1000")
         os.environ["DISPLAY"] = disp
     try:
         for spec in a.models:

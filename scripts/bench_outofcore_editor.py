@@ -30,25 +30,13 @@ import tempfile
 import time
 from pathlib import Path
 
+from xvfb_display import start_xvfb
+
 import numpy as np
 
 ROOT = Path(__file__).resolve().parents[1]
 
 
-def start_xvfb(fbdir: Path):
-    r, w = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "1400x900x24", "-fbdir", str(fbdir),
-                             "-nolisten", "tcp", "-noreset"], stdout=subprocess.DEVNULL,
-                            stderr=subprocess.DEVNULL, pass_fds=(w,))
-    os.close(w)
-    text = b""
-    with os.fdopen(r, "rb") as pipe:
-        while not text.endswith(b"\n"):
-            c = pipe.read(1)
-            if not c:
-                break
-            text += c
-    return proc, f":{int(text)}"
 
 
 class Editor:
@@ -141,7 +129,7 @@ def main(argv=None) -> int:
     load0 = os.getloadavg()[0]
     with tempfile.TemporaryDirectory(prefix="bench-ooc-") as td:
         tmp = Path(td)
-        xvfb, display = start_xvfb(tmp)
+        xvfb, display = start_xvfb("1400x900", fbdir=tmp)
         ed = None
         try:
             ed = Editor(a.scan.resolve(), tmp, display, a.size, a.budget)

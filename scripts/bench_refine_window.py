@@ -33,20 +33,9 @@ import tempfile
 import time
 from pathlib import Path
 
+from xvfb_display import start_xvfb
 
-def _xvfb():
-    r, w = os.pipe()
-    proc = subprocess.Popen(["Xvfb", "-displayfd", str(w), "-screen", "0", "1600x1000x24", "-nolisten", "tcp"],
-                            stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL, pass_fds=(w,))
-    os.close(w)
-    text = b""
-    with os.fdopen(r, "rb") as pipe:
-        while not text.endswith(b"\n"):
-            c = pipe.read(1)
-            if not c:
-                break
-            text += c
-    return proc, f":{int(text)}"
+
 
 
 def _status(path: Path) -> dict:
@@ -129,7 +118,7 @@ def main() -> None:
     ap.add_argument("--repeats", type=int, default=1, help="rounds over the modes")
     a = ap.parse_args()
     size = tuple(int(x) for x in a.size.split("x"))
-    proc, display = _xvfb()
+    proc, display = start_xvfb("1600x1000")
     try:
         for n in a.counts:
             for _ in range(a.repeats):
