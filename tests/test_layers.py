@@ -146,3 +146,18 @@ def test_the_layering_test_sees_a_violation(tmp_path):
     edges = {"splatedit.model.a": {"splatedit.app.b"}, "splatedit.app.b": {"splatedit.model.a"}}
     assert _layer("splatedit.app.b") > _layer("splatedit.model.a")
     assert _cycles(edges, edges) == [frozenset(edges)]
+
+
+def test_no_mixins_parts_are_owned():
+    """Issue 22: a class owns its parts instead of inheriting them from
+    mixins.  No class in the package is named ``*Mixin`` or has two or more
+    bases, except the ``(str, Enum)`` idiom of string-valued enums."""
+    mixed = []
+    for mod, f in _modules().items():
+        for node in ast.walk(ast.parse(f.read_text(), str(f))):
+            if not isinstance(node, ast.ClassDef):
+                continue
+            bases = [ast.unparse(b) for b in node.bases]
+            if node.name.endswith("Mixin") or (len(bases) >= 2 and bases != ["str", "Enum"]):
+                mixed.append(f"{mod}.{node.name}({', '.join(bases)})")
+    assert not mixed, f"classes composed by inheritance (own the parts instead): {mixed}"
