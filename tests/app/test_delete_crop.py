@@ -136,3 +136,24 @@ def test_a_gaussian_scene_crops_with_its_properties_and_the_saved_file_replays(t
     s.undo()
     assert len(gaussians_of(s.cloud)) == len(scene)
     s.close()
+
+
+def test_messages_name_gaussians_in_a_gaussian_scene_and_splats_otherwise(ed):
+    """The tools' messages call a Gaussian scene's elements Gaussians, as
+    the panel does (a tester saw "removed 512 splats" on a Gaussian scene)."""
+    from splatedit.app.document.gaussian import gaussian_document
+    from splatedit.data import gaussian_scene_path
+    from splatedit.io import read_gaussians
+    key(ed, glfw.KEY_DELETE)                                        # nothing selected
+    assert "paint the splats" in ed.messages[-1]
+    s = Session(gaussian_document(read_gaussians(gaussian_scene_path())), fit_sync=True)
+    try:
+        g = StubEditor(s)
+        key(g, glfw.KEY_DELETE)
+        assert "paint the Gaussians" in g.messages[-1]
+        top = s.cloud.positions[:, 1] > np.median(s.cloud.positions[:, 1])
+        s.set_selection(top, np.zeros(s.cloud.n, bool))
+        key(g, glfw.KEY_DELETE)
+        assert f"removed {int(top.sum()):,} Gaussians" in g.messages[-1], g.messages[-1]
+    finally:
+        s.close()

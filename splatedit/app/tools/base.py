@@ -125,6 +125,14 @@ class ToolContext:
         return self._ed.session
 
     @property
+    def items(self) -> str:
+        """What the document's elements are called in messages: ``"Gaussians"``
+        for a Gaussian splatting scene, else ``"splats"`` (as the panel says)."""
+        from splatedit.app.document.gaussian import gaussians_of
+        s = self._ed.session
+        return "Gaussians" if s is not None and gaussians_of(s.cloud) is not None else "splats"
+
+    @property
     def selection_edit(self):
         """The document's selection edit API
         (:class:`~splatedit.app.document.selection_edit.SelectionEdit`)."""

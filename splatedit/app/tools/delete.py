@@ -29,7 +29,7 @@ class DeleteTool(Tool):
         what = "crop" if keep else "delete"
         sup = int(doc.selection.support.sum())
         if sup == 0:
-            c.say(f"{what}: paint the splats to {'keep' if keep else 'remove'} as support first (1)")
+            c.say(f"{what}: paint the {c.items} to {'keep' if keep else 'remove'} as support first (1)")
             return 0
         if doc.pose_pending or doc.manip is not None:
             c.say(f"{what}: apply or discard the pending moves first (Enter / Esc)")
@@ -42,7 +42,7 @@ class DeleteTool(Tool):
             return 0
         n = doc.remove_splats(keep)
         if n:
-            c.say(f"{what}: removed {n:,} splats, {doc.cloud.n:,} left (Ctrl+Z undoes it)")
+            c.say(f"{what}: removed {n:,} {c.items}, {doc.cloud.n:,} left (Ctrl+Z undoes it)")
         return n
 
 

@@ -104,7 +104,7 @@ class MirrorTool(Tool):
             elif not c.install(job, label):
                 c.say("mirror: the selection changed while it ran; nothing mirrored (Ctrl+M again)")
             else:
-                c.say(f"mirror {target} across {AXES[axis]}: {int(c.target_mask().sum()) - before:+,} splats")
+                c.say(f"mirror {target} across {AXES[axis]}: {int(c.target_mask().sum()) - before:+,} {c.items}")
             c.redraw()
 
         c.start_job(JOB, "mirroring the selection", work, land)

@@ -188,9 +188,9 @@ class RegionSelectTool(Tool):
         what = c.target
         before = int(c.target_mask().sum())
         if not c.select(mask, f"{kind} {'erase' if erase else 'select'} {what}"):
-            c.say(f"{kind} select: the {what} did not change ({len(idx):,} splats inside)")
+            c.say(f"{kind} select: the {what} did not change ({len(idx):,} {c.items} inside)")
             return False
-        c.say(f"{kind} {'erase' if erase else 'select'}: {what} {int(c.target_mask().sum()) - before:+,} splats")
+        c.say(f"{kind} {'erase' if erase else 'select'}: {what} {int(c.target_mask().sum()) - before:+,} {c.items}")
         return True
 
     def status(self):
