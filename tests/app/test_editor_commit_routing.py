@@ -11,9 +11,9 @@ import pytest
 from splatedit.app.document.session import GRAB, Session
 from splatedit.app.tools.base import DragMode
 from tests.app.sessions import view
-from tests.app.test_commit_job import _bunny, _posed
+from tests.app.document.test_commit_job import _bunny, _posed
 from tests.app.test_editor_review_fixes import _plane_with_tiny_corner_splats, paint
-from tests.app.test_editor_routing import StubEditor, key, press
+from tests.app.ui.test_editor_routing import StubEditor, key, press
 
 glfw = pytest.importorskip("glfw")
 

@@ -84,7 +84,7 @@ def test_a_view_that_draws_almost_nothing_says_why_on_the_status_line(xvfb, tmp_
     seen from behind: the ring of the post's wall shows; from the front
     (Shift+1) the post covers a good part of the view and no hint is given."""
     from splatedit.io import write
-    from tests.app.test_view_coverage import post_cloud
+    from tests.app.view.test_view_coverage import post_cloud
     path = tmp_path / "post.ply"
     write(str(path), post_cloud())
     ed = EditorProcess(xvfb, tmp_path, str(path))

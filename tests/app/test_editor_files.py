@@ -17,7 +17,7 @@ from splatedit.app.document.session import Session
 from splatedit.io import write
 from splatedit.app.document.manipulation import GRAB
 from tests.app.sessions import plane_cloud, view
-from tests.app.test_session import paint_regions
+from tests.app.document.test_session import paint_regions
 
 glfw = pytest.importorskip("glfw")
 W, H = 800, 600

@@ -114,7 +114,7 @@ def test_gaussian_scene_edit_rotate_save(xvfb, tmp_path):
         ed.close()
     # the live GPU frame (rotation-aware handle drawn by the Gaussian pre-pass) and the
     # committed CPU-deformed frame both show the turned ear, and nothing else moved (that
-    # the two agree pixel for pixel is tests/app/test_gaussian_document.py's, without overlays)
+    # the two agree pixel for pixel is tests/app/document/test_gaussian_document.py's, without overlays)
     h_fg = int(np.nonzero(fg)[0].max()) - top
     for img in (live, after):
         changed = np.abs(img.astype(int) - selected)[..., :3].max(axis=2) > 40

@@ -37,7 +37,7 @@ def test_home_keeps_the_model_out_of_the_panel_column_and_uses_the_window_withou
     import numpy as np
 
     from splatedit.app.document.session import Session
-    from tests.app.test_editor_routing import StubEditor
+    from tests.app.ui.test_editor_routing import StubEditor
     from tests.app.sessions import plane_cloud
 
     s = Session(plane_cloud(), fit_sync=True)
@@ -80,7 +80,7 @@ def test_home_frames_the_main_body_of_a_cloud_with_far_clumps_and_says_so():
 
     from splatedit.model.cloud import SplatCloud
     from tests.app.sessions import plane_cloud
-    from tests.app.test_editor_routing import StubEditor
+    from tests.app.ui.test_editor_routing import StubEditor
 
     plane = plane_cloud()
     far = 50.0 * np.array([[1, 0, 0], [0, 1, 0], [0, 0, 1], [-1, 0, 0], [0, -1, 0],
@@ -123,7 +123,7 @@ def test_home_on_the_clean_bunny_frames_its_full_bounding_sphere():
     from splatedit.app.view.camera_control import OrbitCamera
     from splatedit.data import default_model_path
     from splatedit.io import read
-    from tests.app.test_editor_routing import StubEditor
+    from tests.app.ui.test_editor_routing import StubEditor
 
     cloud = read(default_model_path())
     s = _session_of(cloud)
@@ -153,7 +153,7 @@ def test_a_view_key_replaces_the_previous_status_message_with_the_views_name(key
 
     from splatedit.app.document.session import Session
     from tests.app.sessions import plane_cloud
-    from tests.app.test_editor_routing import StubEditor, key
+    from tests.app.ui.test_editor_routing import StubEditor, key
 
     s = Session(plane_cloud(), fit_sync=True)
     try:

@@ -21,7 +21,7 @@ from splatedit.app.view.camera_control import OrbitCamera
 from splatedit.app.document.session import Session
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.sessions import plane_cloud, view
-from tests.app.test_editor_routing import H, W, StubEditor
+from tests.app.ui.test_editor_routing import H, W, StubEditor
 
 glfw = pytest.importorskip("glfw")
 

@@ -10,7 +10,7 @@ import pytest
 
 from splatedit.app.ui.transform_fields import TargetKind, TransformInput, apply_position, apply_transform, field_target
 from splatedit.select.selection import HANDLE, SUPPORT
-from tests.app.test_editor_routing import ed, key  # noqa: F401 (fixture)
+from tests.app.ui.test_editor_routing import ed, key  # noqa: F401 (fixture)
 
 glfw = pytest.importorskip("glfw")
 #: model units: a committed curve move brings the splat its point was picked on

@@ -11,7 +11,7 @@ from splatedit.app.document.session import GRAB, Session
 from splatedit.deform.distortion import distortion_from_axes
 from splatedit.deform.modes import DeformationMode
 from tests.app.sessions import plane_cloud, view
-from tests.app.test_session import paint_regions
+from tests.app.document.test_session import paint_regions
 
 
 @pytest.mark.parametrize("mode", [DeformationMode.ROTATION, DeformationMode.LINEAR])

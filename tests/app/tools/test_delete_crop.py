@@ -14,7 +14,7 @@ from splatedit.app.document.session import Session
 from splatedit.errors import EditScriptError
 from splatedit.script import parse_script, run_script
 from tests.app.sessions import plane_cloud
-from tests.app.test_editor_routing import StubEditor, key
+from tests.app.ui.test_editor_routing import StubEditor, key
 
 glfw = pytest.importorskip("glfw")
 

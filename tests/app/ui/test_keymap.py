@@ -12,7 +12,7 @@ import pytest
 from splatedit.app.ui import keymap
 from splatedit.app.ui.keymap import KEYMAP, Action, Chord, Context, Section
 
-README = Path(__file__).resolve().parents[2] / "docs" / "editor.md"
+README = Path(__file__).resolve().parents[3] / "docs" / "editor.md"
 
 
 def test_readme_controls_are_the_generated_block():

@@ -14,7 +14,7 @@ from splatedit.app.document.session import Session
 from splatedit.app.tools.region import box_polygon, polygon_mask, splats_through, splats_visible
 from splatedit.select.selection import HANDLE, SUPPORT
 from tests.app.sessions import plane_cloud
-from tests.app.test_editor_routing import StubEditor, key, press
+from tests.app.ui.test_editor_routing import StubEditor, key, press
 
 glfw = pytest.importorskip("glfw")
 

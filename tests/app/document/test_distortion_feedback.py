@@ -10,7 +10,7 @@ from splatedit.app.ui import overlay as ov
 from splatedit.app.document.session import GRAB, SCALE, Session
 from splatedit.deform.distortion import basis_distortion
 from tests.app.sessions import plane_cloud, view
-from tests.app.test_session import paint_regions
+from tests.app.document.test_session import paint_regions
 
 
 @pytest.fixture
