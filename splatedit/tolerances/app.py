@@ -372,12 +372,6 @@ EDITOR_OOC_POINT_BUDGET = 800_000
 EDITOR_OOC_MAX_POINTS = 2_500_000
 #: the view is refined this long after the camera stopped (seconds)
 EDITOR_OOC_SETTLE_S = 0.3
-#: after an out-of-core cloud grows, its level-of-detail pyramid and neighbour graph
-#: are built once its first frame was presented, or after this many seconds without
-#: one (a minimised window).  The first frame of the grown 1.16M-splat cloud of the
-#: 100M-point scan took 2.5 s on lavapipe with both builds beside it on 2 cores, 1.1 s
-#: alone (docs/PERFORMANCE.md, out-of-core editor); 3 s covers it under load
-EDITOR_OOC_DEFER_JOBS_MAX_S = 3.0
 #: the full-resolution region around a painted support: its bounding box
 #: grown by this many of the painted splats' largest radius (so the
 #: selection's rim, transferred to the finer points by nearest neighbour,

@@ -228,34 +228,3 @@ def test_a_refinement_landing_under_a_painted_support_lets_its_region_load_next(
     assert s.cloud.n > cloud.n
     box = scan.region_needed(s)                     # checked on the grown cloud's version, not skipped
     assert box is not None and missing[0] not in box[2] and set(missing[1:]) <= set(box[2])
-
-
-def test_a_grown_clouds_levels_and_graph_wait_for_its_first_presented_frame(scan_file, monkeypatch):
-    import types
-
-    from splatedit import tolerances
-    from splatedit.app.document.jobs import Job
-    from splatedit.app.document.outofcore import REGION_JOB
-    from splatedit.app.document.selection import SelectionTools
-    monkeypatch.setattr(tolerances, "EDITOR_LOD_MIN_SPLATS", 1000)
-    scan, cloud = open_scan(scan_file, lambda *a: None, first=5000, budget=20_000)
-    s = _painted_disc(scan, cloud)
-    ed = _loop_editor(s)
-    ed.use_lod = True
-    ed.presenter = types.SimpleNamespace(frames_presented=7)
-    ed.selection_tools = tools = SelectionTools(lambda name, fn: Job(name, fn))
-    lo, hi, missing = scan.region_box(s)
-    scan.start_region(ed, (lo, hi, missing))
-    region = ed.jobs.pop(REGION_JOB)
-    assert region.wait(60.0) and region.error is None
-    scan.landed(ed, REGION_JOB, region.result)
-    grown = s.cloud
-    assert grown.n > cloud.n
-    scan.poll(ed)
-    tools.prepare(grown)                            # what every frame's document sync asks
-    assert "lod" not in ed.jobs and tools.building(grown) is None and tools.graph(grown, wait=False) is None
-    ed.presenter.frames_presented += 1              # the grown cloud's first frame is on screen
-    scan.poll(ed)
-    tools.prepare(grown)
-    assert "lod" in ed.jobs and tools.building(grown) is not None
-    assert ed.jobs["lod"].wait(60.0) and ed.jobs["lod"].error is None

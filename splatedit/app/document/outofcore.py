@@ -49,8 +49,8 @@ from splatedit.model.cloud import SplatCloud
 from splatedit.model.octree_lod import (OctreeView, finest_shown, key_codes, node_frames,
                                         select_nodes)
 from splatedit.model.tangents import tangent_frame
-from splatedit.tolerances import (EDITOR_OOC_DEFER_JOBS_MAX_S, EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_MAX_POINTS,
-                                  EDITOR_OOC_POINT_BUDGET, EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII,
+from splatedit.tolerances import (EDITOR_OOC_FIRST_POINTS, EDITOR_OOC_MAX_POINTS, EDITOR_OOC_POINT_BUDGET,
+                                  EDITOR_OOC_READ_BATCH, EDITOR_OOC_REGION_MARGIN_RADII,
                                   EDITOR_OOC_REGION_MAX_POINTS, EDITOR_OOC_SETTLE_S,
                                   OCTREE_SPACING_MAX_MEDIAN, SPLAT_RADIUS_FACTOR)
 
@@ -190,9 +190,6 @@ class OutOfCoreScan:
         self.loading_frames = 0
         self.loading_seconds = 0.0
         self._job_start = None          # (time, frames presented) when the running job started
-        #: (frames presented, time, cloud) after a cloud landed: its level-of-detail and
-        #: neighbour-graph builds wait until its first frame is presented (see :meth:`landed`)
-        self.deferred = None
         #: (2, 3) file coordinates of the last full-resolution region asked for, or None
         self.region_world = None
 
@@ -336,7 +333,6 @@ class OutOfCoreScan:
             return
         cam_state = ed.cam.state()
         now = time.perf_counter()
-        self.release_deferred(ed, now)
         if cam_state != self.last_cam:
             self.last_cam, self.moved_at = cam_state, now
         view = ed.jobs.get(VIEW_JOB)
@@ -359,22 +355,6 @@ class OutOfCoreScan:
             # (with a selection the view stays: a grown cloud would refit its basis)
             self.view_state = cam_state
             self.start_refine(ed)
-
-    def release_deferred(self, ed, now: float) -> None:
-        """Start the landed cloud's level-of-detail and neighbour-graph builds once
-        a frame was presented since it landed (or after
-        :data:`EDITOR_OOC_DEFER_JOBS_MAX_S`, e.g. a minimised window)."""
-        if self.deferred is None:
-            return
-        frames, t, cloud = self.deferred
-        if self._frames(ed) <= frames and now - t < EDITOR_OOC_DEFER_JOBS_MAX_S:
-            return
-        self.deferred = None
-        tools = getattr(ed, "selection_tools", None)
-        if tools is not None and tools.hold is cloud:
-            tools.hold = None           # the next frame's document sync starts the graph
-        if ed.session is not None and ed.session.cloud is cloud:
-            start_levels(ed, cloud)
 
     @staticmethod
     def _frames(ed) -> int:
@@ -525,17 +505,7 @@ class OutOfCoreScan:
         s.request_fit()         # a grown cloud: the selection's basis is fitted again
         if name == REGION_JOB:
             ed.say(f"region at full resolution: {cloud.n:,} points shown")
-        if getattr(ed, "presenter", None) is None:
-            restart_levels(ed, cloud)
-        else:
-            # the grown cloud's first frame (full resolution, a new splat count) comes first: the
-            # pyramid and the graph of the whole cloud, built beside it, made it 2x slower on 2 cores
-            drop_levels(ed)
-            self.deferred = (self._frames(ed), time.perf_counter(), cloud)
-            tools = getattr(ed, "selection_tools", None)
-            if tools is not None:
-                tools.cancel()          # the previous cloud's graph, if still being built
-                tools.hold = cloud
+        restart_levels(ed, cloud)
 
     # ------------------------------------------------------------- saving
     def file_indices(self, n: int) -> np.ndarray:
@@ -639,22 +609,12 @@ def adopt_appended(s, cloud, label: str | None) -> None:
 
 def restart_levels(ed, cloud) -> None:
     """The viewport's level-of-detail pyramid for the new cloud (the old one is dropped)."""
-    drop_levels(ed)
-    start_levels(ed, cloud)
-
-
-def drop_levels(ed) -> None:
-    """Drop the viewport's pyramid (of the previous cloud) and stop a build of one."""
+    from splatedit.tolerances import EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS
     old = ed.jobs.pop("lod", None)
     if old is not None:
         old.cancel.set()
     ed.viewport.set_pyramid(None)
     ed.frames.invalidate()
-
-
-def start_levels(ed, cloud) -> None:
-    """Start building ``cloud``'s level-of-detail pyramid (a background job)."""
-    from splatedit.tolerances import EDITOR_LOD_BUDGETS, EDITOR_LOD_MIN_SPLATS
     if ed.use_lod and cloud.n >= EDITOR_LOD_MIN_SPLATS:
         def work(progress):
             from splatedit.model.lod import LodPyramid

@@ -288,9 +288,6 @@ class SelectionTools:
         #: closes only around what changed since (cost follows the stroke)
         self._last_closed = None
         self._failed = None                          # the cloud whose graph failed (not retried)
-        #: a cloud whose graph is not to be built yet (:meth:`prepare` waits; the
-        #: out-of-core editor holds a grown cloud's until its first frame is shown)
-        self.hold = None
 
     # ------------------------------------------------------------ graph
     def toggle_mode(self) -> str:
@@ -300,8 +297,7 @@ class SelectionTools:
     def prepare(self, cloud) -> None:
         """Start building the neighbour graph of ``cloud`` unless it is cached
         or being built."""
-        if (revision.of(cloud) in self._graphs or self._job_cloud is cloud or self._failed is cloud
-                or self.hold is cloud):
+        if revision.of(cloud) in self._graphs or self._job_cloud is cloud or self._failed is cloud:
             return
         if self._job is not None:
             self._job.cancel.set()
