@@ -185,3 +185,28 @@ def test_compute_path_equals_raster_with_float32_accumulators(renderer):
         fg = np.isfinite(x) & (x > 0)
         assert fg.sum() > 1000
         assert np.max(np.abs(x[fg] - y[fg]) / np.abs(x[fg])) < 1e-5, key
+
+
+def test_auto_path_reuses_the_measurement_of_the_next_splat_count_bucket_but_not_further(renderer):
+    """A cloud growing by one half-octave (an out-of-core scan's view refining)
+    takes the measured choice of the bucket next to it; a reused choice is not
+    passed on, so two buckets from a measurement the paths are measured again."""
+    if not renderer.dev.compute_raster:
+        pytest.skip("the device lacks the compute rasterizer: the auto path never probes")
+    saved = renderer.raster_path
+    try:
+        renderer.raster_path = "auto"
+        renderer.path_probes.clear()
+        keys = []
+        for n in (2000, 2900, 4100):                # half-octave buckets 22, 23, 24
+            renderer.set_cloud(sphere(n))
+            path = renderer.frame_path(64, 48)
+            keys.append(probe_key(64, 48, n))
+            assert path == renderer.path_probes[keys[-1]]["path"]
+        assert [k[1] for k in keys] == [22, 23, 24]
+        measured, reused, again = (renderer.path_probes[k] for k in keys)
+        assert "reused" not in measured and "ms_raster" in measured
+        assert reused["reused"] == keys[0] and reused["path"] == measured["path"]
+        assert "reused" not in again and "ms_compute" in again     # next to a reused one only: probed
+    finally:
+        renderer.raster_path = saved

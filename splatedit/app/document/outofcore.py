@@ -335,6 +335,15 @@ class OutOfCoreScan:
         now = time.perf_counter()
         if cam_state != self.last_cam:
             self.last_cam, self.moved_at = cam_state, now
+        view = ed.jobs.get(VIEW_JOB)
+        if view is not None and s.selection.support.any():
+            # a support was painted while the view refined: its region comes first (a swap
+            # would be dropped on landing, an append is not wanted: with a selection the
+            # view stays), so the refinement stops now instead of delaying the region
+            view.cancel.set()
+            del ed.jobs[VIEW_JOB]
+            self._ended(ed)
+            self.view_state = None
         busy = VIEW_JOB in ed.jobs or REGION_JOB in ed.jobs
         if busy or s.manip is not None or s.committing or ed.drag.name != "NONE":
             return                  # (a stroke being painted: its region is loaded when it ends)
@@ -492,7 +501,7 @@ class OutOfCoreScan:
             self.nodes = nodes
         self.segments = segs
         self.view_complete = kind == "swap"
-        self.waiting_version = None if name == REGION_JOB else s.version
+        self.waiting_version = None     # the grown cloud's support may still miss its region's nodes
         s.request_fit()         # a grown cloud: the selection's basis is fitted again
         if name == REGION_JOB:
             ed.say(f"region at full resolution: {cloud.n:,} points shown")

@@ -109,7 +109,11 @@ def choose_path(requested: str, dev: V.Device, width: int, height: int, prepared
     (:meth:`Renderer.frame_path`): the first frame of each image size and
     splat count also draws one frame on each path (GPU timestamps, no
     shading) and keeps the faster, for every size and count in the same
-    half-octave buckets (:func:`probe_key`).  On lavapipe the compute path wins for
+    half-octave buckets (:func:`probe_key`); a count in the bucket next to a
+    measured one (same size bucket) takes that measurement's choice without
+    probing (a cloud that grows, as an out-of-core scan's view refines, would
+    otherwise draw two extra full frames at every half-octave: 3.8 s of 5 s for
+    the first frame of a 1.16M-splat grown scan on lavapipe, docs/PERFORMANCE.md).  On lavapipe the compute path wins for
     dense clouds of small splats and loses for sparse scans of large splats
     (docs/PERFORMANCE.md); on GPUs issue 18 expects compute to win (an
     H100/H200 rasterizes on 3% of the chip; compute point rasterizers reach

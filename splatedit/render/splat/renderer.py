@@ -502,7 +502,12 @@ class Renderer:
         if path == "compute" and self.raster_path == "auto":
             key = probe_key(width, height, self.n)
             if key not in self.path_probes:
-                self.path_probes[key] = self._probe_paths(width, height)
+                near = [k for k, v in self.path_probes.items()
+                        if k[0] == key[0] and abs(k[1] - key[1]) == 1 and "reused" not in v]
+                # a count one half-octave from a measured one (a scan growing as its view
+                # refines): that measurement's choice, not two more full frames per growth
+                self.path_probes[key] = (dict(self.path_probes[near[0]], reused=near[0]) if near
+                                         else self._probe_paths(width, height))
             path = self.path_probes[key]["path"]
         return path
 

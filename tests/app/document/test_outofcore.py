@@ -171,3 +171,60 @@ def test_file_indices_point_at_the_same_points_in_the_file_read_whole(scan_file)
     idx = scan.file_indices(grown.n)
     assert len(np.unique(idx)) == grown.n
     np.testing.assert_allclose(whole.world_positions(idx), grown.positions + scan.origin, rtol=0, atol=1e-6)
+
+
+def _loop_editor(s):
+    """What OutOfCoreScan.poll and landed touch of the editor: no window, no levels of detail."""
+    import types
+    return types.SimpleNamespace(session=s, jobs={}, say=lambda *a: None, wake=lambda: None, size=(640, 480),
+                                 cam=types.SimpleNamespace(state=lambda: (0,)), viewport=types.SimpleNamespace(
+                                     set_pyramid=lambda p: None), frames=types.SimpleNamespace(invalidate=lambda: None),
+                                 drag=types.SimpleNamespace(name="NONE"), use_lod=False)
+
+
+def _painted_disc(scan, cloud):
+    s = Session(cloud, fit_sync=True)
+    centre = np.array([50.0, 60.0, 0.0]) + scan_file_origin_offset(scan)
+    s.end_stroke(s.paint(np.flatnonzero(np.linalg.norm(cloud.positions[:, :2] - centre[:2], axis=1) < 20.0)))
+    return s
+
+
+def test_a_stroke_painted_while_the_view_refines_stops_the_refinement_and_loads_its_region(scan_file):
+    import time
+
+    from splatedit.app.document.jobs import Cancelled, Job
+    from splatedit.app.document.outofcore import REGION_JOB, VIEW_JOB
+    scan, cloud = open_scan(scan_file, lambda *a: None, first=5000, budget=20_000)
+    ed = _loop_editor(Session(cloud, fit_sync=True))
+
+    def refining(progress):          # a view refinement that runs until it is cancelled
+        while True:
+            progress("reading the view's nodes", 0.0)
+            time.sleep(0.01)
+    view = ed.jobs[VIEW_JOB] = Job("refining the view", refining)
+    scan.poll(ed)
+    assert ed.jobs == {VIEW_JOB: view}              # no selection: the refinement goes on
+    ed.session = s = _painted_disc(scan, cloud)
+    scan.poll(ed)
+    assert VIEW_JOB not in ed.jobs and REGION_JOB in ed.jobs     # the region at once, not after the view
+    assert view.wait(10.0) and isinstance(view.error, Cancelled)
+    region = ed.jobs.pop(REGION_JOB)
+    assert region.wait(60.0) and region.error is None
+    scan.landed(ed, REGION_JOB, region.result)
+    assert s.cloud.n > cloud.n and s.waiting is None and scan.region_needed(s) is None
+
+
+def test_a_refinement_landing_under_a_painted_support_lets_its_region_load_next(scan_file):
+    from splatedit.app.document.outofcore import VIEW_JOB
+    scan, cloud = open_scan(scan_file, lambda *a: None, first=5000, budget=20_000)
+    s = _painted_disc(scan, cloud)
+    ed = _loop_editor(s)
+    lo, hi, missing = scan.region_box(s)
+    assert len(missing) >= 2
+    nodes = dict(scan.nodes)
+    nodes.update(scan.read(missing[:1]))            # a view job that brought one of the region's nodes
+    result = ("append",) + scan.extend(cloud, scan.segments, missing[:1], nodes) + (nodes, cloud)
+    scan.landed(ed, VIEW_JOB, result)
+    assert s.cloud.n > cloud.n
+    box = scan.region_needed(s)                     # checked on the grown cloud's version, not skipped
+    assert box is not None and missing[0] not in box[2] and set(missing[1:]) <= set(box[2])
