@@ -33,7 +33,8 @@ import tempfile
 import time
 from pathlib import Path
 
-from xvfb_display import start_xvfb
+sys.path.insert(0, str(Path(__file__).resolve().parent))     # also when loaded by path (the tests)
+from xvfb_display import start_xvfb  # noqa: E402
 
 
 
