@@ -184,8 +184,10 @@ def node_frames(points: np.ndarray, k: int = NODE_NORMAL_NEIGHBOURS,
     distance to the ``spacing_k``-th neighbour (the splat size rule of
     :func:`splatedit.model.estimate.splat_radii`) without the rest of the
     scan: each node is estimated once, when it is loaded.  Normals are oriented
-    with a non-negative z (scans of the ground are Z-up; signs elsewhere are
-    arbitrary: the splat renderer lights both sides).
+    with a non-negative z (scans of the ground are Z-up).  The sign of a
+    near-vertical normal (a wall) is arbitrary here, and the splat renderer
+    culls splats facing away unless two-sided drawing is on (the editor's T),
+    so such a wall can be hidden from one side.
 
     Args:
         points: (n, 3) float64 positions (model units).
