@@ -238,14 +238,8 @@ def render_copc(args, camera_from_args) -> int:
         src.close()
     drawn, path = cloud, getattr(args, "path", None)
     if not getattr(args, "full", False):      # as for any model: a level about a pixel wide where splats crowd
-        import os
-        from splatedit.render.splat.headless import pixel_level
-        from splatedit.tolerances import RENDER_LOD_PATH
-        level = pixel_level(cloud, camera, args.size[1])
-        if level is not None:
-            drawn = level.cloud
-            if path is None and not os.environ.get("SPLATEDIT_RASTER"):
-                path = RENDER_LOD_PATH
+        from splatedit.render.splat.headless import drawn_for_view
+        drawn, path = drawn_for_view(cloud, camera, args.size[1], path)
     render_to_png(drawn, args.output, size=args.size, camera=camera, raster_path=path,
                   edl=getattr(args, "edl", False))
     args.progress.close()

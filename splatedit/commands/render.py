@@ -4,13 +4,11 @@ camera flags, optionally deformed on the GPU by an edit script."""
 
 from __future__ import annotations
 
-import os
 import sys
 from pathlib import Path
 
 from splatedit.commands.edits import print_edit
 from splatedit.errors import ParameterError
-from splatedit.tolerances import RENDER_LOD_PATH
 
 
 def _camera_from_args(args, cloud):
@@ -95,15 +93,8 @@ def cmd_render(args) -> int:
         cloud, basis_rows, d_c = _gpu_edit(args, cloud, on_gpu=_splats_draw)
     drawn, path = cloud, getattr(args, "path", None)
     if basis_rows is None and not getattr(args, "full", False):
-        from splatedit.render.splat.headless import pixel_level
-        level = pixel_level(cloud, camera, args.size[1])
-        if level is not None:
-            drawn = level.cloud
-            if path is None and not os.environ.get("SPLATEDIT_RASTER"):
-                # splats about a pixel wide are the compute path's case: one
-                # frame, so no "auto" probe (two more frames; tolerances
-                # RENDER_LOD_PATH)
-                path = RENDER_LOD_PATH
+        from splatedit.render.splat.headless import drawn_for_view
+        drawn, path = drawn_for_view(cloud, camera, args.size[1], path)
     render_to_png(drawn, args.output, size=args.size, camera=camera, basis=basis_rows, dC=d_c,
                   buffers_path=args.buffers, raster_path=path,
                   edl=getattr(args, "edl", False))

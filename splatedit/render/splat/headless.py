@@ -13,7 +13,7 @@ from splatedit.atomic import atomic_open, check_writable_target
 from splatedit.model.cloud import SplatCloud
 from splatedit.render.camera import Camera
 from splatedit.render.splat.renderer import Renderer
-from splatedit.tolerances import (RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL,
+from splatedit.tolerances import (RENDER_LOD_PATH, RENDER_BUFFERS_BYTES_PER_PIXEL, RENDER_BYTES_PER_PIXEL,
                                   RENDER_LOD_MARGIN, RENDER_LOD_MAX_KEPT_SHARE,
                                   RENDER_LOD_MIN_RADIUS_PX)
 
@@ -103,6 +103,24 @@ def pixel_level(cloud: SplatCloud, camera: Camera, height: int, *,
     if keep.sum() > max_kept_share * cloud.n:
         return None
     return thinned_level(cloud, keep, margin=RENDER_LOD_MARGIN)
+
+
+def drawn_for_view(cloud: SplatCloud, camera: Camera, height: int, raster_path: str | None = None):
+    """What ``splatedit render`` draws of ``cloud`` for this view and on which
+    path: the :func:`pixel_level` when splats crowd under a pixel, drawn on the
+    compute path unless a path was asked for (``raster_path`` or
+    ``SPLATEDIT_RASTER``): one frame, so no ``auto`` probe (two more full
+    frames; ``RENDER_LOD_PATH``); else the cloud itself and the path asked for.
+
+    Returns:
+        (cloud to draw, raster path or None).
+    """
+    level = pixel_level(cloud, camera, height)
+    if level is None:
+        return cloud, raster_path
+    if raster_path is None and not os.environ.get("SPLATEDIT_RASTER"):
+        raster_path = RENDER_LOD_PATH
+    return level.cloud, raster_path
 
 
 def render_to_png(cloud: SplatCloud, out_png, *, size=(512, 512), camera: Camera | None = None,
